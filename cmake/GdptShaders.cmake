@@ -1,0 +1,35 @@
+# gdpt_add_shaders(<target> <kernel.comp>...)
+#
+# Compiles each compute shader to SPIR-V with glslangValidator and embeds it as a
+# `const uint32_t kSpv_<name>[]` array in <build>/shaders/spv/<name>.spv.h. The rule uses
+# glslangValidator's --depfile so that editing any included header (shaders/lib/*.glsl,
+# shaders/shared/gdpt_shared.h) rebuilds the SPIR-V. The headers are exposed through the
+# INTERFACE library <target>.
+find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)
+
+function(gdpt_add_shaders target)
+  set(out_dir ${CMAKE_BINARY_DIR}/shaders/spv)
+  file(MAKE_DIRECTORY ${out_dir})
+  set(outputs)
+  foreach(src ${ARGN})
+    get_filename_component(name ${src} NAME_WE)
+    get_filename_component(abs ${src} ABSOLUTE)
+    set(out ${out_dir}/${name}.spv.h)
+    set(debug_flag $<$<CONFIG:Debug>:-g>)
+    add_custom_command(
+      OUTPUT ${out}
+      COMMAND ${GLSLANG_VALIDATOR} --target-env vulkan1.2 -V ${debug_flag}
+              --vn kSpv_${name} --depfile ${out}.d
+              -I${CMAKE_SOURCE_DIR}/shaders -I${CMAKE_SOURCE_DIR}/shaders/shared
+              -o ${out} ${abs}
+      DEPENDS ${abs}
+      DEPFILE ${out}.d
+      COMMENT "GLSL -> SPIR-V ${name}"
+      VERBATIM)
+    list(APPEND outputs ${out})
+  endforeach()
+  add_custom_target(${target}_spv DEPENDS ${outputs})
+  add_library(${target} INTERFACE)
+  add_dependencies(${target} ${target}_spv)
+  target_include_directories(${target} INTERFACE ${out_dir})
+endfunction()

@@ -1,0 +1,239 @@
+// gdpt_shared.h — THE host/shader interface of gdpt.
+//
+// This one file compiles as C++17 (included from src/) and as GLSL 460 (included from
+// shaders/). Every struct that crosses the host/device boundary, every descriptor binding
+// number and every specialisation-constant id is defined here and nowhere else.
+//
+// Rules (see docs in the repo README, "Host/shader interface"):
+//  * All storage blocks use layout(scalar) (GL_EXT_scalar_block_layout); glm's 12-byte vec3
+//    then matches GLSL. Sizes and offsets are pinned by static_asserts in
+//    tests/unit/test_shared_layout.cpp and by a GPU sentinel test.
+//  * No bool in shared structs: use uint flags.
+//  * Append-only: new fields go at the end of a struct. Every field says its units/space.
+#ifndef GDPT_SHARED_H
+#define GDPT_SHARED_H
+
+#ifdef __cplusplus
+#include <cstdint>
+#include <glm/glm.hpp>
+namespace gdpt::gpu {
+using vec2 = glm::vec2;
+using vec3 = glm::vec3;
+using vec4 = glm::vec4;
+using uvec2 = glm::uvec2;
+using uvec4 = glm::uvec4;
+using uint = std::uint32_t;
+#define GDPT_CONST static constexpr
+#define GDPT_ENUM_BEGIN(name) enum name : std::uint32_t {
+#define GDPT_ENUM_END() }
+#else
+#define GDPT_CONST const
+#define GDPT_ENUM_BEGIN(name) const uint
+#define GDPT_ENUM_END()
+#endif
+
+// ---------------------------------------------------------------------------------------------
+// Limits and sentinels
+// ---------------------------------------------------------------------------------------------
+GDPT_CONST uint kInvalidIndex = 0xFFFFFFFFu;
+GDPT_CONST uint kBvhStackSize = 64u;      // traversal stack entries (max BVH depth is capped below)
+GDPT_CONST uint kBvhMaxDepth = 60u;       // builder never exceeds this depth
+GDPT_CONST uint kMaxLeafTriangles = 255u; // leaf primitive count must fit in this
+
+// ---------------------------------------------------------------------------------------------
+// Geometry (world space, metres as given by the glTF file)
+// ---------------------------------------------------------------------------------------------
+
+// Intersection data of one triangle, in BVH leaf order. 48 bytes.
+struct TriangleGeom {
+    vec3 v0;   // world-space position of vertex 0
+    float pad0;
+    vec3 e1;   // v1 - v0 (world space)
+    float pad1;
+    vec3 e2;   // v2 - v0 (world space)
+    float pad2;
+};
+
+// Shading data of one triangle, same index as TriangleGeom. 80 bytes.
+struct TriangleShading {
+    vec3 n0;        // world-space unit shading normal at vertex 0
+    uint material;  // index into the material table
+    vec3 n1;        // world-space unit shading normal at vertex 1
+    float area;     // world-space area (m^2)
+    vec3 n2;        // world-space unit shading normal at vertex 2
+    uint flags;     // kTriFlag*
+    vec2 uv0;       // texture coordinates (TEXCOORD_0) at vertex 0
+    vec2 uv1;
+    vec2 uv2;
+    uint lightIndex; // index into LightTriangle table, kInvalidIndex if not emissive
+    uint pad3;
+};
+GDPT_CONST uint kTriFlagHasNormals = 1u;  // n0..n2 valid; otherwise use the geometric normal
+
+// Two-wide BVH node: stores both children's boxes so one fetch tests two boxes. 64 bytes.
+// A child with count == 0 is an inner node whose index is `left`/`right`; with count > 0
+// it is a leaf covering triangles [first, first + count) in TriangleGeom order. An absent
+// child has count == 0, index kInvalidIndex and an empty box (min > max).
+struct BvhNode {
+    vec3 lmin;        // left child bounds, world space
+    uint left;        // node index (count==0) or first triangle (count>0)
+    vec3 lmax;
+    uint leftCount;   // 0 = inner node, else triangle count (<= kMaxLeafTriangles)
+    vec3 rmin;        // right child bounds
+    uint right;
+    vec3 rmax;
+    uint rightCount;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Materials and textures
+// ---------------------------------------------------------------------------------------------
+
+// glTF metallic-roughness material (+KHR_materials_specular, emissive_strength). 80 bytes.
+struct Material {
+    vec4 baseColor;       // linear RGBA factor (alpha used for cutout only)
+    vec3 emissive;        // emitted radiance factor, W/(m^2 sr): emissiveFactor * strength
+    float metallic;       // [0,1]
+    vec3 specularColor;   // KHR_materials_specular specularColorFactor (linear)
+    float roughness;      // perceptual roughness [0,1]; GGX alpha = roughness^2
+    float specular;       // KHR_materials_specular specularFactor; 0 = pure Lambertian
+    float ior;            // index of refraction for dielectric F0 (default 1.5)
+    float alphaCutoff;    // cutout threshold, used when flags & kMatFlagAlphaMask
+    uint flags;           // kMatFlag*
+    int baseColorTex;     // texture index or -1
+    int metallicRoughnessTex; // texture index or -1 (G = roughness, B = metallic)
+    int emissiveTex;      // texture index or -1
+    int normalTex;        // texture index or -1 (currently unused by kernels; warned)
+};
+GDPT_CONST uint kMatFlagDoubleSided = 1u;
+GDPT_CONST uint kMatFlagAlphaMask = 2u;
+GDPT_CONST uint kMatFlagEmissive = 4u;
+
+// A texture inside the shared texel buffer. Texels are linear RGBA stored as two uints
+// each (packHalf2x16(r,g), packHalf2x16(b,a)); sRGB textures are decoded on the host.
+struct TextureInfo {
+    uint offset;  // first texel (in texels) in the texel buffer
+    uint width;
+    uint height;
+    uint flags;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Lights
+// ---------------------------------------------------------------------------------------------
+
+// Emissive triangle, sampled in proportion to power = area * luminance(emission) * pi.
+struct LightTriangle {
+    uint triangle;  // index into TriangleGeom
+    float cdf;      // inclusive CDF of the power distribution (last entry == 1)
+    float pmf;      // probability of choosing this triangle
+    float pad;
+};
+
+GDPT_ENUM_BEGIN(PunctualType)
+    kPunctualPoint = 0u,
+    kPunctualSpot = 1u
+GDPT_ENUM_END();
+
+// KHR_lights_punctual point/spot light. Intensity in W/sr (glTF candela treated as
+// radiometric). Sampled uniformly among punctual lights.
+struct PunctualLight {
+    vec3 position;    // world space
+    uint type;        // PunctualType
+    vec3 intensity;   // colour * intensity, W/sr
+    float cosInner;   // spot: cos(innerConeAngle)
+    vec3 direction;   // spot: world-space unit direction the light points to
+    float cosOuter;   // spot: cos(outerConeAngle)
+};
+
+// ---------------------------------------------------------------------------------------------
+// Per-scene constants (one storage buffer, read-only)
+// ---------------------------------------------------------------------------------------------
+struct SceneConstants {
+    vec3 camPosition;     // world space
+    float tanHalfFovY;    // tan(yfov / 2)
+    vec3 camRight;        // unit, world space (+x on the image)
+    float aspect;         // width / height
+    vec3 camUp;           // unit, world space (+y on the image, i.e. towards row 0)
+    uint width;           // image width in pixels
+    vec3 camForward;      // unit view direction
+    uint height;          // image height in pixels
+    vec3 envRadiance;     // constant environment radiance, W/(m^2 sr)
+    uint numLightTriangles;
+    uint numPunctualLights;
+    float lightTrianglePower;  // total power of emissive triangles (selection weight)
+    float punctualPower;       // total selection weight of punctual lights
+    uint maxDepth;        // maximum number of path segments (>= 1)
+    float sceneRadius;    // bounding-sphere radius, metres (for ray offsets / env)
+    uint rrDepth;         // Russian roulette starts after this many segments
+    uint numTriangles;
+    uint pad;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Per-batch push constants (<= 128 bytes)
+// ---------------------------------------------------------------------------------------------
+struct FrameParams {
+    uint sampleBase;     // index of the first sample of this batch (per pixel)
+    uint samplesPerPixel;// samples taken per pixel in this batch
+    uint seed;           // user seed
+    uint rowOffset;      // first image row handled by this dispatch (dispatch tiling)
+    uint rowCount;       // rows handled by this dispatch
+    uint pad0;
+    uint pad1;
+    uint pad2;
+};
+
+// Per-pixel running statistics of one estimator (Welford/Chan merge). 32 bytes.
+// mean and m2 stay bounded as samples grow, so float32 is accurate over 10^5 samples
+// (each merge adds a correction of relative size 1/n to a bounded value).
+struct PixelStats {
+    vec3 mean;    // running mean radiance
+    uint count;   // number of samples merged
+    vec3 m2;      // sum of squared deviations from the mean (per channel)
+    uint pad;
+};
+
+// Device-side counters, reduced per batch (uints; no float atomics anywhere).
+struct Counters {
+    uint raysTraced;      // low 32 bits; host accumulates into 64-bit per batch
+    uint pathsCompleted;
+    uint nanSamples;      // samples dropped because they were NaN/Inf
+    uint pad;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Descriptor bindings of the path-tracing pipelines (set 0)
+// ---------------------------------------------------------------------------------------------
+GDPT_ENUM_BEGIN(SceneBinding)
+    kBindTriGeom = 0u,
+    kBindTriShading = 1u,
+    kBindBvh = 2u,
+    kBindMaterials = 3u,
+    kBindTexInfo = 4u,
+    kBindTexels = 5u,
+    kBindLightTris = 6u,
+    kBindPunctual = 7u,
+    kBindSceneConst = 8u,
+    kBindAccum = 9u,
+    kBindCounters = 10u,
+    kBindCount = 11u
+GDPT_ENUM_END();
+
+// Specialisation-constant ids (scene features compiled in or out per scene).
+GDPT_ENUM_BEGIN(SpecId)
+    kSpecWorkgroupX = 0u,
+    kSpecWorkgroupY = 1u,
+    kSpecHasTextures = 2u,
+    kSpecHasPunctual = 3u,
+    kSpecHasLightTris = 4u,
+    kSpecHasEnv = 5u,
+    kSpecHasGlossy = 6u,
+    kSpecHasAlphaMask = 7u,
+    kSpecMaxDepth = 8u
+GDPT_ENUM_END();
+
+#ifdef __cplusplus
+}  // namespace gdpt::gpu
+#endif
+#endif  // GDPT_SHARED_H
