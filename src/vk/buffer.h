@@ -1,0 +1,60 @@
+// buffer.h — a storage buffer with its own memory allocation (one allocation per buffer:
+// gdpt uses a handful of large buffers, so no sub-allocator is needed). Host-visible
+// device-local memory is used when the device has it (lavapipe, ReBAR GPUs); otherwise
+// the buffer is device-local and uploads/downloads go through a staging copy.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "vk/handle.h"
+
+namespace gdpt::vk {
+
+class Context;
+
+class Buffer {
+public:
+    Buffer() = default;
+    // A zero size is rounded up to 16 bytes (Vulkan forbids empty buffers; empty tables
+    // such as "no punctual lights" still need something bound).
+    Buffer(const Context& ctx, std::uint64_t bytes, const std::string& name);
+
+    [[nodiscard]] VkBuffer get() const { return buffer_.get(); }
+    [[nodiscard]] std::uint64_t size() const { return size_; }
+    [[nodiscard]] const std::string& name() const { return name_; }
+
+    // Copies `bytes` bytes from host memory into the buffer at `offset`.
+    void upload(const void* data, std::uint64_t bytes, std::uint64_t offset = 0);
+    // Copies `bytes` bytes out of the buffer at `offset`. The caller has waited for the
+    // GPU work that wrote it.
+    void download(void* data, std::uint64_t bytes, std::uint64_t offset = 0) const;
+    // Fills the whole buffer with zero bytes.
+    void zero();
+
+    template <typename T>
+    void uploadVector(const std::vector<T>& v) {
+        if (!v.empty()) upload(v.data(), v.size() * sizeof(T));
+    }
+    template <typename T>
+    std::vector<T> downloadVector(std::size_t count) const {
+        std::vector<T> v(count);
+        if (count) download(v.data(), count * sizeof(T));
+        return v;
+    }
+
+private:
+    void stagedCopy(void* hostData, std::uint64_t bytes, std::uint64_t offset, bool toDevice) const;
+
+    const Context* ctx_ = nullptr;
+    std::string name_;
+    std::uint64_t size_ = 0;
+    Handle<VkDeviceMemory> memory_;  // declared before buffer_: the buffer dies first
+    Handle<VkBuffer> buffer_;
+    void* mapped_ = nullptr;  // persistent mapping when host-visible
+};
+
+}  // namespace gdpt::vk

@@ -1,0 +1,98 @@
+// context.h — the Vulkan instance, the chosen physical device, the logical device and its
+// compute queue. Headless (no window-system extensions). Picks lavapipe by default when
+// several devices exist; --device NAME|INDEX overrides. With validation on, a debug
+// messenger counts validation errors (tests fail on any).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "vk/handle.h"
+
+namespace gdpt::vk {
+
+struct ContextOptions {
+    std::string device;       // "" = default choice; else a device index or name substring
+    bool validation = false;  // enable VK_LAYER_KHRONOS_validation + error-counting messenger
+    bool printValidation = true;  // print validation messages to stderr
+};
+
+// What `gdpt devices` prints and what the limits check reads.
+struct DeviceInfo {
+    std::uint32_t index = 0;
+    std::string name;
+    std::string type;        // "cpu", "discrete-gpu", ...
+    std::string driverName;  // e.g. "llvmpipe"
+    std::string driverInfo;  // e.g. "Mesa 22.3.6 (LLVM 15.0.6)"
+    std::uint32_t apiVersion = 0;
+    bool isCpu = false;
+    std::uint64_t maxStorageBufferRange = 0;
+    std::uint32_t maxPushConstantsSize = 0;
+    std::uint32_t maxComputeWorkGroupInvocations = 0;
+    std::uint32_t maxComputeSharedMemorySize = 0;
+    std::uint32_t maxComputeWorkGroupCountX = 0;
+    std::uint32_t subgroupSize = 0;
+    float timestampPeriodNs = 0.0f;
+    std::uint64_t deviceLocalHeapBytes = 0;
+    bool scalarBlockLayout = false;
+    bool timestamps = false;
+    std::string unsuitable;  // why gdpt cannot use it ("" = usable)
+};
+
+class Context {
+public:
+    explicit Context(const ContextOptions& options = {});
+    ~Context();
+    Context(const Context&) = delete;
+    Context& operator=(const Context&) = delete;
+
+    // Enumerates devices with a throw-away instance (for `gdpt devices`).
+    static std::vector<DeviceInfo> listDevices();
+
+    [[nodiscard]] VkInstance instance() const { return instance_.get(); }
+    [[nodiscard]] VkPhysicalDevice physicalDevice() const { return physical_; }
+    [[nodiscard]] VkDevice device() const { return device_.get(); }
+    [[nodiscard]] VkQueue queue() const { return queue_; }
+    [[nodiscard]] std::uint32_t queueFamily() const { return queueFamily_; }
+    [[nodiscard]] const DeviceInfo& info() const { return info_; }
+    [[nodiscard]] std::uint32_t validationErrors() const { return validationErrors_.load(); }
+    [[nodiscard]] std::uint32_t validationWarnings() const { return validationWarnings_.load(); }
+    [[nodiscard]] bool validationEnabled() const { return validation_; }
+
+    // Memory type with all `required` flags among `typeBits`; throws if none.
+    [[nodiscard]] std::uint32_t findMemoryType(std::uint32_t typeBits,
+                                               VkMemoryPropertyFlags required) const;
+    [[nodiscard]] bool hasMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required) const;
+    // Debug name shown by validation messages and tools (no-op without debug utils).
+    void setName(VkObjectType type, std::uint64_t handle, const std::string& name) const;
+
+    // Throws gdpt::Error naming the limit if a single storage buffer of `bytes` bytes
+    // (what: "triangle geometry") exceeds the device's maxStorageBufferRange.
+    void checkStorageBufferSize(std::uint64_t bytes, const std::string& what) const;
+
+private:
+    static VkBool32 VKAPI_PTR messengerCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                VkDebugUtilsMessageTypeFlagsEXT types,
+                                                const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                                void* user);
+
+    bool validation_ = false;
+    bool printValidation_ = true;
+    std::atomic<std::uint32_t> validationErrors_{0};
+    std::atomic<std::uint32_t> validationWarnings_{0};
+    Handle<VkInstance> instance_;
+    Handle<VkDebugUtilsMessengerEXT> messenger_;
+    VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+    DeviceInfo info_;
+    VkPhysicalDeviceMemoryProperties memory_{};
+    Handle<VkDevice> device_;
+    VkQueue queue_ = VK_NULL_HANDLE;
+    std::uint32_t queueFamily_ = 0;
+    PFN_vkSetDebugUtilsObjectNameEXT setObjectName_ = nullptr;
+};
+
+}  // namespace gdpt::vk

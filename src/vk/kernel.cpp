@@ -1,0 +1,139 @@
+#include "vk/kernel.h"
+
+#include <algorithm>
+
+#include "vk/buffer.h"
+#include "vk/context.h"
+#include "vk/timing.h"
+#include "vk/vk_check.h"
+
+namespace gdpt::vk {
+
+Kernel::Kernel(const Context& ctx, const KernelDesc& desc) : ctx_(ctx), desc_(desc) {
+    VkDevice device = ctx.device();
+    GDPT_CHECK(desc.spirv != nullptr && desc.spirvBytes > 0);
+    if (desc.pushConstantBytes > ctx.info().maxPushConstantsSize)
+        throw Error("kernel '" + desc.name + "' needs " + std::to_string(desc.pushConstantBytes) +
+                    " bytes of push constants; device limit maxPushConstantsSize = " +
+                    std::to_string(ctx.info().maxPushConstantsSize));
+
+    VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    moduleInfo.codeSize = desc.spirvBytes;
+    moduleInfo.pCode = desc.spirv;
+    VkShaderModule module = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateShaderModule(device, &moduleInfo, nullptr, &module));
+    module_ = Handle<VkShaderModule>(module, [device](VkShaderModule m) { vkDestroyShaderModule(device, m, nullptr); });
+    ctx.setName(VK_OBJECT_TYPE_SHADER_MODULE, reinterpret_cast<std::uint64_t>(module), desc.name);
+
+    std::vector<VkDescriptorSetLayoutBinding> bindings;
+    for (std::uint32_t b : desc.bindings) {
+        VkDescriptorSetLayoutBinding lb{};
+        lb.binding = b;
+        lb.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        lb.descriptorCount = 1;
+        lb.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+        bindings.push_back(lb);
+    }
+    VkDescriptorSetLayoutCreateInfo setInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    setInfo.bindingCount = static_cast<std::uint32_t>(bindings.size());
+    setInfo.pBindings = bindings.data();
+    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &setLayout));
+    setLayout_ = Handle<VkDescriptorSetLayout>(
+        setLayout, [device](VkDescriptorSetLayout l) { vkDestroyDescriptorSetLayout(device, l, nullptr); });
+
+    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, desc.pushConstantBytes};
+    VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    layoutInfo.setLayoutCount = 1;
+    layoutInfo.pSetLayouts = &setLayout;
+    layoutInfo.pushConstantRangeCount = desc.pushConstantBytes ? 1u : 0u;
+    layoutInfo.pPushConstantRanges = &range;
+    VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
+    VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &pipelineLayout));
+    pipelineLayout_ = Handle<VkPipelineLayout>(
+        pipelineLayout, [device](VkPipelineLayout l) { vkDestroyPipelineLayout(device, l, nullptr); });
+
+    std::vector<VkSpecializationMapEntry> entries;
+    std::vector<std::uint32_t> values;
+    for (const auto& [id, value] : desc.specConstants) {
+        VkSpecializationMapEntry e{};
+        e.constantID = id;
+        e.offset = static_cast<std::uint32_t>(values.size() * sizeof(std::uint32_t));
+        e.size = sizeof(std::uint32_t);
+        entries.push_back(e);
+        values.push_back(value);
+    }
+    VkSpecializationInfo spec{};
+    spec.mapEntryCount = static_cast<std::uint32_t>(entries.size());
+    spec.pMapEntries = entries.data();
+    spec.dataSize = values.size() * sizeof(std::uint32_t);
+    spec.pData = values.data();
+
+    VkComputePipelineCreateInfo pipeInfo{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    pipeInfo.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    pipeInfo.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    pipeInfo.stage.module = module;
+    pipeInfo.stage.pName = "main";
+    pipeInfo.stage.pSpecializationInfo = entries.empty() ? nullptr : &spec;
+    pipeInfo.layout = pipelineLayout;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    try {
+        VK_CHECK(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &pipeInfo, nullptr, &pipeline));
+    } catch (const Error& e) {
+        throw e.withContext("creating pipeline '" + desc.name + "'");
+    }
+    pipeline_ = Handle<VkPipeline>(pipeline, [device](VkPipeline p) { vkDestroyPipeline(device, p, nullptr); });
+    ctx.setName(VK_OBJECT_TYPE_PIPELINE, reinterpret_cast<std::uint64_t>(pipeline), desc.name);
+
+    if (!bindings.empty()) {
+        VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, static_cast<std::uint32_t>(bindings.size())};
+        VkDescriptorPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+        poolInfo.maxSets = 1;
+        poolInfo.poolSizeCount = 1;
+        poolInfo.pPoolSizes = &size;
+        VkDescriptorPool pool = VK_NULL_HANDLE;
+        VK_CHECK(vkCreateDescriptorPool(device, &poolInfo, nullptr, &pool));
+        pool_ = Handle<VkDescriptorPool>(pool, [device](VkDescriptorPool p) { vkDestroyDescriptorPool(device, p, nullptr); });
+        VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+        alloc.descriptorPool = pool;
+        alloc.descriptorSetCount = 1;
+        alloc.pSetLayouts = &setLayout;
+        VK_CHECK(vkAllocateDescriptorSets(device, &alloc, &set_));
+    }
+}
+
+void Kernel::bind(std::uint32_t binding, const Buffer& buffer) {
+    GDPT_CHECK(std::find(desc_.bindings.begin(), desc_.bindings.end(), binding) != desc_.bindings.end());
+    VkDescriptorBufferInfo info{buffer.get(), 0, VK_WHOLE_SIZE};
+    VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    write.dstSet = set_;
+    write.dstBinding = binding;
+    write.descriptorCount = 1;
+    write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    write.pBufferInfo = &info;
+    vkUpdateDescriptorSets(ctx_.device(), 1, &write, 0, nullptr);
+}
+
+void Kernel::dispatch(VkCommandBuffer cmd, std::uint32_t x, std::uint32_t y, std::uint32_t z,
+                      const void* push, GpuTimer* timer) const {
+    if (x == 0 || y == 0 || z == 0) return;
+    if (timer) timer->begin(cmd, desc_.name);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.get());
+    if (set_ != VK_NULL_HANDLE)
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelineLayout_.get(), 0, 1,
+                                &set_, 0, nullptr);
+    if (push && desc_.pushConstantBytes)
+        vkCmdPushConstants(cmd, pipelineLayout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                           desc_.pushConstantBytes, push);
+    vkCmdDispatch(cmd, x, y, z);
+    if (timer) timer->end(cmd);
+}
+
+void Kernel::dispatchItems(VkCommandBuffer cmd, std::uint32_t itemsX, std::uint32_t itemsY,
+                           const void* push, GpuTimer* timer) const {
+    const std::uint32_t gx = (itemsX + desc_.localSizeX - 1) / desc_.localSizeX;
+    const std::uint32_t gy = (itemsY + desc_.localSizeY - 1) / desc_.localSizeY;
+    dispatch(cmd, gx, gy, 1, push, timer);
+}
+
+}  // namespace gdpt::vk

@@ -1,0 +1,70 @@
+// kernel.h — one compute pipeline: a .comp file's embedded SPIR-V, its descriptor-set
+// layout (storage buffers only), push-constant range and specialisation constants, plus
+// one descriptor set that buffers are bound to by binding number.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "vk/handle.h"
+
+namespace gdpt::vk {
+
+class Buffer;
+class Context;
+class GpuTimer;
+
+struct KernelDesc {
+    std::string name;                    // shown in --profile and error messages
+    const std::uint32_t* spirv = nullptr;
+    std::size_t spirvBytes = 0;
+    std::vector<std::uint32_t> bindings;  // storage-buffer binding numbers of set 0
+    std::uint32_t pushConstantBytes = 0;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> specConstants;  // (id, 32-bit value)
+    std::uint32_t localSizeX = 1;  // workgroup size, for dispatch-by-items helpers
+    std::uint32_t localSizeY = 1;
+};
+
+// KernelDesc with the SPIR-V of an embedded array (kSpv_<name> from the build).
+template <std::size_t N>
+KernelDesc kernelDesc(std::string name, const std::uint32_t (&spirv)[N]) {
+    KernelDesc d;
+    d.name = std::move(name);
+    d.spirv = spirv;
+    d.spirvBytes = N * sizeof(std::uint32_t);
+    return d;
+}
+
+class Kernel {
+public:
+    Kernel(const Context& ctx, const KernelDesc& desc);
+
+    // Points `binding` at `buffer` (whole range). Not while a submitted command buffer
+    // that uses this kernel is pending.
+    void bind(std::uint32_t binding, const Buffer& buffer);
+    // Records bind + push constants + dispatch of groups (x, y, z). With a timer, the
+    // dispatch is wrapped in a named timestamp scope.
+    void dispatch(VkCommandBuffer cmd, std::uint32_t x, std::uint32_t y, std::uint32_t z,
+                  const void* push = nullptr, GpuTimer* timer = nullptr) const;
+    // Dispatch enough workgroups to cover itemsX × itemsY invocations.
+    void dispatchItems(VkCommandBuffer cmd, std::uint32_t itemsX, std::uint32_t itemsY,
+                       const void* push = nullptr, GpuTimer* timer = nullptr) const;
+    [[nodiscard]] const std::string& name() const { return desc_.name; }
+
+private:
+    const Context& ctx_;
+    KernelDesc desc_;
+    Handle<VkShaderModule> module_;
+    Handle<VkDescriptorSetLayout> setLayout_;
+    Handle<VkPipelineLayout> pipelineLayout_;
+    Handle<VkPipeline> pipeline_;
+    Handle<VkDescriptorPool> pool_;
+    VkDescriptorSet set_ = VK_NULL_HANDLE;
+};
+
+}  // namespace gdpt::vk
