@@ -1,0 +1,42 @@
+// exr_io.h — OpenEXR input/output of named RGB layers (OpenEXR 3.1).
+//
+// Layout: the layer with an empty name uses the plain channels R, G, B; every other layer
+// "name" uses name.R, name.G, name.B. Written files are 32-bit FLOAT, ZIP compressed,
+// scan-line, with data window = display window = [0, w-1] x [0, h-1].
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "image/image.h"
+
+namespace gdpt {
+
+struct NamedLayer {
+    std::string name;  // "" = default R,G,B channels
+    Image image;
+};
+
+// Writes all layers into one EXR at `path` (via path.tmp + rename, GUIDE §5). All layers
+// must have the same non-zero size and distinct names. Throws gdpt::Error naming the file.
+void writeExr(const std::string& path, const std::vector<NamedLayer>& layers);
+
+// Convenience: one image into the default R,G,B channels.
+void writeExr(const std::string& path, const Image& image);
+
+// Reads every layer of a (single-part, flat) EXR. Channels are grouped by the prefix
+// before their last '.'; the unprefixed group is the layer "". Within a group:
+//   - R, G, B present: used as they are (a missing one of the three reads as 0);
+//   - only Y (luminance) present: Y is copied into R, G and B (gray);
+//   - other channels (A, Z, ...) are ignored; a group with none of R, G, B, Y is skipped.
+// HALF, FLOAT and UINT channels are all converted to float by OpenEXR. The data window may
+// have any origin; the returned image covers the data window (its size). Layers come back
+// sorted by name, so "" comes first. Throws gdpt::Error naming the file and the problem;
+// OpenEXR exceptions (corrupt or truncated files) are caught and wrapped.
+std::vector<NamedLayer> readExr(const std::string& path);
+
+// Reads the layer `name` (default: the unnamed R,G,B layer); throws gdpt::Error listing
+// the available layers if it is missing.
+Image readExrLayer(const std::string& path, const std::string& name = "");
+
+}  // namespace gdpt

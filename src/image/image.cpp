@@ -1,0 +1,33 @@
+// image.cpp — planar float RGB image helpers.
+#include "image/image.h"
+
+#include <string>
+
+#include "util/error.h"
+
+namespace gdpt {
+
+Image::Image(int width, int height, float fill) : width_(width), height_(height) {
+    if (width < 0 || height < 0)
+        throw Error("invalid image size " + std::to_string(width) + "x" +
+                    std::to_string(height));
+    for (auto& p : planes_) p.assign(pixelCount(), fill);
+}
+
+std::array<double, 3> Image::meanRgb() const {
+    std::array<double, 3> mean{0.0, 0.0, 0.0};
+    if (empty()) return mean;
+    for (int c = 0; c < kChannels; ++c) {
+        double sum = 0.0;
+        for (float v : planes_[c]) sum += v;
+        mean[c] = sum / static_cast<double>(pixelCount());
+    }
+    return mean;
+}
+
+double Image::grayMean() const {
+    const auto m = meanRgb();
+    return (m[0] + m[1] + m[2]) / 3.0;
+}
+
+}  // namespace gdpt

@@ -1,0 +1,42 @@
+// metrics.h — image error metrics against a reference.
+//
+// relMSE is computed exactly as Kettunen et al. 2015 computed it (their errata; the
+// calculateRelMSE.m used for the paper, GPT_REFERENCE §4):
+//     relMSE = 3 · mean over pixels p and channels c of (I_pc − R_pc)² / (1e-3 + gray(R_p)²)
+//            = mean over pixels of Σ_c (I_pc − R_pc)² / (1e-3 + gray(R_p)²),
+// with gray(R_p) = (R_pr + R_pg + R_pb) / 3 taken from the reference pixel.
+//
+// Non-finite values: a pixel whose test or reference value is NaN or ±inf in any channel
+// is excluded from every metric and counted in nonFinitePixels; all metrics are then
+// computed over the remaining ("finite") pixels. A NaN therefore never propagates into the
+// numbers silently: check nonFinitePixels. If no pixel is finite, every metric is NaN.
+#pragma once
+
+#include <array>
+#include <cstddef>
+
+#include "image/image.h"
+
+namespace gdpt {
+
+struct ImageErrorStats {
+    double relMse = 0.0;       // Kettunen et al. 2015 relMSE (see above)
+    double mse = 0.0;          // mean over pixel-channels of (I − R)²
+    double mae = 0.0;          // mean over pixel-channels of |I − R|
+    double maxAbsError = 0.0;  // max over pixel-channels of |I − R|
+    double meanBias = 0.0;     // mean over pixel-channels of (I − R)
+    std::array<double, 3> meanTest{};       // per-channel mean of I (finite pixels)
+    std::array<double, 3> meanReference{};  // per-channel mean of R (finite pixels)
+    std::size_t finitePixels = 0;           // pixels used
+    std::size_t nonFinitePixels = 0;        // pixels excluded (NaN/inf in I or R)
+};
+
+// All metrics of `test` against `reference`. Throws gdpt::Error if the sizes differ.
+ImageErrorStats compareImages(const Image& test, const Image& reference);
+
+// Shorthands for compareImages(test, reference).<metric>.
+double relMse(const Image& test, const Image& reference);
+double mse(const Image& test, const Image& reference);
+double mae(const Image& test, const Image& reference);
+
+}  // namespace gdpt

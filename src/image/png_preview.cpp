@@ -1,0 +1,89 @@
+// png_preview.cpp — sRGB PNG previews via stb_image_write, LDR input via stb_image.
+// libstb.so (Debian libstb-dev) carries the stb implementations: no IMPLEMENTATION macros.
+#include "image/png_preview.h"
+
+#include <stb/stb_image.h>
+#include <stb/stb_image_write.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "image/atomic_write.h"
+#include "image/exr_io.h"
+#include "util/error.h"
+
+namespace gdpt {
+
+double linearToSrgb(double linear) {
+    // IEC 61966-2-1: linear segment below 0.0031308, power 1/2.4 segment above.
+    if (linear <= 0.0031308) return 12.92 * linear;
+    return 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
+}
+
+double srgbToLinear(double encoded) {
+    if (encoded <= 0.04045) return encoded / 12.92;
+    return std::pow((encoded + 0.055) / 1.055, 2.4);
+}
+
+std::uint8_t previewCode(float linear, const PreviewOptions& options) {
+    double v = static_cast<double>(linear) * static_cast<double>(options.exposure);
+    if (!(v > 0.0)) return 0;  // negative, zero and NaN
+    if (options.toneMap == ToneMap::Reinhard) v = std::isinf(v) ? 1.0 : v / (1.0 + v);
+    v = std::min(v, 1.0);
+    return static_cast<std::uint8_t>(std::lround(255.0 * linearToSrgb(v)));
+}
+
+void writePngPreview(const std::string& path, const Image& image,
+                     const PreviewOptions& options) {
+    if (image.empty()) throw Error(path + ": cannot write an empty image");
+    const int w = image.width();
+    const int h = image.height();
+    std::vector<std::uint8_t> rgb(image.pixelCount() * 3);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c)
+                rgb[image.index(x, y) * 3 + c] = previewCode(image.at(x, y, c), options);
+    writeFileAtomically(path, [&](const std::string& tmpPath) {
+        if (stbi_write_png(tmpPath.c_str(), w, h, 3, rgb.data(), w * 3) == 0)
+            throw Error("stbi_write_png failed on " + tmpPath);
+    });
+}
+
+Image readPng(const std::string& path) {
+    int w = 0, h = 0, components = 0;
+    const bool sixteen = stbi_is_16_bit(path.c_str()) != 0;
+    // Ask for 3 components: stb expands gray and drops alpha.
+    std::unique_ptr<void, void (*)(void*)> pixels(
+        sixteen ? static_cast<void*>(stbi_load_16(path.c_str(), &w, &h, &components, 3))
+                : static_cast<void*>(stbi_load(path.c_str(), &w, &h, &components, 3)),
+        stbi_image_free);
+    if (!pixels) {
+        const char* reason = stbi_failure_reason();
+        throw Error(path + ": cannot read image: " + (reason ? reason : "unknown error"));
+    }
+    Image image(w, h);
+    const double maxCode = sixteen ? 65535.0 : 255.0;
+    // Precomputing a table would be faster for 8 bit; readImage is not on a hot path.
+    for (std::size_t i = 0; i < image.pixelCount(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            const double code =
+                sixteen ? static_cast<const std::uint16_t*>(pixels.get())[i * 3 + c]
+                        : static_cast<const std::uint8_t*>(pixels.get())[i * 3 + c];
+            image.plane(c)[i] = static_cast<float>(srgbToLinear(code / maxCode));
+        }
+    return image;
+}
+
+Image readImage(const std::string& path) {
+    std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : "";
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+    if (ext != ".exr") return readPng(path);
+    std::vector<NamedLayer> layers = readExr(path);  // sorted: "" first if present
+    return std::move(layers.front().image);
+}
+
+}  // namespace gdpt

@@ -1,0 +1,95 @@
+// test_metrics.cpp — relMSE (Kettunen et al. 2015), MSE, MAE, max error against hand-computed
+// values, non-finite handling, and the shared Cornell-box reference.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "image/exr_io.h"
+#include "image/metrics.h"
+#include "util/error.h"
+
+namespace gdpt {
+namespace {
+
+Image makeImage(int w, int h, std::initializer_list<float> rgbValues) {
+    Image image(w, h);
+    auto it = rgbValues.begin();
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) image.at(x, y, c) = *it++;
+    return image;
+}
+
+// Reference p0 = (0.1, 0.2, 0.3): gray = 0.2, denominator = 1e-3 + 0.04 = 0.041.
+// Test     p0 = (0.2, 0.2, 0.1): diffs (0.1, 0, -0.2), squares (0.01, 0, 0.04), sum 0.05
+//          -> 0.05 / 0.041 = 1.219512195...
+// Reference p1 = (0, 0, 0): gray = 0, denominator = 1e-3.
+// Test     p1 = (0.01, 0, 0.02): squares (1e-4, 0, 4e-4), sum 5e-4 -> 5e-4 / 1e-3 = 0.5.
+// relMSE = (1.219512195 + 0.5) / 2 = 0.859756098 (= 3 x mean over the 6 pixel-channels).
+// MSE  = (0.01 + 0 + 0.04 + 1e-4 + 0 + 4e-4) / 6 = 0.0505 / 6
+// MAE  = (0.1 + 0 + 0.2 + 0.01 + 0 + 0.02) / 6 = 0.33 / 6 = 0.055
+// max  = 0.2;  bias = (0.1 + 0 - 0.2 + 0.01 + 0 + 0.02) / 6 = -0.07 / 6
+TEST(Metrics, HandComputedTwoPixelImage) {
+    const Image reference = makeImage(2, 1, {0.1f, 0.2f, 0.3f, 0.0f, 0.0f, 0.0f});
+    const Image test = makeImage(2, 1, {0.2f, 0.2f, 0.1f, 0.01f, 0.0f, 0.02f});
+    const ImageErrorStats s = compareImages(test, reference);
+    // Inputs are float: allow float rounding of the inputs (relative ~1e-6).
+    EXPECT_NEAR(s.relMse, (0.05 / 0.041 + 0.5) / 2.0, 1e-6);
+    EXPECT_NEAR(s.mse, 0.0505 / 6.0, 1e-8);
+    EXPECT_NEAR(s.mae, 0.055, 1e-7);
+    EXPECT_NEAR(s.maxAbsError, 0.2, 1e-7);
+    EXPECT_NEAR(s.meanBias, -0.07 / 6.0, 1e-7);
+    EXPECT_NEAR(s.meanReference[2], 0.15, 1e-7);
+    EXPECT_NEAR(s.meanTest[0], 0.105, 1e-7);
+    EXPECT_EQ(s.finitePixels, 2u);
+    EXPECT_EQ(s.nonFinitePixels, 0u);
+    EXPECT_DOUBLE_EQ(relMse(test, reference), s.relMse);
+    EXPECT_DOUBLE_EQ(mse(test, reference), s.mse);
+    EXPECT_DOUBLE_EQ(mae(test, reference), s.mae);
+    // Not symmetric: the denominator uses the reference's gray value.
+    EXPECT_GT(std::abs(relMse(reference, test) - s.relMse), 0.1);
+}
+
+TEST(Metrics, NonFinitePixelsAreCountedAndExcluded) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
+    const Image reference =
+        makeImage(4, 1, {0.1f, 0.2f, 0.3f, 0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 1.0f, inf, 0.0f, 0.0f});
+    const Image test =
+        makeImage(4, 1, {0.2f, 0.2f, 0.1f, 0.01f, 0.0f, 0.02f, 1.0f, nan, 1.0f, 0.0f, 0.0f, 0.0f});
+    const ImageErrorStats s = compareImages(test, reference);
+    EXPECT_EQ(s.nonFinitePixels, 2u);
+    EXPECT_EQ(s.finitePixels, 2u);
+    EXPECT_NEAR(s.relMse, (0.05 / 0.041 + 0.5) / 2.0, 1e-6);
+    EXPECT_TRUE(std::isfinite(s.mse));
+    const Image allNan = makeImage(1, 1, {nan, nan, nan});
+    EXPECT_TRUE(std::isnan(relMse(allNan, allNan)));
+    EXPECT_EQ(compareImages(allNan, allNan).nonFinitePixels, 1u);
+}
+
+TEST(Metrics, SizeMismatchThrows) {
+    EXPECT_THROW(compareImages(Image(2, 2), Image(2, 3)), Error);
+    EXPECT_THROW(relMse(Image(3, 1), Image(1, 3)), Error);
+}
+
+TEST(Metrics, CboxReferenceAgainstItselfAndReadmeMean) {
+    const std::string file = std::string(GDPT_SHARED_DIR) + "/scenes/cbox/reference.exr";
+    if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " not present";
+    const Image reference = readExrLayer(file);
+    EXPECT_EQ(reference.width(), 256);
+    EXPECT_EQ(reference.height(), 256);
+    const ImageErrorStats s = compareImages(reference, reference);
+    EXPECT_EQ(s.relMse, 0.0);
+    EXPECT_EQ(s.mse, 0.0);
+    EXPECT_EQ(s.nonFinitePixels, 0u);
+    // Values from /work/shared/scenes/README.md (given to 5 decimals).
+    const auto mean = reference.meanRgb();
+    EXPECT_NEAR(mean[0], 0.19617, 1e-4);
+    EXPECT_NEAR(mean[1], 0.12765, 1e-4);
+    EXPECT_NEAR(mean[2], 0.03613, 1e-4);
+}
+
+}  // namespace
+}  // namespace gdpt
