@@ -1,0 +1,25 @@
+// scene_buffers.glsl — declarations of the scene's storage buffers and the feature
+// specialisation constants, shared by every path-sampling kernel. Binding numbers and
+// constant ids come from gdpt_shared.h only.
+#ifndef GDPT_LIB_SCENE_BUFFERS
+#define GDPT_LIB_SCENE_BUFFERS
+
+layout(constant_id = kSpecHasTextures) const bool kHasTextures = true;
+layout(constant_id = kSpecHasPunctual) const bool kHasPunctual = true;
+layout(constant_id = kSpecHasLightTris) const bool kHasLightTris = true;
+layout(constant_id = kSpecHasEnv) const bool kHasEnv = true;
+layout(constant_id = kSpecHasGlossy) const bool kHasGlossy = true;
+layout(constant_id = kSpecHasAlphaMask) const bool kHasAlphaMask = true;
+layout(constant_id = kSpecMaxDepth) const uint kMaxDepth = 1024u;
+
+layout(set = 0, binding = kBindTriGeom, scalar) readonly buffer TriGeomBuf { TriangleGeom triGeoms[]; };
+layout(set = 0, binding = kBindTriShading, scalar) readonly buffer TriShadingBuf { TriangleShading triShading[]; };
+layout(set = 0, binding = kBindBvh, scalar) readonly buffer BvhBuf { BvhNode bvhNodes[]; };
+layout(set = 0, binding = kBindMaterials, scalar) readonly buffer MaterialBuf { Material materials[]; };
+layout(set = 0, binding = kBindTexInfo, scalar) readonly buffer TexInfoBuf { TextureInfo texInfos[]; };
+layout(set = 0, binding = kBindTexels, scalar) readonly buffer TexelBuf { uvec2 texels[]; };
+layout(set = 0, binding = kBindLightTris, scalar) readonly buffer LightTriBuf { LightTriangle lightTris[]; };
+layout(set = 0, binding = kBindPunctual, scalar) readonly buffer PunctualBuf { PunctualLight punctual[]; };
+layout(set = 0, binding = kBindSceneConst, scalar) readonly buffer SceneConstBuf { SceneConstants scene; };
+
+#endif  // GDPT_LIB_SCENE_BUFFERS

@@ -1,0 +1,50 @@
+// cli.h — the gdpt command line: subcommands, their options and defaults. Parsing only;
+// each subcommand's work lives in commands.cpp.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <glm/glm.hpp>
+
+namespace gdpt {
+
+struct RenderArgs {
+    std::string scene;
+    std::string output = "render.exr";
+    std::uint32_t spp = 64;
+    double time = 0.0;
+    int width = 256;
+    int height = 256;
+    std::uint32_t maxDepth = 64;
+    std::uint32_t seed = 0;
+    std::string env = "0,0,0";
+    std::string device;
+    int camera = -1;
+    bool profile = false;
+    std::string json;
+    bool quiet = false;
+    bool validate = false;
+    std::string method = "pt";
+    std::string workgroup = "8x8";
+};
+
+struct DiffArgs {
+    std::string test;
+    std::string reference;
+    std::string json;
+};
+
+struct InfoArgs {
+    std::string scene;
+    std::string env = "0,0,0";
+};
+
+struct DevicesArgs {
+    bool json = false;
+};
+
+// Parses "R,G,B" (or a single value for gray) into a colour; throws gdpt::UsageError.
+glm::vec3 parseColor(const std::string& text, const std::string& flag);
+
+}  // namespace gdpt

@@ -1,0 +1,250 @@
+#include "app/commands.h"
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "image/exr_io.h"
+#include "image/metrics.h"
+#include "image/png_preview.h"
+#include "render/features.h"
+#include "render/renderer.h"
+#include "scene/gltf_loader.h"
+#include "util/error.h"
+#include "util/timer.h"
+#include "vk/context.h"
+
+namespace gdpt {
+namespace {
+
+using nlohmann::json;
+
+WorkgroupSize parseWorkgroup(const std::string& text) {
+    unsigned x = 0, y = 0;
+    char sep = 0;
+    std::istringstream in(text);
+    if (!(in >> x >> sep >> y) || sep != 'x' || x == 0 || y == 0 || x * y > 1024)
+        throw UsageError("--workgroup '" + text + "' must be WxH with W*H <= 1024, e.g. 8x8");
+    return {x, y};
+}
+
+// Writes text to path via path.tmp + rename, so a failure never leaves a partial file.
+void writeTextAtomically(const std::string& path, const std::string& text) {
+    if (path == "-") {
+        std::fputs(text.c_str(), stdout);
+        return;
+    }
+    const std::string tmp = path + ".tmp";
+    {
+        std::ofstream out(tmp);
+        out << text;
+        if (!out) throw Error(path + ": cannot write");
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+        std::remove(tmp.c_str());
+        throw Error(path + ": cannot write");
+    }
+}
+
+std::string previewPath(const std::string& exrPath) {
+    const auto dot = exrPath.rfind('.');
+    const auto slash = exrPath.rfind('/');
+    const bool hasExt = dot != std::string::npos && (slash == std::string::npos || dot > slash);
+    return (hasExt ? exrPath.substr(0, dot) : exrPath) + ".png";
+}
+
+json kernelJson(const std::map<std::string, vk::KernelTime>& kernels, double frameMs) {
+    json k = json::object();
+    for (const auto& [name, t] : kernels)
+        k[name] = {{"count", t.count},
+                   {"total_ms", t.totalMs},
+                   {"ms_per_call", t.count ? t.totalMs / double(t.count) : 0.0},
+                   {"share", frameMs > 0 ? t.totalMs / frameMs : 0.0}};
+    return k;
+}
+
+void printProfile(const std::map<std::string, vk::KernelTime>& kernels) {
+    double total = 0.0;
+    for (const auto& [name, t] : kernels) total += t.totalMs;
+    std::fprintf(stderr, "%-24s %8s %12s %12s %7s\n", "kernel", "count", "total ms", "ms/call", "share");
+    for (const auto& [name, t] : kernels)
+        std::fprintf(stderr, "%-24s %8llu %12.3f %12.3f %6.1f%%\n", name.c_str(),
+                     static_cast<unsigned long long>(t.count), t.totalMs, t.count ? t.totalMs / double(t.count) : 0.0,
+                     total > 0 ? 100.0 * t.totalMs / total : 0.0);
+}
+
+}  // namespace
+
+glm::vec3 parseColor(const std::string& text, const std::string& flag) {
+    std::vector<float> v;
+    std::stringstream in(text);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        try {
+            std::size_t used = 0;
+            const float f = std::stof(item, &used);
+            if (used != item.size() || !(f >= 0.0f) || f > 3.0e38f) throw std::invalid_argument(item);
+            v.push_back(f);
+        } catch (const std::exception&) {
+            throw UsageError(flag + " '" + text + "': expected R,G,B with finite non-negative numbers");
+        }
+    }
+    if (v.size() == 1) return glm::vec3(v[0]);
+    if (v.size() != 3) throw UsageError(flag + " '" + text + "': expected R,G,B");
+    return {v[0], v[1], v[2]};
+}
+
+int runRender(const RenderArgs& args) {
+    Timer total;
+    RenderOptions options;
+    options.scene.width = args.width;
+    options.scene.height = args.height;
+    options.scene.maxDepth = args.maxDepth;
+    options.scene.envRadiance = parseColor(args.env, "--env");
+    options.scene.camera = args.camera;
+    options.spp = args.spp;
+    options.timeBudget = args.time;
+    options.seed = args.seed;
+    options.profile = args.profile;
+    options.quiet = args.quiet;
+    options.workgroup = parseWorkgroup(args.workgroup);
+
+    Scene scene = loadGltf(args.scene);
+    if (!scene.unsupported.empty() && !args.quiet) {
+        std::string list;
+        for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
+        std::fprintf(stderr, "gdpt: warning: %s: not rendered: %s\n", args.scene.c_str(), list.c_str());
+    }
+    vk::ContextOptions ctxOptions;
+    ctxOptions.device = args.device;
+    ctxOptions.validation = args.validate;
+    vk::Context ctx(ctxOptions);
+    if (!args.quiet)
+        std::fprintf(stderr, "gdpt: device '%s' (%s, %s)\n", ctx.info().name.c_str(), ctx.info().type.c_str(),
+                     ctx.info().driverInfo.c_str());
+    options.elapsedBefore = total.seconds();
+    RenderResult result = renderPt(ctx, scene, options);
+
+    Timer writeTimer;
+    writeExr(args.output, {{"", result.image}, {"variance", result.varianceOfMean}});
+    writePngPreview(previewPath(args.output), result.image);
+    const double writeMs = writeTimer.ms();
+    const RenderStats& s = result.stats;
+    const double seconds = total.seconds();
+    if (args.profile) printProfile(s.kernels);
+    if (!args.quiet)
+        std::fprintf(stderr,
+                     "gdpt: wrote %s (%u spp, %.2f s total, BVH %.1f ms, sampling %.1f ms, %.2f Mrays/s, %.3f Msamples/s)\n",
+                     args.output.c_str(), s.spp, seconds, s.bvhBuildMs, s.samplingMs,
+                     double(s.raysTraced) / (s.samplingMs * 1e-3) * 1e-6,
+                     double(s.pathsCompleted) / (s.samplingMs * 1e-3) * 1e-6);
+    if (!args.json.empty()) {
+        json j = {{"scene", args.scene},
+                  {"output", args.output},
+                  {"method", args.method},
+                  {"device", ctx.info().name},
+                  {"driver", ctx.info().driverInfo},
+                  {"width", args.width},
+                  {"height", args.height},
+                  {"spp", s.spp},
+                  {"seed", args.seed},
+                  {"batches", s.batches},
+                  {"time_s", {{"total", seconds},
+                              {"bvh_build", s.bvhBuildMs * 1e-3},
+                              {"upload", s.uploadMs * 1e-3},
+                              {"sampling", s.samplingMs * 1e-3},
+                              {"readback", s.readbackMs * 1e-3},
+                              {"write", writeMs * 1e-3}}},
+                  {"rays_traced", s.raysTraced},
+                  {"paths_completed", s.pathsCompleted},
+                  {"nan_samples", s.nanSamples},
+                  {"rays_per_s", double(s.raysTraced) / (s.samplingMs * 1e-3)},
+                  {"samples_per_s", double(s.pathsCompleted) / (s.samplingMs * 1e-3)},
+                  {"kernels", kernelJson(s.kernels, s.samplingMs)},
+                  {"validation_errors", ctx.validationErrors()}};
+        writeTextAtomically(args.json, j.dump(2) + "\n");
+    }
+    if (ctx.validationErrors() > 0) {
+        std::fprintf(stderr, "gdpt: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
+        return 1;
+    }
+    return 0;
+}
+
+int runDiff(const DiffArgs& args) {
+    const Image test = readExrLayer(args.test);
+    const Image reference = readExrLayer(args.reference);
+    const ImageErrorStats e = compareImages(test, reference);
+    json j = {{"test", args.test},
+              {"reference", args.reference},
+              {"relmse", e.relMse},
+              {"mse", e.mse},
+              {"mae", e.mae},
+              {"max_abs_error", e.maxAbsError},
+              {"mean_bias", e.meanBias},
+              {"mean_test", e.meanTest},
+              {"mean_reference", e.meanReference},
+              {"finite_pixels", e.finitePixels},
+              {"nonfinite_pixels", e.nonFinitePixels}};
+    if (!args.json.empty()) writeTextAtomically(args.json, j.dump(2) + "\n");
+    if (args.json != "-")
+        std::printf("relMSE %.6g  MSE %.6g  MAE %.6g  max %.6g  bias %.3g  (%zu pixels, %zu non-finite)\n", e.relMse,
+                    e.mse, e.mae, e.maxAbsError, e.meanBias, e.finitePixels, e.nonFinitePixels);
+    return 0;
+}
+
+int runInfo(const InfoArgs& args) {
+    const Scene scene = loadGltf(args.scene);
+    const SceneFeatures f = analyzeScene(scene, parseColor(args.env, "--env"));
+    std::printf("%s\n", describeScene(scene).c_str());
+    for (const auto& [k, v] : describeFeatures(f)) std::printf("  %-26s %s\n", k.c_str(), v.c_str());
+    std::printf("kernel variant: pt[textures=%d punctual=%d lightTris=%d env=%d glossy=%d alphaMask=%d]\n",
+                f.hasTextures, f.hasPunctual, f.hasLightTris, f.hasEnv, f.hasGlossy, f.hasAlphaMask);
+    for (const auto& u : scene.unsupported) std::printf("  unsupported: %s\n", u.c_str());
+    return 0;
+}
+
+int runDevices(const DevicesArgs& args) {
+    const auto devices = vk::Context::listDevices();
+    json list = json::array();
+    for (const auto& d : devices) {
+        list.push_back({{"index", d.index},
+                        {"name", d.name},
+                        {"type", d.type},
+                        {"driver", d.driverName},
+                        {"driver_info", d.driverInfo},
+                        {"api", std::to_string(VK_API_VERSION_MAJOR(d.apiVersion)) + "." +
+                                    std::to_string(VK_API_VERSION_MINOR(d.apiVersion)) + "." +
+                                    std::to_string(VK_API_VERSION_PATCH(d.apiVersion))},
+                        {"max_storage_buffer_range", d.maxStorageBufferRange},
+                        {"max_push_constants", d.maxPushConstantsSize},
+                        {"max_workgroup_invocations", d.maxComputeWorkGroupInvocations},
+                        {"shared_memory", d.maxComputeSharedMemorySize},
+                        {"subgroup_size", d.subgroupSize},
+                        {"timestamps", d.timestamps},
+                        {"device_local_heap", d.deviceLocalHeapBytes},
+                        {"usable", d.unsuitable.empty()},
+                        {"unsuitable_reason", d.unsuitable}});
+    }
+    if (args.json) {
+        std::printf("%s\n", list.dump(2).c_str());
+        return 0;
+    }
+    for (const auto& d : list)
+        std::printf("[%u] %s (%s, %s %s)\n    Vulkan %s, maxStorageBufferRange %llu MiB, push constants %u B, "
+                    "workgroup %u, shared %u KiB, subgroup %u, timestamps %s, heap %llu MiB%s\n",
+                    d["index"].get<unsigned>(), d["name"].get<std::string>().c_str(), d["type"].get<std::string>().c_str(),
+                    d["driver"].get<std::string>().c_str(), d["driver_info"].get<std::string>().c_str(),
+                    d["api"].get<std::string>().c_str(),
+                    static_cast<unsigned long long>(d["max_storage_buffer_range"].get<std::uint64_t>() >> 20),
+                    d["max_push_constants"].get<unsigned>(), d["max_workgroup_invocations"].get<unsigned>(),
+                    d["shared_memory"].get<unsigned>() / 1024, d["subgroup_size"].get<unsigned>(),
+                    d["timestamps"].get<bool>() ? "yes" : "no",
+                    static_cast<unsigned long long>(d["device_local_heap"].get<std::uint64_t>() >> 20),
+                    d["usable"].get<bool>() ? "" : (" — unusable: " + d["unsuitable_reason"].get<std::string>()).c_str());
+    return 0;
+}
+
+}  // namespace gdpt

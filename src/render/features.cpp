@@ -1,0 +1,59 @@
+#include "render/features.h"
+
+#include <algorithm>
+
+namespace gdpt {
+
+SceneFeatures analyzeScene(const Scene& scene, glm::vec3 envRadiance, float shiftThreshold) {
+    SceneFeatures f;
+    f.triangles = static_cast<std::uint32_t>(scene.triangles.size());
+    f.punctualLights = static_cast<std::uint32_t>(scene.punctualLights.size());
+    f.textures = static_cast<std::uint32_t>(scene.textures.size());
+    f.hasPunctual = f.punctualLights > 0;
+    f.hasEnv = envRadiance.x > 0.0f || envRadiance.y > 0.0f || envRadiance.z > 0.0f;
+
+    std::vector<bool> used(scene.materials.size(), false);
+    for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
+        const std::uint32_t m = scene.triangleMaterial[t];
+        if (m < used.size()) used[m] = true;
+        if (m < scene.materials.size() && (scene.materials[m].flags & gpu::kMatFlagEmissive)) ++f.emissiveTriangles;
+    }
+    f.hasLightTris = f.emissiveTriangles > 0;
+    for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+        if (!used[i]) continue;
+        const gpu::Material& m = scene.materials[i];
+        const bool textured = m.baseColorTex >= 0 || m.metallicRoughnessTex >= 0 || m.emissiveTex >= 0;
+        f.hasTextures = f.hasTextures || textured;
+        f.hasAlphaMask = f.hasAlphaMask || (m.flags & gpu::kMatFlagAlphaMask);
+        const bool specularLobe = m.metallic > 0.0f || m.specular > 0.0f;
+        if (specularLobe) {
+            f.hasSpecularLayer = true;
+            // A roughness texture can only lower the factor, so it may reach 0.
+            const float lo = m.metallicRoughnessTex >= 0 ? 0.0f : m.roughness;
+            f.minRoughness = std::min(f.minRoughness, lo);
+            f.maxRoughness = std::max(f.maxRoughness, m.roughness);
+        }
+    }
+    f.hasGlossy = f.hasSpecularLayer && f.minRoughness <= shiftThreshold;
+    if (!f.hasSpecularLayer) f.minRoughness = f.maxRoughness = 1.0f;
+    return f;
+}
+
+std::vector<std::pair<std::string, std::string>> describeFeatures(const SceneFeatures& f) {
+    auto yn = [](bool b) { return std::string(b ? "yes" : "no"); };
+    return {
+        {"triangles", std::to_string(f.triangles)},
+        {"emissive triangles", std::to_string(f.emissiveTriangles)},
+        {"punctual lights", std::to_string(f.punctualLights)},
+        {"textures", std::to_string(f.textures)},
+        {"textures sampled", yn(f.hasTextures)},
+        {"alpha mask", yn(f.hasAlphaMask)},
+        {"specular layer", yn(f.hasSpecularLayer)},
+        {"roughness range", std::to_string(f.minRoughness) + " .. " + std::to_string(f.maxRoughness)},
+        {"glossy/specular vertices", yn(f.hasGlossy)},
+        {"environment", yn(f.hasEnv)},
+        {"transmission", "no (not supported)"},
+    };
+}
+
+}  // namespace gdpt

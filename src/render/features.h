@@ -1,0 +1,41 @@
+// features.h — what a scene needs from the kernels. Computed on the host once per scene; the
+// booleans become specialisation constants so that a scene never pays for a feature it
+// lacks (no texture fetches without textures, no punctual-light code without punctual
+// lights, ...). `gdpt info` prints this.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene/scene.h"
+
+namespace gdpt {
+
+struct SceneFeatures {
+    std::uint32_t triangles = 0;
+    std::uint32_t emissiveTriangles = 0;
+    std::uint32_t punctualLights = 0;
+    std::uint32_t textures = 0;
+    bool hasTextures = false;    // some material samples a texture
+    bool hasPunctual = false;
+    bool hasLightTris = false;
+    bool hasEnv = false;
+    bool hasGlossy = false;      // some vertex can be classified glossy (roughness <= threshold)
+    bool hasSpecularLayer = false;  // some material has a non-Lambertian (metal/dielectric) lobe
+    bool hasAlphaMask = false;
+    float minRoughness = 1.0f;   // over materials with a specular lobe
+    float maxRoughness = 0.0f;
+};
+
+// shiftThreshold: roughness at or below which a vertex is "glossy" for gradient-domain
+// shifts (Kettunen et al. 2015 reference default 0.001).
+SceneFeatures analyzeScene(const Scene& scene, glm::vec3 envRadiance, float shiftThreshold = 0.001f);
+
+// Human-readable lines for `gdpt info`.
+std::vector<std::pair<std::string, std::string>> describeFeatures(const SceneFeatures& f);
+
+}  // namespace gdpt

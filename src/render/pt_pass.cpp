@@ -1,0 +1,90 @@
+#include "render/pt_pass.h"
+
+#include <algorithm>
+
+#include "pt.spv.h"
+#include "render/scene_gpu.h"
+#include "vk/commands.h"
+#include "vk/context.h"
+
+namespace gdpt {
+namespace {
+// Upper bound of pixel-samples in one dispatch (about 0.3 s on lavapipe for the Cornell
+// box); keeps every dispatch far below a GPU driver's watchdog timeout.
+constexpr std::uint64_t kMaxPixelSamplesPerDispatch = 1u << 20;
+
+vk::KernelDesc ptDesc(const SceneGpu& scene, WorkgroupSize wg) {
+    vk::KernelDesc d = vk::kernelDesc("pt", kSpv_pt);
+    d.bindings = SceneGpu::sceneBindings();
+    d.bindings.push_back(gpu::kBindAccum);
+    d.bindings.push_back(gpu::kBindCounters);
+    d.pushConstantBytes = sizeof(gpu::FrameParams);
+    d.specConstants = scene.specConstants();
+    d.specConstants.push_back({gpu::kSpecWorkgroupX, wg.x});
+    d.specConstants.push_back({gpu::kSpecWorkgroupY, wg.y});
+    d.localSizeX = wg.x;
+    d.localSizeY = wg.y;
+    return d;
+}
+}  // namespace
+
+PtPass::PtPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg)
+    : ctx_(ctx),
+      width_(scene.constants().width),
+      height_(scene.constants().height),
+      kernel_(ctx, ptDesc(scene, wg)),
+      accum_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats), "pt pixel statistics"),
+      counters_(ctx, sizeof(gpu::Counters), "pt counters") {
+    ctx.checkStorageBufferSize(accum_.size(), "the per-pixel statistics of a " + std::to_string(width_) + "x" +
+                                                  std::to_string(height_) + " image");
+    scene.bindTo(kernel_);
+    kernel_.bind(gpu::kBindAccum, accum_);
+    kernel_.bind(gpu::kBindCounters, counters_);
+    reset();
+}
+
+void PtPass::reset() {
+    accum_.zero();
+    counters_.zero();
+}
+
+void PtPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
+                    vk::GpuTimer* timer) {
+    const std::uint64_t perRow = std::uint64_t{width_} * spp;
+    const auto rowsPerDispatch =
+        static_cast<std::uint32_t>(std::max<std::uint64_t>(1, kMaxPixelSamplesPerDispatch / std::max<std::uint64_t>(perRow, 1)));
+    for (std::uint32_t row = 0; row < height_; row += rowsPerDispatch) {
+        gpu::FrameParams p{};
+        p.sampleBase = sampleBase;
+        p.samplesPerPixel = spp;
+        p.seed = seed;
+        p.rowOffset = row;
+        p.rowCount = std::min(rowsPerDispatch, height_ - row);
+        kernel_.dispatchItems(cmd, width_, p.rowCount, &p, timer);
+    }
+    vk::computeBarrier(cmd);
+}
+
+gpu::Counters PtPass::takeCounters() {
+    gpu::Counters c{};
+    counters_.download(&c, sizeof c);
+    counters_.zero();
+    return c;
+}
+
+void PtPass::readback(Image& mean, Image& varianceOfMean) const {
+    const auto stats = accum_.downloadVector<gpu::PixelStats>(std::size_t{width_} * height_);
+    mean = Image(static_cast<int>(width_), static_cast<int>(height_));
+    varianceOfMean = Image(static_cast<int>(width_), static_cast<int>(height_));
+    for (std::size_t i = 0; i < stats.size(); ++i) {
+        const auto& s = stats[i];
+        const float n = static_cast<float>(s.count);
+        for (int c = 0; c < 3; ++c) {
+            mean.plane(c)[i] = s.mean[c];
+            // Unbiased sample variance divided by n = variance of the mean estimate.
+            varianceOfMean.plane(c)[i] = s.count > 1 ? s.m2[c] / (n - 1.0f) / n : 0.0f;
+        }
+    }
+}
+
+}  // namespace gdpt

@@ -1,0 +1,48 @@
+// pt_pass.h — the path-tracing pass: owns the pt.comp kernel, the per-pixel statistics and
+// the counters it writes. record() appends one batch (tiled in rows so that no single
+// dispatch runs long enough to trip a GPU watchdog).
+#pragma once
+
+#include <cstdint>
+
+#include "gdpt_shared.h"
+#include "image/image.h"
+#include "vk/buffer.h"
+#include "vk/kernel.h"
+
+namespace gdpt {
+
+class SceneGpu;
+namespace vk {
+class Context;
+class GpuTimer;
+}  // namespace vk
+
+struct WorkgroupSize {
+    std::uint32_t x = 8;
+    std::uint32_t y = 8;
+};
+
+class PtPass {
+public:
+    PtPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg = {});
+
+    // Clears the statistics and counters.
+    void reset();
+    // Records a batch of `spp` samples per pixel starting at sample index `sampleBase`.
+    void record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
+                vk::GpuTimer* timer);
+    // Reads the counters written since the last call and clears them (after the fence).
+    gpu::Counters takeCounters();
+    // Mean radiance and the variance of that mean, per pixel (after the fence).
+    void readback(Image& mean, Image& varianceOfMean) const;
+
+private:
+    const vk::Context& ctx_;
+    std::uint32_t width_, height_;
+    vk::Kernel kernel_;
+    vk::Buffer accum_;
+    vk::Buffer counters_;
+};
+
+}  // namespace gdpt

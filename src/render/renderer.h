@@ -1,0 +1,59 @@
+// renderer.h — the render loop: upload the scene, then for each batch trace samples and fold
+// them into the per-pixel statistics, reporting progress from completed GPU work, until the
+// sample count or the time budget is reached; then read the images back.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "image/image.h"
+#include "render/pt_pass.h"
+#include "render/scene_gpu.h"
+#include "scene/scene.h"
+#include "vk/timing.h"
+
+namespace gdpt {
+
+namespace vk {
+class Context;
+}
+
+struct RenderOptions {
+    SceneGpuOptions scene;
+    std::uint32_t spp = 16;        // samples per pixel (ignored when timeBudget > 0)
+    double timeBudget = 0.0;       // seconds for the whole render (0 = use spp)
+    double elapsedBefore = 0.0;    // seconds already spent (e.g. loading) counted in the budget
+    std::uint32_t seed = 0;
+    bool profile = false;
+    bool quiet = false;
+    WorkgroupSize workgroup;
+    std::uint32_t maxBatchSpp = 16;  // largest batch (samples per pixel per submission)
+    const std::atomic<bool>* cancel = nullptr;  // set asynchronously to stop between batches
+};
+
+struct RenderStats {
+    std::uint32_t spp = 0;
+    std::uint32_t batches = 0;
+    double bvhBuildMs = 0.0;
+    double uploadMs = 0.0;       // scene upload + pipeline creation
+    double samplingMs = 0.0;     // wall time of the batch loop
+    double readbackMs = 0.0;
+    std::uint64_t raysTraced = 0;
+    std::uint64_t pathsCompleted = 0;
+    std::uint64_t nanSamples = 0;
+    bool cancelled = false;
+    std::map<std::string, vk::KernelTime> kernels;
+    SceneFeatures features;
+};
+
+struct RenderResult {
+    Image image;           // mean radiance
+    Image varianceOfMean;  // per-pixel variance of the mean (sample variance / n)
+    RenderStats stats;
+};
+
+RenderResult renderPt(const vk::Context& ctx, const Scene& scene, const RenderOptions& options);
+
+}  // namespace gdpt

@@ -1,0 +1,196 @@
+#include "render/scene_gpu.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/packing.hpp>
+
+#include "bvh/builder.h"
+#include "scene/gltf_loader.h"
+#include "util/error.h"
+#include "util/timer.h"
+#include "vk/context.h"
+#include "vk/kernel.h"
+
+namespace gdpt {
+namespace {
+
+constexpr float kPi = 3.14159265358979f;
+
+float luminance(glm::vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+template <typename T>
+vk::Buffer makeBuffer(const vk::Context& ctx, const std::vector<T>& data, const std::string& name) {
+    const std::uint64_t bytes = data.size() * sizeof(T);
+    ctx.checkStorageBufferSize(bytes, name);
+    vk::Buffer b(ctx, bytes, name);
+    b.uploadVector(data);
+    return b;
+}
+
+// Triangle shading records in BVH leaf order.
+std::vector<gpu::TriangleShading> makeShading(const Scene& scene, const std::vector<std::uint32_t>& order) {
+    std::vector<gpu::TriangleShading> out(order.size());
+    const bool normals = !scene.normals.empty();
+    const bool uvs = !scene.uvs.empty();
+    for (std::size_t i = 0; i < order.size(); ++i) {
+        const glm::uvec3 t = scene.triangles[order[i]];
+        gpu::TriangleShading s{};
+        s.material = scene.triangleMaterial[order[i]];
+        const glm::vec3 p0 = scene.positions[t.x], p1 = scene.positions[t.y], p2 = scene.positions[t.z];
+        s.area = 0.5f * glm::length(glm::cross(p1 - p0, p2 - p0));
+        if (normals) {
+            s.n0 = scene.normals[t.x];
+            s.n1 = scene.normals[t.y];
+            s.n2 = scene.normals[t.z];
+            s.flags |= gpu::kTriFlagHasNormals;
+        }
+        if (uvs) {
+            s.uv0 = scene.uvs[t.x];
+            s.uv1 = scene.uvs[t.y];
+            s.uv2 = scene.uvs[t.z];
+        }
+        s.lightIndex = gpu::kInvalidIndex;
+        out[i] = s;
+    }
+    return out;
+}
+
+}  // namespace
+
+void setCamera(gpu::SceneConstants& c, const Camera& camera, int width, int height) {
+    c.camPosition = camera.position;
+    c.camForward = glm::normalize(camera.forward);
+    c.camRight = glm::normalize(glm::cross(c.camForward, camera.up));
+    c.camUp = glm::cross(c.camRight, c.camForward);
+    c.tanHalfFovY = std::tan(0.5f * camera.yfov);
+    c.aspect = static_cast<float>(width) / static_cast<float>(height);
+    c.width = static_cast<std::uint32_t>(width);
+    c.height = static_cast<std::uint32_t>(height);
+}
+
+std::vector<std::uint32_t> SceneGpu::sceneBindings() {
+    return {gpu::kBindTriGeom, gpu::kBindTriShading, gpu::kBindBvh,      gpu::kBindMaterials, gpu::kBindTexInfo,
+            gpu::kBindTexels,  gpu::kBindLightTris,  gpu::kBindPunctual, gpu::kBindSceneConst};
+}
+
+SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOptions& options) {
+    if (scene.triangles.empty()) throw Error("scene has no triangles to render");
+    if (options.width < 1 || options.height < 1) throw Error("image size must be at least 1x1");
+    features_ = analyzeScene(scene, options.envRadiance, options.shiftThreshold);
+
+    // BVH over the world-space triangles; everything per-triangle is laid out in leaf order.
+    Timer timer;
+    const Bvh bvh = buildBvh(scene.positions, scene.triangles);
+    bvhInfo_.buildMs = timer.ms();
+    bvhInfo_.nodes = static_cast<std::uint32_t>(bvh.nodes.size());
+    bvhInfo_.maxDepth = bvh.stats.maxDepth;
+    std::vector<gpu::TriangleGeom> geoms = makeTriangleGeoms(scene.positions, scene.triangles, bvh.triangleOrder);
+    std::vector<gpu::TriangleShading> shading = makeShading(scene, bvh.triangleOrder);
+
+    // Emissive triangles, with a CDF proportional to power = area * luminance(Le) * pi
+    // (x2 for double-sided emitters). Emissive textures are not in the weight (factor only).
+    std::vector<gpu::LightTriangle> lights;
+    double total = 0.0;
+    std::vector<double> power;
+    for (std::uint32_t i = 0; i < shading.size(); ++i) {
+        const gpu::Material& m = scene.materials.at(shading[i].material);
+        if (!(m.flags & gpu::kMatFlagEmissive) || !(shading[i].area > 0.0f)) continue;
+        double p = shading[i].area * luminance(m.emissive) * kPi;
+        if (m.flags & gpu::kMatFlagDoubleSided) p *= 2.0;
+        if (!(p > 0.0)) p = shading[i].area * kPi * std::max({m.emissive.x, m.emissive.y, m.emissive.z});
+        if (!(p > 0.0)) continue;
+        shading[i].lightIndex = static_cast<std::uint32_t>(lights.size());
+        lights.push_back({i, 0.0f, 0.0f, 0.0f});
+        power.push_back(p);
+        total += p;
+    }
+    double running = 0.0;
+    for (std::size_t i = 0; i < lights.size(); ++i) {
+        running += power[i];
+        lights[i].pmf = static_cast<float>(power[i] / total);
+        lights[i].cdf = i + 1 == lights.size() ? 1.0f : static_cast<float>(running / total);
+    }
+    features_.hasLightTris = !lights.empty();
+    features_.emissiveTriangles = static_cast<std::uint32_t>(lights.size());
+
+    double punctualPower = 0.0;
+    for (const auto& l : scene.punctualLights) punctualPower += 4.0 * kPi * std::max(1e-12, double(luminance(l.intensity)));
+
+    // Textures: linear RGBA as packed halves.
+    std::vector<gpu::TextureInfo> texInfo;
+    std::vector<glm::uvec2> texels;
+    for (const Texture& t : scene.textures) {
+        gpu::TextureInfo info{};
+        info.offset = static_cast<std::uint32_t>(texels.size());
+        info.width = static_cast<std::uint32_t>(t.width);
+        info.height = static_cast<std::uint32_t>(t.height);
+        for (const glm::vec4& c : t.texels)
+            texels.emplace_back(glm::packHalf2x16(glm::vec2(c.x, c.y)), glm::packHalf2x16(glm::vec2(c.z, c.w)));
+        texInfo.push_back(info);
+    }
+
+    Camera camera;
+    if (options.camera >= 0) {
+        if (options.camera >= static_cast<int>(scene.cameras.size()))
+            throw Error("--camera " + std::to_string(options.camera) + " is out of range: the scene has " +
+                        std::to_string(scene.cameras.size()) + " camera(s)");
+        camera = scene.cameras[static_cast<std::size_t>(options.camera)];
+    } else {
+        camera = scene.cameras.empty() ? defaultCamera(scene) : scene.cameras.front();
+    }
+    setCamera(constants_, camera, options.width, options.height);
+    constants_.envRadiance = options.envRadiance;
+    constants_.numLightTriangles = static_cast<std::uint32_t>(lights.size());
+    constants_.numPunctualLights = static_cast<std::uint32_t>(scene.punctualLights.size());
+    constants_.lightTrianglePower = static_cast<float>(total);
+    constants_.punctualPower = static_cast<float>(punctualPower);
+    constants_.maxDepth = options.maxDepth;
+    constants_.rrDepth = options.rrDepth;
+    constants_.numTriangles = static_cast<std::uint32_t>(geoms.size());
+    const Bounds b = scene.bounds();
+    constants_.sceneRadius = 0.5f * glm::length(b.max - b.min);
+    // Kernels loop to min(spec max depth, scene.maxDepth); a small user depth is also
+    // compiled in so that the loop bound is a constant the compiler can see.
+    maxDepthSpec_ = std::min<std::uint32_t>(options.maxDepth + 1, 1024);
+
+    triGeom_ = makeBuffer(ctx, geoms, "triangle geometry");
+    triShading_ = makeBuffer(ctx, shading, "triangle shading");
+    bvh_ = makeBuffer(ctx, bvh.nodes, "BVH nodes");
+    materials_ = makeBuffer(ctx, scene.materials, "materials");
+    texInfo_ = makeBuffer(ctx, texInfo, "texture table");
+    texels_ = makeBuffer(ctx, texels, "texels");
+    lightTris_ = makeBuffer(ctx, lights, "light triangles");
+    punctual_ = makeBuffer(ctx, scene.punctualLights, "punctual lights");
+    sceneConst_ = makeBuffer(ctx, std::vector<gpu::SceneConstants>{constants_}, "scene constants");
+}
+
+void SceneGpu::bindTo(vk::Kernel& kernel) const {
+    kernel.bind(gpu::kBindTriGeom, triGeom_);
+    kernel.bind(gpu::kBindTriShading, triShading_);
+    kernel.bind(gpu::kBindBvh, bvh_);
+    kernel.bind(gpu::kBindMaterials, materials_);
+    kernel.bind(gpu::kBindTexInfo, texInfo_);
+    kernel.bind(gpu::kBindTexels, texels_);
+    kernel.bind(gpu::kBindLightTris, lightTris_);
+    kernel.bind(gpu::kBindPunctual, punctual_);
+    kernel.bind(gpu::kBindSceneConst, sceneConst_);
+}
+
+std::vector<std::pair<std::uint32_t, std::uint32_t>> SceneGpu::specConstants() const {
+    auto b = [](bool v) { return v ? 1u : 0u; };
+    return {{gpu::kSpecHasTextures, b(features_.hasTextures)},
+            {gpu::kSpecHasPunctual, b(features_.hasPunctual)},
+            {gpu::kSpecHasLightTris, b(features_.hasLightTris)},
+            {gpu::kSpecHasEnv, b(features_.hasEnv)},
+            {gpu::kSpecHasGlossy, b(features_.hasGlossy)},
+            {gpu::kSpecHasAlphaMask, b(features_.hasAlphaMask)},
+            {gpu::kSpecMaxDepth, maxDepthSpec_}};
+}
+
+std::uint64_t SceneGpu::deviceBytes() const {
+    return triGeom_.size() + triShading_.size() + bvh_.size() + materials_.size() + texInfo_.size() +
+           texels_.size() + lightTris_.size() + punctual_.size() + sceneConst_.size();
+}
+
+}  // namespace gdpt

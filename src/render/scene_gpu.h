@@ -1,0 +1,65 @@
+// scene_gpu.h — the scene on the device: BVH nodes, triangles (in BVH leaf order),
+// materials, textures, light tables and per-scene constants, each in its own storage
+// buffer, plus the specialisation constants derived from the scene's features.
+#pragma once
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "gdpt_shared.h"
+#include "render/features.h"
+#include "scene/scene.h"
+#include "vk/buffer.h"
+
+namespace gdpt {
+
+namespace vk {
+class Context;
+class Kernel;
+}  // namespace vk
+
+struct SceneGpuOptions {
+    int width = 256;
+    int height = 256;
+    std::uint32_t maxDepth = 64;  // bounces
+    std::uint32_t rrDepth = 5;    // Russian roulette from this many segments on
+    glm::vec3 envRadiance{0.0f};
+    int camera = -1;  // index into Scene::cameras; -1 = first, or a framing default
+    float shiftThreshold = 0.001f;
+};
+
+struct BvhBuildInfo {
+    double buildMs = 0.0;
+    std::uint32_t nodes = 0;
+    std::uint32_t maxDepth = 0;
+};
+
+class SceneGpu {
+public:
+    SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOptions& options);
+
+    // Binds the scene buffers (bindings kBindTriGeom..kBindSceneConst) to a kernel.
+    void bindTo(vk::Kernel& kernel) const;
+    // Specialisation constants for the scene features (ids from gdpt_shared.h).
+    [[nodiscard]] std::vector<std::pair<std::uint32_t, std::uint32_t>> specConstants() const;
+    [[nodiscard]] static std::vector<std::uint32_t> sceneBindings();
+
+    [[nodiscard]] const SceneFeatures& features() const { return features_; }
+    [[nodiscard]] const gpu::SceneConstants& constants() const { return constants_; }
+    [[nodiscard]] const BvhBuildInfo& bvhInfo() const { return bvhInfo_; }
+    [[nodiscard]] std::uint64_t deviceBytes() const;
+
+private:
+    SceneFeatures features_;
+    gpu::SceneConstants constants_{};
+    BvhBuildInfo bvhInfo_;
+    std::uint32_t maxDepthSpec_ = 1024;
+    vk::Buffer triGeom_, triShading_, bvh_, materials_, texInfo_, texels_, lightTris_, punctual_,
+        sceneConst_;
+};
+
+// Builds the camera constants for an image of width × height (shared with tests).
+void setCamera(gpu::SceneConstants& c, const Camera& camera, int width, int height);
+
+}  // namespace gdpt
