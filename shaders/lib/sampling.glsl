@@ -135,9 +135,9 @@ GDPT_INLINE float uniformHemispherePdf() {
 // b1 = u1 sqrt(u0). Chosen over Heitz 2019 because its inverse is closed-form and exact.
 GDPT_INLINE vec3 sampleUniformTriangle(vec2 u) {
     float su = sqrt(u.x);
-    float b0 = 1.0f - su;
-    float b1 = u.y * su;
-    return vec3(b0, b1, 1.0f - b0 - b1);
+    // b2 computed directly (not as 1 - b0 - b1) so that b1 + b2 == sqrt(u0) to rounding and
+    // the inverse stays accurate near the vertex v0.
+    return vec3(1.0f - su, u.y * su, (1.0f - u.y) * su);
 }
 
 // Inverse of sampleUniformTriangle: sqrt(u0) = 1 - b0 = b1 + b2, u1 = b1 / (b1 + b2).
