@@ -11,14 +11,17 @@ function(gdpt_add_shaders target)
   set(out_dir ${CMAKE_BINARY_DIR}/shaders/spv)
   file(MAKE_DIRECTORY ${out_dir})
   set(outputs)
+  set(debug_flags)
+  if(CMAKE_BUILD_TYPE STREQUAL "Debug")
+    set(debug_flags -g)
+  endif()
   foreach(src ${ARGN})
     get_filename_component(name ${src} NAME_WE)
     get_filename_component(abs ${src} ABSOLUTE)
     set(out ${out_dir}/${name}.spv.h)
-    set(debug_flag $<$<CONFIG:Debug>:-g>)
     add_custom_command(
       OUTPUT ${out}
-      COMMAND ${GLSLANG_VALIDATOR} --target-env vulkan1.2 -V ${debug_flag}
+      COMMAND ${GLSLANG_VALIDATOR} --target-env vulkan1.2 -V ${debug_flags}
               --vn kSpv_${name} --depfile ${out}.d
               -I${CMAKE_SOURCE_DIR}/shaders -I${CMAKE_SOURCE_DIR}/shaders/shared
               -o ${out} ${abs}

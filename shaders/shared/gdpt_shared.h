@@ -220,6 +220,13 @@ GDPT_ENUM_BEGIN(SceneBinding)
     kBindCount = 11u
 GDPT_ENUM_END();
 
+// Bindings used only by test kernels (tests/gpu/kernels), kept here so no number repeats.
+GDPT_ENUM_BEGIN(TestBinding)
+    kBindTestInput = 32u,
+    kBindTestOutput = 33u,
+    kBindTestOutput2 = 34u
+GDPT_ENUM_END();
+
 // Specialisation-constant ids (scene features compiled in or out per scene).
 GDPT_ENUM_BEGIN(SpecId)
     kSpecWorkgroupX = 0u,
@@ -232,6 +239,14 @@ GDPT_ENUM_BEGIN(SpecId)
     kSpecHasAlphaMask = 7u,
     kSpecMaxDepth = 8u
 GDPT_ENUM_END();
+
+// A ray of the BVH tests (tests/gpu/test_bvh_gpu.cpp). 32 bytes.
+struct TestRay {
+    vec3 origin;  // world space
+    float tMin;
+    vec3 dir;     // world space, not necessarily unit
+    float tMax;
+};
 
 #ifdef __cplusplus
 }  // namespace gdpt::gpu
