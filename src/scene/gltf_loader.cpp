@@ -1,0 +1,374 @@
+// gltf_loader.cpp — entry point of the glTF loader: reads the file, lets tinygltf parse it,
+// checks extensions, walks the node hierarchy of the chosen scene (glTF 2.0 §3.5) and
+// collects mesh instances, cameras (§3.10) and KHR_lights_punctual lights. Geometry and
+// materials are converted in gltf_geometry.cpp and gltf_materials.cpp.
+#include "scene/gltf_loader.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "scene/gltf_internal.h"
+
+namespace gdpt {
+namespace gltf {
+
+void Context::unsupported(const std::string& what) {
+    auto& list = scene.unsupported;
+    if (std::find(list.begin(), list.end(), what) == list.end()) list.push_back(what);
+}
+
+std::string elementName(const char* kind, int index, const std::string& name) {
+    return name.empty() ? std::string(kind) + " " + std::to_string(index)
+                        : std::string(kind) + " '" + name + "'";
+}
+
+namespace {
+
+constexpr std::uintmax_t kMaxFileBytes = 2ull << 30;
+
+// Extensions whose content we render; any other listed extension is reported.
+const std::set<std::string> kSupportedExtensions = {
+    "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_materials_ior",
+    "KHR_lights_punctual"};
+// Geometry we cannot decode at all: a required one makes the file unrenderable.
+const std::set<std::string> kCompressionExtensions = {
+    "KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_meshopt_compression"};
+
+std::vector<unsigned char> readFile(const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw Error("cannot open file: it does not exist");
+    if (!std::filesystem::is_regular_file(path, ec)) throw Error("cannot open file: not a regular file");
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec) throw Error("cannot read file size: " + ec.message());
+    if (size > kMaxFileBytes) throw Error("file is larger than 2 GiB");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(std::string("cannot open file: ") + std::strerror(errno));
+    std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
+    if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size)))
+        throw Error("cannot read file");
+    return bytes;
+}
+
+// tinygltf's messages are newline-separated; join them into one line.
+std::string oneLine(std::string s) {
+    while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
+    std::replace(s.begin(), s.end(), '\n', ';');
+    return s;
+}
+
+void checkFinite(const std::vector<double>& v, const std::string& what) {
+    for (double x : v)
+        if (!std::isfinite(x)) throw Error(what + " is not finite");
+}
+
+// Local transform of a node: `matrix` (column-major) or T * R * S (glTF 2.0 §3.5.3).
+glm::dmat4 localMatrix(const tinygltf::Node& node) {
+    if (!node.matrix.empty()) {
+        if (node.matrix.size() != 16) throw Error("matrix must have 16 numbers");
+        checkFinite(node.matrix, "matrix");
+        return glm::make_mat4(node.matrix.data());
+    }
+    glm::dmat4 t(1.0), r(1.0), s(1.0);
+    if (!node.translation.empty()) {
+        if (node.translation.size() != 3) throw Error("translation must have 3 numbers");
+        checkFinite(node.translation, "translation");
+        t[3] = glm::dvec4(node.translation[0], node.translation[1], node.translation[2], 1.0);
+    }
+    if (!node.rotation.empty()) {
+        if (node.rotation.size() != 4) throw Error("rotation must have 4 numbers");
+        checkFinite(node.rotation, "rotation");
+        // glTF stores (x, y, z, w); glm's constructor takes (w, x, y, z).
+        glm::dquat q(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]);
+        const double len = glm::length(q);
+        if (!(len > 1e-12)) throw Error("rotation is a zero quaternion");
+        r = glm::mat4_cast(q / len);
+    }
+    if (!node.scale.empty()) {
+        if (node.scale.size() != 3) throw Error("scale must have 3 numbers");
+        checkFinite(node.scale, "scale");
+        s = glm::scale(glm::dmat4(1.0), glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
+    }
+    return t * r * s;
+}
+
+void checkExtensions(gltf::Context& ctx) {
+    const tinygltf::Model& model = ctx.model;
+    for (const auto& ext : model.extensionsRequired) {
+        if (kCompressionExtensions.count(ext))
+            throw Error("required extension " + ext +
+                        " (compressed geometry) is not supported; decompress the file first");
+        if (!kSupportedExtensions.count(ext))
+            ctx.unsupported("required extension " + ext + " (rendering without it)");
+    }
+    for (const auto& ext : model.extensionsUsed)
+        if (!kSupportedExtensions.count(ext)) ctx.unsupported("extension " + ext);
+    if (!model.skins.empty()) ctx.unsupported("skins (meshes rendered in their bind pose)");
+    if (!model.animations.empty()) ctx.unsupported("animations (the static pose is rendered)");
+}
+
+// Checks the node graph: child indices in range, at most one parent per node (glTF 2.0
+// §3.5.2: "node hierarchy MUST be a set of disjoint strict trees"), no cycles. Returns the
+// parent of each node (-1 for none).
+std::vector<int> checkNodeGraph(const tinygltf::Model& model) {
+    const int n = static_cast<int>(model.nodes.size());
+    std::vector<int> parent(static_cast<std::size_t>(n), -1);
+    for (int i = 0; i < n; ++i) {
+        const auto& node = model.nodes[static_cast<std::size_t>(i)];
+        for (int c : node.children) {
+            const std::string label = elementName("node", i, node.name);
+            if (c < 0 || c >= n)
+                throw Error(label + ": child " + std::to_string(c) + " out of range (file has " +
+                            std::to_string(n) + " nodes)");
+            if (c == i) throw Error(label + " is its own child (cyclic node graph)");
+            if (parent[static_cast<std::size_t>(c)] >= 0)
+                throw Error("node " + std::to_string(c) + " is used twice as a child (by node " +
+                            std::to_string(parent[static_cast<std::size_t>(c)]) + " and node " +
+                            std::to_string(i) + ")");
+            parent[static_cast<std::size_t>(c)] = i;
+        }
+    }
+    // With one parent each, a cycle is a chain of parents that returns to its start.
+    std::vector<int> state(static_cast<std::size_t>(n), 0);  // 0 new, 1 on chain, 2 done
+    for (int i = 0; i < n; ++i) {
+        std::vector<int> chain;
+        int p = i;
+        while (p >= 0 && state[static_cast<std::size_t>(p)] == 0) {
+            state[static_cast<std::size_t>(p)] = 1;
+            chain.push_back(p);
+            p = parent[static_cast<std::size_t>(p)];
+        }
+        if (p >= 0 && state[static_cast<std::size_t>(p)] == 1)
+            throw Error("cyclic node graph: node " + std::to_string(p) + " is its own ancestor");
+        for (int c : chain) state[static_cast<std::size_t>(c)] = 2;
+    }
+    return parent;
+}
+
+std::vector<int> sceneRoots(const tinygltf::Model& model, const std::vector<int>& parent) {
+    std::vector<int> roots;
+    if (model.scenes.empty()) {
+        // No scenes: render every root node (§3.5.1 leaves this to the application).
+        for (std::size_t i = 0; i < parent.size(); ++i)
+            if (parent[i] < 0) roots.push_back(static_cast<int>(i));
+        return roots;
+    }
+    const int s = model.defaultScene >= 0 ? model.defaultScene : 0;
+    if (static_cast<std::size_t>(s) >= model.scenes.size())
+        throw Error("scene " + std::to_string(s) + " out of range (file has " +
+                    std::to_string(model.scenes.size()) + " scenes)");
+    const auto& scene = model.scenes[static_cast<std::size_t>(s)];
+    for (int r : scene.nodes) {
+        const std::string label = elementName("scene", s, scene.name);
+        if (r < 0 || static_cast<std::size_t>(r) >= model.nodes.size())
+            throw Error(label + ": node " + std::to_string(r) + " out of range (file has " +
+                        std::to_string(model.nodes.size()) + " nodes)");
+        if (parent[static_cast<std::size_t>(r)] >= 0)
+            throw Error(label + ": root node " + std::to_string(r) + " is also a child of node " +
+                        std::to_string(parent[static_cast<std::size_t>(r)]));
+        if (std::find(roots.begin(), roots.end(), r) != roots.end())
+            throw Error(label + ": root node " + std::to_string(r) + " is listed twice");
+        roots.push_back(r);
+    }
+    return roots;
+}
+
+void addCamera(gltf::Context& ctx, const tinygltf::Node& node, const glm::dmat4& world) {
+    const auto& model = ctx.model;
+    if (static_cast<std::size_t>(node.camera) >= model.cameras.size())
+        throw Error("camera " + std::to_string(node.camera) + " out of range (file has " +
+                    std::to_string(model.cameras.size()) + " cameras)");
+    const tinygltf::Camera& cam = model.cameras[static_cast<std::size_t>(node.camera)];
+    const std::string label = elementName("camera", node.camera, cam.name);
+    if (cam.type != "perspective") {
+        ctx.unsupported(label + ": " + cam.type + " cameras (only perspective)");
+        return;
+    }
+    const double yfov = cam.perspective.yfov;
+    if (!(yfov > 0.0 && yfov < M_PI))
+        throw Error(label + ": yfov " + std::to_string(yfov) + " is not in (0, pi)");
+    Camera out;
+    out.name = cam.name.empty() ? node.name : cam.name;
+    out.position = glm::vec3(world * glm::dvec4(0, 0, 0, 1));
+    // Camera looks down local -Z with local +Y up (§3.10.1); scale is removed by
+    // normalising and the up vector is made orthogonal (Gram-Schmidt).
+    const glm::dvec3 fwd = glm::dmat3(world) * glm::dvec3(0, 0, -1);
+    const glm::dvec3 up = glm::dmat3(world) * glm::dvec3(0, 1, 0);
+    const double fl = glm::length(fwd);
+    if (!(fl > 1e-12) || !std::isfinite(fl)) throw Error(label + ": degenerate camera transform");
+    const glm::dvec3 f = fwd / fl;
+    const glm::dvec3 u = up - glm::dot(up, f) * f;
+    const double ul = glm::length(u);
+    if (!(ul > 1e-12) || !std::isfinite(ul)) throw Error(label + ": degenerate camera transform");
+    out.forward = glm::vec3(f);
+    out.up = glm::vec3(u / ul);
+    out.yfov = static_cast<float>(yfov);
+    out.aspectRatio = cam.perspective.aspectRatio > 0.0 ? static_cast<float>(cam.perspective.aspectRatio) : 0.0f;
+    ctx.scene.cameras.push_back(out);
+}
+
+void addLight(gltf::Context& ctx, const tinygltf::Value& ext, const glm::dmat4& world) {
+    const auto& model = ctx.model;
+    if (!ext.IsObject() || !ext.Has("light") || !ext.Get("light").IsInt())
+        throw Error("KHR_lights_punctual: 'light' is missing or not an integer");
+    const int index = ext.Get("light").GetNumberAsInt();
+    if (index < 0 || static_cast<std::size_t>(index) >= model.lights.size())
+        throw Error("KHR_lights_punctual light " + std::to_string(index) + " out of range (file has " +
+                    std::to_string(model.lights.size()) + " lights)");
+    const tinygltf::Light& light = model.lights[static_cast<std::size_t>(index)];
+    const std::string label = elementName("light", index, light.name);
+    gpu::PunctualLight out{};
+    glm::dvec3 color(1.0);
+    if (!light.color.empty()) {
+        if (light.color.size() != 3) throw Error(label + ": color must have 3 numbers");
+        color = glm::dvec3(light.color[0], light.color[1], light.color[2]);
+    }
+    // Intensity in candela, treated as W/sr (see gdpt_shared.h PunctualLight).
+    out.intensity = glm::vec3(color * light.intensity);
+    out.position = glm::vec3(world * glm::dvec4(0, 0, 0, 1));
+    glm::dvec3 dir = glm::dmat3(world) * glm::dvec3(0, 0, -1);  // lights point down local -Z
+    const double dl = glm::length(dir);
+    out.direction = dl > 0.0 ? glm::vec3(dir / dl) : glm::vec3(0, 0, -1);
+    if (light.range > 0.0 && std::isfinite(light.range))
+        ctx.unsupported(label + ": range ignored (lights have unlimited range)");
+    if (light.type == "point") {
+        out.type = gpu::kPunctualPoint;
+        out.cosInner = out.cosOuter = -1.0f;
+    } else if (light.type == "spot") {
+        const double inner = light.spot.innerConeAngle, outer = light.spot.outerConeAngle;
+        if (!(inner >= 0.0 && inner < outer && outer <= M_PI / 2))
+            throw Error(label + ": spot cone angles must satisfy 0 <= inner < outer <= pi/2");
+        out.type = gpu::kPunctualSpot;
+        out.cosInner = static_cast<float>(std::cos(inner));
+        out.cosOuter = static_cast<float>(std::cos(outer));
+    } else {
+        ctx.unsupported(label + ": " + light.type + " lights (only point and spot)");
+        return;
+    }
+    ctx.scene.punctualLights.push_back(out);
+}
+
+Scene loadImpl(const std::string& path) {
+    const std::vector<unsigned char> bytes = readFile(path);
+    tinygltf::Model model;
+    tinygltf::TinyGLTF parser;
+    parser.SetImageLoader(&gltf::decodeImage, nullptr);
+    std::string err, warn;
+    std::string baseDir = std::filesystem::path(path).parent_path().string();
+    if (baseDir.empty()) baseDir = ".";
+    const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+    const bool ok =
+        binary ? parser.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
+                                             static_cast<unsigned int>(bytes.size()), baseDir)
+               : parser.LoadASCIIFromString(&model, &err, &warn,
+                                            reinterpret_cast<const char*>(bytes.data()),
+                                            static_cast<unsigned int>(bytes.size()), baseDir);
+    if (!ok) throw Error("glTF parse error: " + oneLine(err.empty() ? "unknown error" : err));
+
+    Scene scene;
+    scene.sourcePath = path;
+    gltf::Context ctx{model, scene, {}, -1};
+    if (!warn.empty()) ctx.unsupported("tinygltf warning: " + oneLine(warn));
+    checkExtensions(ctx);
+    gltf::convertMaterials(ctx);
+    const std::vector<int> parent = checkNodeGraph(model);
+
+    // Depth-first traversal with an explicit stack (deep hierarchies must not overflow
+    // the call stack); children are pushed in reverse so the order matches recursion.
+    std::vector<gltf::MeshInstance> instances;
+    std::vector<std::pair<int, glm::dmat4>> stack;
+    const std::vector<int> roots = sceneRoots(model, parent);
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.emplace_back(*it, glm::dmat4(1.0));
+    while (!stack.empty()) {
+        const auto [index, parentWorld] = stack.back();
+        stack.pop_back();
+        const tinygltf::Node& node = model.nodes[static_cast<std::size_t>(index)];
+        try {
+            const glm::dmat4 world = parentWorld * localMatrix(node);
+            if (node.mesh >= 0) {
+                if (static_cast<std::size_t>(node.mesh) >= model.meshes.size())
+                    throw Error("mesh " + std::to_string(node.mesh) + " out of range (file has " +
+                                std::to_string(model.meshes.size()) + " meshes)");
+                instances.push_back({node.mesh, index, world});
+            }
+            if (node.camera >= 0) addCamera(ctx, node, world);
+            if (node.skin >= 0) ctx.unsupported("skins (meshes rendered in their bind pose)");
+            if (!node.weights.empty()) ctx.unsupported("morph target weights");
+            for (const auto& [name, value] : node.extensions) {
+                if (name == "KHR_lights_punctual") addLight(ctx, value, world);
+                else ctx.unsupported("node extension " + name);
+            }
+            for (auto c = node.children.rbegin(); c != node.children.rend(); ++c)
+                stack.emplace_back(*c, world);
+        } catch (const Error& e) {
+            throw e.withContext(gltf::elementName("node", index, node.name));
+        }
+    }
+
+    // Normals/uvs are all-or-nothing per scene (see gltf_loader.h).
+    bool anyNormals = false, anyUvs = false;
+    for (const auto& inst : instances)
+        for (const auto& prim : model.meshes[static_cast<std::size_t>(inst.mesh)].primitives) {
+            anyNormals = anyNormals || prim.attributes.count("NORMAL") > 0;
+            anyUvs = anyUvs || prim.attributes.count("TEXCOORD_0") > 0;
+        }
+    for (const auto& inst : instances) gltf::addMeshInstance(ctx, inst, anyNormals, anyUvs);
+    return scene;
+}
+
+}  // namespace
+}  // namespace gltf
+
+Scene loadGltf(const std::string& path, const LoadOptions& /*opts*/) {
+    try {
+        return gltf::loadImpl(path);
+    } catch (const Error& e) {
+        throw e.withContext(path);
+    } catch (const std::bad_alloc&) {
+        throw Error(path + ": out of memory while loading");
+    } catch (const std::exception& e) {
+        // tinygltf or the standard library threw something other than our errors.
+        throw Error(path + ": " + e.what());
+    }
+}
+
+Camera defaultCamera(const Scene& scene) {
+    Camera cam;
+    cam.name = "default";
+    cam.yfov = glm::radians(45.0f);
+    const Bounds b = scene.bounds();
+    if (b.empty()) return cam;
+    const glm::vec3 centre = 0.5f * (b.min + b.max);
+    const float radius = std::max(0.5f * glm::length(b.max - b.min), 1e-3f);
+    // The bounding sphere fits the vertical field of view at distance r / sin(yfov/2).
+    cam.position = centre + glm::vec3(0.0f, 0.0f, radius / std::sin(0.5f * cam.yfov));
+    cam.forward = glm::vec3(0.0f, 0.0f, -1.0f);
+    cam.up = glm::vec3(0.0f, 1.0f, 0.0f);
+    return cam;
+}
+
+std::string describeScene(const Scene& scene) {
+    std::ostringstream os;
+    const Bounds b = scene.bounds();
+    os << (scene.sourcePath.empty() ? "(generated)" : scene.sourcePath) << ": "
+       << scene.triangles.size() << " triangles, " << scene.positions.size() << " vertices, "
+       << scene.materials.size() << " materials, " << scene.textures.size() << " textures, "
+       << scene.punctualLights.size() << " punctual lights, " << scene.cameras.size()
+       << " cameras";
+    if (!b.empty())
+        os << "\n  bounds (" << b.min.x << ", " << b.min.y << ", " << b.min.z << ") - (" << b.max.x
+           << ", " << b.max.y << ", " << b.max.z << ")";
+    for (const auto& u : scene.unsupported) os << "\n  unsupported: " << u;
+    return os.str();
+}
+
+}  // namespace gdpt

@@ -1,0 +1,35 @@
+// procedural.h — scenes built in code, for tests and the benchmark. They use the same
+// conventions as loaded glTF scenes (world space, metres, radiance in W/(m^2 sr), front face
+// = counter-clockwise) and the "pure Lambertian" material convention (metallic 0,
+// specularFactor 0, roughness 1: albedo = baseColor, no specular layer) unless stated.
+#pragma once
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "scene/scene.h"
+
+namespace gdpt {
+
+// The Cornell box of /work/shared/scenes/cbox/cbox.gltf (Bitterli's layout): same vertices,
+// triangles (36), normals, materials (white, red, green, light = 0..3) and camera.
+[[nodiscard]] Scene makeCornellBox();
+
+// A closed unit sphere (icosphere, 20 * 4^subdivisions triangles, radius 1, centred at the
+// origin) whose front faces and normals point to the centre, with Lambertian albedo
+// `albedo` and uniform emitted radiance `emission`; camera at the centre looking -Z.
+// In such a furnace every path sees radiance emission / (1 - albedo).
+[[nodiscard]] Scene makeFurnaceSphere(float albedo, glm::vec3 emission, int subdivisions);
+
+// One black emissive quad of radiance `radiance` at z = -1 facing a camera at the origin
+// (looking -Z, yfov 45°); it is large enough to fill the view at any aspect ratio < 20.
+[[nodiscard]] Scene makeEmissiveQuad(glm::vec3 radiance);
+
+// A Cornell-box-like room (walls and ceiling light of makeCornellBox, no boxes) filled with
+// randomly placed, slightly squashed diffuse icospheres so that the total is about
+// `targetTriangles` (within 4 % for targets >= 1000); camera as in makeCornellBox. For
+// the 10k/100k/1M-triangle benchmarks. Deterministic for a given (targetTriangles, seed).
+[[nodiscard]] Scene makeTriangleScene(std::uint32_t targetTriangles, std::uint32_t seed);
+
+}  // namespace gdpt

@@ -1,0 +1,297 @@
+// test_gltf_errors.cpp — every malformed input gives gdpt::Error naming the file and the
+// element (GUIDE §5); no input crashes the loader. Each case starts from a valid file
+// (oneTriangle) and breaks exactly one thing, so a loader that ignored the defect would load
+// successfully and fail the test.
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "gltf_test_writer.h"
+#include "scene/gltf_loader.h"
+#include "util/error.h"
+
+namespace gdpt {
+namespace {
+
+using test::TestGltf;
+
+// Loads `path`, requires a gdpt::Error, and checks the message holds every substring.
+void expectError(const std::string& path, const std::vector<std::string>& substrings) {
+    try {
+        (void)loadGltf(path);
+        FAIL() << "no error for " << path;
+    } catch (const Error& e) {
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find(path), std::string::npos) << msg;
+        for (const auto& s : substrings) EXPECT_NE(msg.find(s), std::string::npos) << "'" << s << "' not in: " << msg;
+    }
+}
+
+TEST(GltfErrors, ValidBaseFileLoads) {
+    // The base of every case below must load, otherwise the cases prove nothing.
+    auto g = test::oneTriangle();
+    EXPECT_EQ(loadGltf(g.writeGltf(test::testDir(), "ok")).triangles.size(), 1u);
+}
+
+TEST(GltfErrors, MissingFile) {
+    expectError(test::testDir() + "/does_not_exist.gltf", {"cannot open"});
+}
+
+TEST(GltfErrors, DirectoryInsteadOfFile) { expectError(test::testDir(), {"not a regular file"}); }
+
+TEST(GltfErrors, BadJson) {
+    const std::string path = test::testDir() + "/bad.gltf";
+    TestGltf::writeBytes(path, {'{', '"', 'a', 's', 's', 'e', 't', '"', ':', ' ', '{'});
+    expectError(path, {"parse error"});
+}
+
+TEST(GltfErrors, EmptyFile) {
+    const std::string path = test::testDir() + "/empty.gltf";
+    TestGltf::writeBytes(path, {});
+    expectError(path, {"parse error"});
+}
+
+TEST(GltfErrors, MissingBufferFile) {
+    const std::string dir = test::testDir();
+    auto g = test::oneTriangle();
+    const std::string path = g.writeGltf(dir, "nobin");
+    std::filesystem::remove(dir + "/nobin.bin");
+    expectError(path, {"nobin.bin"});
+}
+
+TEST(GltfErrors, ShortBuffer) {
+    const std::string dir = test::testDir();
+    auto g = test::oneTriangle();
+    const std::string path = g.writeGltf(dir, "short");
+    std::filesystem::resize_file(dir + "/short.bin", 8);  // JSON still claims the full length
+    expectError(path, {"parse error"});
+}
+
+TEST(GltfErrors, BufferViewOutsideBuffer) {
+    auto g = test::oneTriangle();
+    g.doc["bufferViews"][0]["byteLength"] = 4096;
+    expectError(g.writeGltf(test::testDir(), "bv"),
+                {"mesh 'Tri' primitive 0", "accessor 0 (POSITION)", "bufferView 0", "buffer 0"});
+}
+
+TEST(GltfErrors, AccessorBeyondBufferView) {
+    auto g = test::oneTriangle();
+    g.doc["accessors"][0]["count"] = 4;  // 4 x 12 bytes in a 36-byte view
+    expectError(g.writeGltf(test::testDir(), "acc"),
+                {"mesh 'Tri' primitive 0", "accessor 0 (POSITION)", "needs bytes [0, 48)"});
+}
+
+TEST(GltfErrors, AccessorIndexOutOfRange) {
+    auto g = test::oneTriangle();
+    g.doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 42;
+    expectError(g.writeGltf(test::testDir(), "idx"),
+                {"mesh 'Tri' primitive 0", "accessor 42 (POSITION) out of range"});
+}
+
+TEST(GltfErrors, WrongAccessorType) {
+    auto g = test::oneTriangle();
+    g.doc["accessors"][0]["type"] = "VEC2";
+    expectError(g.writeGltf(test::testDir(), "type"),
+                {"mesh 'Tri' primitive 0: accessor 0 (POSITION) has type VEC2, expected VEC3"});
+}
+
+TEST(GltfErrors, WrongComponentType) {
+    auto g = test::oneTriangle();
+    g.doc["accessors"][0]["componentType"] = test::kUShort;
+    expectError(g.writeGltf(test::testDir(), "ctype"),
+                {"accessor 0 (POSITION) has componentType 5123 (UNSIGNED_SHORT), expected FLOAT"});
+}
+
+TEST(GltfErrors, FloatIndices) {
+    auto g = test::oneTriangle();
+    const int idxAccessor = g.doc["meshes"][0]["primitives"][0]["indices"];
+    g.doc["accessors"][static_cast<std::size_t>(idxAccessor)]["componentType"] = test::kFloat;
+    expectError(g.writeGltf(test::testDir(), "fidx"),
+                {"accessor " + std::to_string(idxAccessor) + " (indices) has componentType 5126"});
+}
+
+TEST(GltfErrors, IndexOutOfVertexRange) {
+    TestGltf g;
+    const int mesh = g.addMesh({g.primitive(test::unitTriangle(), {0, 1, 7})}, "Tri");
+    g.setScene({g.addNode({{"mesh", mesh}})});
+    expectError(g.writeGltf(test::testDir(), "oob"),
+                {"mesh 'Tri' primitive 0", "(indices) element 2 is 7, out of range of the 3 vertices"});
+}
+
+TEST(GltfErrors, TriangleIndexCountNotMultipleOfThree) {
+    TestGltf g;
+    const int mesh = g.addMesh({g.primitive(test::unitTriangle(), {0, 1, 2, 0})}, "Tri");
+    g.setScene({g.addNode({{"mesh", mesh}})});
+    expectError(g.writeGltf(test::testDir(), "m3"), {"mesh 'Tri' primitive 0", "not a multiple of 3"});
+}
+
+TEST(GltfErrors, NanPosition) {
+    TestGltf g;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const int mesh = g.addMesh({g.primitive({{0, 0, 0}, {1, nan, 0}, {0, 1, 0}}, {0, 1, 2})}, "Tri");
+    g.setScene({g.addNode({{"mesh", mesh}})});
+    expectError(g.writeGltf(test::testDir(), "nan"),
+                {"mesh 'Tri' primitive 0", "accessor 0 (POSITION) element 1 is not finite"});
+}
+
+TEST(GltfErrors, InfinitePosition) {
+    TestGltf g;
+    const float inf = std::numeric_limits<float>::infinity();
+    const int mesh = g.addMesh({g.primitive({{0, 0, 0}, {1, 0, 0}, {0, 1, -inf}}, {})}, "Tri");
+    g.setScene({g.addNode({{"mesh", mesh}})});
+    expectError(g.writeGltf(test::testDir(), "inf"), {"element 2 is not finite"});
+}
+
+TEST(GltfErrors, PositionOverflowsAfterTransform) {
+    auto g = test::oneTriangle();
+    g.doc["nodes"][0]["scale"] = {1e38, 1e38, 1e38};
+    expectError(g.writeGltf(test::testDir(), "ovf"), {"mesh 'Tri' primitive 0", "not finite after"});
+}
+
+TEST(GltfErrors, AbsurdCount) {
+    auto g = test::oneTriangle();
+    g.doc["accessors"][0]["count"] = 1000000000000ull;
+    expectError(g.writeGltf(test::testDir(), "absurd"),
+                {"accessor 0 (POSITION) has count 1000000000000, more than the limit"});
+}
+
+TEST(GltfErrors, CyclicNodeGraph) {
+    auto g = test::oneTriangle();
+    const int a = g.addNode({{"name", "A"}});
+    const int b = g.addNode({{"name", "B"}, {"children", {a}}});
+    g.doc["nodes"][static_cast<std::size_t>(a)]["children"] = {b};
+    expectError(g.writeGltf(test::testDir(), "cycle"), {"cyclic node graph"});
+}
+
+TEST(GltfErrors, NodeIsItsOwnChild) {
+    auto g = test::oneTriangle();
+    g.doc["nodes"][0]["children"] = {0};
+    expectError(g.writeGltf(test::testDir(), "self"), {"node 'TriNode' is its own child"});
+}
+
+TEST(GltfErrors, NodeUsedTwiceAsChild) {
+    auto g = test::oneTriangle();
+    const int a = g.addNode({{"children", {0}}});
+    const int b = g.addNode({{"children", {0}}});
+    g.setScene({a, b});
+    expectError(g.writeGltf(test::testDir(), "twice"),
+                {"node 0 is used twice as a child (by node 1 and node 2)"});
+}
+
+TEST(GltfErrors, ChildIndexOutOfRange) {
+    auto g = test::oneTriangle();
+    g.doc["nodes"][0]["children"] = {9};
+    expectError(g.writeGltf(test::testDir(), "child"), {"node 'TriNode': child 9 out of range"});
+}
+
+TEST(GltfErrors, CameraIndexOutOfRange) {
+    auto g = test::oneTriangle();
+    g.doc["cameras"] = nlohmann::json::array(
+        {{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}}}}});
+    const int cam = g.addNode({{"name", "Cam"}, {"camera", 3}});
+    g.setScene({0, cam});
+    expectError(g.writeGltf(test::testDir(), "cam"),
+                {"node 'Cam': camera 3 out of range (file has 1 cameras)"});
+}
+
+TEST(GltfErrors, MeshIndexOutOfRange) {
+    auto g = test::oneTriangle();
+    g.doc["nodes"][0]["mesh"] = 5;
+    expectError(g.writeGltf(test::testDir(), "mesh"), {"node 'TriNode': mesh 5 out of range"});
+}
+
+TEST(GltfErrors, MaterialIndexOutOfRange) {
+    auto g = test::oneTriangle();
+    g.doc["meshes"][0]["primitives"][0]["material"] = 3;
+    expectError(g.writeGltf(test::testDir(), "mat"),
+                {"mesh 'Tri' primitive 0: material 3 out of range"});
+}
+
+TEST(GltfErrors, SceneIndexOutOfRange) {
+    auto g = test::oneTriangle();
+    g.doc["scene"] = 4;
+    expectError(g.writeGltf(test::testDir(), "scene"), {"scene"});
+}
+
+TEST(GltfErrors, UndecodableImage) {
+    auto g = test::oneTriangle();
+    const std::string garbage = "this is not a PNG file at all";
+    const int view = g.addView(garbage.data(), garbage.size());
+    g.doc["images"] = nlohmann::json::array({{{"bufferView", view}, {"mimeType", "image/png"}}});
+    g.doc["textures"] = nlohmann::json::array({{{"source", 0}}});
+    g.addMaterial({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+    g.doc["meshes"][0]["primitives"][0]["material"] = 0;
+    expectError(g.writeGltf(test::testDir(), "img"), {"image 0", "cannot decode"});
+}
+
+TEST(GltfErrors, MissingExternalImage) {
+    auto g = test::oneTriangle();
+    g.doc["images"] = nlohmann::json::array({{{"uri", "nowhere.png"}}});
+    g.doc["textures"] = nlohmann::json::array({{{"source", 0}}});
+    g.addMaterial({{"name", "Tex"}, {"emissiveTexture", {{"index", 0}}}});
+    g.doc["meshes"][0]["primitives"][0]["material"] = 0;
+    expectError(g.writeGltf(test::testDir(), "noimg"),
+                {"material 'Tex'", "image 0 'nowhere.png' could not be loaded"});
+}
+
+TEST(GltfErrors, TextureIndexOutOfRange) {
+    auto g = test::oneTriangle();
+    g.addMaterial({{"name", "M"}, {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 2}}}}}});
+    expectError(g.writeGltf(test::testDir(), "tex"),
+                {"material 'M': baseColorTexture: texture 2 out of range"});
+}
+
+TEST(GltfErrors, RequiredCompressionIsAnError) {
+    auto g = test::oneTriangle();
+    g.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+    g.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+    expectError(g.writeGltf(test::testDir(), "draco"), {"KHR_draco_mesh_compression"});
+}
+
+TEST(GltfErrors, TruncatedGlb) {
+    const std::string dir = test::testDir();
+    auto g = test::oneTriangle();
+    const std::string path = g.writeGlb(dir, "trunc");
+    std::filesystem::resize_file(path, std::filesystem::file_size(path) - 40);
+    expectError(path, {"parse error"});
+}
+
+TEST(GltfErrors, BadRotation) {
+    auto g = test::oneTriangle();
+    g.doc["nodes"][0]["rotation"] = {0, 0, 0, 0};
+    expectError(g.writeGltf(test::testDir(), "rot"), {"node 'TriNode': rotation is a zero quaternion"});
+}
+
+// Byte-level mutations of a valid GLB and .gltf (fixed seed): each must load or throw
+// gdpt::Error, never crash or throw anything else.
+TEST(GltfErrors, MutatedFilesNeverCrash) {
+    const std::string dir = test::testDir();
+    auto g = test::oneTriangle();
+    g.doc["cameras"] = nlohmann::json::array(
+        {{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}}}}});
+    g.addNode({{"camera", 0}, {"translation", {0, 0, 3}}});
+    g.doc["scenes"][0]["nodes"].push_back(1);
+    for (const std::string& src : {g.writeGlb(dir, "base"), g.writeGltf(dir, "base")}) {
+        std::ifstream in(src, std::ios::binary);
+        const std::vector<unsigned char> orig((std::istreambuf_iterator<char>(in)), {});
+        std::uint32_t state = 12345u;
+        auto rnd = [&] { return state = state * 1664525u + 1013904223u; };
+        for (int iter = 0; iter < 150; ++iter) {
+            std::vector<unsigned char> bytes = orig;
+            const int edits = 1 + static_cast<int>(rnd() % 4);
+            for (int e = 0; e < edits; ++e)
+                bytes[rnd() % bytes.size()] = static_cast<unsigned char>(rnd() >> 24);
+            const std::string path = dir + "/mut" + std::filesystem::path(src).extension().string();
+            TestGltf::writeBytes(path, bytes);
+            try {
+                (void)loadGltf(path);
+            } catch (const Error&) {
+                // expected for most mutations
+            }
+        }
+    }
+}
+
+}  // namespace
+}  // namespace gdpt
