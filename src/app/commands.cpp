@@ -1,5 +1,9 @@
 #include "app/commands.h"
 
+#include <memory>
+
+#include "app/subcommand.h"
+
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -245,6 +249,70 @@ int runDevices(const DevicesArgs& args) {
                     static_cast<unsigned long long>(d["device_local_heap"].get<std::uint64_t>() >> 20),
                     d["usable"].get<bool>() ? "" : (" — unusable: " + d["unsuitable_reason"].get<std::string>()).c_str());
     return 0;
+}
+
+// ---- CLI registration ----------------------------------------------------------------
+
+Subcommand addRenderCommand(CLI::App& app) {
+    auto args = std::make_shared<RenderArgs>();
+    auto& render = *args;
+    CLI::App* r = app.add_subcommand("render", "Render a glTF 2.0 scene to OpenEXR (+ PNG preview)");
+    r->add_option("scene", render.scene, "glTF 2.0 scene (.gltf or .glb)")->required()->check(CLI::ExistingFile);
+    r->add_option("-o,--output", render.output, "Output EXR; a tone-mapped PNG preview is written beside it")
+        ->capture_default_str();
+    r->add_option("--spp", render.spp, "Samples per pixel")->capture_default_str()->check(CLI::Range(1u, 1u << 24));
+    r->add_option("--time", render.time,
+                  "Time budget in seconds for the whole render (loading included); overrides --spp")
+        ->check(CLI::Range(0.0, 1e7));
+    r->add_option("--width", render.width, "Image width in pixels")->capture_default_str()->check(CLI::Range(1, 16384));
+    r->add_option("--height", render.height, "Image height in pixels")->capture_default_str()->check(CLI::Range(1, 16384));
+    r->add_option("--max-depth", render.maxDepth, "Maximum number of bounces (1 = direct lighting only)")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, 1023u));
+    r->add_option("--seed", render.seed, "Random seed (renders are deterministic per seed and device)")
+        ->capture_default_str();
+    r->add_option("--env", render.env, "Constant environment radiance R,G,B (W/m^2/sr)")->capture_default_str();
+    r->add_option("--device", render.device, "Vulkan device index or name substring (default: lavapipe)");
+    r->add_option("--camera", render.camera, "Camera index in the glTF (default: first camera, or a framing camera)")
+        ->check(CLI::NonNegativeNumber);
+    r->add_option("--method", render.method, "Rendering method")->capture_default_str()->check(CLI::IsMember({"pt"}));
+    r->add_option("--workgroup", render.workgroup, "Compute workgroup size WxH")->capture_default_str();
+    r->add_flag("--profile", render.profile, "Print GPU time per kernel (timestamp queries)");
+    r->add_option("--json", render.json, "Write render statistics as JSON to this file");
+    r->add_flag("--quiet", render.quiet, "No progress output");
+    r->add_flag("--validate", render.validate, "Enable Vulkan validation layers (errors make the run fail)");
+
+    return {r, [args] { return runRender(*args); }};
+}
+
+Subcommand addDiffCommand(CLI::App& app) {
+    auto args = std::make_shared<DiffArgs>();
+    auto& diff = *args;
+    CLI::App* d = app.add_subcommand("diff", "Compare two EXR images: relMSE (Kettunen et al. 2015), MSE, MAE, max error");
+    d->add_option("test", diff.test, "Image to evaluate")->required()->check(CLI::ExistingFile);
+    d->add_option("reference", diff.reference, "Reference image")->required()->check(CLI::ExistingFile);
+    d->add_option("--json", diff.json, "Write the metrics as JSON to this file ('-' = stdout)");
+
+    return {d, [args] { return runDiff(*args); }};
+}
+
+Subcommand addInfoCommand(CLI::App& app) {
+    auto args = std::make_shared<InfoArgs>();
+    auto& info = *args;
+    CLI::App* i = app.add_subcommand("info", "Print a scene's features and the kernel variant gdpt will run");
+    i->add_option("scene", info.scene, "glTF 2.0 scene")->required()->check(CLI::ExistingFile);
+    i->add_option("--env", info.env, "Constant environment radiance R,G,B")->capture_default_str();
+
+    return {i, [args] { return runInfo(*args); }};
+}
+
+Subcommand addDevicesCommand(CLI::App& app) {
+    auto args = std::make_shared<DevicesArgs>();
+    auto& devices = *args;
+    CLI::App* v = app.add_subcommand("devices", "List Vulkan devices with the limits that matter to gdpt");
+    v->add_flag("--json", devices.json, "Print JSON");
+
+    return {v, [args] { return runDevices(*args); }};
 }
 
 }  // namespace gdpt

@@ -1,0 +1,22 @@
+// subcommand.h — how a gdpt subcommand plugs into main(): a factory adds its options to the
+// CLI11 app and returns the function that runs it (returning the exit code). Each
+// subcommand lives in its own file; main.cpp lists the factories.
+#pragma once
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace gdpt {
+
+struct Subcommand {
+    CLI::App* app = nullptr;
+    std::function<int()> run;
+};
+
+Subcommand addRenderCommand(CLI::App& app);
+Subcommand addDiffCommand(CLI::App& app);
+Subcommand addInfoCommand(CLI::App& app);
+Subcommand addDevicesCommand(CLI::App& app);
+
+}  // namespace gdpt

@@ -1,0 +1,101 @@
+// Path tracer against things we did not make up: the white furnace (closed emitting sphere,
+// L = Le / (1 - a)), an emitter seen directly (exactly its radiance), and determinism.
+// Every tolerance is a number of standard errors estimated from the per-pixel sample
+// variance the renderer accumulates, with fixed seeds.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "gpu_fixture.h"
+#include "render/renderer.h"
+#include "scene/procedural.h"
+#include "stats_normal.h"
+
+namespace gdpt {
+namespace {
+
+class RenderPt : public test::GpuTest {
+protected:
+    RenderResult render(const Scene& scene, int w, int h, std::uint32_t spp, std::uint32_t seed = 1) {
+        RenderOptions o;
+        o.scene.width = w;
+        o.scene.height = h;
+        o.spp = spp;
+        o.seed = seed;
+        o.quiet = true;
+        return renderPt(ctx(), scene, o);
+    }
+};
+
+// Closed sphere, Lambertian albedo a, uniform emission Le, camera inside: every path sees
+// L = Le (1 + a + a^2 + ...) = Le / (1 - a) (Neumann series). Tests: the image mean and
+// 16 block means (16 px each) against that value. Each mean's standard error is
+// sqrt(sum of per-pixel variances of the mean) / pixels; the block tests are Šidák-corrected
+// (family alpha = 1e-3 over 16 blocks x 3 channels), the image mean uses 4 sigma.
+void checkFurnace(const RenderResult& r, double expected) {
+    const Image& img = r.image;
+    const Image& var = r.varianceOfMean;
+    const double zBlock = test::twoSidedZ(test::sidakAlpha(1e-3, 16 * 3));
+    for (int c = 0; c < 3; ++c) {
+        double sum = 0.0, varSum = 0.0;
+        for (std::size_t i = 0; i < img.pixelCount(); ++i) {
+            sum += img.plane(c)[i];
+            varSum += var.plane(c)[i];
+        }
+        const double n = static_cast<double>(img.pixelCount());
+        const double mean = sum / n, se = std::sqrt(varSum) / n;
+        EXPECT_GT(se, 0.0);
+        EXPECT_LT(std::abs(mean - expected), 4.0 * se) << "channel " << c << " mean " << mean << " se " << se;
+        for (int by = 0; by < 4; ++by)
+            for (int bx = 0; bx < 4; ++bx) {
+                double bs = 0.0, bv = 0.0;
+                for (int y = by * 4; y < by * 4 + 4; ++y)
+                    for (int x = bx * 4; x < bx * 4 + 4; ++x) {
+                        bs += img.at(x, y, c);
+                        bv += var.at(x, y, c);
+                    }
+                const double bm = bs / 16.0, bse = std::sqrt(bv) / 16.0;
+                EXPECT_LT(std::abs(bm - expected), zBlock * bse) << "block " << bx << "," << by;
+            }
+    }
+    EXPECT_EQ(r.stats.nanSamples, 0u);
+}
+
+TEST_F(RenderPt, WhiteFurnaceAlbedoHalf) {
+    const RenderResult r = render(makeFurnaceSphere(0.5f, glm::vec3(1.0f), 3), 16, 16, 256);
+    checkFurnace(r, 1.0 / (1.0 - 0.5));
+}
+
+TEST_F(RenderPt, WhiteFurnaceAlbedoPointEight) {
+    const RenderResult r = render(makeFurnaceSphere(0.8f, glm::vec3(0.25f), 3), 16, 16, 256, 7);
+    checkFurnace(r, 0.25 / (1.0 - 0.8));
+}
+
+// A black emitter filling the view returns its radiance in every pixel, with no noise.
+TEST_F(RenderPt, EmitterSeenDirectlyIsExact) {
+    const glm::vec3 le(3.0f, 2.0f, 0.5f);
+    const RenderResult r = render(makeEmissiveQuad(le), 24, 16, 4);
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < r.image.pixelCount(); ++i) {
+            ASSERT_FLOAT_EQ(r.image.plane(c)[i], le[c]) << "pixel " << i;
+            ASSERT_EQ(r.varianceOfMean.plane(c)[i], 0.0f);
+        }
+}
+
+// Same scene, seed and spp give bit-identical images; another seed gives another image.
+TEST_F(RenderPt, DeterministicPerSeed) {
+    const Scene scene = makeCornellBox();
+    const RenderResult a = render(scene, 32, 32, 6, 3);
+    const RenderResult b = render(scene, 32, 32, 6, 3);
+    const RenderResult c = render(scene, 32, 32, 6, 4);
+    int differentSeedDiffers = 0;
+    for (int ch = 0; ch < 3; ++ch) {
+        ASSERT_EQ(a.image.plane(ch), b.image.plane(ch));
+        ASSERT_EQ(a.varianceOfMean.plane(ch), b.varianceOfMean.plane(ch));
+        differentSeedDiffers += a.image.plane(ch) != c.image.plane(ch);
+    }
+    EXPECT_GT(differentSeedDiffers, 0);
+}
+
+}  // namespace
+}  // namespace gdpt
