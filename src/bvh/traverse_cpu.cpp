@@ -1,0 +1,201 @@
+// traverse_cpu.cpp — host mirror of shaders/lib/bvh_traverse.glsl (traceClosest, traceAny).
+// Keep the control flow identical to the GLSL so both visit the same nodes and test the
+// same triangles in the same order; the arithmetic is shared through the included GLSL.
+#include "bvh/traverse_cpu.h"
+
+namespace gdpt {
+namespace {
+
+thread_local uint32_t tlsNodeVisits = 0;
+
+// The default GDPT_ANYHIT_FILTER (accept every hit); the host has no cutout materials.
+inline bool anyHitFilter(uint32_t /*tri*/, float /*u*/, float /*v*/) {
+    return true;
+}
+
+}  // namespace
+
+bool intersectTriangleCpu(const gpu::TriangleGeom& g, glm::vec3 orig, glm::vec3 dir,
+                          float tMin, float& tMax, float& u, float& v) {
+    return gpu::intersectTriangleGeom(orig, dir, g.v0, g.e1, g.e2, tMin, tMax, u, v);
+}
+
+Hit traceClosestCpu(const std::vector<gpu::BvhNode>& nodes,
+                    const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
+                    float tMin, float tMax) {
+    Hit hit;
+    hit.t = tMax;
+    hit.u = 0.0f;
+    hit.v = 0.0f;
+    hit.triangle = gpu::kInvalidIndex;
+    const glm::vec3 invDir = gpu::bvhSafeInverse(dir);
+    uint32_t stack[gpu::kBvhStackSize];
+    uint32_t stackSize = 0;
+    uint32_t node = 0;
+    uint32_t visits = 0;
+    while (true) {
+        const gpu::BvhNode& n = nodes[node];
+        ++visits;
+        float dL = 0.0f;
+        float dR = 0.0f;
+        bool hitL = n.left != gpu::kInvalidIndex &&
+                    gpu::intersectBox(orig, invDir, n.lmin, n.lmax, tMin, hit.t, dL);
+        bool hitR = n.right != gpu::kInvalidIndex &&
+                    gpu::intersectBox(orig, invDir, n.rmin, n.rmax, tMin, hit.t, dR);
+        // Visit order: the child with the nearer entry distance first.
+        bool swapLR = hitR && (!hitL || dR < dL);
+        uint32_t c0 = swapLR ? n.right : n.left;
+        uint32_t count0 = swapLR ? n.rightCount : n.leftCount;
+        bool hit0 = swapLR ? hitR : hitL;
+        uint32_t c1 = swapLR ? n.left : n.right;
+        uint32_t count1 = swapLR ? n.leftCount : n.rightCount;
+        bool hit1 = swapLR ? hitL : hitR;
+        uint32_t next = gpu::kInvalidIndex;
+        if (hit0) {
+            if (count0 > 0u) {
+                for (uint32_t i = c0; i < c0 + count0; ++i) {
+                    float tCand = hit.t;
+                    float u;
+                    float v;
+                    if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) &&
+                        anyHitFilter(i, u, v)) {
+                        hit.t = tCand;
+                        hit.u = u;
+                        hit.v = v;
+                        hit.triangle = i;
+                    }
+                }
+            } else {
+                next = c0;
+            }
+        }
+        if (hit1) {
+            if (count1 > 0u) {
+                for (uint32_t i = c1; i < c1 + count1; ++i) {
+                    float tCand = hit.t;
+                    float u;
+                    float v;
+                    if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) &&
+                        anyHitFilter(i, u, v)) {
+                        hit.t = tCand;
+                        hit.u = u;
+                        hit.v = v;
+                        hit.triangle = i;
+                    }
+                }
+            } else if (next == gpu::kInvalidIndex) {
+                next = c1;
+            } else {
+                stack[stackSize] = c1;  // far inner child: visit later
+                ++stackSize;
+            }
+        }
+        if (next == gpu::kInvalidIndex) {
+            if (stackSize == 0u) {
+                break;
+            }
+            --stackSize;
+            next = stack[stackSize];
+        }
+        node = next;
+    }
+    tlsNodeVisits = visits;
+    return hit;
+}
+
+bool traceAnyCpu(const std::vector<gpu::BvhNode>& nodes,
+                 const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
+                 float tMin, float tMax) {
+    const glm::vec3 invDir = gpu::bvhSafeInverse(dir);
+    uint32_t stack[gpu::kBvhStackSize];
+    uint32_t stackSize = 0;
+    uint32_t node = 0;
+    tlsNodeVisits = 0;
+    while (true) {
+        const gpu::BvhNode& n = nodes[node];
+        ++tlsNodeVisits;
+        float dL = 0.0f;
+        float dR = 0.0f;
+        bool hitL = n.left != gpu::kInvalidIndex &&
+                    gpu::intersectBox(orig, invDir, n.lmin, n.lmax, tMin, tMax, dL);
+        bool hitR = n.right != gpu::kInvalidIndex &&
+                    gpu::intersectBox(orig, invDir, n.rmin, n.rmax, tMin, tMax, dR);
+        uint32_t next = gpu::kInvalidIndex;
+        if (hitL) {
+            if (n.leftCount > 0u) {
+                for (uint32_t i = n.left; i < n.left + n.leftCount; ++i) {
+                    float tCand = tMax;
+                    float u;
+                    float v;
+                    if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) &&
+                        anyHitFilter(i, u, v)) {
+                        return true;
+                    }
+                }
+            } else {
+                next = n.left;
+            }
+        }
+        if (hitR) {
+            if (n.rightCount > 0u) {
+                for (uint32_t i = n.right; i < n.right + n.rightCount; ++i) {
+                    float tCand = tMax;
+                    float u;
+                    float v;
+                    if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) &&
+                        anyHitFilter(i, u, v)) {
+                        return true;
+                    }
+                }
+            } else if (next == gpu::kInvalidIndex) {
+                next = n.right;
+            } else {
+                stack[stackSize] = n.right;
+                ++stackSize;
+            }
+        }
+        if (next == gpu::kInvalidIndex) {
+            if (stackSize == 0u) {
+                break;
+            }
+            --stackSize;
+            next = stack[stackSize];
+        }
+        node = next;
+    }
+    return false;
+}
+
+Hit traceClosestBruteForce(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig,
+                           glm::vec3 dir, float tMin, float tMax) {
+    Hit hit{tMax, 0.0f, 0.0f, gpu::kInvalidIndex};
+    for (size_t i = 0; i < geoms.size(); ++i) {
+        float u;
+        float v;
+        if (intersectTriangleCpu(geoms[i], orig, dir, tMin, hit.t, u, v)) {
+            hit.u = u;
+            hit.v = v;
+            hit.triangle = static_cast<uint32_t>(i);
+        }
+    }
+    return hit;
+}
+
+bool traceAnyBruteForce(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig,
+                        glm::vec3 dir, float tMin, float tMax) {
+    for (const gpu::TriangleGeom& g : geoms) {
+        float tCand = tMax;
+        float u;
+        float v;
+        if (intersectTriangleCpu(g, orig, dir, tMin, tCand, u, v)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+uint32_t lastTraversalNodeVisits() {
+    return tlsNodeVisits;
+}
+
+}  // namespace gdpt

@@ -1,0 +1,373 @@
+// test_bvh.cpp — BVH builder and CPU traversal: closest/any hit against brute force on
+// seeded procedural scenes, structural invariants, depth cap, watertightness, determinism.
+// Scenes are small (400-800 triangles) because every ray is also traced by brute force.
+//
+// Tolerance: the BVH traversal and the brute-force loop call the same ray/triangle function
+// on bit-identical TriangleGeom data, so a triangle's t does not depend on the loop. The
+// brute force returns the minimum t over all triangles; if the BVH tested the brute-force
+// winner it accepted it (its running tMax was >= that t), so its own t is <= that minimum.
+// Hence the two t must be EXACTLY equal unless the BVH culled the closest triangle, and
+// differing ids are legitimate only for exact ties (duplicated / coplanar triangles). The
+// "few ulps" tolerance applies only between CPU and GPU (division and dot rounding).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "bvh/builder.h"
+#include "bvh/traverse_cpu.h"
+#include "bvh_test_scenes.h"
+
+namespace gdpt {
+namespace {
+
+using test::Mesh;
+
+// Many zero-area (repeated vertex, collinear), coplanar overlapping and duplicated triangles.
+Mesh degenerateScene(uint32_t seed) {
+    std::mt19937 rng(seed);
+    Mesh m = test::randomSoup(100, 0.2f, seed + 1);
+    for (int i = 0; i < 60; ++i) {
+        glm::vec3 a = test::uniformInBox(rng, glm::vec3(-1.0f), glm::vec3(1.0f));
+        glm::vec3 b = test::uniformInBox(rng, glm::vec3(-1.0f), glm::vec3(1.0f));
+        m.addTriangle(a, a, b);                    // repeated vertex
+        m.addTriangle(a, 0.5f * (a + b), b);       // collinear
+        m.addTriangle(a, a, a);                    // a point
+    }
+    for (int i = 0; i < 100; ++i) {  // overlapping coplanar triangles in the plane z = 0.25
+        glm::vec3 c = test::uniformInBox(rng, glm::vec3(-1.0f, -1.0f, 0.25f),
+                                         glm::vec3(1.0f, 1.0f, 0.25f));
+        glm::vec3 d1 = test::uniformInBox(rng, glm::vec3(-0.3f, -0.3f, 0.0f),
+                                          glm::vec3(0.3f, 0.3f, 0.0f));
+        glm::vec3 d2 = test::uniformInBox(rng, glm::vec3(-0.3f, -0.3f, 0.0f),
+                                          glm::vec3(0.3f, 0.3f, 0.0f));
+        m.addTriangle(c, c + d1, c + d2);
+    }
+    const size_t original = m.triangles.size();
+    for (size_t i = 0; i < original; i += 3) {  // exact duplicates sharing vertex indices
+        m.triangles.push_back(m.triangles[i]);
+    }
+    return m;
+}
+
+// Axis-aligned quads of zero thickness in planes x = k/4 and z = k/4 (boxes are flat).
+Mesh thinAxisAlignedScene() {
+    Mesh m;
+    for (int k = -2; k <= 2; ++k) {
+        float c = 0.25f * float(k);
+        for (int i = 0; i < 5; ++i) {
+            for (int j = 0; j < 5; ++j) {
+                float a0 = -0.75f + 0.25f * float(i);
+                float b0 = -0.75f + 0.25f * float(j);
+                float a1 = a0 + 0.25f;
+                float b1 = b0 + 0.25f;
+                m.addTriangle({a0, b0, c}, {a1, b0, c}, {a1, b1, c});
+                m.addTriangle({a0, b0, c}, {a1, b1, c}, {a0, b1, c});
+                m.addTriangle({c, a0, b0}, {c, a1, b0}, {c, a1, b1});
+                m.addTriangle({c, a0, b0}, {c, a1, b1}, {c, a0, b1});
+            }
+        }
+    }
+    return m;
+}
+
+std::vector<uint32_t> identityOrder(size_t n) {
+    std::vector<uint32_t> order(n);
+    for (size_t i = 0; i < n; ++i) {
+        order[i] = static_cast<uint32_t>(i);
+    }
+    return order;
+}
+
+struct Ray {
+    glm::vec3 orig;
+    glm::vec3 dir;
+    float tMax;
+};
+
+// Half the rays are uniform (origin in the enlarged bounds, direction on the sphere); half
+// aim at a random point of a random triangle, a quarter of those exactly at an edge or a
+// vertex; one in eight has an axis-aligned direction (zero components).
+std::vector<Ray> makeRays(const Mesh& m, uint32_t count, uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+    glm::vec3 lo(1e30f);
+    glm::vec3 hi(-1e30f);
+    for (const glm::vec3& p : m.positions) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    glm::vec3 pad = 0.25f * (hi - lo) + glm::vec3(0.1f);
+    std::vector<Ray> rays(count);
+    for (uint32_t i = 0; i < count; ++i) {
+        Ray& r = rays[i];
+        r.orig = test::uniformInBox(rng, lo - pad, hi + pad);
+        r.tMax = 1e30f;
+        const uint32_t kind = i % 8;
+        if (kind < 4 || m.triangles.empty()) {
+            r.dir = test::uniformOnSphere(rng);
+        } else if (kind < 7) {
+            const glm::uvec3 t = m.triangles[rng() % m.triangles.size()];
+            float b1 = u01(rng);
+            float b2 = u01(rng);
+            if (b1 + b2 > 1.0f) {
+                b1 = 1.0f - b1;
+                b2 = 1.0f - b2;
+            }
+            if (kind == 6) {  // on an edge (b2 = 0) or at a vertex
+                b2 = 0.0f;
+                b1 = (rng() % 4 == 0) ? 0.0f : b1;
+            }
+            glm::vec3 p0 = m.positions[t.x];
+            glm::vec3 target = p0 + b1 * (m.positions[t.y] - p0) + b2 * (m.positions[t.z] - p0);
+            r.dir = target - r.orig;
+            if (rng() % 2 == 0) {
+                r.tMax = 0.5f + u01(rng);  // a segment that may end before the target
+            }
+        } else {
+            r.dir = glm::vec3(0.0f);
+            r.dir[static_cast<int>(rng() % 3)] = (rng() % 2 == 0) ? 1.0f : -1.0f;
+        }
+    }
+    return rays;
+}
+
+// Walks the tree and checks every structural invariant of gdpt_shared.h and buildBvh.
+void checkStructure(const Mesh& m, const Bvh& bvh, uint32_t leafLimit) {
+    const size_t n = m.triangles.size();
+    ASSERT_EQ(bvh.triangleOrder.size(), n);
+    std::vector<int> seenOrder(n, 0);
+    for (uint32_t t : bvh.triangleOrder) {
+        ASSERT_LT(t, n);
+        ASSERT_EQ(seenOrder[t]++, 0) << "triangleOrder is not a permutation";
+    }
+    ASSERT_FALSE(bvh.nodes.empty());
+    ASSERT_EQ(bvh.stats.nodeCount, bvh.nodes.size());
+    std::vector<int> nodeSeen(bvh.nodes.size(), 0);
+    std::vector<int> leafRef(n, 0);
+    uint32_t leaves = 0;
+    uint32_t maxDepth = 0;
+    struct Item { uint32_t node; uint32_t depth; glm::vec3 lo; glm::vec3 hi; };
+    std::vector<Item> todo{{0, 0, glm::vec3(-1e38f), glm::vec3(1e38f)}};
+    while (!todo.empty()) {
+        Item it = todo.back();
+        todo.pop_back();
+        ASSERT_LT(it.node, bvh.nodes.size());
+        ASSERT_EQ(nodeSeen[it.node]++, 0) << "node reached twice";
+        const gpu::BvhNode& nd = bvh.nodes[it.node];
+        for (int side = 0; side < 2; ++side) {
+            const glm::vec3 lo = side == 0 ? nd.lmin : nd.rmin;
+            const glm::vec3 hi = side == 0 ? nd.lmax : nd.rmax;
+            const uint32_t index = side == 0 ? nd.left : nd.right;
+            const uint32_t count = side == 0 ? nd.leftCount : nd.rightCount;
+            if (index == gpu::kInvalidIndex) {  // absent child: only at the root
+                EXPECT_EQ(it.node, 0u);
+                EXPECT_EQ(count, 0u);
+                EXPECT_GT(lo.x, hi.x) << "absent child must have an empty box";
+                continue;
+            }
+            // Nested boxes: a child box lies within its parent's box.
+            EXPECT_TRUE(glm::all(glm::greaterThanEqual(lo, it.lo)) &&
+                        glm::all(glm::lessThanEqual(hi, it.hi)));
+            const uint32_t depth = it.depth + 1;
+            EXPECT_LE(depth, gpu::kBvhMaxDepth);
+            if (count == 0) {
+                todo.push_back({index, depth, lo, hi});
+                continue;
+            }
+            ++leaves;
+            maxDepth = std::max(maxDepth, depth);
+            EXPECT_LE(count, leafLimit);
+            ASSERT_LE(uint64_t{index} + count, n);
+            for (uint32_t i = index; i < index + count; ++i) {
+                ++leafRef[i];
+                const glm::uvec3 t = m.triangles[bvh.triangleOrder[i]];
+                glm::vec3 tlo;
+                glm::vec3 thi;
+                triangleBounds(m.positions[t.x], m.positions[t.y], m.positions[t.z], tlo, thi);
+                EXPECT_TRUE(glm::all(glm::lessThanEqual(lo, tlo)) &&
+                            glm::all(glm::greaterThanEqual(hi, thi)))
+                    << "leaf box does not contain triangle " << bvh.triangleOrder[i];
+            }
+        }
+    }
+    for (size_t i = 0; i < n; ++i) {
+        ASSERT_EQ(leafRef[i], 1) << "leaf position " << i << " referenced " << leafRef[i];
+    }
+    for (size_t i = 0; i < nodeSeen.size(); ++i) {
+        ASSERT_EQ(nodeSeen[i], 1) << "node " << i << " unreachable";
+    }
+    EXPECT_EQ(bvh.stats.leafCount, leaves);
+    EXPECT_EQ(bvh.stats.maxDepth, maxDepth);
+}
+
+// Closest and any hit of the BVH against brute force over the triangles in ORIGINAL order
+// (so triangleOrder and makeTriangleGeoms are checked as well).
+void compareWithBruteForce(const Mesh& m, const BvhBuildOptions& opt, uint32_t rayCount,
+                           uint32_t seed) {
+    const Bvh bvh = buildBvh(m.positions, m.triangles, opt);
+    checkStructure(m, bvh, std::min(opt.maxLeafSize, gpu::kMaxLeafTriangles));
+    const auto leafGeoms = makeTriangleGeoms(m.positions, m.triangles, bvh.triangleOrder);
+    const auto origGeoms =
+        makeTriangleGeoms(m.positions, m.triangles, identityOrder(m.triangles.size()));
+    const std::vector<Ray> rays = makeRays(m, rayCount, seed);
+    uint32_t hits = 0;
+    uint32_t failures = 0;
+    for (const Ray& r : rays) {
+        const Hit b = traceClosestCpu(bvh.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax);
+        const Hit f = traceClosestBruteForce(origGeoms, r.orig, r.dir, 0.0f, r.tMax);
+        const bool anyB = traceAnyCpu(bvh.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax);
+        const bool anyF = traceAnyBruteForce(origGeoms, r.orig, r.dir, 0.0f, r.tMax);
+        bool ok = (b.triangle == gpu::kInvalidIndex) == (f.triangle == gpu::kInvalidIndex) &&
+                  anyB == anyF && anyF == (f.triangle != gpu::kInvalidIndex);
+        if (ok && f.triangle != gpu::kInvalidIndex) {
+            ++hits;
+            ok = b.t == f.t;  // exact, see the file comment
+            if (ok && bvh.triangleOrder[b.triangle] != f.triangle) {
+                // A tie: the BVH's triangle alone must give the same t.
+                float t = r.tMax;
+                float u;
+                float v;
+                ok = intersectTriangleCpu(leafGeoms[b.triangle], r.orig, r.dir, 0.0f, t, u, v) &&
+                     t == f.t;
+            } else if (ok) {
+                ok = b.u == f.u && b.v == f.v;
+            }
+        }
+        if (!ok && ++failures <= 5) {
+            ADD_FAILURE() << "ray o=(" << r.orig.x << "," << r.orig.y << "," << r.orig.z
+                          << ") d=(" << r.dir.x << "," << r.dir.y << "," << r.dir.z
+                          << ") bvh tri " << b.triangle << " t " << b.t << " brute tri "
+                          << f.triangle << " t " << f.t << " any " << anyB << "/" << anyF;
+        }
+    }
+    EXPECT_EQ(failures, 0u);
+    // The test is only meaningful if a good share of rays hit something.
+    if (!m.triangles.empty()) {
+        EXPECT_GT(hits, rayCount / 10) << "too few hits to exercise the traversal";
+    }
+}
+
+const BvhBuildOptions kDeepOptions{1, 4, 1.0f, 1.0f, gpu::kBvhMaxDepth, 1};  // tiny leaves, few bins: deep tree
+
+TEST(BvhTraversal, RandomSoupMatchesBruteForce) {
+    const Mesh m = test::randomSoup(400, 0.25f, 11);
+    compareWithBruteForce(m, BvhBuildOptions{}, 100000, 1);
+    compareWithBruteForce(m, kDeepOptions, 5000, 2);
+}
+
+TEST(BvhTraversal, TerrainMatchesBruteForce) {
+    const Mesh m = test::terrain(14, 12);
+    compareWithBruteForce(m, BvhBuildOptions{}, 100000, 3);
+    compareWithBruteForce(m, kDeepOptions, 5000, 4);
+}
+
+TEST(BvhTraversal, DegenerateCoplanarDuplicatesMatchBruteForce) {
+    const Mesh m = degenerateScene(13);
+    compareWithBruteForce(m, BvhBuildOptions{}, 100000, 5);
+    compareWithBruteForce(m, kDeepOptions, 5000, 6);
+}
+
+TEST(BvhTraversal, ThinAxisAlignedMatchesBruteForce) {
+    const Mesh m = thinAxisAlignedScene();
+    compareWithBruteForce(m, BvhBuildOptions{}, 100000, 7);
+    compareWithBruteForce(m, kDeepOptions, 5000, 8);
+}
+
+TEST(BvhTraversal, SingleTriangle) {
+    Mesh m;
+    m.addTriangle({0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f});
+    compareWithBruteForce(m, BvhBuildOptions{}, 100000, 9);
+    const Bvh bvh = buildBvh(m.positions, m.triangles);
+    ASSERT_EQ(bvh.nodes.size(), 1u);
+    EXPECT_EQ(bvh.nodes[0].leftCount, 1u);
+    EXPECT_EQ(bvh.nodes[0].right, gpu::kInvalidIndex);
+    const auto geoms = makeTriangleGeoms(m.positions, m.triangles, bvh.triangleOrder);
+    const Hit h = traceClosestCpu(bvh.nodes, geoms, {0.25f, 0.5f, 1.0f}, {0.0f, 0.0f, -2.0f},
+                                  0.0f, 1e30f);
+    EXPECT_EQ(h.triangle, 0u);
+    EXPECT_EQ(h.t, 0.5f);
+    EXPECT_EQ(h.u, 0.25f);
+    EXPECT_EQ(h.v, 0.5f);
+}
+
+// The depth cap (median fallback near the limit) must hold for any limit; a low limit makes
+// it engage on an ordinary scene, where unlimited SAH would go deeper.
+TEST(BvhBuilder, DepthCapHoldsAndStaysCorrect) {
+    const Mesh m = test::randomSoup(1000, 0.2f, 16);  // >= 10 levels with leaves of 1
+    BvhBuildOptions capped = kDeepOptions;
+    capped.maxDepth = 11;
+    const Bvh free = buildBvh(m.positions, m.triangles, kDeepOptions);
+    ASSERT_GT(free.stats.maxDepth, capped.maxDepth) << "cap would not be exercised";
+    const Bvh bvh = buildBvh(m.positions, m.triangles, capped);
+    checkStructure(m, bvh, 1);
+    EXPECT_LE(bvh.stats.maxDepth, capped.maxDepth);
+    compareWithBruteForce(m, capped, 20000, 17);
+}
+
+TEST(BvhBuilder, EmptyMeshHasAbsentRootChildren) {
+    const Bvh bvh = buildBvh({}, {});
+    ASSERT_EQ(bvh.nodes.size(), 1u);
+    EXPECT_EQ(bvh.nodes[0].left, gpu::kInvalidIndex);
+    EXPECT_EQ(bvh.nodes[0].right, gpu::kInvalidIndex);
+    EXPECT_GT(bvh.nodes[0].lmin.x, bvh.nodes[0].lmax.x);
+    EXPECT_FALSE(traceAnyCpu(bvh.nodes, {}, glm::vec3(0.0f), {0.0f, 0.0f, 1.0f}, 0.0f, 1e30f));
+    EXPECT_EQ(traceClosestCpu(bvh.nodes, {}, glm::vec3(0.0f), {1.0f, 0.0f, 0.0f}, 0.0f, 1e30f)
+                  .triangle,
+              gpu::kInvalidIndex);
+}
+
+TEST(BvhBuilder, RejectsOutOfRangeVertexIndex) {
+    const std::vector<glm::vec3> p{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    EXPECT_THROW(buildBvh(p, {{0, 1, 3}}), std::invalid_argument);
+}
+
+TEST(BvhBuilder, SameResultForAnyThreadCount) {
+    const Mesh m = test::randomSoup(60000, 0.02f, 14);
+    BvhBuildOptions serial;
+    serial.buildThreads = 1;
+    BvhBuildOptions parallel;
+    parallel.buildThreads = 4;
+    const Bvh a = buildBvh(m.positions, m.triangles, serial);
+    const Bvh b = buildBvh(m.positions, m.triangles, parallel);
+    checkStructure(m, b, serial.maxLeafSize);
+    ASSERT_EQ(a.nodes.size(), b.nodes.size());
+    EXPECT_EQ(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(gpu::BvhNode)),
+              0);
+    EXPECT_EQ(a.triangleOrder, b.triangleOrder);
+}
+
+// After pbrt-v3 shapes_test.cpp (Triangle.Watertight): rays from inside a closed mesh towards
+// points exactly on shared edges and at vertices must hit something.
+TEST(BvhTraversal, WatertightThroughSharedEdges) {
+    const Mesh m = test::icosphere(4);
+    const Bvh bvh = buildBvh(m.positions, m.triangles);
+    const auto geoms = makeTriangleGeoms(m.positions, m.triangles, bvh.triangleOrder);
+    std::mt19937 rng(15);
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+    uint32_t misses = 0;
+    const uint32_t rayCount = 100000;
+    for (uint32_t i = 0; i < rayCount; ++i) {
+        const glm::uvec3 t = m.triangles[rng() % m.triangles.size()];
+        const glm::vec3 a = m.positions[t[i % 3]];
+        const glm::vec3 b = m.positions[t[(i + 1) % 3]];
+        const float s = (i % 5 == 0) ? 0.0f : u01(rng);  // every fifth ray at a vertex
+        const glm::vec3 target = a + s * (b - a);
+        const glm::vec3 orig = 0.5f * test::uniformInBox(rng, glm::vec3(-1.0f), glm::vec3(1.0f));
+        const glm::vec3 dir = target - orig;
+        const Hit h = traceClosestCpu(bvh.nodes, geoms, orig, dir, 0.0f, 1e30f);
+        const bool any = traceAnyCpu(bvh.nodes, geoms, orig, dir, 0.0f, 1e30f);
+        if ((h.triangle == gpu::kInvalidIndex || !any) && ++misses <= 5) {
+            ADD_FAILURE() << "ray through a shared edge escaped the closed mesh (ray " << i
+                          << ")";
+        }
+    }
+    EXPECT_EQ(misses, 0u);
+}
+
+}  // namespace
+}  // namespace gdpt
