@@ -1,0 +1,132 @@
+// The gdpt program as a user meets it: exit codes (0 ok, 1 input/runtime error, 2 usage),
+// one clear error line naming the file, no output file left behind on failure, complete
+// --help, and a small validated render that writes EXR + PNG + JSON.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "image/exr_io.h"
+
+namespace gdpt {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RunResult {
+    int code = -1;
+    std::string output;  // stdout + stderr
+};
+
+RunResult run(const std::string& args) {
+    const std::string cmd = std::string(GDPT_BINARY) + " " + args + " 2>&1";
+    RunResult r;
+    FILE* pipe = popen(cmd.c_str(), "r");
+    if (!pipe) return r;
+    char buf[4096];
+    while (std::fgets(buf, sizeof buf, pipe)) r.output += buf;
+    const int status = pclose(pipe);
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+}
+
+class Cli : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() /
+               ("gdpt_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+    std::string path(const std::string& name) const { return (dir_ / name).string(); }
+    fs::path dir_;
+};
+
+const std::string kScene = std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.gltf";
+
+TEST_F(Cli, HelpDocumentsEveryRenderFlag) {
+    const RunResult r = run("render --help");
+    EXPECT_EQ(r.code, 0);
+    for (const char* flag : {"--output", "--spp", "--time", "--width", "--height", "--max-depth", "--seed", "--env",
+                             "--device", "--camera", "--method", "--profile", "--json", "--quiet", "--validate"})
+        EXPECT_NE(r.output.find(flag), std::string::npos) << flag;
+    EXPECT_EQ(run("--help").code, 0);
+}
+
+TEST_F(Cli, UsageErrorsExitWithTwo) {
+    EXPECT_EQ(run("render " + kScene + " --spp 0").code, 2);
+    EXPECT_EQ(run("render " + kScene + " --width -3").code, 2);
+    EXPECT_EQ(run("render " + kScene + " --env 1,2").code, 2);
+    EXPECT_EQ(run("render").code, 2);
+    EXPECT_EQ(run("frobnicate").code, 2);
+    EXPECT_EQ(run("render " + path("missing.gltf")).code, 2);
+}
+
+TEST_F(Cli, MalformedSceneIsAnErrorNamingTheFileAndWritesNothing) {
+    const std::string bad = path("bad.gltf");
+    std::ofstream(bad) << "{ \"asset\": { \"version\": \"2.0\" }, \"buffers\": [ { \"byteLength\": 12, ";
+    const std::string out = path("out.exr");
+    const RunResult r = run("render " + bad + " -o " + out + " --quiet");
+    EXPECT_EQ(r.code, 1) << r.output;
+    EXPECT_NE(r.output.find("bad.gltf"), std::string::npos) << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << "one line: " << r.output;
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_FALSE(fs::exists(path("out.png")));
+    EXPECT_FALSE(fs::exists(out + ".tmp"));
+}
+
+TEST_F(Cli, SmallValidatedRenderWritesExrPngAndJson) {
+    const std::string out = path("cb.exr");
+    const std::string json = path("cb.json");
+    const RunResult r = run("render " + kScene + " -o " + out + " --width 24 --height 16 --spp 4 --validate --quiet "
+                            "--profile --json " + json);
+    ASSERT_EQ(r.code, 0) << r.output;
+    ASSERT_TRUE(fs::exists(out));
+    EXPECT_TRUE(fs::exists(path("cb.png")));
+    const auto layers = readExr(out);
+    ASSERT_GE(layers.size(), 2u);
+    EXPECT_EQ(layers[0].name, "");
+    EXPECT_EQ(layers[0].image.width(), 24);
+    EXPECT_EQ(layers[0].image.height(), 16);
+    std::ifstream in(json);
+    const auto j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["spp"].get<int>(), 4);
+    EXPECT_EQ(j["validation_errors"].get<int>(), 0);
+    EXPECT_GT(j["rays_traced"].get<double>(), 0.0);
+    EXPECT_TRUE(j["kernels"].contains("pt"));
+    EXPECT_NE(r.output.find("pt"), std::string::npos) << "--profile prints the kernel table";
+}
+
+TEST_F(Cli, DiffOfAnImageWithItselfIsZero) {
+    const std::string out = path("a.exr");
+    ASSERT_EQ(run("render " + kScene + " -o " + out + " --width 8 --height 8 --spp 2 --quiet").code, 0);
+    const RunResult r = run("diff " + out + " " + out + " --json -");
+    ASSERT_EQ(r.code, 0) << r.output;
+    const auto j = nlohmann::json::parse(r.output);
+    EXPECT_EQ(j["relmse"].get<double>(), 0.0);
+    EXPECT_EQ(j["max_abs_error"].get<double>(), 0.0);
+}
+
+TEST_F(Cli, DevicesListsAtLeastOneUsableDevice) {
+    const RunResult r = run("devices --json");
+    ASSERT_EQ(r.code, 0) << r.output;
+    const auto j = nlohmann::json::parse(r.output);
+    ASSERT_FALSE(j.empty());
+    bool usable = false;
+    for (const auto& d : j) usable = usable || d["usable"].get<bool>();
+    EXPECT_TRUE(usable);
+}
+
+TEST_F(Cli, UnknownDeviceIsAnError) {
+    const RunResult r = run("render " + kScene + " --device no-such-device --quiet -o " + path("x.exr"));
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.output.find("no-such-device"), std::string::npos);
+    EXPECT_FALSE(fs::exists(path("x.exr")));
+}
+
+}  // namespace
+}  // namespace gdpt
