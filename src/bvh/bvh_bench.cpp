@@ -5,6 +5,7 @@
 // one (different memory system and no SIMT divergence), so treat small differences as noise.
 //
 // Usage: gdpt_bvh_bench [maxTriangles=1000000] [rays=200000] [buildThreads=1]
+//                       [traversalCost=1] [intersectCost=1]
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -74,6 +75,8 @@ int main(int argc, char** argv) {
     const auto maxTriangles = static_cast<uint32_t>(argc > 1 ? std::atol(argv[1]) : 1000000);
     const auto rayCount = static_cast<uint32_t>(argc > 2 ? std::atol(argv[2]) : 200000);
     const auto buildThreads = static_cast<uint32_t>(argc > 3 ? std::atol(argv[3]) : 1);
+    const float traversalCost = argc > 4 ? std::strtof(argv[4], nullptr) : 1.0f;
+    const float intersectCost = argc > 5 ? std::strtof(argv[5], nullptr) : 1.0f;
     for (uint32_t size : {10000u, 100000u, 1000000u}) {
         if (size > maxTriangles) {
             continue;
@@ -97,6 +100,8 @@ int main(int argc, char** argv) {
                     opt.maxLeafSize = leaf;
                     opt.binCount = bins;
                     opt.buildThreads = buildThreads;
+                    opt.traversalCost = traversalCost;
+                    opt.intersectCost = intersectCost;
                     const gdpt::Bvh bvh = gdpt::buildBvh(scene.positions, scene.triangles, opt);
                     const auto geoms = gdpt::makeTriangleGeoms(scene.positions, scene.triangles,
                                                                bvh.triangleOrder);
@@ -113,10 +118,10 @@ int main(int argc, char** argv) {
                         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
                             .count();
                     std::printf(
-                        "{\"scene\":\"%s\",\"triangles\":%zu,\"maxLeafSize\":%u,\"binCount\":%u,"
+                        "{\"scene\":\"%s\",\"triangles\":%zu,\"maxLeafSize\":%u,\"binCount\":%u,\"ct\":%.2f,"
                         "\"buildMs\":%.1f,\"sahCost\":%.2f,\"nodes\":%u,\"maxDepth\":%u,"
                         "\"mraysPerS\":%.3f,\"nodesPerRay\":%.1f,\"hitFraction\":%.3f}\n",
-                        scene.name.c_str(), scene.triangles.size(), leaf, bins,
+                        scene.name.c_str(), scene.triangles.size(), leaf, bins, double(traversalCost),
                         bvh.stats.buildMs, double(bvh.stats.sahCost), bvh.stats.nodeCount,
                         bvh.stats.maxDepth, double(rayCount) / sec * 1e-6,
                         double(visits) / double(rayCount), double(hits) / double(rayCount));
