@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
         addDiffCommand(app),
         addInfoCommand(app),
         addDevicesCommand(app),
+        addBenchCommand(app),
     };
 
     try {

@@ -18,5 +18,6 @@ Subcommand addRenderCommand(CLI::App& app);
 Subcommand addDiffCommand(CLI::App& app);
 Subcommand addInfoCommand(CLI::App& app);
 Subcommand addDevicesCommand(CLI::App& app);
+Subcommand addBenchCommand(CLI::App& app);
 
 }  // namespace gdpt

@@ -1,0 +1,152 @@
+// bench_command.cpp — `gdpt bench`: prints machine-readable throughput figures (JSON): BVH
+// build ms, primary and incoherent (4-segment diffuse) rays/s, path-tracing samples/s and
+// rays/s, and per-kernel GPU ms, on the Cornell box and procedural scenes of ~10k, 100k and
+// 1M triangles (same camera). Every figure is the median over --repeats runs; compare
+// figures as ratios within one run (the machines are shared and noisy).
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "app/subcommand.h"
+#include "bvh/builder.h"
+#include "render/bench_pass.h"
+#include "render/renderer.h"
+#include "scene/procedural.h"
+#include "util/error.h"
+#include "util/timer.h"
+#include "vk/context.h"
+
+namespace gdpt {
+namespace {
+
+struct BenchArgs {
+    std::string scenes = "cbox,10k,100k,1m";
+    int width = 256;
+    int height = 256;
+    std::uint32_t spp = 4;
+    int repeats = 3;
+    std::string workgroup = "8x8";
+    std::string device;
+    std::string output = "-";
+};
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
+}
+
+Scene benchScene(const std::string& name) {
+    if (name == "cbox") return makeCornellBox();
+    if (name == "10k") return makeTriangleScene(10'000, 1);
+    if (name == "100k") return makeTriangleScene(100'000, 1);
+    if (name == "1m") return makeTriangleScene(1'000'000, 1);
+    throw UsageError("--scenes: unknown scene '" + name + "' (cbox, 10k, 100k, 1m)");
+}
+
+WorkgroupSize parseWg(const std::string& s) {
+    unsigned x = 0, y = 0;
+    char sep = 0;
+    std::istringstream in(s);
+    if (!(in >> x >> sep >> y) || sep != 'x' || x == 0 || y == 0 || x * y > 1024)
+        throw UsageError("--workgroup '" + s + "' must be WxH, e.g. 8x8");
+    return {x, y};
+}
+
+int runBench(const BenchArgs& a) {
+    using nlohmann::json;
+    vk::ContextOptions co;
+    co.device = a.device;
+    vk::Context ctx(co);
+    const WorkgroupSize wg = parseWg(a.workgroup);
+    json out = {{"device", ctx.info().name},
+                {"driver", ctx.info().driverInfo},
+                {"width", a.width},
+                {"height", a.height},
+                {"spp", a.spp},
+                {"repeats", a.repeats},
+                {"workgroup", a.workgroup},
+                {"scenes", json::array()}};
+    std::stringstream list(a.scenes);
+    std::string name;
+    while (std::getline(list, name, ',')) {
+        std::fprintf(stderr, "gdpt bench: %s\n", name.c_str());
+        const Scene scene = benchScene(name);
+        std::vector<double> buildMs;
+        for (int r = 0; r < a.repeats; ++r) buildMs.push_back(buildBvh(scene.positions, scene.triangles).stats.buildMs);
+
+        SceneGpuOptions so;
+        so.width = a.width;
+        so.height = a.height;
+        std::vector<double> primary, incoherent;
+        {
+            SceneGpu sceneGpu(ctx, scene, so);
+            BenchRaysPass pass(ctx, sceneGpu, wg);
+            pass.run(1, false, 99);  // warm-up: pipeline compilation happens lazily on some drivers
+            for (int r = 0; r < a.repeats; ++r) {
+                const auto p = pass.run(a.spp, false, static_cast<std::uint32_t>(r));
+                primary.push_back(static_cast<double>(p.rays) / p.seconds);
+                const auto i = pass.run(a.spp, true, static_cast<std::uint32_t>(r));
+                incoherent.push_back(static_cast<double>(i.rays) / i.seconds);
+            }
+        }
+        std::vector<double> ptSamples, ptRays, ptMs;
+        json kernels = json::object();
+        for (int r = 0; r < a.repeats; ++r) {
+            RenderOptions ro;
+            ro.scene = so;
+            ro.spp = a.spp;
+            ro.seed = static_cast<std::uint32_t>(r);
+            ro.quiet = true;
+            ro.profile = true;
+            ro.workgroup = wg;
+            const RenderResult res = renderPt(ctx, scene, ro);
+            const double s = res.stats.samplingMs * 1e-3;
+            ptSamples.push_back(static_cast<double>(res.stats.pathsCompleted) / s);
+            ptRays.push_back(static_cast<double>(res.stats.raysTraced) / s);
+            ptMs.push_back(res.stats.samplingMs);
+            for (const auto& [k, t] : res.stats.kernels)
+                kernels[k] = {{"count", t.count}, {"total_ms", t.totalMs}, {"ms_per_call", t.totalMs / double(t.count)}};
+        }
+        out["scenes"].push_back({{"scene", name},
+                                 {"triangles", scene.triangles.size()},
+                                 {"bvh_build_ms", median(buildMs)},
+                                 {"primary_rays_per_s", median(primary)},
+                                 {"incoherent_rays_per_s", median(incoherent)},
+                                 {"pt_samples_per_s", median(ptSamples)},
+                                 {"pt_rays_per_s", median(ptRays)},
+                                 {"pt_sampling_ms", median(ptMs)},
+                                 {"pt_kernels", kernels}});
+    }
+    const std::string text = out.dump(2) + "\n";
+    if (a.output == "-") {
+        std::fputs(text.c_str(), stdout);
+    } else {
+        FILE* f = std::fopen(a.output.c_str(), "w");
+        if (!f) throw Error(a.output + ": cannot write");
+        std::fputs(text.c_str(), f);
+        std::fclose(f);
+    }
+    return 0;
+}
+
+}  // namespace
+
+Subcommand addBenchCommand(CLI::App& app) {
+    auto args = std::make_shared<BenchArgs>();
+    CLI::App* b = app.add_subcommand("bench", "Throughput benchmark: BVH build, rays/s, PT samples/s (JSON)");
+    b->add_option("--scenes", args->scenes, "Comma-separated scenes: cbox, 10k, 100k, 1m")->capture_default_str();
+    b->add_option("--width", args->width, "Image width")->capture_default_str()->check(CLI::Range(1, 8192));
+    b->add_option("--height", args->height, "Image height")->capture_default_str()->check(CLI::Range(1, 8192));
+    b->add_option("--spp", args->spp, "Samples per pixel per measurement")->capture_default_str()->check(CLI::Range(1u, 4096u));
+    b->add_option("--repeats", args->repeats, "Repeats (the median is reported)")->capture_default_str()->check(CLI::Range(1, 100));
+    b->add_option("--workgroup", args->workgroup, "Compute workgroup size WxH")->capture_default_str();
+    b->add_option("--device", args->device, "Vulkan device index or name substring");
+    b->add_option("-o,--output", args->output, "Write the JSON here ('-' = stdout)")->capture_default_str();
+    return {b, [args] { return runBench(*args); }};
+}
+
+}  // namespace gdpt

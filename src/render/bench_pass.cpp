@@ -1,0 +1,57 @@
+#include "render/bench_pass.h"
+
+#include "bench_rays.spv.h"
+#include "render/scene_gpu.h"
+#include "util/timer.h"
+#include "vk/commands.h"
+#include "vk/context.h"
+
+namespace gdpt {
+namespace {
+vk::KernelDesc benchDesc(const SceneGpu& scene, WorkgroupSize wg) {
+    vk::KernelDesc d = vk::kernelDesc("bench_rays", kSpv_bench_rays);
+    d.bindings = SceneGpu::sceneBindings();
+    d.bindings.push_back(gpu::kBindCounters);
+    d.pushConstantBytes = sizeof(gpu::FrameParams);
+    d.specConstants = scene.specConstants();
+    d.specConstants.push_back({gpu::kSpecWorkgroupX, wg.x});
+    d.specConstants.push_back({gpu::kSpecWorkgroupY, wg.y});
+    d.localSizeX = wg.x;
+    d.localSizeY = wg.y;
+    return d;
+}
+}  // namespace
+
+BenchRaysPass::BenchRaysPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg)
+    : ctx_(ctx),
+      width_(scene.constants().width),
+      height_(scene.constants().height),
+      kernel_(ctx, benchDesc(scene, wg)),
+      counters_(ctx, sizeof(gpu::Counters), "bench counters") {
+    scene.bindTo(kernel_);
+    kernel_.bind(gpu::kBindCounters, counters_);
+}
+
+BenchRaysPass::Result BenchRaysPass::run(std::uint32_t spp, bool incoherent, std::uint32_t seed) {
+    counters_.zero();
+    vk::CommandStream stream(ctx_, incoherent ? "bench incoherent rays" : "bench primary rays");
+    gpu::FrameParams p{};
+    p.samplesPerPixel = spp;
+    p.seed = seed;
+    p.rowOffset = 0;
+    p.rowCount = height_;
+    p.pad0 = incoherent ? 1u : 0u;
+    VkCommandBuffer cmd = stream.begin();
+    kernel_.dispatchItems(cmd, width_, height_, &p);
+    vk::computeBarrier(cmd);
+    Timer t;
+    stream.submitAndWait();
+    Result r;
+    r.seconds = t.seconds();
+    gpu::Counters c{};
+    counters_.download(&c, sizeof c);
+    r.rays = c.raysTraced;
+    return r;
+}
+
+}  // namespace gdpt
