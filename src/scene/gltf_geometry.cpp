@@ -119,6 +119,10 @@ const unsigned char* checkedRange(const tinygltf::Model& model, int view, std::u
                     std::to_string(viewEnd) + ") but buffer " + std::to_string(bv.buffer) +
                     " has only " + std::to_string(bufferSize) + " bytes (missing or short buffer)");
     if (count == 0) return nullptr;
+    if (byteOffset > bv.byteLength || stride > (1ull << 32) || elemSize > stride)
+        throw Error(label + ": byteOffset " + std::to_string(byteOffset) + " / stride " +
+                    std::to_string(stride) + " do not fit bufferView " + std::to_string(view) +
+                    " of " + std::to_string(bv.byteLength) + " bytes");
     // count <= kMaxAccessorCount and stride <= 2^32, so this cannot overflow 64 bits.
     const std::uint64_t needEnd = byteOffset + (count - 1) * stride + elemSize;
     if (needEnd > bv.byteLength)

@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include <stb/stb_image.h>
 
@@ -26,13 +27,29 @@ float srgbToLinear(float c) {
 
 bool decodeImage(tinygltf::Image* image, int imageIndex, std::string* err, std::string* /*warn*/,
                  int /*reqWidth*/, int /*reqHeight*/, const unsigned char* bytes, int size,
-                 void* /*userData*/) {
+                 void* userData) {
     const std::string label = "image " + std::to_string(imageIndex) +
                               (image->name.empty() ? std::string() : " '" + image->name + "'");
     auto fail = [&](const std::string& why) {
         if (err) *err += label + ": " + why + "\n";
         return false;
     };
+    // tinygltf 2.7.0 hands over &buffer.data[view.byteOffset] and view.byteLength for images
+    // stored in a bufferView without checking them against the buffer (found by the
+    // mutation test), so check here, before reading a byte. userData is the Model being
+    // filled; its buffers and bufferViews are complete when images are decoded.
+    const auto* model = static_cast<const tinygltf::Model*>(userData);
+    if (model != nullptr && image->bufferView >= 0) {
+        const auto view = static_cast<std::size_t>(image->bufferView);
+        if (view >= model->bufferViews.size()) return fail("bufferView out of range");
+        const tinygltf::BufferView& bv = model->bufferViews[view];
+        if (bv.buffer < 0 || static_cast<std::size_t>(bv.buffer) >= model->buffers.size())
+            return fail("bufferView " + std::to_string(view) + ": buffer out of range");
+        const std::uint64_t end = std::uint64_t(bv.byteOffset) + std::uint64_t(bv.byteLength);
+        if (end < bv.byteOffset || end > model->buffers[static_cast<std::size_t>(bv.buffer)].data.size() ||
+            bv.byteLength > std::uint64_t(std::numeric_limits<int>::max()))
+            return fail("bufferView " + std::to_string(view) + " lies outside its buffer");
+    }
     if (bytes == nullptr || size <= 0) return fail("no image data");
     int w = 0, h = 0, comp = 0;
     if (!stbi_info_from_memory(bytes, size, &w, &h, &comp))

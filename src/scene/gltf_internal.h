@@ -63,7 +63,8 @@ void addMeshInstance(Context& ctx, const MeshInstance& inst, bool sceneHasNormal
 void convertMaterials(Context& ctx);
 std::uint32_t materialIndex(Context& ctx, int material);
 
-// Decodes PNG/JPEG bytes for tinygltf (gltf_images.cpp); registered with SetImageLoader.
+// Decodes PNG/JPEG bytes for tinygltf (gltf_images.cpp); registered with SetImageLoader
+// with userData = the tinygltf::Model being loaded (used to bounds-check bufferView images).
 bool decodeImage(tinygltf::Image* image, int imageIndex, std::string* err, std::string* warn,
                  int reqWidth, int reqHeight, const unsigned char* bytes, int size,
                  void* userData);

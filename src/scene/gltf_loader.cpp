@@ -13,6 +13,7 @@
 #include <set>
 #include <sstream>
 
+#include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -194,7 +195,7 @@ void addCamera(gltf::Context& ctx, const tinygltf::Node& node, const glm::dmat4&
         return;
     }
     const double yfov = cam.perspective.yfov;
-    if (!(yfov > 0.0 && yfov < M_PI))
+    if (!(yfov > 0.0 && yfov < glm::pi<double>()))
         throw Error(label + ": yfov " + std::to_string(yfov) + " is not in (0, pi)");
     Camera out;
     out.name = cam.name.empty() ? node.name : cam.name;
@@ -245,7 +246,7 @@ void addLight(gltf::Context& ctx, const tinygltf::Value& ext, const glm::dmat4& 
         out.cosInner = out.cosOuter = -1.0f;
     } else if (light.type == "spot") {
         const double inner = light.spot.innerConeAngle, outer = light.spot.outerConeAngle;
-        if (!(inner >= 0.0 && inner < outer && outer <= M_PI / 2))
+        if (!(inner >= 0.0 && inner < outer && outer <= glm::half_pi<double>()))
             throw Error(label + ": spot cone angles must satisfy 0 <= inner < outer <= pi/2");
         out.type = gpu::kPunctualSpot;
         out.cosInner = static_cast<float>(std::cos(inner));
@@ -261,7 +262,7 @@ Scene loadImpl(const std::string& path) {
     const std::vector<unsigned char> bytes = readFile(path);
     tinygltf::Model model;
     tinygltf::TinyGLTF parser;
-    parser.SetImageLoader(&gltf::decodeImage, nullptr);
+    parser.SetImageLoader(&gltf::decodeImage, &model);  // model: see decodeImage
     std::string err, warn;
     std::string baseDir = std::filesystem::path(path).parent_path().string();
     if (baseDir.empty()) baseDir = ".";

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include <gtest/gtest.h>
+#include <stb/stb_image_write.h>
 
 #include "gltf_test_writer.h"
 #include "scene/gltf_loader.h"
@@ -225,6 +226,15 @@ TEST(GltfErrors, UndecodableImage) {
     expectError(g.writeGltf(test::testDir(), "img"), {"image 0", "cannot decode"});
 }
 
+TEST(GltfErrors, ImageBufferViewOutsideBuffer) {
+    // tinygltf does not check this itself; it would hand the decoder a wild pointer.
+    auto g = test::oneTriangle();
+    g.doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 1 << 20}, {"byteLength", 64}});
+    g.doc["images"] = nlohmann::json::array(
+        {{{"bufferView", g.doc["bufferViews"].size() - 1}, {"mimeType", "image/png"}}});
+    expectError(g.writeGltf(test::testDir(), "imgbv"), {"image 0", "lies outside its buffer"});
+}
+
 TEST(GltfErrors, MissingExternalImage) {
     auto g = test::oneTriangle();
     g.doc["images"] = nlohmann::json::array({{{"uri", "nowhere.png"}}});
@@ -291,6 +301,68 @@ TEST(GltfErrors, MutatedFilesNeverCrash) {
             }
         }
     }
+}
+
+// Structural mutations: random integer fields of a richer document (camera, light, sparse
+// accessor, texture) are replaced by boundary values (-1, 0, 1, 2, 3, large). Each load
+// must succeed or throw gdpt::Error. Run under GDPT_SANITIZE to catch silent memory errors.
+TEST(GltfErrors, MutatedIndicesNeverCrash) {
+    const std::string dir = test::testDir();
+    auto g = test::oneTriangle();
+    const std::vector<std::uint32_t> sparseIdx = {2};
+    const std::vector<glm::vec3> sparseVal = {{0, 2, 0}};
+    const int iv = g.addView(sparseIdx.data(), 4), vv = g.addView(sparseVal.data(), 12);
+    g.doc["accessors"][0]["sparse"] = {{"count", 1},
+                                       {"indices", {{"bufferView", iv}, {"componentType", test::kUInt}}},
+                                       {"values", {{"bufferView", vv}}}};
+    // A valid 1x1 PNG in a bufferView, so that the base document loads completely.
+    std::vector<unsigned char> png;
+    const unsigned char pixel[4] = {200, 100, 50, 255};
+    stbi_write_png_to_func(
+        [](void* ctx, void* data, int size) {
+            auto* v = static_cast<std::vector<unsigned char>*>(ctx);
+            v->insert(v->end(), static_cast<unsigned char*>(data), static_cast<unsigned char*>(data) + size);
+        },
+        &png, 1, 1, 4, pixel, 4);
+    g.doc["cameras"] = nlohmann::json::array(
+        {{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}}}}});
+    g.doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}}};
+    g.addNode({{"camera", 0}, {"children", {}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    g.doc["scenes"][0]["nodes"].push_back(1);
+    g.doc["textures"] = nlohmann::json::array({{{"source", 0}}});
+    g.doc["images"] = nlohmann::json::array(
+        {{{"bufferView", g.addView(png.data(), png.size())}, {"mimeType", "image/png"}}});
+    g.addMaterial({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+    g.doc["meshes"][0]["primitives"][0]["material"] = 0;
+    const Scene base = loadGltf(g.writeGltf(dir, "base"));
+    ASSERT_EQ(base.textures.size(), 1u);
+    ASSERT_EQ(base.punctualLights.size(), 1u);
+    ASSERT_EQ(base.positions[2], glm::vec3(0, 2, 0));  // sparse substitution applied
+
+    // Collect JSON pointers of all integer fields.
+    std::vector<nlohmann::json::json_pointer> fields;
+    const nlohmann::json flat = g.doc.flatten();
+    for (auto it = flat.begin(); it != flat.end(); ++it)
+        if (it.value().is_number_integer()) fields.emplace_back(it.key());
+    ASSERT_GT(fields.size(), 20u);
+    const std::int64_t values[] = {-1, 0, 1, 2, 3, 5, 4096, 4294967295ll, 1ll << 40};
+    std::uint32_t state = 99u;
+    auto rnd = [&] { return state = state * 1664525u + 1013904223u; };
+    int loaded = 0;
+    for (int iter = 0; iter < 300; ++iter) {
+        TestGltf m = g;
+        const int edits = 1 + static_cast<int>(rnd() % 3);
+        for (int e = 0; e < edits; ++e)
+            m.doc[fields[rnd() % fields.size()]] = values[rnd() % std::size(values)];
+        try {
+            (void)loadGltf(m.writeGltf(dir, "mut"));
+            ++loaded;
+        } catch (const Error&) {
+        }
+    }
+    // Both outcomes occur: the mutations reach the checks, and not every mutation is fatal.
+    EXPECT_GT(loaded, 0);
+    EXPECT_LT(loaded, 300);
 }
 
 }  // namespace

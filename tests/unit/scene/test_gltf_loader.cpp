@@ -102,7 +102,7 @@ TEST(GltfLoader, SharedCornellBox) {
     expectNear(s.cameras[0].position, {0, 1, 6.8f}, 1e-6f);
     expectNear(s.cameras[0].forward, {0, 0, -1}, 1e-6f);
     expectNear(s.cameras[0].up, {0, 1, 0}, 1e-6f);
-    EXPECT_NEAR(s.cameras[0].yfov, 19.5 * M_PI / 180.0, 1e-6);
+    EXPECT_NEAR(s.cameras[0].yfov, 19.5 * glm::pi<double>() / 180.0, 1e-6);
     EXPECT_TRUE(s.unsupported.empty()) << describeScene(s);
 }
 
