@@ -1,0 +1,180 @@
+// shift.glsl — the pure mathematics of the gradient-domain shift mapping (Kettunen et al.
+// 2015, "Gradient-Domain Path Tracing", §4 and the reference code summarised in
+// GPT_REFERENCE §1.3–1.6), in the GLSL/C++ common subset so the CPU unit tests run exactly
+// the code gpt.comp runs.
+//
+// Conventions (as bsdf.glsl): local shading space is z-up; `wo` points from a vertex back
+// towards the previous vertex (the camera side), `wi` is the direction the path continues
+// in (the sampled direction). All pdfs are per steradian (pdfSolidAngle) unless the name
+// says otherwise; Dirac lobes use their discrete selection probability.
+//
+// Ratio form (GPT_REFERENCE §7.1): a path's pdf product can underflow float32 after a few
+// bounces, so gpt.comp never forms it. It carries, per offset, the throughput f'/p (offset
+// measurement contribution divided by the BASE path's pdf, Jacobians included) and the
+// ratio r = J·p'/p of the offset path's density (in the base's measure) to the base's. MIS
+// weights are written in terms of per-segment pdfs and that ratio.
+#ifndef GDPT_LIB_SHIFT
+#define GDPT_LIB_SHIFT
+
+#include "common.glsl"
+#include "sampling.glsl"
+#include "bsdf.glsl"
+
+GDPT_NAMESPACE_BEGIN
+
+// Connection status of an offset path (Kettunen et al. 2015 §4.2; reference gpt.cpp).
+GDPT_CONST uint kShiftNotConnected = 0u;       // offset has its own vertices so far
+GDPT_CONST uint kShiftRecentlyConnected = 1u;  // offset reconnected to the base's current vertex
+GDPT_CONST uint kShiftConnected = 2u;          // offset shares every later vertex with the base
+
+// ---------------------------------------------------------------------------------------------
+// Vertex classification (GPT_REFERENCE §1.3)
+// ---------------------------------------------------------------------------------------------
+
+// Roughness of the component the base path sampled, applied to a (base or offset) BSDF.
+// Wraps bsdfRoughnessForShift, which assumes the lobe exists: a material without a
+// glossy/mirror layer has only its diffuse lobe, so it counts as fully rough (1) whatever
+// the base sampled (e.g. a Lambertian with roughnessFactor 0 is not a mirror).
+GDPT_INLINE float shiftRoughnessSampled(BsdfParams m, uint sampledLobe) {
+    if (sampledLobe == kLobeDiffuse || !bsdfHasGlossyOrMirror(m)) {
+        return 1.0f;
+    }
+    return bsdfRoughnessForShift(m, sampledLobe);
+}
+
+// Lowest roughness over the smooth (non-Dirac) components: the classification of a vertex
+// for next-event estimation, which evaluates only those (reference: BSDF::ESmooth).
+GDPT_INLINE float shiftRoughnessSmooth(BsdfParams m) {
+    if (bsdfHasGlossyOrMirror(m) && m.alpha >= kDeltaAlpha) {
+        return sqrt(m.alpha);
+    }
+    return 1.0f;
+}
+
+// Lowest roughness over all components present (reference: BSDF::EAll), used for the base's
+// next vertex before it has sampled anything there. A Dirac layer counts as 0. A BSDF with
+// no lobe at all (a black emitter) is rough: nothing can be half-vector shifted through it.
+GDPT_INLINE float shiftRoughnessAll(BsdfParams m) {
+    if (bsdfHasGlossyOrMirror(m)) {
+        return m.alpha < kDeltaAlpha ? 0.0f : sqrt(m.alpha);
+    }
+    return 1.0f;
+}
+
+// "Diffuse" (reconnectable) iff roughness > threshold (GPT_REFERENCE §1.1 shiftThreshold).
+GDPT_INLINE bool shiftIsRough(float roughness, float threshold) {
+    return roughness > threshold;
+}
+
+// Reconnection shift iff base current, base next and offset current vertices are all rough
+// (GPT_REFERENCE §1.4); otherwise the half-vector copy shift.
+GDPT_INLINE bool shiftUseReconnection(bool baseCurRough, bool baseNextRough, bool offsetCurRough) {
+    return baseCurRough && baseNextRough && offsetCurRough;
+}
+
+// Invertibility of a half-vector step: the reverse shift (offset path as base) reconnects iff
+// its current vertex (the offset's), its next vertex (the offset's new one) and its offset
+// vertex (the base's current one) are all rough. Then the forward half-vector step has no
+// inverse and must fail (GPT_REFERENCE §1.4 "invertibility check").
+GDPT_INLINE bool shiftHalfVectorInvertible(bool baseCurRough, bool offsetCurRough, bool offsetNextRough) {
+    return !(baseCurRough && offsetCurRough && offsetNextRough);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Jacobians (Kettunen et al. 2015 §4.2, eqs. 11–12; GPT_REFERENCE §1.4)
+// ---------------------------------------------------------------------------------------------
+
+// Reconnection shift: the base continues from baseFrom to `target` (geometric normal
+// targetNormal); the offset connects offsetFrom to the same target. The Jacobian of the map
+// from the base's sampled direction to the offset's (both per steradian) is
+//   |dω'/dω| = (|cos θ'_target| / |cos θ_target|) · (|target − baseFrom|² / |target − offsetFrom|²),
+// i.e. the ratio of the two solid-angle-to-area conversions (Veach 1997 eq. 8.10).
+// Returns 0 for a degenerate configuration (grazing base edge, coincident points).
+GDPT_INLINE float reconnectionJacobian(vec3 baseFrom, vec3 offsetFrom, vec3 target, vec3 targetNormal) {
+    vec3 eBase = baseFrom - target;
+    vec3 eOffset = offsetFrom - target;
+    float dist2Base = dot(eBase, eBase);
+    float dist2Offset = dot(eOffset, eOffset);
+    if (!(dist2Base > 0.0f) || !(dist2Offset > 0.0f)) {
+        return 0.0f;
+    }
+    // |cos| = |n·e| / |e|, so the ratio is |n·e'| |e| / (|n·e| |e'|); with d² / d'² this is
+    // |n·e'| |e|³ / (|n·e| |e'|³).
+    float cosBaseTimesLen = abs(dot(targetNormal, eBase));
+    float cosOffsetTimesLen = abs(dot(targetNormal, eOffset));
+    if (!(cosBaseTimesLen > 0.0f)) {
+        return 0.0f;
+    }
+    float lenRatio = sqrt(dist2Base / dist2Offset);  // |e| / |e'|
+    float jacobianShift = (cosOffsetTimesLen / cosBaseTimesLen) * lenRatio * lenRatio * lenRatio;
+    return isFinite(jacobianShift) ? jacobianShift : 0.0f;
+}
+
+// Half-vector copy shift for reflection (Kettunen et al. 2015 §4.2; Lehtinen et al. 2013
+// §5.2): the base's local half vector h = normalize(woBase + wiBase) is reused at the
+// offset vertex, wiOffset = reflect(-woOffset, h) = 2 (woOffset·h) h − woOffset. All vectors
+// are in the respective vertex's local shading frame. Since dω_i = 4 |ω_i·h| dh for
+// reflection, the Jacobian of ω_i → ω_i' at fixed h is
+//   |dω_i'/dω_i| = |wiOffset·h| / |wiBase·h|            (= |ω_o'·h| / |ω_o·h| in Mitsuba's names).
+// For a Dirac (mirror) lobe h = n and the Jacobian is 1 (the caller sets it; point
+// evaluation). Returns false when h is undefined (wo = −wi) or the Jacobian degenerates.
+GDPT_INLINE bool halfVectorReflect(vec3 woBase, vec3 wiBase, vec3 woOffset, GDPT_OUT(vec3) wiOffset,
+                                   GDPT_OUT(float) jacobianShift) {
+    wiOffset = vec3(0.0f, 0.0f, 1.0f);
+    jacobianShift = 0.0f;
+    vec3 h = woBase + wiBase;
+    float hLen2 = dot(h, h);
+    if (!(hLen2 > 1e-12f)) {
+        return false;
+    }
+    h = h * inversesqrt(hLen2);
+    float cosBase = abs(dot(wiBase, h));
+    float woOffsetDotH = dot(woOffset, h);
+    wiOffset = 2.0f * woOffsetDotH * h - woOffset;
+    // Reflection about h preserves the angle: |wiOffset·h| = |woOffset·h|.
+    float cosOffset = abs(woOffsetDotH);
+    if (!(cosBase > 0.0f) || !(cosOffset > 0.0f)) {
+        return false;
+    }
+    jacobianShift = cosOffset / cosBase;
+    return isFinite(jacobianShift);
+}
+
+// ---------------------------------------------------------------------------------------------
+// MIS between base and offset (GPT_REFERENCE §1.6, §7.1), ratio form
+// ---------------------------------------------------------------------------------------------
+
+// Power heuristic over the four strategies {own technique, other technique} × {base, offset}
+// (Veach 1997 eq. 9.13 with the path-prefix pdf divided out, GPT_REFERENCE §7.1):
+//   w = pOwn² / (pOwn² + pOther² + qOwn² + qOther²)
+// pOwn/pOther: the base's last-segment pdfs (e.g. BSDF and light, solid angle at the base
+// vertex); qOwn/qOther: the offset's, multiplied by the prefix ratio r = J·p'/p and by the
+// last segment's Jacobian, i.e. already in the base's measure. The sum is normalised by its
+// largest term first, so no square overflows or underflows (GGX pdfs reach 1e20). A zero
+// pOther/qOther removes that strategy. Returns 0 for pOwn <= 0 or any NaN.
+GDPT_INLINE float gptMisWeight(float pOwn, float pOther, float qOwn, float qOther) {
+    if (!(pOwn > 0.0f) || !(pOther >= 0.0f) || !(qOwn >= 0.0f) || !(qOther >= 0.0f)) {
+        return 0.0f;
+    }
+    float m = max(max(pOwn, pOther), max(qOwn, qOther));
+    if (!isFinite(m)) {
+        // Only the own pdf can win against an infinite competitor if it is the infinite one.
+        return isFinite(pOwn) ? 0.0f : 1.0f;
+    }
+    float a = pOwn / m;
+    float b = pOther / m;
+    float c = qOwn / m;
+    float d = qOther / m;
+    // The largest term is exactly 1, so the denominator is in [1, 4].
+    return a * a / (a * a + b * b + c * c + d * d);
+}
+
+// Two strategies {base, offset} of one technique (half-vector branch, environment, Dirac):
+// w = p² / (p² + (J p')²) = 1 / (1 + r²) with r = J·p'/p of the whole path.
+GDPT_INLINE float gptMisWeightPair(float ratioOffsetToBase) {
+    return powerHeuristicRatio(ratioOffsetToBase);
+}
+
+GDPT_NAMESPACE_END
+
+#endif  // GDPT_LIB_SHIFT

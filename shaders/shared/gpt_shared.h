@@ -1,0 +1,72 @@
+// gpt_shared.h — host/shader interface of gradient-domain path tracing (gpt.comp and
+// gpt_resolve.comp). Same rules as gdpt_shared.h, which it extends: C++17 and GLSL 460,
+// layout(scalar), no bool, append-only structs, units/space of every field in its comment,
+// and binding numbers / spec ids defined only here (they do not collide with
+// gdpt_shared.h's, which this file checks under C++).
+#ifndef GDPT_GPT_SHARED_H
+#define GDPT_GPT_SHARED_H
+
+#include "gdpt_shared.h"
+
+#ifdef __cplusplus
+namespace gdpt::gpu {
+#endif
+
+// Neighbour order of the offset paths (GPT_REFERENCE §1.2): right, down, left, up, with
+// +y = next image row. Offset i starts at the base's sub-pixel position + kGptOffset[i].
+GDPT_CONST uint kGptRight = 0u;
+GDPT_CONST uint kGptDown = 1u;
+GDPT_CONST uint kGptLeft = 2u;
+GDPT_CONST uint kGptUp = 3u;
+GDPT_CONST uint kGptNumOffsets = 4u;
+
+// Per-batch push constants of gpt.comp and gpt_resolve.comp (<= 128 bytes). 32 bytes.
+struct GptFrameParams {
+    uint sampleBase;       // index of the first sample of this batch (per pixel)
+    uint samplesPerPixel;  // samples per pixel in this batch
+    uint seed;             // user seed
+    uint rowOffset;        // first image row of this dispatch (dispatch tiling)
+    uint rowCount;         // rows in this dispatch
+    float shiftThreshold;  // roughness (perceptual, sqrt of GGX alpha) at or below which a
+                           // vertex is glossy/specular (half-vector shift); reference 0.001
+    uint pad0;
+    uint pad1;
+};
+
+// Resolved per-pixel output of gpt_resolve.comp (linear RGB radiance, W/(m^2 sr)). 84 bytes;
+// 77 MB for 1280x720, below lavapipe's 128 MiB maxStorageBufferRange.
+struct GptResolved {
+    vec3 primal;      // indirect ("throughput") estimate of I(p): average of the pair estimators
+    vec3 dx;          // forward difference I(x+1,y) - I(x,y); 0 in the last column
+    vec3 dy;          // forward difference I(x,y+1) - I(x,y); 0 in the last row
+    vec3 direct;      // emission seen directly by the camera ("very direct")
+    vec3 varPrimal;   // variance of the primal estimate (of the mean, not per sample)
+    vec3 varDx;       // variance of the dx estimate
+    vec3 varDy;       // variance of the dy estimate
+};
+
+// Descriptor bindings of the G-PT pipelines (set 0). The scene uses kBindTriGeom ..
+// kBindSceneConst and the counters kBindCounters of gdpt_shared.h; the per-pixel statistics
+// (PixelStats each, one buffer per quantity so none exceeds 128 MiB) follow here.
+GDPT_ENUM_BEGIN(GptBinding)
+    kBindGptCentral = 12u,    // base's MIS-weighted radiance summed over the pairs of pixel p
+    kBindGptNeighbor0 = 13u,  // offset i's MIS-weighted radiance (belongs to pixel p + δ_i), i = 0..3
+    kBindGptNeighbor1 = 14u,
+    kBindGptNeighbor2 = 15u,
+    kBindGptNeighbor3 = 16u,
+    kBindGptGradient0 = 17u,  // MIS-weighted f_offset − f_base of direction i, i = 0..3
+    kBindGptGradient1 = 18u,
+    kBindGptGradient2 = 19u,
+    kBindGptGradient3 = 20u,
+    kBindGptDirect = 21u,     // very-direct emission (first hit seen from the camera)
+    kBindGptResolved = 22u    // GptResolved[] written by gpt_resolve.comp
+GDPT_ENUM_END();
+
+#ifdef __cplusplus
+static_assert(sizeof(GptFrameParams) == 32, "GptFrameParams layout");
+static_assert(sizeof(GptResolved) == 84, "GptResolved layout (scalar)");
+static_assert(kBindGptCentral > kBindCount && kBindGptResolved < kBindTestInput,
+              "G-PT bindings must not collide with gdpt_shared.h's");
+}  // namespace gdpt::gpu
+#endif
+#endif  // GDPT_GPT_SHARED_H
