@@ -81,7 +81,7 @@ int runBench(const BenchArgs& a) {
         SceneGpuOptions so;
         so.width = a.width;
         so.height = a.height;
-        std::vector<double> primary, incoherent;
+        std::vector<double> primary, incoherent, primaryCpu, incoherentCpu;
         {
             SceneGpu sceneGpu(ctx, scene, so);
             BenchRaysPass pass(ctx, sceneGpu, wg);
@@ -89,11 +89,13 @@ int runBench(const BenchArgs& a) {
             for (int r = 0; r < a.repeats; ++r) {
                 const auto p = pass.run(a.spp, false, static_cast<std::uint32_t>(r));
                 primary.push_back(static_cast<double>(p.rays) / p.seconds);
+                primaryCpu.push_back(static_cast<double>(p.rays) / p.cpuSeconds);
                 const auto i = pass.run(a.spp, true, static_cast<std::uint32_t>(r));
                 incoherent.push_back(static_cast<double>(i.rays) / i.seconds);
+                incoherentCpu.push_back(static_cast<double>(i.rays) / i.cpuSeconds);
             }
         }
-        std::vector<double> ptSamples, ptRays, ptMs;
+        std::vector<double> ptSamples, ptRays, ptMs, ptRaysCpu;
         json kernels = json::object();
         for (int r = 0; r < a.repeats; ++r) {
             RenderOptions ro;
@@ -103,11 +105,14 @@ int runBench(const BenchArgs& a) {
             ro.quiet = true;
             ro.profile = true;
             ro.workgroup = wg;
+            const double cpu0 = processCpuSeconds();
             const RenderResult res = renderPt(ctx, scene, ro);
+            const double cpu = processCpuSeconds() - cpu0;
             const double s = res.stats.samplingMs * 1e-3;
             ptSamples.push_back(static_cast<double>(res.stats.pathsCompleted) / s);
             ptRays.push_back(static_cast<double>(res.stats.raysTraced) / s);
             ptMs.push_back(res.stats.samplingMs);
+            ptRaysCpu.push_back(static_cast<double>(res.stats.raysTraced) / cpu);
             for (const auto& [k, t] : res.stats.kernels)
                 kernels[k] = {{"count", t.count}, {"total_ms", t.totalMs}, {"ms_per_call", t.totalMs / double(t.count)}};
         }
@@ -116,8 +121,11 @@ int runBench(const BenchArgs& a) {
                                  {"bvh_build_ms", median(buildMs)},
                                  {"primary_rays_per_s", median(primary)},
                                  {"incoherent_rays_per_s", median(incoherent)},
+                                 {"primary_rays_per_cpu_s", median(primaryCpu)},
+                                 {"incoherent_rays_per_cpu_s", median(incoherentCpu)},
                                  {"pt_samples_per_s", median(ptSamples)},
                                  {"pt_rays_per_s", median(ptRays)},
+                                 {"pt_rays_per_cpu_s", median(ptRaysCpu)},
                                  {"pt_sampling_ms", median(ptMs)},
                                  {"pt_kernels", kernels}});
     }

@@ -45,9 +45,11 @@ BenchRaysPass::Result BenchRaysPass::run(std::uint32_t spp, bool incoherent, std
     kernel_.dispatchItems(cmd, width_, height_, &p);
     vk::computeBarrier(cmd);
     Timer t;
+    const double cpu0 = processCpuSeconds();
     stream.submitAndWait();
     Result r;
     r.seconds = t.seconds();
+    r.cpuSeconds = processCpuSeconds() - cpu0;
     gpu::Counters c{};
     counters_.download(&c, sizeof c);
     r.rays = c.raysTraced;

@@ -19,7 +19,9 @@ public:
     // (rays traced, seconds of GPU time measured by timestamps, or wall time without them).
     struct Result {
         std::uint64_t rays = 0;
-        double seconds = 0.0;
+        double seconds = 0.0;     // wall time of the submission
+        double cpuSeconds = 0.0;  // process CPU time (user + system) spent meanwhile: on a
+                                  // CPU device this is the work done, insensitive to load
     };
     Result run(std::uint32_t spp, bool incoherent, std::uint32_t seed);
 
