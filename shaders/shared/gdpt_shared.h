@@ -217,7 +217,9 @@ GDPT_ENUM_BEGIN(SceneBinding)
     kBindSceneConst = 8u,
     kBindAccum = 9u,
     kBindCounters = 10u,
-    kBindCount = 11u
+    kBindCount = 11u,
+    kBindPathState = 12u,   // wavefront schedule: PathState per path
+    kBindPathHits = 13u     // wavefront schedule: closest hit per path (t, u, v, triangle bits)
 GDPT_ENUM_END();
 
 // Bindings used only by test kernels (tests/gpu/kernels), kept here so no number repeats.
@@ -247,6 +249,27 @@ struct TestRay {
     vec3 dir;     // world space, not necessarily unit
     float tMax;
 };
+
+// State of one path between the kernels of the wavefront schedule (wf_extend.comp,
+// wf_shade.comp); the megakernel keeps the same struct in registers. 80 bytes.
+struct PathState {
+    vec3 origin;     // world-space origin of the next segment
+    uint pixel;      // y * width + x
+    vec3 dir;        // unit direction of the next segment
+    float prevPdf;   // solid-angle pdf of the BSDF sample that chose dir
+    vec3 beta;       // path throughput f/p so far
+    uint flags;      // kPathFlag*
+    vec3 radiance;   // radiance gathered so far
+    uint rng;        // Rng state
+    vec3 prevP;      // position of the vertex that spawned the segment (for MIS)
+    uint depth;      // index of the vertex the next hit will be (0 = first hit)
+    uint rays;       // rays traced by this path so far
+    uint pad0;
+    uint pad1;
+    uint pad2;
+};
+GDPT_CONST uint kPathFlagAlive = 1u;
+GDPT_CONST uint kPathFlagPrevSpecular = 2u;  // camera ray or Dirac bounce: no MIS on emission
 
 #ifdef __cplusplus
 }  // namespace gdpt::gpu

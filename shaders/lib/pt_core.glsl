@@ -1,0 +1,144 @@
+// pt_core.glsl — one vertex of the unidirectional path tracer, shared by the megakernel
+// (pt.comp) and the wavefront schedule (wf_shade.comp) so that both compute the same
+// estimator. GLSL only; the including kernel has declared the scene buffers and included
+// scene_access.glsl and bvh_traverse.glsl.
+//
+// Estimator (Veach 1997 ch. 9; pbrt-v4 PathIntegrator): at every non-Dirac vertex one light
+// sample (NEE to an emissive triangle chosen in proportion to power, or to a punctual
+// light) and one BSDF sample; emission found by the BSDF sample is weighted against NEE by
+// the power heuristic. Russian roulette from scene.rrDepth segments on with survival
+// probability min(max(throughput), 0.95). The constant environment is reached only by BSDF
+// sampling. Depth convention (pbrt): vertex `depth` is reached after depth bounces; paths end
+// after scene.maxDepth bounces.
+#ifndef GDPT_LIB_PT_CORE
+#define GDPT_LIB_PT_CORE
+
+vec3 cameraRay(vec2 pixelPos) {
+    vec2 ndc = vec2(2.0 * pixelPos.x / float(scene.width) - 1.0,
+                    1.0 - 2.0 * pixelPos.y / float(scene.height));
+    vec3 d = scene.camForward + ndc.x * scene.tanHalfFovY * scene.aspect * scene.camRight +
+             ndc.y * scene.tanHalfFovY * scene.camUp;
+    return normalize(d);
+}
+
+// Starts the path of sample `sampleIndex` of pixel (x, y): box filter, so the sample
+// position is uniform over the pixel square.
+PathState ptBegin(uint x, uint y, uint sampleIndex, uint seed) {
+    PathState s;
+    s.pixel = y * scene.width + x;
+    Rng rng = rngInit(s.pixel, sampleIndex, seed);
+    vec2 jitter = rngNext2(rng);
+    s.origin = scene.camPosition;
+    s.dir = cameraRay(vec2(x, y) + jitter);
+    s.prevPdf = 0.0;
+    s.beta = vec3(1.0);
+    s.flags = kPathFlagAlive | kPathFlagPrevSpecular;
+    s.radiance = vec3(0.0);
+    s.rng = rng.state;
+    s.prevP = s.origin;
+    s.depth = 0u;
+    s.rays = 0u;
+    return s;
+}
+
+// Consumes the closest hit of the current segment; updates the state to the next segment
+// or clears kPathFlagAlive.
+void ptProcessHit(inout PathState s, Hit hit) {
+    Rng rng;
+    rng.state = s.rng;
+    s.rays++;
+    s.flags &= ~kPathFlagAlive;  // set again below if the path continues
+    if (hit.triangle == kInvalidIndex) {
+        if (kHasEnv) s.radiance += s.beta * scene.envRadiance;
+        return;
+    }
+    vec3 d = s.dir;
+    SurfaceHit sh = makeSurfaceHit(hit.triangle, hit.u, hit.v, d);
+    vec3 Le = surfaceEmission(sh);
+    if (kHasLightTris && maxComponent(Le) > 0.0) {
+        float w = 1.0;
+        if ((s.flags & kPathFlagPrevSpecular) == 0u) {
+            vec3 nl = normalize(cross(triGeoms[sh.triangle].e1, triGeoms[sh.triangle].e2));
+            float lightPdf = lightTrianglePdf(sh.triangle, s.prevP, sh.p, nl);
+            w = powerHeuristic(1.0, s.prevPdf, 1.0, lightPdf);
+        }
+        s.radiance += s.beta * Le * w;
+    }
+    Material mat = materials[sh.material];
+    // One-sided materials: the back face is an opaque black absorber.
+    if (!sh.frontFace && (mat.flags & kMatFlagDoubleSided) == 0u) return;
+    if (s.depth >= scene.maxDepth || s.depth + 1u >= kMaxDepth) return;  // no further segment
+
+    BsdfParams bsdf = materialBsdf(sh.material, sh.uv);
+    vec3 t, b;
+    makeBasis(sh.ns, t, b);
+    vec3 woLocal = toLocal(-d, t, b, sh.ns);
+    vec3 origin = offsetRayOrigin(sh.p, sh.ng);
+
+    // Next-event estimation (the three numbers are drawn even when unused, so that the
+    // random stream does not depend on the material).
+    vec3 ul = rngNext3(rng);
+    if (!bsdfIsDeltaOnly(bsdf)) {
+        LightSample ls;
+        if (sampleLight(sh.p, ul, ls) && dot(ls.wi, sh.ng) > 0.0) {
+            vec3 wiLocal = toLocal(ls.wi, t, b, sh.ns);
+            vec3 f = bsdfEval(bsdf, woLocal, wiLocal);
+            if (maxComponent(f) > 0.0) {
+                s.rays++;
+                if (!traceAny(origin, ls.wi, 0.0, ls.dist * (1.0 - 1e-4))) {
+                    float w = 1.0;
+                    if (ls.isDelta == 0u) w = powerHeuristic(1.0, ls.pdf, 1.0, bsdfPdf(bsdf, woLocal, wiLocal));
+                    s.radiance += s.beta * f * ls.Li * (w / ls.pdf);
+                }
+            }
+        }
+    }
+
+    // BSDF sampling continues the path.
+    BsdfSample bs;
+    bool sampled = bsdfSample(bsdf, woLocal, rngNext3(rng), bs);
+    vec3 wi = sampled ? toWorld(bs.wi, t, b, sh.ns) : vec3(0.0);
+    // A sample below the geometric surface (shading-normal leak) ends the path.
+    if (sampled && dot(wi, sh.ng) > 0.0) {
+        s.beta *= bs.weight;
+        s.prevPdf = bs.pdf;
+        s.flags = (s.flags & ~kPathFlagPrevSpecular) | (bs.lobe == kLobeSpecular ? kPathFlagPrevSpecular : 0u);
+        s.prevP = sh.p;
+        s.origin = origin;
+        s.dir = wi;
+        s.depth++;
+        bool survive = true;
+        if (s.depth >= scene.rrDepth) {
+            float q = min(maxComponent(s.beta), 0.95);
+            survive = rngNext(rng) < q;
+            s.beta /= q;
+        }
+        if (survive) s.flags |= kPathFlagAlive;
+    }
+    s.rng = rng.state;
+}
+
+// Folds one sample into per-invocation Welford statistics (NaN/Inf counted, not written).
+void welfordAdd(inout vec3 mean, inout vec3 m2, inout uint n, inout uint nan, vec3 L) {
+    if (!isFinite(L)) {
+        nan++;
+        L = vec3(0.0);
+    }
+    n++;
+    vec3 delta = L - mean;
+    mean += delta / float(n);
+    m2 += delta * (L - mean);
+}
+
+// Chan et al. 1979 pairwise merge of (n, mean, m2) into the running PixelStats.
+void mergeStats(inout PixelStats acc, uint n, vec3 mean, vec3 m2) {
+    uint total = acc.count + n;
+    if (total == 0u) return;
+    vec3 delta = mean - acc.mean;
+    float fb = float(n) / float(total);
+    acc.mean += delta * fb;
+    acc.m2 += m2 + delta * delta * float(acc.count) * fb;
+    acc.count = total;
+}
+
+#endif  // GDPT_LIB_PT_CORE
