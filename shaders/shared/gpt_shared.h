@@ -29,8 +29,8 @@ struct GptFrameParams {
     uint rowCount;         // rows in this dispatch
     float shiftThreshold;  // roughness (perceptual, sqrt of GGX alpha) at or below which a
                            // vertex is glossy/specular (half-vector shift); reference 0.001
-    uint pad0;
-    uint pad1;
+    uint width;            // image width in pixels (gpt_resolve.comp, which has no scene)
+    uint height;           // image height in pixels
 };
 
 // Resolved per-pixel output of gpt_resolve.comp (linear RGB radiance, W/(m^2 sr)). 84 bytes;
@@ -47,25 +47,26 @@ struct GptResolved {
 
 // Descriptor bindings of the G-PT pipelines (set 0). The scene uses kBindTriGeom ..
 // kBindSceneConst and the counters kBindCounters of gdpt_shared.h; the per-pixel statistics
-// (PixelStats each, one buffer per quantity so none exceeds 128 MiB) follow here.
+// (PixelStats each, one buffer per quantity so none exceeds 128 MiB) follow here, above
+// every number gdpt_shared.h uses (its scene list grows from 12 up, tests use 32..34).
 GDPT_ENUM_BEGIN(GptBinding)
-    kBindGptCentral = 12u,    // base's MIS-weighted radiance summed over the pairs of pixel p
-    kBindGptNeighbor0 = 13u,  // offset i's MIS-weighted radiance (belongs to pixel p + δ_i), i = 0..3
-    kBindGptNeighbor1 = 14u,
-    kBindGptNeighbor2 = 15u,
-    kBindGptNeighbor3 = 16u,
-    kBindGptGradient0 = 17u,  // MIS-weighted f_offset − f_base of direction i, i = 0..3
-    kBindGptGradient1 = 18u,
-    kBindGptGradient2 = 19u,
-    kBindGptGradient3 = 20u,
-    kBindGptDirect = 21u,     // very-direct emission (first hit seen from the camera)
-    kBindGptResolved = 22u    // GptResolved[] written by gpt_resolve.comp
+    kBindGptCentral = 40u,    // base's MIS-weighted radiance summed over the pairs of pixel p
+    kBindGptNeighbor0 = 41u,  // offset i's MIS-weighted radiance (belongs to pixel p + δ_i), i = 0..3
+    kBindGptNeighbor1 = 42u,
+    kBindGptNeighbor2 = 43u,
+    kBindGptNeighbor3 = 44u,
+    kBindGptGradient0 = 45u,  // MIS-weighted f_offset − f_base of direction i, i = 0..3
+    kBindGptGradient1 = 46u,
+    kBindGptGradient2 = 47u,
+    kBindGptGradient3 = 48u,
+    kBindGptDirect = 49u,     // very-direct emission (first hit seen from the camera)
+    kBindGptResolved = 50u    // GptResolved[] written by gpt_resolve.comp
 GDPT_ENUM_END();
 
 #ifdef __cplusplus
 static_assert(sizeof(GptFrameParams) == 32, "GptFrameParams layout");
 static_assert(sizeof(GptResolved) == 84, "GptResolved layout (scalar)");
-static_assert(kBindGptCentral > kBindCount && kBindGptResolved < kBindTestInput,
+static_assert(std::uint32_t{kBindGptCentral} > std::uint32_t{kBindTestOutput2},
               "G-PT bindings must not collide with gdpt_shared.h's");
 }  // namespace gdpt::gpu
 #endif

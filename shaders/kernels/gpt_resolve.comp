@@ -1,0 +1,101 @@
+// gpt_resolve.comp — gathers the per-pixel statistics of gpt.comp into the G-PT images
+// (GPT_REFERENCE §1.7). One invocation = one pixel p; it only reads its own and its four
+// neighbours' statistics and writes its own GptResolved: deterministic, no atomics.
+//
+// Notation: m_X(p) = mean of quantity X at pixel p over its N samples, v_X(p) = variance of
+// that mean = M2 / (N − 1) / N; δ_i = right, down, left, up.
+//   primal(p) = [m_central(p) + Σ_{i: p−δ_i in image} m_neighbor_i(p − δ_i)] / k(p)
+// where k(p) = number of neighbours of p inside the image (2, 3 or 4). Each pixel pair
+// (p, q) gives one unbiased estimator of I(p): the base part from p's samples plus the
+// offset part from q's samples (their MIS weights sum to 1, shift.glsl). central(p) holds
+// the base parts of the k(p) pairs and p receives exactly k(p) neighbour parts, so the
+// average of the k(p) pair estimators is unbiased at borders and corners too. (The
+// reference always divides by 4N; it has no border rule because Mitsuba films splat off the
+// image with a weight.)
+//   dx(p) = m_gradient_right(p) − m_gradient_left(p + (1,0))   estimates I(x+1,y) − I(x,y)
+//   dy(p) = m_gradient_down(p)  − m_gradient_up(p + (0,1))     estimates I(x,y+1) − I(x,y)
+// (both endpoints' estimators of the pair, MIS weights summing to 1); zero in the last
+// column / row, whose gradient rows the Poisson solver drops.
+// Variances: every term comes from a different pixel's samples, and distinct pixels use
+// independent random streams (rngInit(pixel, sample, seed)), so the terms are independent
+// and their variances add: var_primal = [v_central(p) + Σ v_neighbor_i(p − δ_i)] / k(p)²,
+// var_dx = v_gradient_right(p) + v_gradient_left(p + (1,0)), likewise var_dy.
+#version 460
+#extension GL_EXT_scalar_block_layout : require
+#extension GL_GOOGLE_include_directive : require
+
+#include "gpt_shared.h"
+
+layout(local_size_x_id = kSpecWorkgroupX, local_size_y_id = kSpecWorkgroupY) in;
+
+layout(set = 0, binding = kBindGptCentral, scalar) readonly buffer CentralBuf { PixelStats statCentral[]; };
+layout(set = 0, binding = kBindGptNeighbor0, scalar) readonly buffer Neighbor0Buf { PixelStats statNeighbor0[]; };
+layout(set = 0, binding = kBindGptNeighbor1, scalar) readonly buffer Neighbor1Buf { PixelStats statNeighbor1[]; };
+layout(set = 0, binding = kBindGptNeighbor2, scalar) readonly buffer Neighbor2Buf { PixelStats statNeighbor2[]; };
+layout(set = 0, binding = kBindGptNeighbor3, scalar) readonly buffer Neighbor3Buf { PixelStats statNeighbor3[]; };
+layout(set = 0, binding = kBindGptGradient0, scalar) readonly buffer Gradient0Buf { PixelStats statGradient0[]; };
+layout(set = 0, binding = kBindGptGradient1, scalar) readonly buffer Gradient1Buf { PixelStats statGradient1[]; };
+layout(set = 0, binding = kBindGptGradient2, scalar) readonly buffer Gradient2Buf { PixelStats statGradient2[]; };
+layout(set = 0, binding = kBindGptGradient3, scalar) readonly buffer Gradient3Buf { PixelStats statGradient3[]; };
+layout(set = 0, binding = kBindGptDirect, scalar) readonly buffer DirectBuf { PixelStats statDirect[]; };
+layout(set = 0, binding = kBindGptResolved, scalar) writeonly buffer ResolvedBuf { GptResolved resolved[]; };
+layout(push_constant, scalar) uniform Push { GptFrameParams frame; };
+
+// Variance of the mean of one statistic (unbiased sample variance / n).
+vec3 varianceOfMean(PixelStats s) {
+    if (s.count < 2u) return vec3(0.0);
+    float n = float(s.count);
+    return s.m2 / ((n - 1.0) * n);
+}
+
+void main() {
+    uint x = gl_GlobalInvocationID.x;
+    uint y = gl_GlobalInvocationID.y + frame.rowOffset;
+    if (x >= frame.width || y >= frame.height || gl_GlobalInvocationID.y >= frame.rowCount) return;
+    uint w = frame.width;
+    uint p = y * w + x;
+
+    PixelStats c = statCentral[p];
+    vec3 sum = c.mean;
+    vec3 var = varianceOfMean(c);
+    float k = 0.0;
+    // Neighbour q = p − δ_i sent its offset i to p.
+    if (x > 0u) {  // q = left neighbour, its offset "right"
+        PixelStats s = statNeighbor0[p - 1u];
+        sum += s.mean; var += varianceOfMean(s); k += 1.0;
+    }
+    if (y > 0u) {  // q = upper neighbour, its offset "down"
+        PixelStats s = statNeighbor1[p - w];
+        sum += s.mean; var += varianceOfMean(s); k += 1.0;
+    }
+    if (x + 1u < w) {  // q = right neighbour, its offset "left"
+        PixelStats s = statNeighbor2[p + 1u];
+        sum += s.mean; var += varianceOfMean(s); k += 1.0;
+    }
+    if (y + 1u < frame.height) {  // q = lower neighbour, its offset "up"
+        PixelStats s = statNeighbor3[p + w];
+        sum += s.mean; var += varianceOfMean(s); k += 1.0;
+    }
+
+    GptResolved r;
+    r.primal = k > 0.0 ? sum / k : vec3(0.0);  // k = 0 only for a 1x1 image
+    r.varPrimal = k > 0.0 ? var / (k * k) : vec3(0.0);
+    r.dx = vec3(0.0);
+    r.varDx = vec3(0.0);
+    if (x + 1u < w) {
+        PixelStats a = statGradient0[p];
+        PixelStats b = statGradient2[p + 1u];
+        r.dx = a.mean - b.mean;
+        r.varDx = varianceOfMean(a) + varianceOfMean(b);
+    }
+    r.dy = vec3(0.0);
+    r.varDy = vec3(0.0);
+    if (y + 1u < frame.height) {
+        PixelStats a = statGradient1[p];
+        PixelStats b = statGradient3[p + w];
+        r.dy = a.mean - b.mean;
+        r.varDy = varianceOfMean(a) + varianceOfMean(b);
+    }
+    r.direct = statDirect[p].mean;
+    resolved[p] = r;
+}

@@ -1,0 +1,152 @@
+#include "render/gpt_pass.h"
+
+#include <algorithm>
+#include <string>
+
+#include "gpt.spv.h"
+#include "gpt_resolve.spv.h"
+#include "render/scene_gpu.h"
+#include "vk/commands.h"
+#include "vk/context.h"
+
+namespace gdpt {
+namespace {
+// Pixel-samples per dispatch: a G-PT sample costs about twice a PT sample, so half of
+// PtPass's bound keeps each dispatch equally short.
+constexpr std::uint64_t kMaxPixelSamplesPerDispatch = 1u << 19;
+constexpr std::uint32_t kNumStats = 10;  // bindings kBindGptCentral .. kBindGptDirect
+
+const char* const kStatNames[kNumStats] = {"gpt central",    "gpt neighbor right", "gpt neighbor down",
+                                           "gpt neighbor left", "gpt neighbor up",  "gpt gradient right",
+                                           "gpt gradient down", "gpt gradient left", "gpt gradient up",
+                                           "gpt direct"};
+
+// Whether some vertex can be classified glossy: a specular layer at or below the threshold,
+// or one below bsdf.glsl's Dirac cutoff (perceptual roughness 0.01), which
+// bsdfRoughnessForShift reports as 0 whatever the threshold. features.cpp's hasGlossy only
+// tests the first, so the kernel's kHasGlossy is recomputed here.
+bool needsHalfVector(const SceneGpu& scene, float threshold) {
+    const SceneFeatures& f = scene.features();
+    constexpr float kDiracRoughness = 0.01f;  // sqrt(kDeltaAlpha)
+    return f.hasSpecularLayer && (f.minRoughness <= threshold || f.minRoughness < kDiracRoughness);
+}
+
+vk::KernelDesc gptDesc(const SceneGpu& scene, WorkgroupSize wg, bool halfVector) {
+    vk::KernelDesc d = vk::kernelDesc("gpt", kSpv_gpt);
+    d.bindings = SceneGpu::sceneBindings();
+    d.bindings.push_back(gpu::kBindCounters);
+    for (std::uint32_t i = 0; i < kNumStats; ++i) d.bindings.push_back(gpu::kBindGptCentral + i);
+    d.pushConstantBytes = sizeof(gpu::GptFrameParams);
+    for (const auto& [id, value] : scene.specConstants())
+        d.specConstants.push_back({id, id == gpu::kSpecHasGlossy ? (halfVector ? 1u : 0u) : value});
+    d.specConstants.push_back({gpu::kSpecWorkgroupX, wg.x});
+    d.specConstants.push_back({gpu::kSpecWorkgroupY, wg.y});
+    d.localSizeX = wg.x;
+    d.localSizeY = wg.y;
+    return d;
+}
+
+vk::KernelDesc resolveDesc(WorkgroupSize wg) {
+    vk::KernelDesc d = vk::kernelDesc("gpt_resolve", kSpv_gpt_resolve);
+    for (std::uint32_t i = 0; i < kNumStats; ++i) d.bindings.push_back(gpu::kBindGptCentral + i);
+    d.bindings.push_back(gpu::kBindGptResolved);
+    d.pushConstantBytes = sizeof(gpu::GptFrameParams);
+    d.specConstants = {{gpu::kSpecWorkgroupX, wg.x}, {gpu::kSpecWorkgroupY, wg.y}};
+    d.localSizeX = wg.x;
+    d.localSizeY = wg.y;
+    return d;
+}
+
+std::array<vk::Buffer, kNumStats> makeStats(const vk::Context& ctx, std::uint64_t pixels) {
+    auto make = [&](std::uint32_t i) { return vk::Buffer(ctx, pixels * sizeof(gpu::PixelStats), kStatNames[i]); };
+    return {make(0), make(1), make(2), make(3), make(4), make(5), make(6), make(7), make(8), make(9)};
+}
+}  // namespace
+
+GptPass::GptPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg, GptPassOptions options)
+    : ctx_(ctx),
+      width_(scene.constants().width),
+      height_(scene.constants().height),
+      options_(options),
+      halfVector_(options.forceHalfVector || needsHalfVector(scene, options.shiftThreshold)),
+      kernel_(ctx, gptDesc(scene, wg, halfVector_)),
+      resolveKernel_(ctx, resolveDesc(wg)),
+      stats_(makeStats(ctx, std::uint64_t{width_} * height_)),
+      resolved_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::GptResolved), "gpt resolved"),
+      counters_(ctx, sizeof(gpu::Counters), "gpt counters") {
+    const std::string what = " of a " + std::to_string(width_) + "x" + std::to_string(height_) + " image";
+    ctx.checkStorageBufferSize(stats_[0].size(), "each G-PT per-pixel statistics buffer" + what);
+    ctx.checkStorageBufferSize(resolved_.size(), "the resolved G-PT images" + what);
+    scene.bindTo(kernel_);
+    kernel_.bind(gpu::kBindCounters, counters_);
+    for (std::uint32_t i = 0; i < kNumStats; ++i) {
+        kernel_.bind(gpu::kBindGptCentral + i, stats_[i]);
+        resolveKernel_.bind(gpu::kBindGptCentral + i, stats_[i]);
+    }
+    resolveKernel_.bind(gpu::kBindGptResolved, resolved_);
+    reset();
+}
+
+void GptPass::reset() {
+    for (auto& b : stats_) b.zero();
+    counters_.zero();
+}
+
+void GptPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
+                     vk::GpuTimer* timer) {
+    const std::uint64_t perRow = std::uint64_t{width_} * spp;
+    const auto rowsPerDispatch = static_cast<std::uint32_t>(
+        std::max<std::uint64_t>(1, kMaxPixelSamplesPerDispatch / std::max<std::uint64_t>(perRow, 1)));
+    for (std::uint32_t row = 0; row < height_; row += rowsPerDispatch) {
+        gpu::GptFrameParams p{};
+        p.sampleBase = sampleBase;
+        p.samplesPerPixel = spp;
+        p.seed = seed;
+        p.rowOffset = row;
+        p.rowCount = std::min(rowsPerDispatch, height_ - row);
+        p.shiftThreshold = options_.shiftThreshold;
+        p.width = width_;
+        p.height = height_;
+        kernel_.dispatchItems(cmd, width_, p.rowCount, &p, timer);
+    }
+    vk::computeBarrier(cmd);
+}
+
+void GptPass::resolve(VkCommandBuffer cmd, vk::GpuTimer* timer) {
+    gpu::GptFrameParams p{};
+    p.rowOffset = 0;
+    p.rowCount = height_;
+    p.shiftThreshold = options_.shiftThreshold;
+    p.width = width_;
+    p.height = height_;
+    resolveKernel_.dispatchItems(cmd, width_, height_, &p, timer);
+    vk::computeBarrier(cmd);
+}
+
+gpu::Counters GptPass::takeCounters() {
+    gpu::Counters c{};
+    counters_.download(&c, sizeof c);
+    counters_.zero();
+    return c;
+}
+
+GptImages GptPass::readback() const {
+    const auto px = resolved_.downloadVector<gpu::GptResolved>(std::size_t{width_} * height_);
+    const int w = static_cast<int>(width_), h = static_cast<int>(height_);
+    GptImages out{Image(w, h), Image(w, h), Image(w, h), Image(w, h), Image(w, h), Image(w, h), Image(w, h)};
+    for (std::size_t i = 0; i < px.size(); ++i) {
+        const gpu::GptResolved& r = px[i];
+        for (int c = 0; c < 3; ++c) {
+            out.primal.plane(c)[i] = r.primal[c];
+            out.dx.plane(c)[i] = r.dx[c];
+            out.dy.plane(c)[i] = r.dy[c];
+            out.direct.plane(c)[i] = r.direct[c];
+            out.varPrimal.plane(c)[i] = r.varPrimal[c];
+            out.varDx.plane(c)[i] = r.varDx[c];
+            out.varDy.plane(c)[i] = r.varDy[c];
+        }
+    }
+    return out;
+}
+
+}  // namespace gdpt

@@ -1,0 +1,68 @@
+// gpt_pass.h — the gradient-domain path-tracing pass: owns gpt.comp (base + 4 offset paths
+// per camera sample, per-pixel statistics of central / neighbour / gradient / direct
+// radiance) and gpt_resolve.comp (gathers neighbours' terms into primal, dx, dy, direct and
+// their variances), with the buffers they write. Like PtPass: record() appends one batch
+// tiled in rows; resolve() appends the gather; readback() after the fence.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "gpt_shared.h"
+#include "image/image.h"
+#include "render/pt_pass.h"
+#include "vk/buffer.h"
+#include "vk/kernel.h"
+
+namespace gdpt {
+
+class SceneGpu;
+namespace vk {
+class Context;
+class GpuTimer;
+}  // namespace vk
+
+struct GptPassOptions {
+    float shiftThreshold = 0.001f;  // perceptual roughness <= this: glossy vertex (half-vector)
+    // Compile the half-vector branch in even if the scene has no glossy/specular vertex
+    // (kHasGlossy spec constant forced true; for measuring what the branch costs).
+    bool forceHalfVector = false;
+};
+
+// The resolved images (see gpt_resolve.comp for the estimators).
+struct GptImages {
+    Image primal, dx, dy, direct, varPrimal, varDx, varDy;
+};
+
+class GptPass {
+public:
+    GptPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg = {}, GptPassOptions options = {});
+
+    // Clears the statistics and counters.
+    void reset();
+    // Records a batch of `spp` camera samples per pixel starting at sample `sampleBase`.
+    void record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
+                vk::GpuTimer* timer);
+    // Records the gather into the resolved buffer (after the batches).
+    void resolve(VkCommandBuffer cmd, vk::GpuTimer* timer);
+    // Reads the counters written since the last call and clears them (after the fence).
+    gpu::Counters takeCounters();
+    // Reads the resolved images (after the fence of a resolve()).
+    [[nodiscard]] GptImages readback() const;
+    // Whether the half-vector branch is compiled in (kHasGlossy as specialised).
+    [[nodiscard]] bool halfVectorCompiled() const { return halfVector_; }
+
+private:
+    const vk::Context& ctx_;
+    std::uint32_t width_, height_;
+    GptPassOptions options_;
+    bool halfVector_ = false;
+    vk::Kernel kernel_;
+    vk::Kernel resolveKernel_;
+    // central, neighbor 0..3, gradient 0..3, direct (binding kBindGptCentral + index).
+    std::array<vk::Buffer, 10> stats_;
+    vk::Buffer resolved_;
+    vk::Buffer counters_;
+};
+
+}  // namespace gdpt
