@@ -1,0 +1,39 @@
+// poisson_residual.comp — r = b − A x on one level (or r = A x with kPoissonFlagApplyOnly),
+// A the weighted 5-point Laplacian + screening (poisson_shared.h). Default operands: x in X,
+// b in B, r to R at this level's offsets. With kPoissonFlagFromSol: x = Sol, b = Rhs and r
+// goes to B (level 0), which is how CG starts and how the true final residual is computed.
+// kPoissonFlagDot: partial ‖r‖² to slot RR.
+#version 460
+#extension GL_EXT_scalar_block_layout : require
+#extension GL_GOOGLE_include_directive : require
+#include "poisson_shared.h"
+layout(local_size_x_id = kSpecWorkgroupX, local_size_y_id = kSpecWorkgroupY) in;
+#include "lib/poisson_common.glsl"
+
+float loadX(uint j) { return (pc.flags & kPoissonFlagFromSol) != 0u ? Sol[j] : X[pc.xOff + j]; }
+
+void main() {
+    uint x = gl_GlobalInvocationID.x, y = gl_GlobalInvocationID.y;
+    uint w = pc.width, h = pc.height, n = w * h;
+    vec3 rr = vec3(0.0);
+    if (x < w && y < h) {
+        Stencil s = loadStencil(x, y, w, h, pc.cOff);
+        bool fromSol = (pc.flags & kPoissonFlagFromSol) != 0u;
+        for (uint c = 0u; c < 3u; ++c) {
+            uint o = c * n;
+            float ax = applyStencil(s, loadX(o + s.i), loadX(o + s.iW), loadX(o + s.iE),
+                                    loadX(o + s.iN), loadX(o + s.iS));
+            float r;
+            if ((pc.flags & kPoissonFlagApplyOnly) != 0u)
+                r = ax;
+            else
+                r = (fromSol ? Rhs[o + s.i] : B[pc.bOff + o + s.i]) - ax;
+            if (fromSol)
+                B[o + s.i] = r;
+            else
+                R[pc.rOff + o + s.i] = r;
+            rr[c] = r * r;
+        }
+    }
+    if ((pc.flags & kPoissonFlagDot) != 0u) writePartials(rr, kPoissonSlotRR);
+}

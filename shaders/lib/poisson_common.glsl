@@ -1,0 +1,88 @@
+// poisson_common.glsl — bindings, push constants and stencil helpers shared by the
+// poisson_*.comp kernels (maths in shaders/shared/poisson_shared.h and
+// src/poisson/poisson_cpu.h). Include after "poisson_shared.h".
+#ifndef POISSON_COMMON_GLSL
+#define POISSON_COMMON_GLSL
+
+layout(set = 0, binding = kPoissonBindCoef, scalar) buffer CoefBuf { float Coef[]; };
+layout(set = 0, binding = kPoissonBindX, scalar) buffer XBuf { float X[]; };
+layout(set = 0, binding = kPoissonBindB, scalar) buffer BBuf { float B[]; };
+layout(set = 0, binding = kPoissonBindR, scalar) buffer RBuf { float R[]; };
+layout(set = 0, binding = kPoissonBindP, scalar) buffer PBuf { float P[]; };
+layout(set = 0, binding = kPoissonBindAp, scalar) buffer ApBuf { float Ap[]; };
+layout(set = 0, binding = kPoissonBindSol, scalar) buffer SolBuf { float Sol[]; };
+layout(set = 0, binding = kPoissonBindRhs, scalar) buffer RhsBuf { float Rhs[]; };
+layout(set = 0, binding = kPoissonBindPrimal, scalar) readonly buffer PrimalBuf { float Primal[]; };
+layout(set = 0, binding = kPoissonBindDx, scalar) readonly buffer DxBuf { float Dx[]; };
+layout(set = 0, binding = kPoissonBindDy, scalar) readonly buffer DyBuf { float Dy[]; };
+layout(set = 0, binding = kPoissonBindWeights, scalar) readonly buffer WeightBuf { float Wt[]; };
+layout(set = 0, binding = kPoissonBindIrls, scalar) buffer IrlsBuf { float Irls[]; };
+layout(set = 0, binding = kPoissonBindScalars, scalar) buffer ScalarBuf {
+    PoissonScalars sc;
+    float history[];
+};
+layout(set = 0, binding = kPoissonBindPartials, scalar) buffer PartialBuf { float Partials[]; };
+
+layout(push_constant, scalar) uniform Push { PoissonPush pc; };
+
+// The 5-point stencil of pixel (x, y) on a level: edge weights to the four neighbours
+// (0 where the neighbour does not exist, its index then repeats i) and the screening term.
+struct Stencil {
+    uint i, iW, iE, iN, iS;  // pixel and neighbour indices (N = y−1, S = y+1)
+    float cW, cE, cN, cS;    // edge weights c_ij
+    float cp;                // screening diagonal α² wp
+};
+
+Stencil loadStencil(uint x, uint y, uint w, uint h, uint cOff) {
+    Stencil s;
+    uint n = w * h;
+    s.i = y * w + x;
+    s.iW = x > 0u ? s.i - 1u : s.i;
+    s.iE = x + 1u < w ? s.i + 1u : s.i;
+    s.iN = y > 0u ? s.i - w : s.i;
+    s.iS = y + 1u < h ? s.i + w : s.i;
+    s.cE = x + 1u < w ? Coef[cOff + s.i] : 0.0;
+    s.cW = x > 0u ? Coef[cOff + s.iW] : 0.0;
+    s.cS = y + 1u < h ? Coef[cOff + n + s.i] : 0.0;
+    s.cN = y > 0u ? Coef[cOff + n + s.iN] : 0.0;
+    s.cp = Coef[cOff + 2u * n + s.i];
+    return s;
+}
+
+float stencilDiag(Stencil s) { return s.cp + s.cW + s.cE + s.cN + s.cS; }
+
+// (A x)_i in the flux form Σ c_ij (x_i − x_j) + cp x_i (differences first: accurate for
+// large, smooth x), given the five values.
+float applyStencil(Stencil s, float xi, float xW, float xE, float xN, float xS) {
+    return s.cp * xi + s.cW * (xi - xW) + s.cE * (xi - xE) + s.cN * (xi - xN) + s.cS * (xi - xS);
+}
+
+// Deterministic per-workgroup partial sums of three values (one per channel): a fixed
+// shared-memory tree, written to Partials[(slot·3 + c)·G + g]. Every invocation of the
+// workgroup must call it (it contains barriers); the workgroup size is a power of two ≤ 256.
+shared float sPartial[3u * kPoissonMaxGroupSize];
+
+void writePartials(vec3 v, uint slot) {
+    uint l = gl_LocalInvocationIndex;
+    uint size = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
+    sPartial[l] = v.x;
+    sPartial[kPoissonMaxGroupSize + l] = v.y;
+    sPartial[2u * kPoissonMaxGroupSize + l] = v.z;
+    barrier();
+    for (uint s = size / 2u; s > 0u; s >>= 1u) {
+        if (l < s) {
+            sPartial[l] += sPartial[l + s];
+            sPartial[kPoissonMaxGroupSize + l] += sPartial[kPoissonMaxGroupSize + l + s];
+            sPartial[2u * kPoissonMaxGroupSize + l] += sPartial[2u * kPoissonMaxGroupSize + l + s];
+        }
+        barrier();
+    }
+    if (l == 0u) {
+        uint groups = gl_NumWorkGroups.x * gl_NumWorkGroups.y;
+        uint g = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+        for (uint c = 0u; c < 3u; ++c)
+            Partials[(slot * 3u + c) * groups + g] = sPartial[c * kPoissonMaxGroupSize];
+    }
+}
+
+#endif
