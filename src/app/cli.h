@@ -27,6 +27,7 @@ struct RenderArgs {
     bool validate = false;
     std::string method = "pt";
     std::string workgroup = "8x8";
+    std::string schedule = "megakernel";
 };
 
 struct DiffArgs {

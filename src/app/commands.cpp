@@ -114,6 +114,7 @@ int runRender(const RenderArgs& args) {
     options.profile = args.profile;
     options.quiet = args.quiet;
     options.workgroup = parseWorkgroup(args.workgroup);
+    options.schedule = args.schedule == "wavefront" ? Schedule::Wavefront : Schedule::Megakernel;
 
     Scene scene = loadGltf(args.scene);
     if (!scene.unsupported.empty() && !args.quiet) {
@@ -277,6 +278,10 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->check(CLI::NonNegativeNumber);
     r->add_option("--method", render.method, "Rendering method")->capture_default_str()->check(CLI::IsMember({"pt"}));
     r->add_option("--workgroup", render.workgroup, "Compute workgroup size WxH")->capture_default_str();
+    r->add_option("--schedule", render.schedule,
+                  "Kernel schedule: megakernel (one kernel per path batch) or wavefront (kernel per bounce stage)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"megakernel", "wavefront"}));
     r->add_flag("--profile", render.profile, "Print GPU time per kernel (timestamp queries)");
     r->add_option("--json", render.json, "Write render statistics as JSON to this file");
     r->add_flag("--quiet", render.quiet, "No progress output");

@@ -36,6 +36,9 @@ public:
     gpu::Counters takeCounters();
     // Mean radiance and the variance of that mean, per pixel (after the fence).
     void readback(Image& mean, Image& varianceOfMean) const;
+    // The statistics and counters, shared with the wavefront schedule.
+    [[nodiscard]] const vk::Buffer& accum() const { return accum_; }
+    [[nodiscard]] const vk::Buffer& counters() const { return counters_; }
 
 private:
     const vk::Context& ctx_;

@@ -1,8 +1,10 @@
 #include "render/renderer.h"
 
 #include <algorithm>
+#include <memory>
 #include <cstdio>
 
+#include "render/wavefront_pass.h"
 #include "util/progress.h"
 #include "util/timer.h"
 #include "vk/commands.h"
@@ -19,6 +21,9 @@ RenderResult renderPt(const vk::Context& ctx, const Scene& scene, const RenderOp
     stats.bvhBuildMs = sceneGpu.bvhInfo().buildMs;
     stats.features = sceneGpu.features();
     PtPass pass(ctx, sceneGpu, options.workgroup);
+    std::unique_ptr<WavefrontPass> wavefront;
+    if (options.schedule == Schedule::Wavefront)
+        wavefront = std::make_unique<WavefrontPass>(ctx, sceneGpu, pass, options.workgroup);
     vk::GpuTimer timer(ctx);
     vk::CommandStream stream(ctx, "pt");
     stats.uploadMs = phase.ms() - stats.bvhBuildMs;
@@ -54,16 +59,22 @@ RenderResult renderPt(const vk::Context& ctx, const Scene& scene, const RenderOp
             }
         }
         Timer batchTimer;
-        VkCommandBuffer cmd = stream.begin();
-        if (options.profile) timer.reset(cmd);
-        pass.record(cmd, done, n, options.seed, options.profile ? &timer : nullptr);
         stream.setWhat("pt batch " + std::to_string(stats.batches) + " (samples " + std::to_string(done) + ".." +
                        std::to_string(done + n - 1) + ", seed " + std::to_string(options.seed) + ")");
-        stream.submit();
-        stream.waitAll([&] {
+        const auto onWait = [&] {
             if (timed) progress.update(total.seconds());
-        });
-        if (options.profile) timer.collect();
+        };
+        if (wavefront) {
+            for (std::uint32_t i = 0; i < n; ++i)
+                wavefront->traceSample(stream, done + i, options.seed, options.profile ? &timer : nullptr, onWait);
+        } else {
+            VkCommandBuffer cmd = stream.begin();
+            if (options.profile) timer.reset(cmd);
+            pass.record(cmd, done, n, options.seed, options.profile ? &timer : nullptr);
+            stream.submit();
+            stream.waitAll(onWait);
+            if (options.profile) timer.collect();
+        }
         const gpu::Counters c = pass.takeCounters();
         stats.raysTraced += c.raysTraced;
         stats.pathsCompleted += c.pathsCompleted;

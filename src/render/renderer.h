@@ -20,6 +20,10 @@ namespace vk {
 class Context;
 }
 
+// How the path tracer is scheduled on the device: one kernel per whole path batch
+// (megakernel, the default: measured faster on lavapipe) or a kernel per bounce stage.
+enum class Schedule { Megakernel, Wavefront };
+
 struct RenderOptions {
     SceneGpuOptions scene;
     std::uint32_t spp = 16;        // samples per pixel (ignored when timeBudget > 0)
@@ -29,6 +33,7 @@ struct RenderOptions {
     bool profile = false;
     bool quiet = false;
     WorkgroupSize workgroup;
+    Schedule schedule = Schedule::Megakernel;
     std::uint32_t maxBatchSpp = 16;  // largest batch (samples per pixel per submission)
     const std::atomic<bool>* cancel = nullptr;  // set asynchronously to stop between batches
 };
