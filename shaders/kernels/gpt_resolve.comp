@@ -96,6 +96,8 @@ void main() {
         r.dy = a.mean - b.mean;
         r.varDy = varianceOfMean(a) + varianceOfMean(b);
     }
-    r.direct = statDirect[p].mean;
+    PixelStats dir = statDirect[p];
+    r.direct = dir.mean;
+    r.varDirect = varianceOfMean(dir);
     resolved[p] = r;
 }

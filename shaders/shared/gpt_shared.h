@@ -33,8 +33,8 @@ struct GptFrameParams {
     uint height;           // image height in pixels
 };
 
-// Resolved per-pixel output of gpt_resolve.comp (linear RGB radiance, W/(m^2 sr)). 84 bytes;
-// 77 MB for 1280x720, below lavapipe's 128 MiB maxStorageBufferRange.
+// Resolved per-pixel output of gpt_resolve.comp (linear RGB radiance, W/(m^2 sr)). 96 bytes;
+// 88 MB for 1280x720, below lavapipe's 128 MiB maxStorageBufferRange.
 struct GptResolved {
     vec3 primal;      // indirect ("throughput") estimate of I(p): average of the pair estimators
     vec3 dx;          // forward difference I(x+1,y) - I(x,y); 0 in the last column
@@ -43,6 +43,7 @@ struct GptResolved {
     vec3 varPrimal;   // variance of the primal estimate (of the mean, not per sample)
     vec3 varDx;       // variance of the dx estimate
     vec3 varDy;       // variance of the dy estimate
+    vec3 varDirect;   // variance of the direct estimate
 };
 
 // Descriptor bindings of the G-PT pipelines (set 0). The scene uses kBindTriGeom ..
@@ -65,7 +66,7 @@ GDPT_ENUM_END();
 
 #ifdef __cplusplus
 static_assert(sizeof(GptFrameParams) == 32, "GptFrameParams layout");
-static_assert(sizeof(GptResolved) == 84, "GptResolved layout (scalar)");
+static_assert(sizeof(GptResolved) == 96, "GptResolved layout (scalar)");
 static_assert(std::uint32_t{kBindGptCentral} > std::uint32_t{kBindTestOutput2},
               "G-PT bindings must not collide with gdpt_shared.h's");
 }  // namespace gdpt::gpu

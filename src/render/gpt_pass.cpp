@@ -133,7 +133,8 @@ gpu::Counters GptPass::takeCounters() {
 GptImages GptPass::readback() const {
     const auto px = resolved_.downloadVector<gpu::GptResolved>(std::size_t{width_} * height_);
     const int w = static_cast<int>(width_), h = static_cast<int>(height_);
-    GptImages out{Image(w, h), Image(w, h), Image(w, h), Image(w, h), Image(w, h), Image(w, h), Image(w, h)};
+    GptImages out{Image(w, h), Image(w, h), Image(w, h), Image(w, h),
+                  Image(w, h), Image(w, h), Image(w, h), Image(w, h)};
     for (std::size_t i = 0; i < px.size(); ++i) {
         const gpu::GptResolved& r = px[i];
         for (int c = 0; c < 3; ++c) {
@@ -144,6 +145,7 @@ GptImages GptPass::readback() const {
             out.varPrimal.plane(c)[i] = r.varPrimal[c];
             out.varDx.plane(c)[i] = r.varDx[c];
             out.varDy.plane(c)[i] = r.varDy[c];
+            out.varDirect.plane(c)[i] = r.varDirect[c];
         }
     }
     return out;

@@ -31,7 +31,7 @@ struct GptPassOptions {
 
 // The resolved images (see gpt_resolve.comp for the estimators).
 struct GptImages {
-    Image primal, dx, dy, direct, varPrimal, varDx, varDy;
+    Image primal, dx, dy, direct, varPrimal, varDx, varDy, varDirect;
 };
 
 class GptPass {

@@ -99,6 +99,7 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     result.varPrimal = std::move(images.varPrimal);
     result.varDx = std::move(images.varDx);
     result.varDy = std::move(images.varDy);
+    result.varDirect = std::move(images.varDirect);
     stats.readbackMs = phase.ms();
     stats.kernels = timer.totals();
     if (stats.nanSamples > 0 && !options.quiet)

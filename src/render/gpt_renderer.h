@@ -17,6 +17,7 @@ struct RenderResultGpt {
     Image varPrimal;  // variance of the primal estimate (of the mean)
     Image varDx;      // variance of the dx estimate
     Image varDy;      // variance of the dy estimate
+    Image varDirect;  // variance of the direct estimate
     RenderStats stats;  // spp = camera samples per pixel (each = 1 base + 4 offset paths)
 };
 

@@ -1,0 +1,199 @@
+// G-PT sampling half against the path tracer: the mean gradients equal the differences of
+// neighbouring PT pixel values, the primal equals the PT image, directly seen emission gives
+// exactly zero gradients, no NaN samples, and renders are deterministic.
+//
+// Statistics. G-PT and PT renders use different seeds, so they are independent. Every
+// tolerance is z standard errors, the standard error estimated from the per-pixel variances
+// both renderers return (Welford M2 / (n-1) / n):
+//  * dx(x,y) depends only on the samples of pixels (x,y) and (x+1,y) (gpt_resolve.comp), so
+//    the dx values at even x are independent of each other, and so are the PT differences
+//    I(x+1,y) − I(x,y) at even x. Region sums over those have variance = Σ varDx + Σ (v_pt(x)
+//    + v_pt(x+1)). Likewise dy at even y.
+//  * primal(p) depends on the samples of p and its 4 neighbours, so pixels on a lattice of
+//    step 3 are independent; region sums over the lattice are tested the same way.
+//  * PT's image contains the emission seen directly; G-PT keeps it in `direct`, so G-PT's
+//    direct (and its variance) is added back. Its covariance with the primal / gradient of
+//    the same pixel is neglected: a sample that sees an emitter first ends there (black
+//    emitters), so the per-sample product is 0 and the covariance −E[d]E[g] is small.
+// z is Šidák-corrected over all region × channel tests of a scene (family alpha 1e-3), and at
+// least 4. Each test also checks its own power: the same statistic against a wrong
+// expectation (the gradient of the mirrored sign, or the PT image of the neighbour) must be
+// rejected somewhere, so a test that could not fail would fail.
+#include <cmath>
+#include <functional>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "gpu_fixture.h"
+#include "render/gpt_renderer.h"
+#include "render/renderer.h"
+#include "scene/gltf_loader.h"
+#include "scene/procedural.h"
+#include "stats_normal.h"
+
+namespace gdpt {
+namespace {
+
+class GptRender : public test::GpuTest {
+protected:
+    static RenderOptions options(int w, int h, std::uint32_t spp, std::uint32_t seed) {
+        RenderOptions o;
+        o.scene.width = w;
+        o.scene.height = h;
+        o.spp = spp;
+        o.seed = seed;
+        o.quiet = true;
+        return o;
+    }
+};
+
+// One z-test of a region sum: |sum of (estimate − expected)| <= z sqrt(sum of variances).
+struct RegionTest {
+    double diff = 0.0, var = 0.0;
+    int count = 0;
+    void add(double estimate, double expected, double variance) {
+        diff += estimate - expected;
+        var += variance;
+        ++count;
+    }
+    [[nodiscard]] double zScore() const { return var > 0.0 ? std::abs(diff) / std::sqrt(var) : (diff == 0.0 ? 0.0 : 1e30); }
+};
+
+// Tests dx (axis 0) or dy (axis 1) of a G-PT render against PT finite differences over
+// regions of `region` pixels. Returns the largest |z| found with the sign of the PT difference
+// flipped (the power check).
+double checkGradients(const RenderResultGpt& g, const RenderResult& pt, int axis, int region, double z,
+                      const std::string& name) {
+    const Image& grad = axis == 0 ? g.dx : g.dy;
+    const Image& gvar = axis == 0 ? g.varDx : g.varDy;
+    const int w = pt.image.width(), h = pt.image.height();
+    double maxWrongZ = 0.0;
+    for (int ry = 0; ry < h / region; ++ry)
+        for (int rx = 0; rx < w / region; ++rx)
+            for (int c = 0; c < 3; ++c) {
+                RegionTest right, wrong;
+                for (int y = ry * region; y < (ry + 1) * region; ++y)
+                    for (int x = rx * region; x < (rx + 1) * region; ++x) {
+                        if ((axis == 0 ? x : y) % 2 != 0) continue;  // independent terms only
+                        const int x1 = axis == 0 ? x + 1 : x, y1 = axis == 0 ? y : y + 1;
+                        if (x1 >= w || y1 >= h) continue;
+                        const double ptDiff = pt.image.at(x1, y1, c) - pt.image.at(x, y, c);
+                        // PT includes the very-direct light that G-PT keeps out of the
+                        // gradients: add G-PT's direct difference back.
+                        const double estimate = grad.at(x, y, c) + g.direct.at(x1, y1, c) - g.direct.at(x, y, c);
+                        const double v = gvar.at(x, y, c) + g.varDirect.at(x, y, c) + g.varDirect.at(x1, y1, c) +
+                                         pt.varianceOfMean.at(x, y, c) + pt.varianceOfMean.at(x1, y1, c);
+                        right.add(estimate, ptDiff, v);
+                        wrong.add(estimate, -ptDiff, v);
+                    }
+                EXPECT_LE(right.zScore(), z) << name << (axis == 0 ? " dx" : " dy") << " region " << rx << ","
+                                             << ry << " channel " << c << ": sum diff " << right.diff
+                                             << " se " << std::sqrt(right.var);
+                maxWrongZ = std::max(maxWrongZ, wrong.zScore());
+            }
+    return maxWrongZ;
+}
+
+// Tests the primal against PT on the step-3 lattice. Returns the largest |z| against the
+// PT image shifted by one pixel (power check).
+double checkPrimal(const RenderResultGpt& g, const RenderResult& pt, int region, double z, const std::string& name) {
+    const int w = pt.image.width(), h = pt.image.height();
+    double maxWrongZ = 0.0;
+    for (int ry = 0; ry < h / region; ++ry)
+        for (int rx = 0; rx < w / region; ++rx)
+            for (int c = 0; c < 3; ++c) {
+                RegionTest right, wrong;
+                for (int y = ry * region; y < (ry + 1) * region; ++y)
+                    for (int x = rx * region; x < (rx + 1) * region; ++x) {
+                        if (x % 3 != 0 || y % 3 != 0) continue;
+                        // Very-direct emission is in g.direct, never in the primal.
+                        const double estimate = g.primal.at(x, y, c) + g.direct.at(x, y, c);
+                        const double gv = g.varPrimal.at(x, y, c) + g.varDirect.at(x, y, c);
+                        right.add(estimate, pt.image.at(x, y, c), gv + pt.varianceOfMean.at(x, y, c));
+                        const int xs = std::min(x + 1, w - 1);
+                        wrong.add(estimate, pt.image.at(xs, y, c), gv + pt.varianceOfMean.at(xs, y, c));
+                    }
+                EXPECT_LE(right.zScore(), z) << name << " primal region " << rx << "," << ry << " channel " << c
+                                             << ": sum diff " << right.diff << " se " << std::sqrt(right.var);
+                maxWrongZ = std::max(maxWrongZ, wrong.zScore());
+            }
+    return maxWrongZ;
+}
+
+void checkAgainstPt(const RenderResultGpt& g, const RenderResult& pt, int region, const std::string& name) {
+    ASSERT_EQ(g.stats.nanSamples, 0u) << name;
+    ASSERT_EQ(pt.stats.nanSamples, 0u) << name;
+    const int w = pt.image.width(), h = pt.image.height();
+    const int tests = 3 * (w / region) * (h / region) * 3;  // dx, dy, primal × regions × RGB
+    const double z = std::max(4.0, test::twoSidedZ(test::sidakAlpha(1e-3, tests)));
+    const double wrongDx = checkGradients(g, pt, 0, region, z, name);
+    const double wrongDy = checkGradients(g, pt, 1, region, z, name);
+    const double wrongPrimal = checkPrimal(g, pt, region, z, name);
+    EXPECT_GT(std::max(wrongDx, wrongDy), z) << name << ": the gradient test has no power here";
+    EXPECT_GT(wrongPrimal, z) << name << ": the primal test has no power here";
+    // Last column / row carry no gradient.
+    for (int c = 0; c < 3; ++c) {
+        for (int y = 0; y < h; ++y) EXPECT_EQ(g.dx.at(w - 1, y, c), 0.0f);
+        for (int x = 0; x < w; ++x) EXPECT_EQ(g.dy.at(x, h - 1, c), 0.0f);
+    }
+}
+
+// Diffuse Cornell box: reconnection shifts only, occlusion edges at the boxes and walls.
+TEST_F(GptRender, DiffuseCornellGradientsAndPrimalMatchPathTracer) {
+    const Scene scene = makeCornellBox();
+    const RenderResultGpt g = renderGpt(ctx(), scene, options(24, 24, 256, 101));
+    const RenderResult pt = renderPt(ctx(), scene, options(24, 24, 512, 202));
+    checkAgainstPt(g, pt, 6, "cornell");
+}
+
+// Glossy Cornell box: GGX 0.3 metal box (rough at the default threshold: reconnection) and a
+// mirror sphere (Dirac: half-vector copies, specular chains, invertibility checks).
+TEST_F(GptRender, GlossyCornellWithMirrorGradientsAndPrimalMatchPathTracer) {
+    const Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/glossy_cornell.gltf");
+    const RenderResultGpt g = renderGpt(ctx(), scene, options(24, 24, 256, 103));
+    const RenderResult pt = renderPt(ctx(), scene, options(24, 24, 512, 204));
+    checkAgainstPt(g, pt, 6, "glossy cornell");
+}
+
+// Same scene with a threshold above the metal's roughness: the GGX vertices become glossy
+// and are shifted by half-vector copies of a smooth lobe (Jacobian |wo'·h| / |wo·h|).
+TEST_F(GptRender, GlossyLobeHalfVectorShiftMatchesPathTracer) {
+    const Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/glossy_cornell.gltf");
+    RenderOptions o = options(24, 24, 256, 105);
+    o.scene.shiftThreshold = 0.5f;
+    const RenderResultGpt g = renderGpt(ctx(), scene, o);
+    const RenderResult pt = renderPt(ctx(), scene, options(24, 24, 512, 206));
+    checkAgainstPt(g, pt, 6, "glossy cornell, threshold 0.5");
+}
+
+// An emitter filling the view: everything is very-direct light, so primal and gradients are
+// exactly zero and direct is exactly the radiance.
+TEST_F(GptRender, DirectlySeenEmitterHasExactlyZeroGradients) {
+    const glm::vec3 le(3.0f, 2.0f, 0.5f);
+    const RenderResultGpt g = renderGpt(ctx(), makeEmissiveQuad(le), options(16, 12, 8, 1));
+    EXPECT_EQ(g.stats.nanSamples, 0u);
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < g.primal.pixelCount(); ++i) {
+            ASSERT_EQ(g.dx.plane(c)[i], 0.0f) << "pixel " << i;
+            ASSERT_EQ(g.dy.plane(c)[i], 0.0f) << "pixel " << i;
+            ASSERT_EQ(g.primal.plane(c)[i], 0.0f) << "pixel " << i;
+            ASSERT_EQ(g.direct.plane(c)[i], le[c]) << "pixel " << i;
+        }
+}
+
+// Same seed and spp give bit-identical images (no atomics in the accumulation).
+TEST_F(GptRender, DeterministicPerSeed) {
+    const Scene scene = makeCornellBox();
+    const RenderResultGpt a = renderGpt(ctx(), scene, options(12, 12, 6, 3));
+    const RenderResultGpt b = renderGpt(ctx(), scene, options(12, 12, 6, 3));
+    for (int c = 0; c < 3; ++c) {
+        ASSERT_EQ(a.primal.plane(c), b.primal.plane(c));
+        ASSERT_EQ(a.dx.plane(c), b.dx.plane(c));
+        ASSERT_EQ(a.dy.plane(c), b.dy.plane(c));
+        ASSERT_EQ(a.varDx.plane(c), b.varDx.plane(c));
+    }
+}
+
+}  // namespace
+}  // namespace gdpt
