@@ -1,0 +1,373 @@
+// poisson_gpu.cpp — the GPU solvers (L2 by MG-PCG/CG/Jacobi/MG, WL2, L1 by IRLS) built from
+// the engine's kernels; see poisson_gpu.h. Batching: each command buffer holds a batch of
+// iterations whose size grows geometrically, the device computes α_k/β_k and convergence
+// flags itself and freezes converged channels, so a batch may overshoot without changing
+// the result; the host reads the flags between batches only.
+#include "poisson/poisson_gpu.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "poisson_shared.h"
+#include "util/error.h"
+#include "util/timer.h"
+#include "vk/context.h"
+
+namespace gdpt {
+namespace {
+
+using namespace gpu;
+
+bool finite3(const Image& im, std::size_t i) {
+    return std::isfinite(im.plane(0)[i]) && std::isfinite(im.plane(1)[i]) && std::isfinite(im.plane(2)[i]);
+}
+
+// Copies an image's planes into one planar RGB vector, replacing non-finite values by 0
+// and counting them; returns per-pixel validity (all three channels finite).
+std::vector<float> sanitise(const Image& im, std::size_t& count, std::vector<std::uint8_t>& valid) {
+    const std::size_t n = im.pixelCount();
+    std::vector<float> out(3 * n);
+    valid.assign(n, 1);
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < n; ++i) {
+            const float v = im.plane(c)[i];
+            if (std::isfinite(v)) {
+                out[static_cast<std::size_t>(c) * n + i] = v;
+            } else {
+                out[static_cast<std::size_t>(c) * n + i] = 0.0f;
+                valid[i] = 0;
+                ++count;
+            }
+        }
+    return out;
+}
+
+// Row weight from an RGB variance image: 1/(mean variance + ε), 0 for non-finite/negative.
+float inverseVariance(const Image& var, std::size_t i, double eps, std::size_t& bad) {
+    if (!finite3(var, i)) {
+        ++bad;
+        return 0.0f;
+    }
+    const double v = (double(var.plane(0)[i]) + var.plane(1)[i] + var.plane(2)[i]) / 3.0;
+    if (v < 0.0) {
+        ++bad;
+        return 0.0f;
+    }
+    return static_cast<float>(1.0 / (v + eps));
+}
+
+int growBatch(int batch, int cap) { return std::min(batch * 2, cap); }
+
+}  // namespace
+
+Reconstruction parseReconstruction(const std::string& t) {
+    if (t == "l2") return Reconstruction::L2;
+    if (t == "wl2") return Reconstruction::WeightedL2;
+    if (t == "l1") return Reconstruction::L1;
+    throw UsageError("unknown reconstruction '" + t + "' (expected l1, l2 or wl2)");
+}
+
+GpuSolver parseGpuSolver(const std::string& t) {
+    if (t == "mg-pcg") return GpuSolver::MgPcg;
+    if (t == "cg") return GpuSolver::Cg;
+    if (t == "jacobi") return GpuSolver::Jacobi;
+    if (t == "mg") return GpuSolver::Mg;
+    throw UsageError("unknown solver '" + t + "' (expected mg-pcg, cg, jacobi or mg)");
+}
+
+const char* toString(Reconstruction r) {
+    switch (r) {
+        case Reconstruction::L2: return "l2";
+        case Reconstruction::WeightedL2: return "wl2";
+        case Reconstruction::L1: return "l1";
+    }
+    return "?";
+}
+
+const char* toString(GpuSolver s) {
+    switch (s) {
+        case GpuSolver::MgPcg: return "mg-pcg";
+        case GpuSolver::Cg: return "cg";
+        case GpuSolver::Jacobi: return "jacobi";
+        case GpuSolver::Mg: return "mg";
+    }
+    return "?";
+}
+
+PoissonSolverGpu::PoissonSolverGpu(const vk::Context& ctx, int width, int height, PoissonKernels* kernels)
+    : engine_(ctx, width, height, kernels), stream_(ctx, "poisson solve") {}
+
+void PoissonSolverGpu::readHistory(int count, SolveReport& report) {
+    const int entries = std::min(count + 1, static_cast<int>(kPoissonMaxHistory));
+    std::vector<float> raw(static_cast<std::size_t>(entries) * 3);
+    engine_.scalars.download(raw.data(), raw.size() * sizeof(float), sizeof(PoissonScalars));
+    PoissonScalars sc{};
+    engine_.scalars.download(&sc, sizeof(sc));
+    report.history.clear();
+    for (int k = 0; k < entries; ++k) {
+        std::array<double, 3> rel{};
+        for (int c = 0; c < 3; ++c) {
+            const double rr = raw[static_cast<std::size_t>(k) * 3 + static_cast<std::size_t>(c)];
+            rel[static_cast<std::size_t>(c)] = sc.bb[c] > 0.0f ? std::sqrt(rr / double(sc.bb[c])) : std::sqrt(rr);
+        }
+        report.history.push_back(rel);
+    }
+}
+
+PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o, double tolerance, bool irls,
+                                                           SolveReport& report) {
+    // irls: the IRLS weights and their scale have been recorded/computed already by the caller
+    // into this batch's command buffer (see solve()).
+    PoissonGpuEngine& e = engine_;
+    vk::GpuTimer* timer = o.timer;
+    const float tol = static_cast<float>(tolerance);
+    const std::uint64_t fine = 3ull * e.pixels();
+    const bool cgFamily = o.solver == GpuSolver::MgPcg || o.solver == GpuSolver::Cg;
+    const bool pcg = o.solver == GpuSolver::MgPcg;
+    const std::uint32_t zIsR = pcg ? 0u : kPoissonFlagZIsR;
+    VkCommandBuffer cmd = stream_.cmd();
+
+    e.recordSetup(cmd, static_cast<float>(o.alpha * o.alpha), irls, timer);
+    if (o.solver != GpuSolver::Cg && o.solver != GpuSolver::Jacobi) e.recordCoarsenAll(cmd, timer);
+    if (cgFamily) {
+        e.recordResidual(cmd, 0, kPoissonFlagFromSol | kPoissonFlagDot, timer);
+        if (pcg) e.recordVcycle(cmd, o.vcycle, true, true, timer);
+    } else {
+        PoissonGpuEngine::recordCopy(cmd, e.rhs, e.b, fine);
+        PoissonGpuEngine::recordCopy(cmd, e.sol, e.x, fine);
+        e.recordResidual(cmd, 0, kPoissonFlagDot, timer);
+    }
+    e.recordScalars(cmd, kPoissonModeInit, zIsR, 0, tol, 0.0f, timer);
+
+    int batch = 4, cap = 32;
+    if (o.solver == GpuSolver::Cg) batch = 16, cap = 128;
+    if (o.solver == GpuSolver::Jacobi) batch = 64, cap = 1024;
+    int k = 0;
+    PoissonScalars sc{};
+    for (;;) {
+        // Close the open command buffer (set-up or previous batch), run it, check the flags.
+        stream_.submit();
+        stream_.waitAll();
+        ++report.batches;
+        if (timer) timer->collect();
+        e.scalars.download(&sc, sizeof(sc));
+        const bool done = sc.done[0] && sc.done[1] && sc.done[2];
+        if (done || k >= o.maxIterations) break;
+        cmd = stream_.begin();
+        if (timer) timer->reset(cmd);
+        const int count = std::min(batch, o.maxIterations - k);
+        for (int j = 0; j < count; ++j) {
+            ++k;
+            const std::uint32_t it = static_cast<std::uint32_t>(k);
+            if (cgFamily) {
+                const std::uint32_t pNew = static_cast<std::uint32_t>((k % 2) * fine);
+                const std::uint32_t pOld = static_cast<std::uint32_t>(((k + 1) % 2) * fine);
+                e.recordCgDirection(cmd, zIsR | (k == 1 ? kPoissonFlagFirst : 0u), pOld, pNew, timer);
+                e.recordScalars(cmd, kPoissonModeAlpha, zIsR, it, tol, 0.0f, timer);
+                e.recordCgUpdate(cmd, pNew, timer);
+                if (pcg) e.recordVcycle(cmd, o.vcycle, true, true, timer);
+                e.recordScalars(cmd, kPoissonModeBeta, zIsR, it, tol, 0.0f, timer);
+            } else if (o.solver == GpuSolver::Mg) {
+                e.recordVcycle(cmd, o.vcycle, false, false, timer);
+                e.recordResidual(cmd, 0, kPoissonFlagDot, timer);
+                e.recordScalars(cmd, kPoissonModeRecord, kPoissonFlagZIsR, it, tol, 0.0f, timer);
+            } else {
+                // Jacobi: two sweeps (X -> R -> X) per recorded iteration pair.
+                e.recordSmooth(cmd, 0, kPoissonFlagJacobi | kPoissonFlagToR, 0u, o.vcycle.omega, timer);
+                ++k;
+                e.recordSmooth(cmd, 0, kPoissonFlagJacobi, 0u, o.vcycle.omega, timer);
+                e.recordResidual(cmd, 0, kPoissonFlagDot, timer);
+                e.recordScalars(cmd, kPoissonModeRecord, kPoissonFlagZIsR, static_cast<std::uint32_t>(k / 2), tol,
+                                0.0f, timer);
+                ++j;
+            }
+        }
+        batch = growBatch(batch, cap);
+    }
+    // True residual of the returned x.
+    cmd = stream_.begin();
+    if (timer) timer->reset(cmd);
+    if (!cgFamily) PoissonGpuEngine::recordCopy(cmd, e.x, e.sol, fine);
+    e.recordResidual(cmd, 0, kPoissonFlagFromSol | kPoissonFlagDot, timer);
+    e.recordScalars(cmd, kPoissonModeFinal, zIsR, 0, tol, 0.0f, timer);
+    stream_.submit();
+    stream_.waitAll();
+    ++report.batches;
+    if (timer) timer->collect();
+    e.scalars.download(&sc, sizeof(sc));
+
+    InnerResult result;
+    result.converged = true;
+    double worst = 0.0;
+    for (int c = 0; c < 3; ++c) {
+        const int its = static_cast<int>(sc.iterations[c]) * (o.solver == GpuSolver::Jacobi ? 2 : 1);
+        result.iterations = std::max(result.iterations, its);
+        result.converged = result.converged && sc.done[c] != 0;
+        const double rel = sc.bb[c] > 0.0f ? std::sqrt(double(sc.finalRr[c]) / sc.bb[c]) : std::sqrt(double(sc.finalRr[c]));
+        worst = std::max(worst, rel);
+    }
+    report.residual = worst;
+    if (o.keepHistory) readHistory(o.solver == GpuSolver::Jacobi ? k / 2 : k, report);
+    return result;
+}
+
+SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& o, Image& out) {
+    Timer wall;
+    if (!in.primal || !in.dx || !in.dy) throw Error("Poisson solve: primal, dx and dy are required");
+    const int w = engine_.width(), h = engine_.height();
+    for (const Image* im : {in.primal, in.dx, in.dy, in.varPrimal, in.varDx, in.varDy})
+        if (im && (im->width() != w || im->height() != h))
+            throw Error("Poisson solve: input of size " + std::to_string(im->width()) + "x" +
+                        std::to_string(im->height()) + " does not match the solver's " + std::to_string(w) + "x" +
+                        std::to_string(h));
+    if (!std::isfinite(o.alpha) || o.alpha < 0.0) throw Error("Poisson solve: alpha must be finite and >= 0");
+    if (!(o.tolerance > 0.0) || !(o.tolerance < 1.0)) throw Error("Poisson solve: tolerance must be in (0, 1)");
+    if (o.maxIterations < 1) throw Error("Poisson solve: max iterations must be >= 1");
+    if (o.method == Reconstruction::L1 && !(o.alpha > 0.0))
+        throw Error("Poisson solve: L1 (IRLS) needs alpha > 0 (the primal rows anchor each iterate)");
+    if (o.method == Reconstruction::WeightedL2 && !(in.varPrimal && in.varDx && in.varDy))
+        throw Error("Poisson solve: wl2 needs the variance layers var_primal, var_dx and var_dy");
+    const std::size_t n = engine_.pixels();
+    for (const std::vector<float>* wv : {in.weightPrimal, in.weightDx, in.weightDy})
+        if (wv && wv->size() != n) throw Error("Poisson solve: weight vector size does not match the image");
+
+    SolveReport report;
+    std::vector<std::uint8_t> okP, okX, okY;
+    const std::vector<float> primal = sanitise(*in.primal, report.nonFinite.primal, okP);
+    const std::vector<float> dx = sanitise(*in.dx, report.nonFinite.dx, okX);
+    const std::vector<float> dy = sanitise(*in.dy, report.nonFinite.dy, okY);
+    std::vector<float> weights(3 * n, 1.0f);
+    const bool wl2 = o.method == Reconstruction::WeightedL2;
+    for (std::size_t i = 0; i < n; ++i) {
+        float* wp = &weights[i];
+        float* wx = &weights[n + i];
+        float* wy = &weights[2 * n + i];
+        auto userWeight = [&](const std::vector<float>* v) {
+            if (!v) return 1.0f;
+            const float u = (*v)[i];
+            if (std::isfinite(u) && u >= 0.0f) return u;
+            ++report.nonFinite.weight;
+            return 0.0f;
+        };
+        *wp = userWeight(in.weightPrimal);
+        *wx = userWeight(in.weightDx);
+        *wy = userWeight(in.weightDy);
+        if (wl2) {
+            *wp *= inverseVariance(*in.varPrimal, i, o.varianceEpsilon, report.nonFinite.variance);
+            *wx *= inverseVariance(*in.varDx, i, o.varianceEpsilon, report.nonFinite.variance);
+            *wy *= inverseVariance(*in.varDy, i, o.varianceEpsilon, report.nonFinite.variance);
+        }
+        if (!okP[i]) *wp = 0.0f;
+        if (!okX[i]) *wx = 0.0f;
+        if (!okY[i]) *wy = 0.0f;
+    }
+    // Kept rows (dropped boundary rows excluded) and the WL2 mean-1 normalisation.
+    double sum = 0.0;
+    std::size_t rows = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+            const float rowW[3] = {weights[i], x + 1 < w ? weights[n + i] : 0.0f, y + 1 < h ? weights[2 * n + i] : 0.0f};
+            for (float v : rowW)
+                if (v > 0.0f) {
+                    sum += v;
+                    ++rows;
+                }
+        }
+    if (wl2 && sum > 0.0) {
+        const float scale = static_cast<float>(double(rows) / sum);
+        for (float& v : weights) v *= scale;
+    }
+    bool singular = o.alpha == 0.0;
+    if (!singular) {
+        singular = true;
+        for (std::size_t i = 0; i < n && singular; ++i) singular = !(weights[i] > 0.0f);
+    }
+
+    engine_.bind();
+    engine_.primal.uploadVector(primal);
+    engine_.dx.uploadVector(dx);
+    engine_.dy.uploadVector(dy);
+    engine_.weights.uploadVector(weights);
+    if (o.warmStart)
+        engine_.sol.uploadVector(primal);  // warm start from the primal, as the published solver
+    else
+        engine_.sol.zero();
+
+    VkCommandBuffer cmd = stream_.begin();
+    if (o.timer) o.timer->reset(cmd);
+    if (o.method != Reconstruction::L1) {
+        const InnerResult r = innerSolve(o, o.tolerance, false, report);
+        report.iterations = r.iterations;
+        report.converged = r.converged;
+        report.irlsIterations = 1;
+    } else {
+        const int rounds = std::max(1, o.irlsIterations);
+        double reg = o.irlsRegInit;
+        for (int k = 0; k < rounds; ++k) {
+            const bool last = k + 1 == rounds;
+            const double tol = last ? o.tolerance : std::max(o.tolerance, o.irlsInnerTolerance);
+            if (k > 0) {
+                // The previous inner solve submitted its buffers: open a new one for the
+                // weights, their mean-1 scale and the next solve's set-up.
+                cmd = stream_.begin();
+                if (o.timer) o.timer->reset(cmd);
+                engine_.recordIrlsWeights(cmd, static_cast<float>(o.alpha * o.alpha), static_cast<float>(reg), o.timer);
+                engine_.recordScalars(cmd, kPoissonModeIrls, 0u, 0u, 0.0f, static_cast<float>(rows), o.timer);
+                reg *= o.irlsRegIter;
+            }
+            const InnerResult r = innerSolve(o, tol, k > 0, report);
+            report.iterations += r.iterations;
+            report.converged = r.converged;
+            ++report.irlsIterations;
+        }
+    }
+    // Download and fix the weighted mean from the primal. Summing the rows of A x = b gives
+    // Σ cp_i x_i = Σ cp_i t_i exactly for every α > 0 (the Laplacian's columns sum to 0), so
+    // this shift only removes error along the near-null constant mode, which a float32
+    // residual cannot see when α is tiny; for α = 0 it picks the α → 0 limit. L1's final
+    // primal weights live on the device (IRLS), so there the shift is for α = 0 only, which
+    // L1 rejects anyway.
+    out = Image(w, h);
+    std::vector<float> sol = engine_.sol.downloadVector<float>(3 * n);
+    const bool shiftMean = singular || o.method != Reconstruction::L1;
+    for (int c = 0; c < 3; ++c) {
+        const std::size_t o0 = static_cast<std::size_t>(c) * n;
+        if (shiftMean) {
+            double sw = 0.0, swd = 0.0, sd = 0.0;
+            for (std::size_t i = 0; i < n; ++i) {
+                const double d = double(primal[o0 + i]) - sol[o0 + i];
+                sw += weights[i];
+                swd += weights[i] * d;
+                sd += d;
+            }
+            const double shift = sw > 0.0 ? swd / sw : sd / double(n);
+            for (std::size_t i = 0; i < n; ++i) sol[o0 + i] = static_cast<float>(sol[o0 + i] + shift);
+        }
+        std::copy(sol.begin() + static_cast<std::ptrdiff_t>(o0), sol.begin() + static_cast<std::ptrdiff_t>(o0 + n),
+                  out.plane(c).begin());
+    }
+    if (o.timer) report.kernels = o.timer->totals();
+    report.ms = wall.ms();
+    return report;
+}
+
+Image reconstruct(const vk::Context& ctx, const Image& primal, const Image& dx, const Image& dy,
+                  const Image* varPrimal, const Image* varDx, const Image* varDy, const SolveOptions& options,
+                  SolveReport* report) {
+    PoissonSolverGpu solver(ctx, primal.width(), primal.height());
+    PoissonInput in;
+    in.primal = &primal;
+    in.dx = &dx;
+    in.dy = &dy;
+    in.varPrimal = varPrimal;
+    in.varDx = varDx;
+    in.varDy = varDy;
+    Image out;
+    const SolveReport r = solver.solve(in, options, out);
+    if (report) *report = r;
+    return out;
+}
+
+}  // namespace gdpt

@@ -1,0 +1,129 @@
+// poisson_gpu.h — screened Poisson reconstruction on the GPU (GLSL compute, float32), the
+// device counterpart of the double-precision reference in poisson_cpu.h / poisson_irls.h.
+//
+// Solves, per RGB channel, argmin_I ‖H_dx I − dx‖²_W + ‖H_dy I − dy‖²_W + α²‖I − primal‖²_W
+// (forward differences, gradient rows beyond the last column/row dropped; Kettunen et al.
+// 2015, §4; GPT_REFERENCE §2) with
+//   L2   one weighted least-squares solve, by
+//          mg-pcg  CG preconditioned with one symmetric multigrid V-cycle (default),
+//          cg      plain CG (the published solver's method),
+//          jacobi  damped Jacobi sweeps, mg  repeated V-cycles;
+//        all iterate to the relative residual tolerance ‖b − A x‖ ≤ τ ‖b‖ per channel;
+//   WL2  L2 with per-pixel inverse-variance row weights w = 1/(var + ε) from var_primal,
+//        var_dx, var_dy (RGB-averaged, so one operator serves the three channels),
+//        renormalised to mean 1;
+//   L1   IRLS: weights 1/(‖RGB residual‖ + ε_k) with ε_k = regInit·regIter^(k−1), warm
+//        starts, each inner solve by the chosen solver (poisson_irls.h).
+// The whole iteration (including the CG scalars α_k, β_k) runs on the device; the host
+// only submits batches of iterations and reads the convergence flags between batches.
+// Sums are fixed-order tree reductions: the same input gives the same bits.
+//
+// Non-finite inputs are counted and neutralised before upload: a non-finite primal value
+// becomes 0 with primal weight 0, a non-finite gradient 0 with row weight 0, a non-finite
+// variance gives weight 0. α = 0 (or all primal weights 0) leaves A singular; the solution
+// is then shifted so its weighted mean equals the primal's (the α → 0 limit, poisson_cpu.h).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "image/image.h"
+#include "poisson/poisson_gpu_engine.h"
+#include "vk/commands.h"
+#include "vk/timing.h"
+
+namespace gdpt {
+
+enum class Reconstruction { L2, WeightedL2, L1 };
+enum class GpuSolver { MgPcg, Cg, Jacobi, Mg };
+
+// Parses "l1|l2|wl2" and "mg-pcg|cg|jacobi|mg"; throws gdpt::UsageError otherwise.
+Reconstruction parseReconstruction(const std::string& text);
+GpuSolver parseGpuSolver(const std::string& text);
+const char* toString(Reconstruction r);
+const char* toString(GpuSolver s);
+
+struct SolveOptions {
+    Reconstruction method = Reconstruction::L2;
+    GpuSolver solver = GpuSolver::MgPcg;
+    double alpha = 0.2;            // primal rows are α (I − t): energy weight α²
+    double tolerance = 1e-4;       // relative residual per channel
+    int maxIterations = 2000;      // per (inner) solve: CG steps, V-cycles or Jacobi sweeps
+    // IRLS (L1): the published default schedule (regInit 0.05, regIter 0.5), fewer rounds
+    // because each inner solve is converged instead of a fixed 50 CG steps.
+    int irlsIterations = 8;
+    double irlsRegInit = 0.05;
+    double irlsRegIter = 0.5;
+    double irlsInnerTolerance = 1e-3;  // inner tolerance before the last IRLS round
+    double varianceEpsilon = 1e-4;     // WL2: w = 1/(var + ε)
+    VcycleParams vcycle{};             // smoother and sweeps of mg / mg-pcg
+    bool keepHistory = false;          // fill SolveReport::history (test mode)
+    bool warmStart = true;             // start from the primal (else from 0)
+    vk::GpuTimer* timer = nullptr;     // per-kernel GPU times (capacity: scopes per batch)
+};
+
+struct NonFiniteCounts {
+    std::size_t primal = 0, dx = 0, dy = 0, variance = 0, weight = 0;  // values replaced
+    [[nodiscard]] std::size_t total() const { return primal + dx + dy + variance + weight; }
+};
+
+struct SolveReport {
+    int iterations = 0;          // inner iterations, summed over IRLS rounds
+    int irlsIterations = 0;      // 1 for L2/WL2
+    int batches = 0;             // command buffers submitted (host round trips)
+    double residual = 0.0;       // true final relative residual, max over channels
+    bool converged = false;      // every channel of the last solve reached the tolerance
+    double ms = 0.0;             // wall time of the solve (upload to download)
+    NonFiniteCounts nonFinite;
+    // Test mode: relative residual ‖r_k‖/‖b‖ per channel after iteration k of the last
+    // solve (k = 0 is the initial guess; Jacobi records every second sweep).
+    std::vector<std::array<double, 3>> history;
+    std::map<std::string, vk::KernelTime> kernels;  // copy of the timer's totals
+};
+
+// Inputs of one reconstruction: all images of one size. Optional per-pixel weights (shared
+// by the channels, ≥ 0) multiply the rows; optional variances enable WL2 weights.
+struct PoissonInput {
+    const Image* primal = nullptr;
+    const Image* dx = nullptr;
+    const Image* dy = nullptr;
+    const Image* varPrimal = nullptr;
+    const Image* varDx = nullptr;
+    const Image* varDy = nullptr;
+    const std::vector<float>* weightPrimal = nullptr;
+    const std::vector<float>* weightDx = nullptr;
+    const std::vector<float>* weightDy = nullptr;
+};
+
+class PoissonSolverGpu {
+public:
+    PoissonSolverGpu(const vk::Context& ctx, int width, int height, PoissonKernels* kernels = nullptr);
+
+    // Reconstructs into `out` (resized). Throws gdpt::Error on size mismatch or bad options.
+    SolveReport solve(const PoissonInput& in, const SolveOptions& options, Image& out);
+
+    [[nodiscard]] PoissonGpuEngine& engine() { return engine_; }
+
+private:
+    struct InnerResult {
+        int iterations = 0;
+        bool converged = false;
+    };
+    InnerResult innerSolve(const SolveOptions& o, double tolerance, bool irls, SolveReport& report);
+    void readHistory(int count, SolveReport& report);
+
+    PoissonGpuEngine engine_;
+    vk::CommandStream stream_;
+};
+
+// One-call reconstruction for the renderer: primal, gradients and optional variances (WL2
+// uses them when options.method == WeightedL2).
+Image reconstruct(const vk::Context& ctx, const Image& primal, const Image& dx, const Image& dy,
+                  const Image* varPrimal, const Image* varDx, const Image* varDy,
+                  const SolveOptions& options, SolveReport* report = nullptr);
+
+}  // namespace gdpt

@@ -1,0 +1,296 @@
+// poisson_gpu_engine.cpp — pipelines, buffers, level layout and kernel recording of the GPU
+// Poisson solver (see poisson_gpu_engine.h).
+#include "poisson/poisson_gpu_engine.h"
+
+#include <string>
+
+#include "poisson_shared.h"
+#include "poisson_cg_direction.spv.h"
+#include "poisson_cg_update.spv.h"
+#include "poisson_coarsen.spv.h"
+#include "poisson_coarsest.spv.h"
+#include "poisson_irls_weights.spv.h"
+#include "poisson_prolong.spv.h"
+#include "poisson_residual.spv.h"
+#include "poisson_restrict.spv.h"
+#include "poisson_scalars.spv.h"
+#include "poisson_setup.spv.h"
+#include "poisson_smooth.spv.h"
+#include "util/error.h"
+#include "vk/commands.h"
+#include "vk/context.h"
+
+namespace gdpt {
+namespace {
+
+using gpu::PoissonPush;
+
+vk::KernelDesc describe(vk::KernelDesc d, std::uint32_t gx, std::uint32_t gy, bool grid) {
+    for (std::uint32_t b = 0; b < gpu::kPoissonBindCount; ++b) d.bindings.push_back(b);
+    d.pushConstantBytes = sizeof(PoissonPush);
+    if (grid) {
+        d.specConstants = {{gpu::kSpecWorkgroupX, gx}, {gpu::kSpecWorkgroupY, gy}};
+        d.localSizeX = gx;
+        d.localSizeY = gy;
+    }
+    return d;
+}
+
+PoissonPush levelPush(const PoissonLevel& l) {
+    PoissonPush p{};
+    p.width = static_cast<std::uint32_t>(l.width);
+    p.height = static_cast<std::uint32_t>(l.height);
+    p.xOff = p.bOff = p.rOff = p.cOff = l.offset;
+    return p;
+}
+
+void withCoarse(PoissonPush& p, const PoissonLevel& c) {
+    p.coarseWidth = static_cast<std::uint32_t>(c.width);
+    p.coarseHeight = static_cast<std::uint32_t>(c.height);
+    p.coarseXOff = p.coarseBOff = p.coarseCOff = c.offset;
+}
+
+}  // namespace
+
+PoissonKernels::PoissonKernels(const vk::Context& ctx, std::uint32_t gx, std::uint32_t gy)
+    : setup(ctx, describe(vk::kernelDesc("poisson_setup", kSpv_poisson_setup), gx, gy, true)),
+      coarsen(ctx, describe(vk::kernelDesc("poisson_coarsen", kSpv_poisson_coarsen), gx, gy, true)),
+      residual(ctx, describe(vk::kernelDesc("poisson_residual", kSpv_poisson_residual), gx, gy, true)),
+      smooth(ctx, describe(vk::kernelDesc("poisson_smooth", kSpv_poisson_smooth), gx, gy, true)),
+      restrictResidual(ctx, describe(vk::kernelDesc("poisson_restrict", kSpv_poisson_restrict), gx, gy, true)),
+      prolong(ctx, describe(vk::kernelDesc("poisson_prolong", kSpv_poisson_prolong), gx, gy, true)),
+      coarsest(ctx, describe(vk::kernelDesc("poisson_coarsest", kSpv_poisson_coarsest), gx, gy, false)),
+      cgDirection(ctx, describe(vk::kernelDesc("poisson_cg_direction", kSpv_poisson_cg_direction), gx, gy, true)),
+      cgUpdate(ctx, describe(vk::kernelDesc("poisson_cg_update", kSpv_poisson_cg_update), gx, gy, true)),
+      scalars(ctx, describe(vk::kernelDesc("poisson_scalars", kSpv_poisson_scalars), gx, gy, false)),
+      irlsWeights(ctx, describe(vk::kernelDesc("poisson_irls_weights", kSpv_poisson_irls_weights), gx, gy, true)),
+      groupX_(gx),
+      groupY_(gy) {
+    const std::uint32_t size = gx * gy;
+    if (size == 0 || size > gpu::kPoissonMaxGroupSize || (size & (size - 1)) != 0)
+        throw Error("Poisson solver: workgroup " + std::to_string(gx) + "x" + std::to_string(gy) +
+                    " must have a power-of-two size <= 256");
+}
+
+PoissonGpuEngine::PoissonGpuEngine(const vk::Context& ctx, int width, int height,
+                                   PoissonKernels* kernels)
+    : ctx_(ctx) {
+    if (width <= 0 || height <= 0)
+        throw Error("Poisson solver: invalid size " + std::to_string(width) + "x" + std::to_string(height));
+    if (kernels) {
+        kernels_ = kernels;
+    } else {
+        ownKernels_ = std::make_unique<PoissonKernels>(ctx);
+        kernels_ = ownKernels_.get();
+    }
+    // Levels: halve (rounding up) until the coarsest fits the one-workgroup solver.
+    std::uint64_t offset = 0;
+    int w = width, h = height;
+    for (;;) {
+        levels_.push_back({w, h, static_cast<std::uint32_t>(offset)});
+        offset += 3ull * static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
+        if (w <= static_cast<int>(gpu::kPoissonCoarsestMax) && h <= static_cast<int>(gpu::kPoissonCoarsestMax)) break;
+        w = (w + 1) / 2;
+        h = (h + 1) / 2;
+    }
+    const std::uint64_t fine = 3ull * pixels() * sizeof(float);
+    const std::uint64_t all = offset * sizeof(float);
+    const std::string what = "Poisson solve of " + std::to_string(width) + "x" + std::to_string(height);
+    ctx.checkStorageBufferSize(all, what + " (all multigrid levels of one field)");
+    coef = vk::Buffer(ctx, all, "poissonCoef");
+    x = vk::Buffer(ctx, all, "poissonX");
+    b = vk::Buffer(ctx, all, "poissonB");
+    r = vk::Buffer(ctx, all, "poissonR");
+    p = vk::Buffer(ctx, 2 * fine, "poissonP");
+    ap = vk::Buffer(ctx, fine, "poissonAp");
+    sol = vk::Buffer(ctx, fine, "poissonSol");
+    rhs = vk::Buffer(ctx, fine, "poissonRhs");
+    primal = vk::Buffer(ctx, fine, "poissonPrimal");
+    dx = vk::Buffer(ctx, fine, "poissonDx");
+    dy = vk::Buffer(ctx, fine, "poissonDy");
+    weights = vk::Buffer(ctx, fine, "poissonWeights");
+    irls = vk::Buffer(ctx, fine, "poissonIrls");
+    scalars = vk::Buffer(ctx, sizeof(gpu::PoissonScalars) + 3ull * gpu::kPoissonMaxHistory * sizeof(float),
+                         "poissonScalars");
+    partials = vk::Buffer(ctx, std::uint64_t{gpu::kPoissonSlotCount} * 3 * groups() * sizeof(float),
+                          "poissonPartials");
+    // Defined contents everywhere (no stale NaN can leak through a 0 coefficient).
+    for (vk::Buffer* buf : {&coef, &x, &b, &r, &p, &ap, &sol, &rhs, &irls, &scalars, &partials})
+        buf->zero();
+    bind();
+}
+
+std::uint32_t PoissonGpuEngine::groups() const {
+    const std::uint32_t gx = (static_cast<std::uint32_t>(width()) + kernels_->groupX() - 1) / kernels_->groupX();
+    const std::uint32_t gy = (static_cast<std::uint32_t>(height()) + kernels_->groupY() - 1) / kernels_->groupY();
+    return gx * gy;
+}
+
+void PoissonGpuEngine::bind() {
+    const vk::Buffer* buffers[gpu::kPoissonBindCount] = {&coef, &x,   &b,      &r,  &p,
+                                                         &ap,   &sol, &rhs,    &primal, &dx,
+                                                         &dy,   &weights, &irls, &scalars, &partials};
+    for (vk::Kernel* k : {&kernels_->setup, &kernels_->coarsen, &kernels_->residual, &kernels_->smooth,
+                          &kernels_->restrictResidual, &kernels_->prolong, &kernels_->coarsest,
+                          &kernels_->cgDirection, &kernels_->cgUpdate, &kernels_->scalars,
+                          &kernels_->irlsWeights})
+        for (std::uint32_t i = 0; i < gpu::kPoissonBindCount; ++i) k->bind(i, *buffers[i]);
+}
+
+void PoissonGpuEngine::dispatch(VkCommandBuffer cmd, const vk::Kernel& kernel, int itemsX, int itemsY,
+                                const void* push, vk::GpuTimer* timer) {
+    kernel.dispatchItems(cmd, static_cast<std::uint32_t>(itemsX), static_cast<std::uint32_t>(itemsY), push,
+                         timer);
+    vk::computeBarrier(cmd);
+}
+
+void PoissonGpuEngine::recordSetup(VkCommandBuffer cmd, float alpha2, bool irlsWeights, vk::GpuTimer* timer) {
+    PoissonPush push = levelPush(levels_[0]);
+    push.alpha2 = alpha2;
+    push.flags = gpu::kPoissonFlagDot | (irlsWeights ? gpu::kPoissonFlagIrls : 0u);
+    dispatch(cmd, kernels_->setup, width(), height(), &push, timer);
+}
+
+void PoissonGpuEngine::recordCoarsenAll(VkCommandBuffer cmd, vk::GpuTimer* timer) {
+    for (std::size_t l = 0; l + 1 < levels_.size(); ++l) {
+        PoissonPush push = levelPush(levels_[l]);
+        withCoarse(push, levels_[l + 1]);
+        dispatch(cmd, kernels_->coarsen, levels_[l + 1].width, levels_[l + 1].height, &push, timer);
+    }
+}
+
+void PoissonGpuEngine::recordResidual(VkCommandBuffer cmd, int level, std::uint32_t flags, vk::GpuTimer* timer) {
+    PoissonPush push = levelPush(levels_.at(static_cast<std::size_t>(level)));
+    push.flags = flags;
+    dispatch(cmd, kernels_->residual, push.width, push.height, &push, timer);
+}
+
+void PoissonGpuEngine::recordSmooth(VkCommandBuffer cmd, int level, std::uint32_t flags, std::uint32_t colour,
+                                    float omega, vk::GpuTimer* timer) {
+    const std::size_t l = static_cast<std::size_t>(level);
+    PoissonPush push = levelPush(levels_.at(l));
+    if (l + 1 < levels_.size()) withCoarse(push, levels_[l + 1]);
+    push.flags = flags;
+    push.colour = colour;
+    push.omega = omega;
+    dispatch(cmd, kernels_->smooth, push.width, push.height, &push, timer);
+}
+
+void PoissonGpuEngine::recordRestrict(VkCommandBuffer cmd, int level, std::uint32_t flags, vk::GpuTimer* timer) {
+    const std::size_t l = static_cast<std::size_t>(level);
+    PoissonPush push = levelPush(levels_.at(l));
+    withCoarse(push, levels_.at(l + 1));
+    push.flags = flags;
+    dispatch(cmd, kernels_->restrictResidual, push.coarseWidth, push.coarseHeight, &push, timer);
+}
+
+void PoissonGpuEngine::recordProlong(VkCommandBuffer cmd, int level, vk::GpuTimer* timer) {
+    const std::size_t l = static_cast<std::size_t>(level);
+    PoissonPush push = levelPush(levels_.at(l));
+    withCoarse(push, levels_.at(l + 1));
+    dispatch(cmd, kernels_->prolong, push.width, push.height, &push, timer);
+}
+
+void PoissonGpuEngine::recordCoarsest(VkCommandBuffer cmd, bool zeroGuess, vk::GpuTimer* timer) {
+    PoissonPush push = levelPush(levels_.back());
+    push.flags = zeroGuess ? gpu::kPoissonFlagZeroGuess : 0u;
+    kernels_->coarsest.dispatch(cmd, 1, 1, 1, &push, timer);
+    vk::computeBarrier(cmd);
+}
+
+void PoissonGpuEngine::recordCgDirection(VkCommandBuffer cmd, std::uint32_t flags, std::uint32_t pOld,
+                                         std::uint32_t pNew, vk::GpuTimer* timer) {
+    PoissonPush push = levelPush(levels_[0]);
+    push.flags = flags;
+    push.pOld = pOld;
+    push.pNew = pNew;
+    dispatch(cmd, kernels_->cgDirection, width(), height(), &push, timer);
+}
+
+void PoissonGpuEngine::recordCgUpdate(VkCommandBuffer cmd, std::uint32_t pNew, vk::GpuTimer* timer) {
+    PoissonPush push = levelPush(levels_[0]);
+    push.pNew = pNew;
+    dispatch(cmd, kernels_->cgUpdate, width(), height(), &push, timer);
+}
+
+void PoissonGpuEngine::recordScalars(VkCommandBuffer cmd, std::uint32_t mode, std::uint32_t flags,
+                                     std::uint32_t iteration, float tolerance, float value, vk::GpuTimer* timer) {
+    PoissonPush push = levelPush(levels_[0]);
+    push.mode = mode;
+    push.flags = flags;
+    push.iteration = iteration;
+    push.tolerance = tolerance;
+    push.value = value;
+    push.groups = groups();
+    kernels_->scalars.dispatch(cmd, 1, 1, 1, &push, timer);
+    vk::computeBarrier(cmd);
+}
+
+void PoissonGpuEngine::recordIrlsWeights(VkCommandBuffer cmd, float alpha2, float reg, vk::GpuTimer* timer) {
+    PoissonPush push = levelPush(levels_[0]);
+    push.alpha2 = alpha2;
+    push.reg = reg;
+    dispatch(cmd, kernels_->irlsWeights, width(), height(), &push, timer);
+}
+
+void PoissonGpuEngine::recordVcycle(VkCommandBuffer cmd, const VcycleParams& params, bool zeroGuess, bool dotOut,
+                                    vk::GpuTimer* timer) {
+    vcycleLevel(cmd, 0, params, zeroGuess, dotOut, timer);
+}
+
+void PoissonGpuEngine::vcycleLevel(VkCommandBuffer cmd, int level, const VcycleParams& params, bool zeroGuess,
+                                   bool dotOut, vk::GpuTimer* timer) {
+    using namespace gpu;
+    const float omega = params.omega;
+    if (level + 1 == static_cast<int>(levels_.size())) {
+        recordCoarsest(cmd, zeroGuess, timer);
+        // Colour 2 matches no pixel: a pure b·x reduction pass.
+        if (dotOut) recordSmooth(cmd, level, kPoissonFlagDot, 2u, omega, timer);
+        return;
+    }
+    if (params.jacobi) {
+        // Ping-pong X -> R -> X: an even number of sweeps ends in X.
+        const int pre = params.preSmooth + params.preSmooth % 2;
+        for (int s = 0; s < pre; ++s)
+            recordSmooth(cmd, level,
+                         kPoissonFlagJacobi | (s % 2 == 0 ? kPoissonFlagToR : 0u) |
+                             (s == 0 && zeroGuess ? kPoissonFlagZeroGuess : 0u),
+                         0u, omega, timer);
+        recordRestrict(cmd, level, 0u, timer);
+        vcycleLevel(cmd, level + 1, params, true, false, timer);
+        recordProlong(cmd, level, timer);
+        const int post = params.postSmooth + params.postSmooth % 2;
+        for (int s = 0; s < post; ++s)
+            recordSmooth(cmd, level,
+                         kPoissonFlagJacobi | (s % 2 == 0 ? kPoissonFlagToR : 0u) |
+                             (s + 1 == post && dotOut ? kPoissonFlagDot : 0u),
+                         0u, omega, timer);
+        return;
+    }
+    // Red-black Gauss-Seidel: pre-sweeps red first, post-sweeps black first (symmetric).
+    for (int s = 0; s < params.preSmooth; ++s) {
+        recordSmooth(cmd, level, s == 0 && zeroGuess ? kPoissonFlagZeroGuess : 0u, 0u, omega, timer);
+        recordSmooth(cmd, level, 0u, 1u, omega, timer);
+    }
+    if (params.preSmooth == 0 && zeroGuess) {
+        // The restriction reads x: give it a defined zero without a separate clear pass.
+        recordSmooth(cmd, level, kPoissonFlagJacobi | kPoissonFlagZeroGuess, 0u, 0.0f, timer);
+    }
+    recordRestrict(cmd, level, 0u, timer);
+    vcycleLevel(cmd, level + 1, params, true, false, timer);
+    const int post = params.postSmooth < 1 ? 1 : params.postSmooth;
+    for (int s = 0; s < post; ++s) {
+        recordSmooth(cmd, level, s == 0 ? kPoissonFlagCorrect : 0u, 1u, omega, timer);
+        recordSmooth(cmd, level, s + 1 == post && dotOut ? kPoissonFlagDot : 0u, 0u, omega, timer);
+    }
+}
+
+void PoissonGpuEngine::recordCopy(VkCommandBuffer cmd, const vk::Buffer& from, const vk::Buffer& to,
+                                  std::uint64_t floats) {
+    VkBufferCopy region{};
+    region.size = floats * sizeof(float);
+    vkCmdCopyBuffer(cmd, from.get(), to.get(), 1, &region);
+    vk::computeBarrier(cmd);
+}
+
+}  // namespace gdpt

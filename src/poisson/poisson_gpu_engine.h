@@ -1,0 +1,118 @@
+// poisson_gpu_engine.h — the GPU building blocks of the screened Poisson solver: the
+// poisson_*.comp pipelines (PoissonKernels, size-independent, created once per context) and
+// the buffers + multigrid level layout of one image size (PoissonGpuEngine), with one
+// record*() call per kernel. PoissonSolverGpu (poisson_gpu.h) strings these into solvers;
+// tests drive the single operators to compare them with the CPU reference (poisson_cpu.h).
+//
+// Every record*() call dispatches one kernel and ends with a compute barrier, so calls can
+// be chained freely in one command buffer. Field layout: shaders/shared/poisson_shared.h.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "vk/buffer.h"
+#include "vk/kernel.h"
+
+namespace gdpt::vk {
+class Context;
+class GpuTimer;
+}  // namespace gdpt::vk
+
+namespace gdpt {
+
+// The compiled poisson_* pipelines for one workgroup shape (2D kernels; reductions need
+// x·y to be a power of two ≤ 256). Pipeline creation dominates set-up on lavapipe, so
+// callers that solve many sizes keep one PoissonKernels and pass it to each engine.
+class PoissonKernels {
+public:
+    PoissonKernels(const vk::Context& ctx, std::uint32_t groupX = 16, std::uint32_t groupY = 16);
+    [[nodiscard]] std::uint32_t groupX() const { return groupX_; }
+    [[nodiscard]] std::uint32_t groupY() const { return groupY_; }
+
+    vk::Kernel setup, coarsen, residual, smooth, restrictResidual, prolong, coarsest,
+        cgDirection, cgUpdate, scalars, irlsWeights;
+
+private:
+    std::uint32_t groupX_, groupY_;
+};
+
+struct PoissonLevel {
+    int width = 0;
+    int height = 0;
+    std::uint32_t offset = 0;  // float offset of this level's 3 planes in X, B, R and Coef
+    [[nodiscard]] std::uint32_t pixels() const {
+        return static_cast<std::uint32_t>(width) * static_cast<std::uint32_t>(height);
+    }
+};
+
+// V-cycle parameters (Briggs et al., "A Multigrid Tutorial", ch. 3).
+struct VcycleParams {
+    bool jacobi = false;   // smoother: damped Jacobi (else red-black Gauss-Seidel)
+    int preSmooth = 1;     // sweeps before the coarse-grid correction (Jacobi: rounded to even)
+    int postSmooth = 1;    // sweeps after it (≥ 1)
+    float omega = 0.8f;    // Jacobi damping
+};
+
+class PoissonGpuEngine {
+public:
+    // Allocates every buffer for a width x height RGB problem; uses `kernels` if given (it
+    // must outlive the engine), else creates its own. Throws gdpt::Error naming the device
+    // limit if a field exceeds maxStorageBufferRange.
+    PoissonGpuEngine(const vk::Context& ctx, int width, int height,
+                     PoissonKernels* kernels = nullptr);
+
+    [[nodiscard]] int width() const { return levels_[0].width; }
+    [[nodiscard]] int height() const { return levels_[0].height; }
+    [[nodiscard]] std::uint32_t pixels() const { return levels_[0].pixels(); }
+    [[nodiscard]] const std::vector<PoissonLevel>& levels() const { return levels_; }
+    // Workgroups of a fine-level dispatch = number of partial sums per slot and channel.
+    [[nodiscard]] std::uint32_t groups() const;
+    [[nodiscard]] const vk::Context& context() const { return ctx_; }
+
+    // Points every kernel's descriptors at this engine's buffers (call before recording
+    // when several engines share one PoissonKernels).
+    void bind();
+
+    vk::Buffer coef, x, b, r, p, ap, sol, rhs, primal, dx, dy, weights, irls, scalars, partials;
+
+    // ---- one kernel each (see the kernel files for the maths) ----
+    void recordSetup(VkCommandBuffer cmd, float alpha2, bool irlsWeights, vk::GpuTimer* timer);
+    void recordCoarsenAll(VkCommandBuffer cmd, vk::GpuTimer* timer);
+    void recordResidual(VkCommandBuffer cmd, int level, std::uint32_t flags, vk::GpuTimer* timer);
+    void recordSmooth(VkCommandBuffer cmd, int level, std::uint32_t flags, std::uint32_t colour,
+                      float omega, vk::GpuTimer* timer);
+    void recordRestrict(VkCommandBuffer cmd, int level, std::uint32_t flags, vk::GpuTimer* timer);
+    void recordProlong(VkCommandBuffer cmd, int level, vk::GpuTimer* timer);
+    void recordCoarsest(VkCommandBuffer cmd, bool zeroGuess, vk::GpuTimer* timer);
+    void recordCgDirection(VkCommandBuffer cmd, std::uint32_t flags, std::uint32_t pOld,
+                           std::uint32_t pNew, vk::GpuTimer* timer);
+    void recordCgUpdate(VkCommandBuffer cmd, std::uint32_t pNew, vk::GpuTimer* timer);
+    void recordScalars(VkCommandBuffer cmd, std::uint32_t mode, std::uint32_t flags,
+                       std::uint32_t iteration, float tolerance, float value, vk::GpuTimer* timer);
+    void recordIrlsWeights(VkCommandBuffer cmd, float alpha2, float reg, vk::GpuTimer* timer);
+
+    // One V-cycle on level 0 for X₀ ≈ A⁻¹ B₀ (zeroGuess: X₀ starts at 0). dotOut: the last
+    // post-sweep writes partial sums of B₀·X₀ (r·z for PCG) to slot RZ.
+    void recordVcycle(VkCommandBuffer cmd, const VcycleParams& params, bool zeroGuess, bool dotOut,
+                      vk::GpuTimer* timer);
+    // Copies `floats` floats between buffers (with a barrier).
+    static void recordCopy(VkCommandBuffer cmd, const vk::Buffer& from, const vk::Buffer& to,
+                           std::uint64_t floats);
+
+private:
+    void vcycleLevel(VkCommandBuffer cmd, int level, const VcycleParams& params, bool zeroGuess,
+                     bool dotOut, vk::GpuTimer* timer);
+    void dispatch(VkCommandBuffer cmd, const vk::Kernel& kernel, int itemsX, int itemsY,
+                  const void* push, vk::GpuTimer* timer);
+
+    const vk::Context& ctx_;
+    std::unique_ptr<PoissonKernels> ownKernels_;
+    PoissonKernels* kernels_ = nullptr;
+    std::vector<PoissonLevel> levels_;
+};
+
+}  // namespace gdpt

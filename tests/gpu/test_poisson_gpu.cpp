@@ -1,0 +1,605 @@
+// test_poisson_gpu.cpp — the GPU screened-Poisson solver against the double-precision CPU
+// reference (src/poisson/poisson_cpu.h): every kernel on its own, then whole solves
+// (exact gradients, CPU exact solve, solver agreement, CG monotonicity, L1 robustness,
+// extreme inputs, non-finite inputs, determinism).
+//
+// Float tolerances: a kernel output is a sum of ≤ 10 products of float inputs, so its
+// rounding error is ≤ ~10·2⁻²⁴·Σ|terms| ≈ 6e-7 Σ|terms|; we allow 1e-5 of the magnitude
+// of the terms (values are O(1) here). Solves are compared with the CPU solution in the
+// relative 2-norm at 1e-4 after converging to a relative residual of 1e-6: float32 floors
+// the residual near 1e-7, and the error is bounded by cond(A)·residual with cond(A) ≲ 100
+// for these small grids.
+#include <cmath>
+#include <cstring>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "gpu_fixture.h"
+#include "poisson/poisson_cpu.h"
+#include "poisson/poisson_gpu.h"
+#include "poisson/poisson_irls.h"
+#include "poisson_shared.h"
+#include "vk/commands.h"
+
+namespace gdpt {
+namespace {
+
+using namespace gpu;
+
+PoissonKernels& sharedKernels() {
+    static PoissonKernels k(test::gpuContext());
+    return k;
+}
+
+Field randomField(int w, int h, unsigned seed, double lo = 0.0, double hi = 1.0) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(lo, hi);
+    Field v(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+    for (double& x : v) x = u(rng);
+    return v;
+}
+
+// Smooth ramp + sharp box + line, different per channel.
+Image structuredImage(int w, int h, double scale = 1.0) {
+    Image im(w, h);
+    for (int c = 0; c < 3; ++c)
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                double v = 0.5 + 0.3 * std::sin(0.7 * x + c) * std::cos(0.4 * y);
+                if (x >= w / 4 && x < w / 2 && y >= h / 3 && y < (2 * h) / 3) v += 2.0 + c;
+                if (x == w / 2) v += 0.7;
+                im.at(x, y, c) = static_cast<float>(scale * v);
+            }
+    return im;
+}
+
+Image randomImage(int w, int h, unsigned seed, double lo, double hi) {
+    Image im(w, h);
+    for (int c = 0; c < 3; ++c) {
+        const Field f = randomField(w, h, seed + static_cast<unsigned>(c), lo, hi);
+        for (std::size_t i = 0; i < f.size(); ++i) im.plane(c)[i] = static_cast<float>(f[i]);
+    }
+    return im;
+}
+
+// Forward differences of an image (dropped rows 0).
+void gradients(const Image& im, Image& dx, Image& dy) {
+    const int w = im.width(), h = im.height();
+    dx = Image(w, h);
+    dy = Image(w, h);
+    for (int c = 0; c < 3; ++c)
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                if (x + 1 < w) dx.at(x, y, c) = im.at(x + 1, y, c) - im.at(x, y, c);
+                if (y + 1 < h) dy.at(x, y, c) = im.at(x, y + 1, c) - im.at(x, y, c);
+            }
+}
+
+Field channel(const Image& im, int c) { return Field(im.plane(c).begin(), im.plane(c).end()); }
+
+PoissonProblem channelProblem(const Image& primal, const Image& dx, const Image& dy, double alpha, int c) {
+    PoissonProblem p;
+    p.width = primal.width();
+    p.height = primal.height();
+    p.alpha = alpha;
+    p.primal = channel(primal, c);
+    p.dx = channel(dx, c);
+    p.dy = channel(dy, c);
+    return p;
+}
+
+double relError(const Field& a, const Field& b) {
+    double num = 0.0, den = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        num += (a[i] - b[i]) * (a[i] - b[i]);
+        den += b[i] * b[i];
+    }
+    return den > 0.0 ? std::sqrt(num / den) : std::sqrt(num);
+}
+
+double maxAbs(const Field& a) {
+    double m = 0.0;
+    for (double v : a) m = std::max(m, std::abs(v));
+    return m;
+}
+
+// Uploads one double field per channel into a float buffer at a float offset.
+void uploadRgb(vk::Buffer& buf, std::uint32_t offset, const std::array<Field, 3>& f) {
+    std::vector<float> v;
+    for (const Field& c : f)
+        for (double x : c) v.push_back(static_cast<float>(x));
+    buf.upload(v.data(), v.size() * sizeof(float), std::uint64_t{offset} * sizeof(float));
+}
+
+std::vector<float> downloadFloats(const vk::Buffer& buf, std::uint32_t offset, std::size_t count) {
+    std::vector<float> v(count);
+    buf.download(v.data(), count * sizeof(float), std::uint64_t{offset} * sizeof(float));
+    return v;
+}
+
+void expectNear(const std::vector<float>& gpu, std::size_t gpuOffset, const Field& cpu, double tol,
+                const char* what) {
+    const double scale = std::max(1.0, maxAbs(cpu));
+    for (std::size_t i = 0; i < cpu.size(); ++i)
+        ASSERT_NEAR(gpu[gpuOffset + i], cpu[i], tol * scale) << what << " at " << i;
+}
+
+class PoissonGpu : public test::GpuTest {
+protected:
+    template <typename F>
+    void run(PoissonGpuEngine& e, F record) {
+        vk::CommandStream s(ctx(), "poisson test");
+        VkCommandBuffer cmd = s.begin();
+        e.bind();
+        record(cmd);
+        s.submitAndWait();
+    }
+
+    SolveReport solve(const Image& primal, const Image& dx, const Image& dy, const SolveOptions& o, Image& out,
+                      const PoissonInput* extra = nullptr) {
+        PoissonSolverGpu solver(ctx(), primal.width(), primal.height(), &sharedKernels());
+        PoissonInput in = extra ? *extra : PoissonInput{};
+        in.primal = &primal;
+        in.dx = &dx;
+        in.dy = &dy;
+        return solver.solve(in, o, out);
+    }
+};
+
+// A 37x21 problem with random weights: 4 levels (37x21, 19x11, 10x6, 5x3).
+struct OperatorCase {
+    int w = 37, h = 21;
+    double alpha = 0.3;
+    std::array<PoissonProblem, 3> problems;
+    OperatorCase() {
+        for (int c = 0; c < 3; ++c) {
+            PoissonProblem& p = problems[static_cast<std::size_t>(c)];
+            p.width = w;
+            p.height = h;
+            p.alpha = alpha;
+            const unsigned s = 100u * static_cast<unsigned>(c);
+            p.primal = randomField(w, h, s + 1, -1.0, 2.0);
+            p.dx = randomField(w, h, s + 2, -1.0, 1.0);
+            p.dy = randomField(w, h, s + 3, -1.0, 1.0);
+            // Shared weights (the GPU operator is one for all channels).
+            p.weightPrimal = randomField(w, h, 7, 0.1, 2.0);
+            p.weightDx = randomField(w, h, 8, 0.1, 2.0);
+            p.weightDy = randomField(w, h, 9, 0.1, 2.0);
+        }
+    }
+    void upload(PoissonGpuEngine& e) const {
+        uploadRgb(e.primal, 0, {problems[0].primal, problems[1].primal, problems[2].primal});
+        uploadRgb(e.dx, 0, {problems[0].dx, problems[1].dx, problems[2].dx});
+        uploadRgb(e.dy, 0, {problems[0].dy, problems[1].dy, problems[2].dy});
+        uploadRgb(e.weights, 0, {problems[0].weightPrimal, problems[0].weightDx, problems[0].weightDy});
+    }
+};
+
+TEST_F(PoissonGpu, SetupAndCoarseningMatchCpu) {
+    OperatorCase oc;
+    PoissonGpuEngine e(ctx(), oc.w, oc.h, &sharedKernels());
+    ASSERT_EQ(e.levels().size(), 4u);
+    oc.upload(e);
+    run(e, [&](VkCommandBuffer cmd) {
+        e.recordSetup(cmd, static_cast<float>(oc.alpha * oc.alpha), false, nullptr);
+        e.recordCoarsenAll(cmd, nullptr);
+    });
+    PoissonOperator op = makeOperator(oc.problems[0]);
+    const std::vector<float> rhs = downloadFloats(e.rhs, 0, 3 * e.pixels());
+    for (int c = 0; c < 3; ++c)
+        expectNear(rhs, static_cast<std::size_t>(c) * e.pixels(), computeRhs(oc.problems[static_cast<std::size_t>(c)]),
+                   1e-5, "rhs");
+    for (const PoissonLevel& l : e.levels()) {
+        const std::vector<float> coef = downloadFloats(e.coef, l.offset, 3 * l.pixels());
+        expectNear(coef, 0, op.cx, 1e-5, "cx");
+        expectNear(coef, l.pixels(), op.cy, 1e-5, "cy");
+        expectNear(coef, 2 * l.pixels(), op.cp, 1e-5, "cp");
+        if (l.offset != e.levels().back().offset) op = coarsenOperator(op);
+    }
+}
+
+TEST_F(PoissonGpu, ApplyResidualSmoothersRestrictProlongMatchCpu) {
+    OperatorCase oc;
+    PoissonGpuEngine e(ctx(), oc.w, oc.h, &sharedKernels());
+    oc.upload(e);
+    run(e, [&](VkCommandBuffer cmd) {
+        e.recordSetup(cmd, static_cast<float>(oc.alpha * oc.alpha), false, nullptr);
+        e.recordCoarsenAll(cmd, nullptr);
+    });
+    const PoissonOperator op0 = makeOperator(oc.problems[0]);
+    const PoissonOperator op1 = coarsenOperator(op0);
+    const std::size_t n = e.pixels();
+    std::array<Field, 3> x, b, xc;
+    for (int c = 0; c < 3; ++c) {
+        x[static_cast<std::size_t>(c)] = randomField(oc.w, oc.h, 40u + static_cast<unsigned>(c), -2.0, 2.0);
+        b[static_cast<std::size_t>(c)] = randomField(oc.w, oc.h, 50u + static_cast<unsigned>(c), -2.0, 2.0);
+        xc[static_cast<std::size_t>(c)] = randomField(op1.width, op1.height, 60u + static_cast<unsigned>(c), -1.0, 1.0);
+    }
+    const PoissonLevel& l1 = e.levels()[1];
+    auto reset = [&] {
+        uploadRgb(e.x, 0, x);
+        uploadRgb(e.b, 0, b);
+        uploadRgb(e.x, l1.offset, xc);
+    };
+    // A x and b − A x.
+    reset();
+    run(e, [&](VkCommandBuffer cmd) { e.recordResidual(cmd, 0, kPoissonFlagApplyOnly, nullptr); });
+    std::vector<float> out = downloadFloats(e.r, 0, 3 * n);
+    for (std::size_t c = 0; c < 3; ++c) {
+        Field y;
+        applyA(op0, x[c], y);
+        expectNear(out, c * n, y, 1e-5, "A x");
+    }
+    run(e, [&](VkCommandBuffer cmd) { e.recordResidual(cmd, 0, 0u, nullptr); });
+    out = downloadFloats(e.r, 0, 3 * n);
+    for (std::size_t c = 0; c < 3; ++c) {
+        Field r;
+        residual(op0, b[c], x[c], r);
+        expectNear(out, c * n, r, 1e-5, "b - A x");
+    }
+    // Fused residual restriction and plain restriction of the stored residual.
+    run(e, [&](VkCommandBuffer cmd) { e.recordRestrict(cmd, 0, 0u, nullptr); });
+    out = downloadFloats(e.b, l1.offset, 3 * l1.pixels());
+    for (std::size_t c = 0; c < 3; ++c) {
+        Field r, rc;
+        residual(op0, b[c], x[c], r);
+        restrictFullWeighting(oc.w, oc.h, r, rc);
+        expectNear(out, c * l1.pixels(), rc, 1e-5, "R (b - A x)");
+    }
+    run(e, [&](VkCommandBuffer cmd) { e.recordRestrict(cmd, 0, kPoissonFlagPlain, nullptr); });
+    std::vector<float> plain = downloadFloats(e.b, l1.offset, 3 * l1.pixels());
+    for (std::size_t i = 0; i < plain.size(); ++i) ASSERT_NEAR(plain[i], out[i], 1e-5);
+    // Prolongation x += P x_H.
+    run(e, [&](VkCommandBuffer cmd) { e.recordProlong(cmd, 0, nullptr); });
+    out = downloadFloats(e.x, 0, 3 * n);
+    for (std::size_t c = 0; c < 3; ++c) {
+        Field f = x[c];
+        prolongate(oc.w, oc.h, xc[c], f);
+        expectNear(out, c * n, f, 1e-5, "x + P x_H");
+    }
+    // One red-black Gauss-Seidel sweep (red then black half-sweep).
+    reset();
+    run(e, [&](VkCommandBuffer cmd) {
+        e.recordSmooth(cmd, 0, 0u, 0u, 0.8f, nullptr);
+        e.recordSmooth(cmd, 0, 0u, 1u, 0.8f, nullptr);
+    });
+    out = downloadFloats(e.x, 0, 3 * n);
+    for (std::size_t c = 0; c < 3; ++c) {
+        Field f = x[c];
+        gaussSeidelRedBlackSweep(op0, b[c], f, true);
+        expectNear(out, c * n, f, 1e-5, "RB-GS sweep");
+    }
+    // Fused correction: black-first sweep reading x + P x_H equals prolongate + sweep.
+    reset();
+    run(e, [&](VkCommandBuffer cmd) {
+        e.recordSmooth(cmd, 0, kPoissonFlagCorrect, 1u, 0.8f, nullptr);
+        e.recordSmooth(cmd, 0, 0u, 0u, 0.8f, nullptr);
+    });
+    out = downloadFloats(e.x, 0, 3 * n);
+    for (std::size_t c = 0; c < 3; ++c) {
+        Field f = x[c];
+        prolongate(oc.w, oc.h, xc[c], f);
+        gaussSeidelRedBlackSweep(op0, b[c], f, false);
+        expectNear(out, c * n, f, 1e-5, "prolongate + black-first sweep");
+    }
+    // One damped Jacobi sweep X -> R.
+    reset();
+    run(e, [&](VkCommandBuffer cmd) {
+        e.recordSmooth(cmd, 0, kPoissonFlagJacobi | kPoissonFlagToR, 0u, 0.8f, nullptr);
+    });
+    out = downloadFloats(e.r, 0, 3 * n);
+    for (std::size_t c = 0; c < 3; ++c) {
+        Field f = x[c];
+        jacobiSweep(op0, b[c], f, 0.8);
+        expectNear(out, c * n, f, 1e-5, "Jacobi sweep");
+    }
+}
+
+TEST_F(PoissonGpu, IrlsWeightsMatchCpu) {
+    OperatorCase oc;
+    PoissonGpuEngine e(ctx(), oc.w, oc.h, &sharedKernels());
+    oc.upload(e);
+    // Input weights all 1: every kept row counts.
+    std::vector<float> ones(3 * e.pixels(), 1.0f);
+    e.weights.uploadVector(ones);
+    RgbPoissonProblem rgb;
+    rgb.width = oc.w;
+    rgb.height = oc.h;
+    rgb.alpha = oc.alpha;
+    std::array<Field, 3> x;
+    for (std::size_t c = 0; c < 3; ++c) {
+        rgb.primal[c] = oc.problems[c].primal;
+        rgb.dx[c] = oc.problems[c].dx;
+        rgb.dy[c] = oc.problems[c].dy;
+        x[c] = randomField(oc.w, oc.h, 70u + static_cast<unsigned>(c), -1.0, 2.0);
+    }
+    uploadRgb(e.sol, 0, x);
+    const double reg = 0.05;
+    const int rows = oc.w * oc.h + (oc.w - 1) * oc.h + oc.w * (oc.h - 1);
+    run(e, [&](VkCommandBuffer cmd) {
+        e.recordIrlsWeights(cmd, static_cast<float>(oc.alpha * oc.alpha), static_cast<float>(reg), nullptr);
+        e.recordScalars(cmd, kPoissonModeIrls, 0u, 0u, 0.0f, static_cast<float>(rows), nullptr);
+    });
+    const IrlsWeights cpu = computeIrlsWeights(rgb, x, reg);
+    PoissonScalars sc{};
+    e.scalars.download(&sc, sizeof(sc));
+    std::vector<float> raw = downloadFloats(e.irls, 0, 3 * e.pixels());
+    for (float& v : raw) v *= sc.irlsScale;
+    expectNear(raw, 0, cpu.primal, 1e-5, "IRLS primal weight");
+    expectNear(raw, e.pixels(), cpu.dx, 1e-5, "IRLS dx weight");
+    expectNear(raw, 2 * e.pixels(), cpu.dy, 1e-5, "IRLS dy weight");
+}
+
+// Exact gradients and primal of an image reproduce it, from a zero initial guess.
+TEST_F(PoissonGpu, ExactGradientsReturnTheImage) {
+    const Image im = structuredImage(45, 31);
+    Image dx, dy;
+    gradients(im, dx, dy);
+    for (double alpha : {1e-4, 0.2, 10.0}) {
+        SolveOptions o;
+        o.alpha = alpha;
+        o.tolerance = 1e-6;
+        o.warmStart = false;
+        Image out;
+        const SolveReport r = solve(im, dx, dy, o, out);
+        EXPECT_TRUE(r.converged) << "alpha " << alpha;
+        for (int c = 0; c < 3; ++c)
+            EXPECT_LT(relError(channel(out, c), channel(im, c)), 1e-4) << "alpha " << alpha << " c " << c;
+    }
+}
+
+// GPU L2 equals the CPU exact solve; all four solvers agree.
+TEST_F(PoissonGpu, L2MatchesCpuExactForEverySolver) {
+    struct Case {
+        Image primal, dx, dy;
+    };
+    std::vector<Case> cases(2);
+    cases[0].primal = randomImage(24, 17, 11, 0.0, 1.0);
+    cases[0].dx = randomImage(24, 17, 21, -0.5, 0.5);
+    cases[0].dy = randomImage(24, 17, 31, -0.5, 0.5);
+    const Image truth = structuredImage(33, 20);
+    gradients(truth, cases[1].dx, cases[1].dy);
+    cases[1].primal = truth;
+    for (std::size_t i = 0; i < cases[1].primal.pixelCount(); ++i)
+        cases[1].primal.plane(0)[i] += 0.3f * static_cast<float>(i % 7) - 0.9f;  // structured noise
+    for (const Case& k : cases)
+        for (GpuSolver s : {GpuSolver::MgPcg, GpuSolver::Cg, GpuSolver::Jacobi, GpuSolver::Mg}) {
+            SolveOptions o;
+            o.solver = s;
+            o.tolerance = 1e-6;
+            o.maxIterations = 20000;
+            Image out;
+            const SolveReport r = solve(k.primal, k.dx, k.dy, o, out);
+            EXPECT_TRUE(r.converged) << toString(s);
+            EXPECT_LT(r.residual, 1e-5) << toString(s);
+            for (int c = 0; c < 3; ++c) {
+                const PoissonProblem p = channelProblem(k.primal, k.dx, k.dy, o.alpha, c);
+                const Field exact = solvePoissonL2(p, L2Method::Exact);
+                EXPECT_LT(relError(channel(out, c), exact), 1e-4) << toString(s) << " channel " << c;
+            }
+        }
+}
+
+// MG-PCG needs far fewer iterations than CG (the point of the preconditioner).
+TEST_F(PoissonGpu, MultigridPreconditionerCutsIterations) {
+    const Image truth = structuredImage(96, 80);
+    Image dx, dy;
+    gradients(truth, dx, dy);
+    const Image primal = randomImage(96, 80, 5, 0.0, 3.0);
+    SolveOptions o;
+    Image out;
+    o.solver = GpuSolver::Cg;
+    const SolveReport cg = solve(primal, dx, dy, o, out);
+    o.solver = GpuSolver::MgPcg;
+    const SolveReport pcg = solve(primal, dx, dy, o, out);
+    EXPECT_TRUE(cg.converged && pcg.converged);
+    EXPECT_LT(pcg.iterations * 3, cg.iterations) << "mg-pcg " << pcg.iterations << " cg " << cg.iterations;
+}
+
+// CG minimises ‖x − x*‖_A over growing Krylov spaces: that error never increases, checked
+// by stopping after k = 1..12 iterations (the iteration sequence does not depend on where a
+// solve stops). The stand-alone V-cycle is a contraction: its residual history decreases.
+TEST_F(PoissonGpu, CgErrorAndMultigridResidualAreMonotone) {
+    const Image primal = randomImage(32, 32, 3, 0.0, 1.0);
+    const Image dx = randomImage(32, 32, 13, -0.3, 0.3), dy = randomImage(32, 32, 23, -0.3, 0.3);
+    const double alpha = 0.05;
+    std::array<PoissonOperator, 3> ops;
+    std::array<Field, 3> exact;
+    for (int c = 0; c < 3; ++c) {
+        const PoissonProblem p = channelProblem(primal, dx, dy, alpha, c);
+        ops[static_cast<std::size_t>(c)] = makeOperator(p);
+        exact[static_cast<std::size_t>(c)] = solveExact(ops[static_cast<std::size_t>(c)], computeRhs(p));
+    }
+    for (GpuSolver s : {GpuSolver::Cg, GpuSolver::MgPcg}) {
+        std::array<double, 3> previous{1e300, 1e300, 1e300};
+        for (int k = 1; k <= 12; ++k) {
+            SolveOptions o;
+            o.solver = s;
+            o.alpha = alpha;
+            o.tolerance = 1e-7;
+            o.maxIterations = k;
+            Image out;
+            solve(primal, dx, dy, o, out);
+            for (std::size_t c = 0; c < 3; ++c) {
+                Field e = channel(out, static_cast<int>(c)), ae;
+                for (std::size_t i = 0; i < e.size(); ++i) e[i] -= exact[c][i];
+                applyA(ops[c], e, ae);
+                const double energy = std::sqrt(std::max(0.0, dot(e, ae)));
+                // Float noise floor: 1e-5 of the initial error.
+                EXPECT_LE(energy, previous[c] * (1.0 + 1e-4) + 1e-6) << toString(s) << " k " << k;
+                previous[c] = energy;
+            }
+        }
+    }
+    SolveOptions o;
+    o.solver = GpuSolver::Mg;
+    o.alpha = alpha;
+    o.tolerance = 1e-6;
+    o.keepHistory = true;
+    Image out;
+    const SolveReport r = solve(primal, dx, dy, o, out);
+    ASSERT_GE(r.history.size(), 3u);
+    for (std::size_t k = 1; k < r.history.size(); ++k)
+        for (std::size_t c = 0; c < 3; ++c) EXPECT_LT(r.history[k][c], r.history[k - 1][c]) << "V-cycle " << k;
+}
+
+// L1 (IRLS) shrugs off a few grossly wrong gradients that L2 smears over the image.
+TEST_F(PoissonGpu, L1RecoversCorruptedGradientsBetterThanL2) {
+    const int w = 48, h = 48;
+    const Image truth = structuredImage(w, h);
+    Image dx, dy;
+    gradients(truth, dx, dy);
+    Image primal = truth;
+    std::mt19937 rng(17);
+    std::normal_distribution<float> noise(0.0f, 0.05f);
+    for (int c = 0; c < 3; ++c)
+        for (float& v : primal.plane(c)) v += noise(rng);
+    for (int k = 0; k < 12; ++k) {
+        const int x = 3 + (k * 7) % (w - 6), y = 2 + (k * 11) % (h - 4);
+        for (int c = 0; c < 3; ++c) dx.at(x, y, c) += 5.0f;
+    }
+    auto rmse = [&](const Image& im) {
+        double s = 0.0;
+        for (int c = 0; c < 3; ++c)
+            for (std::size_t i = 0; i < im.pixelCount(); ++i) {
+                const double d = im.plane(c)[i] - truth.plane(c)[i];
+                s += d * d;
+            }
+        return std::sqrt(s / (3.0 * double(im.pixelCount())));
+    };
+    SolveOptions o;
+    Image l2, l1;
+    solve(primal, dx, dy, o, l2);
+    o.method = Reconstruction::L1;
+    const SolveReport r = solve(primal, dx, dy, o, l1);
+    EXPECT_EQ(r.irlsIterations, o.irlsIterations);
+    const double e2 = rmse(l2), e1 = rmse(l1);
+    EXPECT_LT(e1, 0.25 * e2) << "L1 rmse " << e1 << " L2 rmse " << e2;
+}
+
+// Extreme scales, α, and degenerate sizes agree with the CPU exact solve.
+TEST_F(PoissonGpu, StableAcrossScalesAlphasAndShapes) {
+    struct Shape {
+        int w, h;
+    };
+    for (Shape sh : {Shape{1, 1}, Shape{1, 37}, Shape{41, 1}, Shape{17, 13}, Shape{64, 9}})
+        for (double scale : {1e-6, 1.0, 1e6})
+            for (double alpha : {1e-4, 0.2, 10.0}) {
+                const Image truth = structuredImage(sh.w, sh.h, scale);
+                Image dx, dy;
+                gradients(truth, dx, dy);
+                Image primal = truth;
+                for (int c = 0; c < 3; ++c)
+                    for (std::size_t i = 0; i < primal.pixelCount(); ++i)
+                        primal.plane(c)[i] *= 1.0f + 0.1f * static_cast<float>((i * 7 + static_cast<std::size_t>(c)) % 5);
+                SolveOptions o;
+                o.alpha = alpha;
+                o.tolerance = 1e-6;
+                o.maxIterations = 500;
+                Image out;
+                const SolveReport r = solve(primal, dx, dy, o, out);
+                for (int c = 0; c < 3; ++c) {
+                    const PoissonProblem p = channelProblem(primal, dx, dy, alpha, c);
+                    const Field exact = solvePoissonL2(p, L2Method::Exact);
+                    EXPECT_LT(relError(channel(out, c), exact), 1e-3)
+                        << sh.w << "x" << sh.h << " scale " << scale << " alpha " << alpha << " residual "
+                        << r.residual << " its " << r.iterations;
+                }
+            }
+}
+
+// α = 0: the Laplacian alone is singular; the mean is taken from the primal (CPU
+// solvePoissonL2 does the same).
+TEST_F(PoissonGpu, AlphaZeroFixesTheMeanFromThePrimal) {
+    const Image primal = randomImage(29, 22, 41, 0.0, 2.0);
+    const Image dx = randomImage(29, 22, 42, -0.2, 0.2), dy = randomImage(29, 22, 43, -0.2, 0.2);
+    SolveOptions o;
+    o.alpha = 0.0;
+    o.tolerance = 1e-6;
+    Image out;
+    const SolveReport r = solve(primal, dx, dy, o, out);
+    EXPECT_TRUE(r.converged);
+    for (int c = 0; c < 3; ++c) {
+        const Field exact = solvePoissonL2(channelProblem(primal, dx, dy, 0.0, c), L2Method::Exact);
+        EXPECT_LT(relError(channel(out, c), exact), 1e-4) << c;
+    }
+}
+
+// Inverse-variance weights equal the CPU solve with the same row weights.
+TEST_F(PoissonGpu, WeightedL2MatchesCpuWithInverseVarianceWeights) {
+    const int w = 26, h = 19;
+    const Image primal = randomImage(w, h, 51, 0.0, 1.0);
+    const Image dx = randomImage(w, h, 52, -0.3, 0.3), dy = randomImage(w, h, 53, -0.3, 0.3);
+    const Image vp = randomImage(w, h, 54, 0.01, 1.0), vx = randomImage(w, h, 55, 0.01, 1.0),
+                vy = randomImage(w, h, 56, 0.01, 1.0);
+    SolveOptions o;
+    o.method = Reconstruction::WeightedL2;
+    o.tolerance = 1e-6;
+    PoissonInput in;
+    in.varPrimal = &vp;
+    in.varDx = &vx;
+    in.varDy = &vy;
+    Image out;
+    const SolveReport r = solve(primal, dx, dy, o, out, &in);
+    EXPECT_TRUE(r.converged);
+    auto inv = [&](const Image& v) {
+        Field f(v.pixelCount());
+        for (std::size_t i = 0; i < f.size(); ++i)
+            f[i] = 1.0 / ((double(v.plane(0)[i]) + v.plane(1)[i] + v.plane(2)[i]) / 3.0 + o.varianceEpsilon);
+        return f;
+    };
+    for (int c = 0; c < 3; ++c) {
+        PoissonProblem p = channelProblem(primal, dx, dy, o.alpha, c);
+        p.weightPrimal = inv(vp);
+        p.weightDx = inv(vx);
+        p.weightDy = inv(vy);
+        EXPECT_LT(relError(channel(out, c), solvePoissonL2(p, L2Method::Exact)), 1e-4) << c;
+    }
+}
+
+// NaN/Inf inputs are counted, replaced with zero-weight rows, and do not spread.
+TEST_F(PoissonGpu, NonFiniteInputsAreCountedAndContained) {
+    const Image truth = structuredImage(30, 20);
+    Image dx, dy;
+    gradients(truth, dx, dy);
+    Image primal = truth;
+    primal.at(5, 5, 0) = std::nanf("");
+    primal.at(6, 5, 1) = INFINITY;
+    dx.at(10, 10, 2) = -INFINITY;
+    dy.at(20, 3, 0) = std::nanf("");
+    for (Reconstruction m : {Reconstruction::L2, Reconstruction::L1}) {
+        SolveOptions o;
+        o.method = m;
+        Image out;
+        const SolveReport r = solve(primal, dx, dy, o, out);
+        EXPECT_EQ(r.nonFinite.primal, 2u);
+        EXPECT_EQ(r.nonFinite.dx, 1u);
+        EXPECT_EQ(r.nonFinite.dy, 1u);
+        double worst = 0.0;
+        for (int c = 0; c < 3; ++c)
+            for (std::size_t i = 0; i < out.pixelCount(); ++i) {
+                ASSERT_TRUE(std::isfinite(out.plane(c)[i]));
+                worst = std::max(worst, double(std::abs(out.plane(c)[i] - truth.plane(c)[i])));
+            }
+        // Exact data elsewhere: the dropped rows lose nothing the other rows do not pin down.
+        EXPECT_LT(worst, 1e-2) << toString(m);
+    }
+}
+
+TEST_F(PoissonGpu, SolvesAreBitReproducible) {
+    const Image primal = randomImage(57, 43, 61, 0.0, 1.0);
+    const Image dx = randomImage(57, 43, 62, -0.3, 0.3), dy = randomImage(57, 43, 63, -0.3, 0.3);
+    for (Reconstruction m : {Reconstruction::L2, Reconstruction::L1}) {
+        SolveOptions o;
+        o.method = m;
+        Image a, b;
+        solve(primal, dx, dy, o, a);
+        solve(primal, dx, dy, o, b);
+        for (int c = 0; c < 3; ++c)
+            EXPECT_EQ(0, std::memcmp(a.plane(c).data(), b.plane(c).data(), a.pixelCount() * sizeof(float)));
+    }
+}
+
+}  // namespace
+}  // namespace gdpt
