@@ -28,6 +28,7 @@ struct RenderArgs {
     std::string method = "pt";
     std::string workgroup = "8x8";
     std::string schedule = "megakernel";
+    float shiftThreshold = 0.001f;
 };
 
 struct DiffArgs {

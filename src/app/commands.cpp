@@ -14,6 +14,7 @@
 #include "image/metrics.h"
 #include "image/png_preview.h"
 #include "render/features.h"
+#include "render/gpt_renderer.h"
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
@@ -130,13 +131,35 @@ int runRender(const RenderArgs& args) {
         std::fprintf(stderr, "gdpt: device '%s' (%s, %s)\n", ctx.info().name.c_str(), ctx.info().type.c_str(),
                      ctx.info().driverInfo.c_str());
     options.elapsedBefore = total.seconds();
-    RenderResult result = renderPt(ctx, scene, options);
+    options.scene.shiftThreshold = args.shiftThreshold;
+
+    // Sample, then assemble the output layers. PT: the image and its variance. G-PT: the
+    // final image in the default channels (primal + direct until a reconstruction is
+    // chosen), plus every buffer the sampler produced as a named layer.
+    std::vector<NamedLayer> layers;
+    RenderStats stats;
+    if (args.method == "gpt") {
+        GptPassOptions gptOptions;
+        gptOptions.shiftThreshold = args.shiftThreshold;
+        RenderResultGpt g = renderGpt(ctx, scene, options, gptOptions);
+        Image preview = g.primal;
+        for (int c = 0; c < 3; ++c)
+            for (std::size_t i = 0; i < preview.pixelCount(); ++i) preview.plane(c)[i] += g.direct.plane(c)[i];
+        layers = {{"", preview},          {"primal", g.primal},       {"dx", g.dx},
+                  {"dy", g.dy},           {"direct", g.direct},       {"var_primal", g.varPrimal},
+                  {"var_dx", g.varDx},    {"var_dy", g.varDy},        {"var_direct", g.varDirect}};
+        stats = g.stats;
+    } else {
+        RenderResult r = renderPt(ctx, scene, options);
+        layers = {{"", r.image}, {"variance", r.varianceOfMean}};
+        stats = r.stats;
+    }
 
     Timer writeTimer;
-    writeExr(args.output, {{"", result.image}, {"variance", result.varianceOfMean}});
-    writePngPreview(previewPath(args.output), result.image);
+    writeExr(args.output, layers);
+    writePngPreview(previewPath(args.output), layers.front().image);
     const double writeMs = writeTimer.ms();
-    const RenderStats& s = result.stats;
+    const RenderStats& s = stats;
     const double seconds = total.seconds();
     if (args.profile) printProfile(s.kernels);
     if (!args.quiet)
@@ -276,7 +299,16 @@ Subcommand addRenderCommand(CLI::App& app) {
     r->add_option("--device", render.device, "Vulkan device index or name substring (default: lavapipe)");
     r->add_option("--camera", render.camera, "Camera index in the glTF (default: first camera, or a framing camera)")
         ->check(CLI::NonNegativeNumber);
-    r->add_option("--method", render.method, "Rendering method")->capture_default_str()->check(CLI::IsMember({"pt"}));
+    r->add_option("--method", render.method,
+                  "pt: path tracing; gpt: gradient-domain path tracing (base + 4 shifted offset paths, "
+                  "Kettunen et al. 2015), writes primal/dx/dy/direct/variance layers")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"pt", "gpt"}));
+    r->add_option("--shift-threshold", render.shiftThreshold,
+                  "G-PT: roughness at or below which a vertex is glossy (half-vector shift) instead of "
+                  "reconnectable")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0f, 1.0f));
     r->add_option("--workgroup", render.workgroup, "Compute workgroup size WxH")->capture_default_str();
     r->add_option("--schedule", render.schedule,
                   "Kernel schedule: megakernel (one kernel per path batch) or wavefront (kernel per bounce stage)")
