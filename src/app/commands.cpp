@@ -4,6 +4,9 @@
 
 #include "app/subcommand.h"
 
+#include <algorithm>
+#include <atomic>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -25,6 +28,22 @@ namespace gdpt {
 namespace {
 
 using nlohmann::json;
+
+// Set by SIGINT/SIGTERM; the render loops stop at the next batch boundary.
+std::atomic<bool> gInterrupted{false};
+
+extern "C" void onInterrupt(int) { gInterrupted.store(true); }
+
+// Largest batch (samples per pixel per submission) such that one batch is about 2^19
+// pixel-samples of PT work (G-PT: a quarter, it costs more per sample). Depends only on the
+// image size, so the batch schedule -- and hence the bits of the result -- is the same on
+// every run, and a batch stays well under a second on lavapipe, so an interrupt is served
+// promptly.
+std::uint32_t batchLimit(int width, int height, bool gpt) {
+    const std::uint64_t pixels = std::uint64_t(width) * std::uint64_t(height);
+    const std::uint64_t budget = gpt ? (1u << 16) : (1u << 18);
+    return static_cast<std::uint32_t>(std::clamp<std::uint64_t>(budget / pixels, 1, 16));
+}
 
 WorkgroupSize parseWorkgroup(const std::string& text) {
     unsigned x = 0, y = 0;
@@ -132,6 +151,10 @@ int runRender(const RenderArgs& args) {
                      ctx.info().driverInfo.c_str());
     options.elapsedBefore = total.seconds();
     options.scene.shiftThreshold = args.shiftThreshold;
+    options.maxBatchSpp = batchLimit(args.width, args.height, args.method == "gpt");
+    options.cancel = &gInterrupted;
+    std::signal(SIGINT, onInterrupt);
+    std::signal(SIGTERM, onInterrupt);
 
     // Sample, then assemble the output layers. PT: the image and its variance. G-PT: the
     // final image in the default channels (primal + direct until a reconstruction is
@@ -155,6 +178,10 @@ int runRender(const RenderArgs& args) {
         stats = r.stats;
     }
 
+    if (stats.cancelled) {
+        std::fprintf(stderr, "gdpt: interrupted after %u spp; no output written\n", stats.spp);
+        return 130;
+    }
     Timer writeTimer;
     writeExr(args.output, layers);
     writePngPreview(previewPath(args.output), layers.front().image);

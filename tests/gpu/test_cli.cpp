@@ -130,3 +130,31 @@ TEST_F(Cli, UnknownDeviceIsAnError) {
 
 }  // namespace
 }  // namespace gdpt
+
+namespace gdpt {
+namespace {
+
+// SIGINT during a render stops it at the next batch boundary (batches are sized to stay
+// well under a second), exits with 130 and leaves no output file.
+TEST_F(Cli, InterruptStopsPromptlyWithoutOutput) {
+    const std::string out = path("long.exr");
+    const std::string cmd = std::string(GDPT_BINARY) + " render " + kScene + " -o " + out +
+                            " --spp 100000 --quiet 2>/dev/null & pid=$!; sleep 1.5; kill -INT $pid; "
+                            "start=$(date +%s%N); wait $pid; rc=$?; end=$(date +%s%N); "
+                            "echo $rc $(( (end - start) / 1000000 ))";
+    FILE* pipe = popen(cmd.c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    int rc = -1;
+    long stopMs = -1;
+    ASSERT_EQ(std::fscanf(pipe, "%d %ld", &rc, &stopMs), 2);
+    pclose(pipe);
+    EXPECT_EQ(rc, 130);
+    // A batch is at most 2^18 pixel-samples (~0.3 s on two idle cores); allow for a loaded
+    // CI machine.
+    EXPECT_LT(stopMs, 3000);
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_FALSE(fs::exists(out + ".tmp"));
+}
+
+}  // namespace
+}  // namespace gdpt
