@@ -17,6 +17,7 @@
 #include "image/metrics.h"
 #include "image/png_preview.h"
 #include "render/features.h"
+#include "poisson/poisson_gpu.h"
 #include "render/gpt_renderer.h"
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
@@ -165,13 +166,37 @@ int runRender(const RenderArgs& args) {
         GptPassOptions gptOptions;
         gptOptions.shiftThreshold = args.shiftThreshold;
         RenderResultGpt g = renderGpt(ctx, scene, options, gptOptions);
-        Image preview = g.primal;
-        for (int c = 0; c < 3; ++c)
-            for (std::size_t i = 0; i < preview.pixelCount(); ++i) preview.plane(c)[i] += g.direct.plane(c)[i];
-        layers = {{"", preview},          {"primal", g.primal},       {"dx", g.dx},
-                  {"dy", g.dy},           {"direct", g.direct},       {"var_primal", g.varPrimal},
-                  {"var_dx", g.varDx},    {"var_dy", g.varDy},        {"var_direct", g.varDirect}};
         stats = g.stats;
+        // Screened Poisson reconstruction of the indirect image from primal + gradients;
+        // the final image is reconstruction + very-direct light (Kettunen et al. 2015 §5).
+        auto solve = [&](const std::string& name) {
+            SolveOptions so;
+            so.method = parseReconstruction(name);
+            so.alpha = args.alpha;
+            so.tolerance = args.tolerance;
+            SolveReport report;
+            Image recon = reconstruct(ctx, g.primal, g.dx, g.dy, &g.varPrimal, &g.varDx, &g.varDy, so, &report);
+            if (!args.quiet)
+                std::fprintf(stderr, "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g, %.1f ms\n",
+                             name.c_str(), report.iterations, report.irlsIterations, report.residual, report.ms);
+            stats.reconstructionMs += report.ms;
+            return recon;
+        };
+        auto plus = [](Image a, const Image& b) {
+            for (int c = 0; c < 3; ++c)
+                for (std::size_t i = 0; i < a.pixelCount(); ++i) a.plane(c)[i] += b.plane(c)[i];
+            return a;
+        };
+        const Image recon = solve(args.recon);
+        layers = {{"", plus(recon, g.direct)}, {"recon_" + args.recon, recon}};
+        if (args.allRecon)
+            for (const char* other : {"l1", "l2", "wl2"})
+                if (args.recon != other) layers.push_back({std::string("recon_") + other, solve(other)});
+        const std::vector<NamedLayer> buffers = {
+            {"primal", g.primal}, {"dx", g.dx},         {"dy", g.dy},         {"direct", g.direct},
+            {"var_primal", g.varPrimal}, {"var_dx", g.varDx}, {"var_dy", g.varDy}, {"var_direct", g.varDirect},
+            {"primal_plus_direct", plus(g.primal, g.direct)}};
+        layers.insert(layers.end(), buffers.begin(), buffers.end());
     } else {
         RenderResult r = renderPt(ctx, scene, options);
         layers = {{"", r.image}, {"variance", r.varianceOfMean}};
@@ -211,6 +236,7 @@ int runRender(const RenderArgs& args) {
                               {"upload", s.uploadMs * 1e-3},
                               {"sampling", s.samplingMs * 1e-3},
                               {"readback", s.readbackMs * 1e-3},
+                              {"reconstruction", s.reconstructionMs * 1e-3},
                               {"write", writeMs * 1e-3}}},
                   {"rays_traced", s.raysTraced},
                   {"paths_completed", s.pathsCompleted},
@@ -331,6 +357,18 @@ Subcommand addRenderCommand(CLI::App& app) {
                   "Kettunen et al. 2015), writes primal/dx/dy/direct/variance layers")
         ->capture_default_str()
         ->check(CLI::IsMember({"pt", "gpt"}));
+    r->add_option("--recon", render.recon,
+                  "G-PT reconstruction in the default channels: l1 (IRLS), l2 (unbiased), wl2 (inverse-variance "
+                  "weighted L2)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"l1", "l2", "wl2"}));
+    r->add_flag("--all-recon", render.allRecon, "G-PT: also write the other reconstructions as layers recon_*");
+    r->add_option("--alpha", render.alpha, "G-PT: weight of the primal term in the screened Poisson energy")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1e3));
+    r->add_option("--tolerance", render.tolerance, "G-PT: relative residual at which the solver stops")
+        ->capture_default_str()
+        ->check(CLI::Range(1e-9, 1.0));
     r->add_option("--shift-threshold", render.shiftThreshold,
                   "G-PT: roughness at or below which a vertex is glossy (half-vector shift) instead of "
                   "reconnectable")

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
         addInfoCommand(app),
         addDevicesCommand(app),
         addBenchCommand(app),
+        addConvergeCommand(app),
     };
 
     try {

@@ -19,5 +19,6 @@ Subcommand addDiffCommand(CLI::App& app);
 Subcommand addInfoCommand(CLI::App& app);
 Subcommand addDevicesCommand(CLI::App& app);
 Subcommand addBenchCommand(CLI::App& app);
+Subcommand addConvergeCommand(CLI::App& app);
 
 }  // namespace gdpt

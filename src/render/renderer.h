@@ -45,6 +45,7 @@ struct RenderStats {
     double uploadMs = 0.0;       // scene upload + pipeline creation
     double samplingMs = 0.0;     // wall time of the batch loop
     double readbackMs = 0.0;
+    double reconstructionMs = 0.0;  // G-PT: screened Poisson solve(s)
     std::uint64_t raysTraced = 0;
     std::uint64_t pathsCompleted = 0;
     std::uint64_t nanSamples = 0;

@@ -1,0 +1,374 @@
+// converge_command.cpp — `gdpt converge`: run time against error. Renders a scene with each
+// method at each time budget (independent seeds per repeat), measures relMSE (Kettunen et
+// al.'s definition, as `gdpt diff`), MSE and mean bias against a reference, and writes
+// DIR/results.json, DIR/results.csv, DIR/error_vs_time.png (gnuplot, log-log, median with
+// min/max bars over repeats), an equal-time table and the time each method needs to reach a
+// target relMSE. The time counted is everything the user waits for after the scene file is
+// parsed: BVH build, upload, sampling and (G-PT) reconstruction.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "app/subcommand.h"
+#include "image/exr_io.h"
+#include "image/metrics.h"
+#include "poisson/poisson_gpu.h"
+#include "render/gpt_renderer.h"
+#include "render/renderer.h"
+#include "scene/gltf_loader.h"
+#include "util/error.h"
+#include "util/timer.h"
+#include "vk/context.h"
+
+namespace gdpt {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct ConvergeArgs {
+    std::string scene;
+    std::string reference;
+    std::string methods = "pt,gpt-l1,gpt-l2";
+    std::string times = "1,2,4,8";
+    int repeats = 3;
+    int width = 256;
+    int height = 256;
+    std::uint32_t makeReference = 0;
+    double target = 0.0;
+    std::string output = "converge";
+    std::string device;
+};
+
+std::vector<std::string> splitList(const std::string& s) {
+    std::vector<std::string> out;
+    std::stringstream in(s);
+    std::string item;
+    while (std::getline(in, item, ','))
+        if (!item.empty()) out.push_back(item);
+    return out;
+}
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
+}
+
+// FNV-1a of the scene file's bytes and the render settings: the cache key of a made reference.
+std::string referenceKey(const std::string& scenePath, int w, int h, std::uint32_t spp) {
+    std::ifstream in(scenePath, std::ios::binary);
+    std::uint64_t hash = 1469598103934665603ull;
+    char c = 0;
+    while (in.get(c)) hash = (hash ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+    for (std::uint64_t v : {std::uint64_t(w), std::uint64_t(h), std::uint64_t(spp)})
+        hash = (hash ^ v) * 1099511628211ull;
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(hash));
+    return buf;
+}
+
+Image addImages(const Image& a, const Image& b) {
+    Image out = a;
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < out.pixelCount(); ++i) out.plane(c)[i] += b.plane(c)[i];
+    return out;
+}
+
+struct Run {
+    std::string method;
+    double budget = 0.0;
+    int repeat = 0;
+    double seconds = 0.0;  // measured total
+    double reconSeconds = 0.0;
+    std::uint32_t spp = 0;
+    ImageErrorStats error;
+};
+
+class Converger {
+public:
+    Converger(const vk::Context& ctx, const Scene& scene, const ConvergeArgs& a) : ctx_(ctx), scene_(scene), a_(a) {}
+
+    // Renders `method` within `budget` seconds with seed `seed`.
+    Run run(const std::string& method, double budget, std::uint32_t seed, const Image& reference) {
+        Run r;
+        r.method = method;
+        r.budget = budget;
+        RenderOptions o;
+        o.scene.width = a_.width;
+        o.scene.height = a_.height;
+        o.seed = seed;
+        o.quiet = true;
+        Timer total;
+        Image result;
+        if (method == "pt") {
+            o.timeBudget = budget;
+            RenderResult res = renderPt(ctx_, scene_, o);
+            result = std::move(res.image);
+            r.spp = res.stats.spp;
+        } else {
+            SolveOptions so = solveOptions(method);
+            // Sampling gets what is left after the (measured) reconstruction time.
+            o.timeBudget = std::max(0.05 * budget, budget - reconSeconds(method, so));
+            o.maxBatchSpp = std::max<std::uint32_t>(1, static_cast<std::uint32_t>((1u << 16) / (a_.width * a_.height)));
+            RenderResultGpt g = renderGpt(ctx_, scene_, o);
+            Timer recon;
+            const Image solved = reconstruct(ctx_, g.primal, g.dx, g.dy, &g.varPrimal, &g.varDx, &g.varDy, so);
+            r.reconSeconds = recon.seconds();
+            result = addImages(solved, g.direct);
+            r.spp = g.stats.spp;
+        }
+        r.seconds = total.seconds();
+        r.error = compareImages(result, reference);
+        return r;
+    }
+
+private:
+    static SolveOptions solveOptions(const std::string& method) {
+        SolveOptions so;
+        if (method == "gpt-l1") so.method = Reconstruction::L1;
+        else if (method == "gpt-l2") so.method = Reconstruction::L2;
+        else if (method == "gpt-wl2") so.method = Reconstruction::WeightedL2;
+        else throw UsageError("--methods: unknown method '" + method + "' (pt, gpt-l1, gpt-l2, gpt-wl2)");
+        return so;
+    }
+
+    // Reconstruction time of `method` at this image size, measured once on synthetic input.
+    double reconSeconds(const std::string& method, const SolveOptions& so) {
+        auto it = reconCache_.find(method);
+        if (it != reconCache_.end()) return it->second;
+        Image primal(a_.width, a_.height, 0.5f), dx(a_.width, a_.height, 0.0f), dy(a_.width, a_.height, 0.0f);
+        for (int c = 0; c < 3; ++c)
+            for (std::size_t i = 0; i < primal.pixelCount(); ++i)
+                primal.plane(c)[i] = 0.5f + 0.25f * std::sin(0.37f * static_cast<float>(i % 97));
+        Image var(a_.width, a_.height, 1e-3f);
+        Timer t;
+        (void)reconstruct(ctx_, primal, dx, dy, &var, &var, &var, so);
+        return reconCache_[method] = t.seconds();
+    }
+
+    const vk::Context& ctx_;
+    const Scene& scene_;
+    const ConvergeArgs& a_;
+    std::map<std::string, double> reconCache_;
+};
+
+void writePlot(const fs::path& dir, const std::vector<std::string>& methods, const json& summary) {
+    std::ofstream dat(dir / "error_vs_time.dat");
+    for (std::size_t m = 0; m < methods.size(); ++m) {
+        dat << "# " << methods[m] << "\n";
+        for (const auto& s : summary)
+            if (s["method"] == methods[m])
+                dat << s["seconds_median"].get<double>() << " " << s["relmse_median"].get<double>() << " "
+                    << s["relmse_min"].get<double>() << " " << s["relmse_max"].get<double>() << "\n";
+        dat << "\n\n";
+    }
+    dat.close();
+    std::ofstream gp(dir / "error_vs_time.gp");
+    gp << "set terminal pngcairo size 900,600 noenhanced\n"
+       << "set output '" << (dir / "error_vs_time.png").string() << "'\n"
+       << "set logscale xy\nset xlabel 'time (s)'\nset ylabel 'relMSE'\nset grid\nset key top right\n"
+       << "plot ";
+    for (std::size_t m = 0; m < methods.size(); ++m)
+        gp << (m ? ", " : "") << "'" << (dir / "error_vs_time.dat").string() << "' index " << m
+           << " with yerrorlines title '" << methods[m] << "'";
+    gp << "\n";
+    gp.close();
+    const std::string cmd = "gnuplot '" + (dir / "error_vs_time.gp").string() + "' 2>/dev/null";
+    if (std::system(cmd.c_str()) != 0)
+        std::fprintf(stderr, "gdpt converge: warning: gnuplot failed; the plot data is in %s\n",
+                     (dir / "error_vs_time.dat").c_str());
+}
+
+// Time at which the median relMSE of `method` first reaches `target`, interpolated in
+// log-log between measured budgets; -1 if never.
+double timeToReach(const json& summary, const std::string& method, double target) {
+    double prevT = 0, prevE = 0;
+    bool have = false;
+    for (const auto& s : summary) {
+        if (s["method"] != method) continue;
+        const double t = s["seconds_median"], e = s["relmse_median"];
+        if (e <= target) {
+            if (!have) return t;
+            const double f = (std::log(target) - std::log(prevE)) / (std::log(e) - std::log(prevE));
+            return std::exp(std::log(prevT) + f * (std::log(t) - std::log(prevT)));
+        }
+        prevT = t;
+        prevE = e;
+        have = true;
+    }
+    return -1.0;
+}
+
+int runConverge(const ConvergeArgs& a) {
+    const Scene scene = loadGltf(a.scene);
+    vk::ContextOptions co;
+    co.device = a.device;
+    vk::Context ctx(co);
+    const fs::path dir(a.output);
+    fs::create_directories(dir);
+
+    Image reference;
+    if (!a.reference.empty()) {
+        reference = readExrLayer(a.reference);
+    } else if (a.makeReference > 0) {
+        const fs::path cached = dir / ("reference_" + referenceKey(a.scene, a.width, a.height, a.makeReference) + ".exr");
+        if (fs::exists(cached)) {
+            reference = readExrLayer(cached.string());
+        } else {
+            std::fprintf(stderr, "gdpt converge: rendering a %u spp PT reference (cached as %s)\n", a.makeReference,
+                         cached.c_str());
+            RenderOptions o;
+            o.scene.width = a.width;
+            o.scene.height = a.height;
+            o.spp = a.makeReference;
+            o.seed = 0xC0FFEEu;
+            reference = renderPt(ctx, scene, o).image;
+            writeExr(cached.string(), reference);
+        }
+    } else {
+        throw UsageError("give --reference REF.exr or --make-reference SPP");
+    }
+    if (reference.width() != a.width || reference.height() != a.height)
+        throw Error(a.reference + ": reference is " + std::to_string(reference.width()) + "x" +
+                    std::to_string(reference.height()) + ", the render is " + std::to_string(a.width) + "x" +
+                    std::to_string(a.height) + " (use --width/--height)");
+
+    const auto methods = splitList(a.methods);
+    std::vector<double> times;
+    for (const auto& t : splitList(a.times)) {
+        try {
+            times.push_back(std::stod(t));
+        } catch (const std::exception&) {
+            throw UsageError("--times: '" + t + "' is not a number");
+        }
+        if (!(times.back() > 0.0)) throw UsageError("--times: budgets must be positive");
+    }
+    Converger conv(ctx, scene, a);
+    std::vector<Run> runs;
+    json summary = json::array();
+    std::uint32_t seed = 1;
+    for (const auto& m : methods)
+        for (double t : times) {
+            std::vector<double> rel, sec, mse, bias;
+            std::vector<double> spp;
+            for (int k = 0; k < a.repeats; ++k) {
+                Run r = conv.run(m, t, seed++, reference);
+                std::fprintf(stderr, "gdpt converge: %-8s budget %6.2fs  took %6.2fs  %5u spp  relMSE %.5g\n",
+                             m.c_str(), t, r.seconds, r.spp, r.error.relMse);
+                rel.push_back(r.error.relMse);
+                sec.push_back(r.seconds);
+                mse.push_back(r.error.mse);
+                bias.push_back(r.error.meanBias);
+                spp.push_back(r.spp);
+                runs.push_back(r);
+            }
+            summary.push_back({{"method", m},
+                               {"budget_s", t},
+                               {"seconds_median", median(sec)},
+                               {"spp_median", median(spp)},
+                               {"relmse_median", median(rel)},
+                               {"relmse_min", *std::min_element(rel.begin(), rel.end())},
+                               {"relmse_max", *std::max_element(rel.begin(), rel.end())},
+                               {"mse_median", median(mse)},
+                               {"bias_median", median(bias)}});
+        }
+
+    // Equal-time table (ratio to PT where PT was run) and time to reach the target.
+    double target = a.target;
+    if (!(target > 0.0)) {
+        // Default target: PT's median error at its largest budget (or the first method's).
+        for (const auto& s : summary)
+            if (s["method"] == methods.front() && s["budget_s"] == times.back()) target = s["relmse_median"];
+    }
+    json equalTime = json::array();
+    for (double t : times) {
+        json row = {{"budget_s", t}};
+        double ptErr = 0.0;
+        for (const auto& s : summary)
+            if (s["budget_s"] == t && s["method"] == "pt") ptErr = s["relmse_median"];
+        for (const auto& s : summary)
+            if (s["budget_s"] == t) {
+                row[s["method"].get<std::string>()] = s["relmse_median"];
+                if (ptErr > 0.0 && s["method"] != "pt")
+                    row[s["method"].get<std::string>() + "_gain_vs_pt"] = ptErr / s["relmse_median"].get<double>();
+            }
+        equalTime.push_back(row);
+    }
+    json reach = json::object();
+    for (const auto& m : methods) reach[m] = timeToReach(summary, m, target);
+
+    json runsJson = json::array();
+    std::ofstream csv(dir / "results.csv");
+    csv << "method,budget_s,repeat,seconds,recon_seconds,spp,relmse,mse,mae,mean_bias\n";
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+        const Run& r = runs[i];
+        const int repeat = static_cast<int>(i % static_cast<std::size_t>(a.repeats));
+        runsJson.push_back({{"method", r.method}, {"budget_s", r.budget}, {"repeat", repeat}, {"seconds", r.seconds},
+                            {"recon_seconds", r.reconSeconds}, {"spp", r.spp}, {"relmse", r.error.relMse},
+                            {"mse", r.error.mse}, {"mae", r.error.mae}, {"mean_bias", r.error.meanBias}});
+        csv << r.method << "," << r.budget << "," << repeat << "," << r.seconds << "," << r.reconSeconds << ","
+            << r.spp << "," << r.error.relMse << "," << r.error.mse << "," << r.error.mae << "," << r.error.meanBias
+            << "\n";
+    }
+    const json results = {{"schema", "gdpt-converge-1"},
+                          {"scene", a.scene},
+                          {"reference", a.reference.empty() ? "(made)" : a.reference},
+                          {"width", a.width},
+                          {"height", a.height},
+                          {"repeats", a.repeats},
+                          {"device", ctx.info().name},
+                          {"methods", methods},
+                          {"times", times},
+                          {"runs", runsJson},
+                          {"summary", summary},
+                          {"equal_time", equalTime},
+                          {"target_relmse", target},
+                          {"time_to_target_s", reach}};
+    std::ofstream(dir / "results.json") << results.dump(2) << "\n";
+    writePlot(dir, methods, summary);
+
+    std::printf("%-10s", "budget(s)");
+    for (const auto& m : methods) std::printf(" %12s", m.c_str());
+    std::printf("\n");
+    for (const auto& row : equalTime) {
+        std::printf("%-10g", row["budget_s"].get<double>());
+        for (const auto& m : methods) std::printf(" %12.5g", row.value(m, 0.0));
+        std::printf("\n");
+    }
+    std::printf("time to relMSE %.4g:", target);
+    for (const auto& m : methods) std::printf("  %s %.3gs", m.c_str(), reach[m].get<double>());
+    std::printf("\nwrote %s/results.json, results.csv, error_vs_time.png\n", dir.c_str());
+    return 0;
+}
+
+}  // namespace
+
+Subcommand addConvergeCommand(CLI::App& app) {
+    auto a = std::make_shared<ConvergeArgs>();
+    CLI::App* c = app.add_subcommand("converge", "Error against time: each method at each time budget vs a reference");
+    c->add_option("scene", a->scene, "glTF 2.0 scene")->required()->check(CLI::ExistingFile);
+    c->add_option("--reference", a->reference, "Converged reference EXR (same size and camera)")->check(CLI::ExistingFile);
+    c->add_option("--make-reference", a->makeReference, "Render a PT reference with this many spp (cached by scene hash)");
+    c->add_option("--methods", a->methods, "Methods: pt, gpt-l1, gpt-l2, gpt-wl2")->capture_default_str();
+    c->add_option("--times", a->times, "Time budgets in seconds (comma-separated)")->capture_default_str();
+    c->add_option("--repeats", a->repeats, "Independent repeats per budget (median reported)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 100));
+    c->add_option("--width", a->width, "Image width")->capture_default_str()->check(CLI::Range(1, 16384));
+    c->add_option("--height", a->height, "Image height")->capture_default_str()->check(CLI::Range(1, 16384));
+    c->add_option("--target", a->target, "relMSE for the time-to-reach figure (default: the first method's error at "
+                                         "the largest budget)");
+    c->add_option("-o,--output", a->output, "Output directory")->capture_default_str();
+    c->add_option("--device", a->device, "Vulkan device index or name substring");
+    return {c, [a] { return runConverge(*a); }};
+}
+
+}  // namespace gdpt
