@@ -169,13 +169,21 @@ int runRender(const RenderArgs& args) {
         stats = g.stats;
         // Screened Poisson reconstruction of the indirect image from primal + gradients;
         // the final image is reconstruction + very-direct light (Kettunen et al. 2015 §5).
+        PoissonSolverGpu solver(ctx, args.width, args.height);
+        PoissonInput input;
+        input.primal = &g.primal;
+        input.dx = &g.dx;
+        input.dy = &g.dy;
+        input.varPrimal = &g.varPrimal;
+        input.varDx = &g.varDx;
+        input.varDy = &g.varDy;
         auto solve = [&](const std::string& name) {
             SolveOptions so;
             so.method = parseReconstruction(name);
             so.alpha = args.alpha;
             so.tolerance = args.tolerance;
-            SolveReport report;
-            Image recon = reconstruct(ctx, g.primal, g.dx, g.dy, &g.varPrimal, &g.varDx, &g.varDy, so, &report);
+            Image recon;
+            const SolveReport report = solver.solve(input, so, recon);
             if (!args.quiet)
                 std::fprintf(stderr, "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g, %.1f ms\n",
                              name.c_str(), report.iterations, report.irlsIterations, report.residual, report.ms);

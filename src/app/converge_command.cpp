@@ -120,7 +120,7 @@ public:
             o.maxBatchSpp = std::max<std::uint32_t>(1, static_cast<std::uint32_t>((1u << 16) / (a_.width * a_.height)));
             RenderResultGpt g = renderGpt(ctx_, scene_, o);
             Timer recon;
-            const Image solved = reconstruct(ctx_, g.primal, g.dx, g.dy, &g.varPrimal, &g.varDx, &g.varDy, so);
+            const Image solved = solve(g.primal, g.dx, g.dy, &g.varPrimal, &g.varDx, &g.varDy, so);
             r.reconSeconds = recon.seconds();
             result = addImages(solved, g.direct);
             r.spp = g.stats.spp;
@@ -140,7 +140,25 @@ private:
         return so;
     }
 
-    // Reconstruction time of `method` at this image size, measured once on synthetic input.
+    // One solver for every run: its pipelines are compiled once, as in a long-running
+    // application (the one-time compilation is excluded from the timings, like scene parsing).
+    Image solve(const Image& primal, const Image& dx, const Image& dy, const Image* vp, const Image* vx,
+                const Image* vy, const SolveOptions& so) {
+        if (!solver_) solver_ = std::make_unique<PoissonSolverGpu>(ctx_, a_.width, a_.height);
+        PoissonInput in;
+        in.primal = &primal;
+        in.dx = &dx;
+        in.dy = &dy;
+        in.varPrimal = vp;
+        in.varDx = vx;
+        in.varDy = vy;
+        Image out;
+        solver_->solve(in, so, out);
+        return out;
+    }
+
+    // Reconstruction time of `method` at this image size, measured once on synthetic input
+    // (after a warm-up solve that compiles the pipelines).
     double reconSeconds(const std::string& method, const SolveOptions& so) {
         auto it = reconCache_.find(method);
         if (it != reconCache_.end()) return it->second;
@@ -149,8 +167,9 @@ private:
             for (std::size_t i = 0; i < primal.pixelCount(); ++i)
                 primal.plane(c)[i] = 0.5f + 0.25f * std::sin(0.37f * static_cast<float>(i % 97));
         Image var(a_.width, a_.height, 1e-3f);
+        (void)solve(primal, dx, dy, &var, &var, &var, so);
         Timer t;
-        (void)reconstruct(ctx_, primal, dx, dy, &var, &var, &var, so);
+        (void)solve(primal, dx, dy, &var, &var, &var, so);
         return reconCache_[method] = t.seconds();
     }
 
@@ -158,6 +177,7 @@ private:
     const Scene& scene_;
     const ConvergeArgs& a_;
     std::map<std::string, double> reconCache_;
+    std::unique_ptr<PoissonSolverGpu> solver_;
 };
 
 void writePlot(const fs::path& dir, const std::vector<std::string>& methods, const json& summary) {
