@@ -88,14 +88,22 @@ bool gptPairExists(uint px, uint py, uint i) {
 
 // Vertex classification; a scene without glossy/specular vertices (kHasGlossy false) has
 // every vertex rough, which the compiler folds away with the half-vector branch.
-bool roughSampled(BsdfParams m, uint lobe) {
-    return !kHasGlossy || shiftIsRough(shiftRoughnessSampled(m, lobe), frame.shiftThreshold);
+//
+// Deviation from the reference (GPT_REFERENCE §1.3), which classifies the base's current
+// vertex by the component it sampled and the offset's by that same component: the sampled
+// component is not a function of the path (a mixture reaches one direction through several
+// lobes), and an offset may lack the component altogether (base samples the diffuse lobe of
+// a wall, the offset sits on a metal), so the forward and the reverse shift of one pair can
+// pick different shift types and the pair's MIS weights stop summing to one. Here every
+// vertex is classified by its lowest roughness over all components (shiftRoughnessAll), a
+// property of the vertex alone, so the rule is symmetric. Cost: a diffuse lobe under a
+// smooth coat never reconnects (half-vector copies instead). On the test scenes (metals and
+// Lambertian walls) both rules pass the same tests; the difference is argued, not measured.
+bool roughAll(BsdfParams m) {
+    return !kHasGlossy || shiftIsRough(shiftRoughnessAll(m), frame.shiftThreshold);
 }
 bool roughSmooth(BsdfParams m) {
     return !kHasGlossy || shiftIsRough(shiftRoughnessSmooth(m), frame.shiftThreshold);
-}
-bool roughAll(BsdfParams m) {
-    return !kHasGlossy || shiftIsRough(shiftRoughnessAll(m), frame.shiftThreshold);
 }
 
 bool oneSidedBack(SurfaceHit h) {
@@ -166,6 +174,7 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
         BsdfParams offBsdf[4];
         vec3 offT[4], offB[4], offWo[4];
         for (uint i = 0u; i < 4u; ++i) {
+            offBsdf[i] = bsdf;  // placeholder for shared / dead offsets (never read)
             if (!offs[i].alive) continue;
             if (offs[i].state == kShiftNotConnected) {
                 SurfaceHit oh = offs[i].hit;
@@ -177,82 +186,88 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
             }
         }
 
+        // Whether the light strategy exists for each pair at this vertex (GPT_REFERENCE §1.5):
+        // always for a lone base (failed shift) and a shared vertex; for separate vertices
+        // only if both are rough (area lights; the BSDF never hits a punctual light). The
+        // BSDF-sampled emission of the next vertex then competes with it or not.
+        bool baseRoughNee = roughSmooth(bsdf);
+        bool lightActive[4];
+        for (uint i = 0u; i < 4u; ++i) {
+            lightActive[i] = !offs[i].alive || offs[i].state != kShiftNotConnected ||
+                             (baseRoughNee && roughSmooth(offBsdf[i]));
+        }
+
         // ---- Next-event estimation with the same light point for all (§1.5) ----
+        // Densities are visibility-aware: a path whose last segment is occluded cannot be
+        // produced by BSDF sampling (its BSDF density is 0) but can by light sampling. This
+        // keeps the four weights of a path equal whichever technique sampled it.
         vec3 ul = rngNext3(rng);
         LightSample ls;
         if (!bsdfIsDeltaOnly(bsdf) && sampleLight(sh.p, ul, ls) && dot(ls.wi, sh.ng) > 0.0) {
             vec3 wiLocal = toLocal(ls.wi, t, b, sh.ns);
             vec3 f = bsdfEval(bsdf, woLocal, wiLocal);
             float pdfBsdf = ls.isDelta != 0u ? 0.0 : bsdfPdf(bsdf, woLocal, wiLocal);
-            float tMax = ls.dist * (1.0 - 1e-4);
-            vec3 fBase = vec3(0.0);
-            int baseVisibility = -1;  // shadow ray from the (shared) base vertex: -1 not traced
-            if (maxComponent(f) > 0.0) {
-                rays++;
-                baseVisibility = traceAny(origin, ls.wi, 0.0, tMax) ? 0 : 1;
-                if (baseVisibility == 1) fBase = beta * f * ls.Li / ls.pdf;
-            }
-            bool baseRough = roughSmooth(bsdf);
+            rays++;
+            bool visible = !traceAny(origin, ls.wi, 0.0, ls.dist * (1.0 - 1e-4));
+            vec3 fBase = visible ? beta * f * ls.Li / ls.pdf : vec3(0.0);
+            float pdfBsdfV = visible ? pdfBsdf : 0.0;  // BSDF density including visibility
             for (uint i = 0u; i < 4u; ++i) {
+                if (!gptPairExists(px, py, i)) continue;
                 if (!offs[i].alive) {
                     // Failed shift: the base alone, with PT's weight.
-                    if (gptPairExists(px, py, i))
-                        addPair(offs[i], gptMisWeight(ls.pdf, pdfBsdf, 0.0, 0.0), fBase, vec3(0.0));
+                    addPair(offs[i], gptMisWeight(ls.pdf, pdfBsdfV, 0.0, 0.0), fBase, vec3(0.0));
                     continue;
                 }
                 if (offs[i].state != kShiftNotConnected) {
                     // Shared vertex: same light point and visibility; the offset's own
                     // incoming direction only changes the BSDF (§1.5 RECENTLY_CONNECTED).
                     vec3 fo = f;
-                    float pdfBsdfO = pdfBsdf;
+                    float pdfBsdfO = pdfBsdfV;
                     if (offs[i].state == kShiftRecentlyConnected) {
                         fo = bsdfEval(bsdf, offWo[i], wiLocal);
-                        pdfBsdfO = ls.isDelta != 0u ? 0.0 : bsdfPdf(bsdf, offWo[i], wiLocal);
+                        pdfBsdfO = (ls.isDelta != 0u || !visible) ? 0.0 : bsdfPdf(bsdf, offWo[i], wiLocal);
                     }
-                    vec3 fOff = vec3(0.0);
-                    if (maxComponent(fo) > 0.0) {
-                        if (baseVisibility < 0) {  // not traced yet (base f was 0)
-                            rays++;
-                            baseVisibility = traceAny(origin, ls.wi, 0.0, tMax) ? 0 : 1;
-                        }
-                        if (baseVisibility == 1) fOff = offs[i].beta * fo * ls.Li / ls.pdf;
-                    }
-                    float w = gptMisWeight(ls.pdf, pdfBsdf, offs[i].r * ls.pdf, offs[i].r * pdfBsdfO);
+                    vec3 fOff = visible ? offs[i].beta * fo * ls.Li / ls.pdf : vec3(0.0);
+                    float w = gptMisWeight(ls.pdf, pdfBsdfV, offs[i].r * ls.pdf, offs[i].r * pdfBsdfO);
                     addPair(offs[i], w, fBase, fOff);
                     continue;
                 }
                 // NOT_CONNECTED: reconnect the offset vertex to the same light point, only if
                 // both vertices are rough or the light is punctual; otherwise this NEE sample
                 // counts for neither (weight 0, the reference's choice).
+                if (ls.isDelta == 0u && !lightActive[i]) continue;
                 BsdfParams ob = offBsdf[i];
-                if (ls.isDelta == 0u && !(baseRough && roughSmooth(ob))) continue;
                 SurfaceHit oh = offs[i].hit;
                 vec3 toLight = ls.pLight - oh.p;
                 float distO = length(toLight);
                 vec3 wiO = toLight / distO;
                 // Densities of the offset path under the reverse technique: zero where the
                 // base sampler at p+δ would have rejected it (light behind the surface, light
-                // facing away, Dirac-only vertex), which makes the shift fail (§7.1).
+                // facing away, Dirac-only vertex), which makes the shift fail.
                 vec3 liO;
                 float jacobianLight;
                 bool valid = distO > 0.0 && dot(wiO, oh.ng) > 0.0 && !bsdfIsDeltaOnly(ob) &&
                              gptOffsetLight(ls, ul, sh.p, oh.p, wiO, distO, liO, jacobianLight);
                 if (!valid) {
-                    addPair(offs[i], gptMisWeight(ls.pdf, pdfBsdf, 0.0, 0.0), fBase, vec3(0.0));
+                    addPair(offs[i], gptMisWeight(ls.pdf, pdfBsdfV, 0.0, 0.0), fBase, vec3(0.0));
                     continue;
                 }
                 vec3 wiLocalO = toLocal(wiO, offT[i], offB[i], oh.ns);
-                vec3 fo = bsdfEval(ob, offWo[i], wiLocalO);
+                vec3 fo = bsdfEval(ob, offWo[i], wiLocalO) * liO;
                 float pdfBsdfO = ls.isDelta != 0u ? 0.0 : bsdfPdf(ob, offWo[i], wiLocalO);
                 vec3 fOff = vec3(0.0);
-                if (maxComponent(fo) > 0.0 && maxComponent(liO) > 0.0) {
+                // The offset's visibility matters for its contribution and for its BSDF
+                // density (which enters the base's weight).
+                if (maxComponent(fo) > 0.0 || (pdfBsdfO > 0.0 && maxComponent(fBase) > 0.0)) {
                     rays++;
                     if (!traceAny(offsetRayOrigin(oh.p, oh.ng), wiO, 0.0, distO * (1.0 - 1e-4)))
-                        fOff = offs[i].beta * fo * liO * (jacobianLight / ls.pdf);
+                        fOff = offs[i].beta * fo * (jacobianLight / ls.pdf);
+                    else
+                        pdfBsdfO = 0.0;
                 }
                 // Light strategy of the offset in the base's measure: p'_L J = p_L (same light
                 // point, area measure); BSDF strategy p'_B J.
-                float w = gptMisWeight(ls.pdf, pdfBsdf, offs[i].r * ls.pdf,
+                float w = gptMisWeight(ls.pdf, pdfBsdfV, offs[i].r * ls.pdf,
                                        offs[i].r * pdfBsdfO * jacobianLight);
                 addPair(offs[i], w, fBase, fOff);
             }
@@ -287,7 +302,7 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
             nextSh = makeSurfaceHit(next.triangle, next.u, next.v, wi);
             if (kHasGlossy) baseNextRough = roughAll(materialBsdf(nextSh.material, nextSh.uv));
         }
-        bool baseCurRough = roughSampled(bsdf, bs.lobe);
+        bool baseCurRough = roughAll(bsdf);
 
         // ---- Shift every live offset over this segment (§1.4) ----
         for (uint i = 0u; i < 4u; ++i) {
@@ -311,49 +326,52 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
             SurfaceHit oh = offs[i].hit;
             BsdfParams ob = offBsdf[i];
             vec3 ohOrigin = offsetRayOrigin(oh.p, oh.ng);
-            bool offCurRough = roughSampled(ob, bs.lobe);
+            bool offCurRough = roughAll(ob);
             if (shiftUseReconnection(baseCurRough, baseNextRough, offCurRough)) {
                 // Reconnection shift: connect to the base's next vertex (or the environment
                 // in the same direction, J = 1); occlusion = failure.
                 vec3 wiO = wi;
                 float jacobianShift = 1.0;
                 bool ok;
+                float dist = kInf;
                 if (baseMissed) {
                     ok = dot(wiO, oh.ng) > 0.0;
-                    if (ok) {
-                        rays++;
-                        ok = !traceAny(ohOrigin, wiO, 0.0, kInf);  // visibility from the offset
-                    }
                 } else {
                     vec3 e = nextSh.p - oh.p;
-                    float dist = length(e);
+                    dist = length(e);
                     wiO = e / dist;
                     jacobianShift = reconnectionJacobian(sh.p, oh.p, nextSh.p, nextSh.ng);
                     // Same side of the target as the base (else it is another surface point
                     // for BSDF and emission), leaving above the offset's geometric surface.
                     ok = dist > 0.0 && jacobianShift > 0.0 && dot(wiO, oh.ng) > 0.0 &&
                          dot(wiO, nextSh.ng) < 0.0;
-                    if (ok) {
-                        rays++;
-                        ok = !traceAny(ohOrigin, wiO, 0.0, dist * (1.0 - 1e-4));
-                    }
                 }
                 if (!ok) {
-                    offs[i].alive = false;
+                    offs[i].alive = false;  // no offset path: the reverse never maps here
                     continue;
                 }
-                vec3 wiLocalO = toLocal(wiO, offT[i], offB[i], oh.ns);
-                vec3 fo = bsdfEval(ob, offWo[i], wiLocalO);
-                float po = bsdfPdf(ob, offWo[i], wiLocalO);
                 float rPrefix = offs[i].r;
-                offs[i].beta *= fo * (jacobianShift * rrInv / bs.pdf);
-                offs[i].r *= po * jacobianShift / bs.pdf;
                 // Light strategy at the target: p'_L J = p_L, so the offset's light density in
                 // the base's measure is rPrefix·p_L (zero if the offset vertex cannot do NEE).
                 offs[i].rLight = bsdfIsDeltaOnly(ob) ? 0.0 : rPrefix;
                 offs[i].woWorld = -wiO;
                 offs[i].state = kShiftRecentlyConnected;
-                if (!(offs[i].r > 0.0)) offs[i].alive = false;  // density 0: reverse never maps here
+                // Visibility from the offset vertex (for the environment too: the 2019 fix).
+                rays++;
+                if (traceAny(ohOrigin, wiO, 0.0, baseMissed ? kInf : dist * (1.0 - 1e-4))) {
+                    // Occluded: the offset path has no BSDF density and no contribution, but
+                    // light sampling could still produce it, so its light density stays in
+                    // this vertex's emission weight. r = 0 and beta' = 0 then act as a failed
+                    // shift for everything after.
+                    offs[i].beta = vec3(0.0);
+                    offs[i].r = 0.0;
+                    continue;
+                }
+                vec3 wiLocalO = toLocal(wiO, offT[i], offB[i], oh.ns);
+                vec3 fo = bsdfEval(ob, offWo[i], wiLocalO);
+                float po = bsdfPdf(ob, offWo[i], wiLocalO);
+                offs[i].beta *= fo * (jacobianShift * rrInv / bs.pdf);
+                offs[i].r *= po * jacobianShift / bs.pdf;
                 continue;
             }
             if (!kHasGlossy) {
@@ -433,9 +451,13 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
             }
             for (uint i = 0u; i < 4u; ++i) {
                 if (!gptPairExists(px, py, i)) continue;
+                // The light strategy competes only where NEE counted for this pair.
+                float pdfLightPair = lightActive[i] ? pdfLight : 0.0;
                 if (!offs[i].alive) {
+                    // Failed shift (before or at this bounce): the base alone. After a failed
+                    // half-vector step the pair had no NEE, so the base takes full weight.
                     if (maxComponent(le) > 0.0)
-                        addPair(offs[i], gptMisWeight(bs.pdf, pdfLight, 0.0, 0.0), beta * le, vec3(0.0));
+                        addPair(offs[i], gptMisWeight(bs.pdf, pdfLightPair, 0.0, 0.0), beta * le, vec3(0.0));
                 } else if (offs[i].state == kShiftNotConnected) {
                     // Half-vector branch: BSDF sampling only, w = p²/(p² + (J p')²).
                     vec3 leO = surfaceEmission(offs[i].hit);
@@ -443,7 +465,8 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
                         addPair(offs[i], gptMisWeightPair(offs[i].r), beta * le, offs[i].beta * leO);
                 } else if (maxComponent(le) > 0.0) {
                     // Reconnected (this bounce or before): four strategies.
-                    float w = gptMisWeight(bs.pdf, pdfLight, offs[i].r * bs.pdf, offs[i].rLight * pdfLight);
+                    float w = gptMisWeight(bs.pdf, pdfLightPair, offs[i].r * bs.pdf,
+                                           offs[i].rLight * pdfLightPair);
                     addPair(offs[i], w, beta * le, offs[i].beta * le);
                 }
             }

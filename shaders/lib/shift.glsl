@@ -31,7 +31,9 @@ GDPT_CONST uint kShiftConnected = 2u;          // offset shares every later vert
 // Vertex classification (GPT_REFERENCE §1.3)
 // ---------------------------------------------------------------------------------------------
 
-// Roughness of the component the base path sampled, applied to a (base or offset) BSDF.
+// Roughness of the component the base path sampled, applied to a (base or offset) BSDF: the
+// reference's rule (GPT_REFERENCE §1.3). gpt.comp classifies by shiftRoughnessAll instead
+// (a symmetric rule; see the comment there) and keeps this for comparison and tests.
 // Wraps bsdfRoughnessForShift, which assumes the lobe exists: a material without a
 // glossy/mirror layer has only its diffuse lobe, so it counts as fully rough (1) whatever
 // the base sampled (e.g. a Lambertian with roughnessFactor 0 is not a mirror).

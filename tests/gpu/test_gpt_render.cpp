@@ -121,7 +121,44 @@ double checkPrimal(const RenderResultGpt& g, const RenderResult& pt, int region,
     return maxWrongZ;
 }
 
-void checkAgainstPt(const RenderResultGpt& g, const RenderResult& pt, int region, const std::string& name) {
+// Per-pixel z-tests of dx, dy and primal (+ direct) against PT, for errors confined to a few
+// pixels (a highlight in a mirror) that region sums dilute. Šidák over all pixel tests of
+// the image (the tests are not all independent; Šidák's bound stays conservative for the
+// positive dependence here).
+void checkPixels(const RenderResultGpt& g, const RenderResult& pt, const std::string& name) {
+    const int w = pt.image.width(), h = pt.image.height();
+    const double z = std::max(4.0, test::twoSidedZ(test::sidakAlpha(1e-3, 3 * 3 * w * h)));
+    int failures = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) {
+                auto test = [&](double estimate, double expected, double variance, const char* what) {
+                    const double zs = variance > 0.0 ? std::abs(estimate - expected) / std::sqrt(variance)
+                                                     : (estimate == expected ? 0.0 : 1e30);
+                    if (zs > z && failures++ < 10)
+                        ADD_FAILURE() << name << " " << what << " pixel " << x << "," << y << " channel " << c
+                                      << ": G-PT " << estimate << " PT " << expected << " z " << zs;
+                };
+                test(g.primal.at(x, y, c) + g.direct.at(x, y, c), pt.image.at(x, y, c),
+                     g.varPrimal.at(x, y, c) + g.varDirect.at(x, y, c) + pt.varianceOfMean.at(x, y, c), "primal");
+                if (x + 1 < w)
+                    test(g.dx.at(x, y, c) + g.direct.at(x + 1, y, c) - g.direct.at(x, y, c),
+                         pt.image.at(x + 1, y, c) - pt.image.at(x, y, c),
+                         g.varDx.at(x, y, c) + g.varDirect.at(x, y, c) + g.varDirect.at(x + 1, y, c) +
+                             pt.varianceOfMean.at(x, y, c) + pt.varianceOfMean.at(x + 1, y, c),
+                         "dx");
+                if (y + 1 < h)
+                    test(g.dy.at(x, y, c) + g.direct.at(x, y + 1, c) - g.direct.at(x, y, c),
+                         pt.image.at(x, y + 1, c) - pt.image.at(x, y, c),
+                         g.varDy.at(x, y, c) + g.varDirect.at(x, y, c) + g.varDirect.at(x, y + 1, c) +
+                             pt.varianceOfMean.at(x, y, c) + pt.varianceOfMean.at(x, y + 1, c),
+                         "dy");
+            }
+    EXPECT_EQ(failures, 0) << name << ": pixels outside " << z << " standard errors";
+}
+
+void checkAgainstPt(const RenderResultGpt& g, const RenderResult& pt, int region, const std::string& name,
+                    bool perPixel = true) {
     ASSERT_EQ(g.stats.nanSamples, 0u) << name;
     ASSERT_EQ(pt.stats.nanSamples, 0u) << name;
     const int w = pt.image.width(), h = pt.image.height();
@@ -130,6 +167,7 @@ void checkAgainstPt(const RenderResultGpt& g, const RenderResult& pt, int region
     const double wrongDx = checkGradients(g, pt, 0, region, z, name);
     const double wrongDy = checkGradients(g, pt, 1, region, z, name);
     const double wrongPrimal = checkPrimal(g, pt, region, z, name);
+    if (perPixel) checkPixels(g, pt, name);
     EXPECT_GT(std::max(wrongDx, wrongDy), z) << name << ": the gradient test has no power here";
     EXPECT_GT(wrongPrimal, z) << name << ": the primal test has no power here";
     // Last column / row carry no gradient.
@@ -164,7 +202,11 @@ TEST_F(GptRender, GlossyLobeHalfVectorShiftMatchesPathTracer) {
     o.scene.shiftThreshold = 0.5f;
     const RenderResultGpt g = renderGpt(ctx(), scene, o);
     const RenderResult pt = renderPt(ctx(), scene, options(24, 24, 512, 206));
-    checkAgainstPt(g, pt, 6, "glossy cornell, threshold 0.5");
+    // Region sums only: half-vector copies through a GGX-0.3 lobe give heavy-tailed offset
+    // contributions (rare large J·p'/p ratios), so single-pixel variance estimates at 256 spp
+    // are unreliable there (measured: a pixel's standard error barely shrinks from 256 to
+    // 2048 spp, in PT as well); region sums average the tails.
+    checkAgainstPt(g, pt, 6, "glossy cornell, threshold 0.5", false);
 }
 
 // An emitter filling the view: everything is very-direct light, so primal and gradients are
