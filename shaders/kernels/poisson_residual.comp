@@ -2,7 +2,9 @@
 // A the weighted 5-point Laplacian + screening (poisson_shared.h). Default operands: x in X,
 // b in B, r to R at this level's offsets. With kPoissonFlagFromSol: x = Sol, b = Rhs and r
 // goes to B (level 0), which is how CG starts and how the true final residual is computed.
-// kPoissonFlagDot: partial ‖r‖² to slot RR.
+// kPoissonFlagDot: partial ‖r‖² to slot RR. kPoissonFlagProject (singular A, α = 0): b is
+// replaced by b − mean(b), its projection onto range(A), so float rounding in Σ b cannot
+// leave CG chasing an unreachable constant component.
 #version 460
 #extension GL_EXT_scalar_block_layout : require
 #extension GL_GOOGLE_include_directive : require
@@ -28,6 +30,7 @@ void main() {
                 r = ax;
             else
                 r = (fromSol ? Rhs[o + s.i] : B[pc.bOff + o + s.i]) - ax;
+            if ((pc.flags & kPoissonFlagProject) != 0u) r -= sc.bMean[c];
             if (fromSol)
                 B[o + s.i] = r;
             else

@@ -10,6 +10,7 @@
 //   Record: rr = Σ RR, history[k] = rr, convergence test (stationary solvers)
 //   Final:  finalRr = Σ RR (true residual of the returned x)
 //   Irls:   irlsScale = value / Σ WEIGHT (IRLS weights renormalised to mean 1)
+//   Mean:   bMean = Σ SUM / value (value = pixel count)
 // CG recurrences: Shewchuk, "CG without the agonizing pain", §B2 (preconditioned: §B3).
 #version 460
 #extension GL_EXT_scalar_block_layout : require
@@ -59,6 +60,7 @@ void main() {
                 sc.alpha[c] = 0.0;
                 sc.done[c] = converged(rr, bb) ? 1u : 0u;
                 sc.iterations[c] = 0u;
+                sc.rrMin[c] = rr;
                 recordHistory(c, rr);
             }
         } else if (pc.mode == kPoissonModeAlpha) {
@@ -78,7 +80,12 @@ void main() {
                 if (sc.done[c] == 0u) {
                     sc.iterations[c] = pc.iteration;
                     if (converged(rr, sc.bb[c])) sc.done[c] = 1u;
+                    // Singular A at the float32 floor: rounding leaves a component CG cannot
+                    // remove and the recurrences lose conjugacy; stop once the residual has
+                    // grown 10x past its best instead of diverging.
+                    if ((pc.flags & kPoissonFlagProject) != 0u && rr > 100.0 * sc.rrMin[c]) sc.done[c] = 1u;
                 }
+                sc.rrMin[c] = min(sc.rrMin[c], rr);
                 if (pc.mode == kPoissonModeBeta) {
                     sc.beta[c] = sc.done[c] == 0u && sc.rz[c] > 0.0 ? rz / sc.rz[c] : 0.0;
                     sc.rz[c] = rz;
@@ -89,6 +96,11 @@ void main() {
             if (lead) sc.finalRr[c] = rr;
         }
     }
+    if (pc.mode == kPoissonModeMean)
+        for (uint c = 0u; c < 3u; ++c) {
+            float sum = sumSlot(kPoissonSlotSum, c);
+            if (lead) sc.bMean[c] = sum / pc.value;
+        }
     if (pc.mode == kPoissonModeIrls) {
         float sum = sumSlot(kPoissonSlotWeight, 0u);
         if (lead) sc.irlsScale = sum > 0.0 ? pc.value / sum : 1.0;

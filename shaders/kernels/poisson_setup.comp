@@ -4,7 +4,7 @@
 //   cx_i = wdx_i (x < W−1, else 0),  cy_i = wdy_i (y < H−1, else 0),  cp_i = α² wp_i,
 //   b_i  = α² wp_i t_i − wdx_i dx_i + wdx_{i−1} dx_{i−1} − wdy_i dy_i + wdy_{i−W} dy_{i−W}
 // (b = Pᵀ W target gathered per pixel, so no atomics), written to Rhs; partial ‖b‖² sums
-// go to slot BB when kPoissonFlagDot is set.
+// go to slot BB and of Σ b to slot SUM when kPoissonFlagDot is set.
 #version 460
 #extension GL_EXT_scalar_block_layout : require
 #extension GL_GOOGLE_include_directive : require
@@ -22,7 +22,7 @@ float rowWeight(uint k, uint j, uint n) {
 void main() {
     uint x = gl_GlobalInvocationID.x, y = gl_GlobalInvocationID.y;
     uint w = pc.width, h = pc.height, n = w * h;
-    vec3 bb = vec3(0.0);
+    vec3 bb = vec3(0.0), bsum = vec3(0.0);
     if (x < w && y < h) {
         uint i = y * w + x;
         float wp = rowWeight(0u, i, n);
@@ -42,7 +42,12 @@ void main() {
             if (y > 0u) b += wdyN * Dy[o + i - w];
             Rhs[o + i] = b;
             bb[c] = b * b;
+            bsum[c] = b;
         }
     }
-    if ((pc.flags & kPoissonFlagDot) != 0u) writePartials(bb, kPoissonSlotBB);
+    if ((pc.flags & kPoissonFlagDot) != 0u) {
+        writePartials(bb, kPoissonSlotBB);
+        barrier();  // writePartials reuses its shared scratch
+        writePartials(bsum, kPoissonSlotSum);
+    }
 }

@@ -35,38 +35,50 @@ float current(uint px, uint py, uint c) {
     return v;
 }
 
+// One invocation per horizontal pixel pair (2·gx, 2·gx + 1) of row y: exactly one of the
+// two has the colour being updated, and which one depends on y only, so SIMD lanes along a
+// row never diverge and a half-sweep launches half the invocations.
 void main() {
-    uint x = gl_GlobalInvocationID.x, y = gl_GlobalInvocationID.y;
+    uint gx = gl_GlobalInvocationID.x, y = gl_GlobalInvocationID.y;
     uint w = pc.width, h = pc.height, n = w * h;
+    bool jacobi = flag(kPoissonFlagJacobi);
     vec3 dotv = vec3(0.0);
-    if (x < w && y < h) {
-        Stencil s = loadStencil(x, y, w, h, pc.cOff);
-        float d = stencilDiag(s);
-        uint xW = x > 0u ? x - 1u : x, xE = x + 1u < w ? x + 1u : x;
-        uint yN = y > 0u ? y - 1u : y, yS = y + 1u < h ? y + 1u : y;
-        bool jacobi = flag(kPoissonFlagJacobi);
-        bool mine = ((x + y) & 1u) == pc.colour;
-        for (uint c = 0u; c < 3u; ++c) {
-            float b = B[pc.bOff + c * n + s.i];
-            float xNew;
-            if (jacobi) {
-                float xi = current(x, y, c);
-                float r = b - applyStencil(s, xi, current(xW, y, c), current(xE, y, c),
-                                           current(x, yN, c), current(x, yS, c));
-                xNew = d > 0.0 ? xi + pc.omega * r / d : xi;
-                if (flag(kPoissonFlagToR))
-                    R[pc.rOff + c * n + s.i] = xNew;
-                else
-                    X[pc.xOff + c * n + s.i] = xNew;
-            } else if (mine) {
-                float sum = b + s.cW * current(xW, y, c) + s.cE * current(xE, y, c) +
-                            s.cN * current(x, yN, c) + s.cS * current(x, yS, c);
-                xNew = d > 0.0 ? sum / d : current(x, y, c);
-                X[pc.xOff + c * n + s.i] = xNew;
-            } else {
-                xNew = X[pc.xOff + c * n + s.i];  // the other colour: read only
+    if (2u * gx < w && y < h) {
+        for (uint k = 0u; k < 2u; ++k) {
+            uint x = 2u * gx + k;
+            if (x >= w) break;
+            bool mine = ((x + y) & 1u) == pc.colour;
+            uint i = y * w + x;
+            if (!jacobi && !mine) {
+                // The other colour is only read (its final value for the dot product).
+                if (flag(kPoissonFlagDot))
+                    for (uint c = 0u; c < 3u; ++c) dotv[c] += B[pc.bOff + c * n + i] * X[pc.xOff + c * n + i];
+                continue;
             }
-            dotv[c] = b * xNew;
+            Stencil s = loadStencil(x, y, w, h, pc.cOff);
+            float d = stencilDiag(s);
+            uint xW = x > 0u ? x - 1u : x, xE = x + 1u < w ? x + 1u : x;
+            uint yN = y > 0u ? y - 1u : y, yS = y + 1u < h ? y + 1u : y;
+            for (uint c = 0u; c < 3u; ++c) {
+                float b = B[pc.bOff + c * n + i];
+                float xNew;
+                if (jacobi) {
+                    float xi = current(x, y, c);
+                    float r = b - applyStencil(s, xi, current(xW, y, c), current(xE, y, c),
+                                               current(x, yN, c), current(x, yS, c));
+                    xNew = d > 0.0 ? xi + pc.omega * r / d : xi;
+                    if (flag(kPoissonFlagToR))
+                        R[pc.rOff + c * n + i] = xNew;
+                    else
+                        X[pc.xOff + c * n + i] = xNew;
+                } else {
+                    float sum = b + s.cW * current(xW, y, c) + s.cE * current(xE, y, c) +
+                                s.cN * current(x, yN, c) + s.cS * current(x, yS, c);
+                    xNew = d > 0.0 ? sum / d : current(x, y, c);
+                    X[pc.xOff + c * n + i] = xNew;
+                }
+                dotv[c] += b * xNew;
+            }
         }
     }
     if (flag(kPoissonFlagDot)) writePartials(dotv, kPoissonSlotRZ);

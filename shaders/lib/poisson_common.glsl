@@ -4,6 +4,9 @@
 #ifndef POISSON_COMMON_GLSL
 #define POISSON_COMMON_GLSL
 
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+
 layout(set = 0, binding = kPoissonBindCoef, scalar) buffer CoefBuf { float Coef[]; };
 layout(set = 0, binding = kPoissonBindX, scalar) buffer XBuf { float X[]; };
 layout(set = 0, binding = kPoissonBindB, scalar) buffer BBuf { float B[]; };
@@ -57,31 +60,29 @@ float applyStencil(Stencil s, float xi, float xW, float xE, float xN, float xS) 
     return s.cp * xi + s.cW * (xi - xW) + s.cE * (xi - xE) + s.cN * (xi - xN) + s.cS * (xi - xS);
 }
 
-// Deterministic per-workgroup partial sums of three values (one per channel): a fixed
-// shared-memory tree, written to Partials[(slot·3 + c)·G + g]. Every invocation of the
-// workgroup must call it (it contains barriers); the workgroup size is a power of two ≤ 256.
-shared float sPartial[3u * kPoissonMaxGroupSize];
+// Deterministic per-workgroup partial sums of three values (one per channel), written to
+// Partials[(slot·3 + c)·G + g] (G = pc.groups ≥ this dispatch's workgroup count): subgroupAdd inside each subgroup (a fixed reduction order of
+// the implementation), then invocation 0 adds the subgroup sums in subgroup order. One
+// barrier at most: on lavapipe every barrier switches all of a workgroup's SIMD "threads"
+// (coroutines), so the former 8-level shared-memory tree cost as much as the stencil itself.
+// Every invocation of the workgroup must call it.
+shared vec3 sPartial[kPoissonMaxGroupSize];
 
 void writePartials(vec3 v, uint slot) {
-    uint l = gl_LocalInvocationIndex;
-    uint size = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
-    sPartial[l] = v.x;
-    sPartial[kPoissonMaxGroupSize + l] = v.y;
-    sPartial[2u * kPoissonMaxGroupSize + l] = v.z;
-    barrier();
-    for (uint s = size / 2u; s > 0u; s >>= 1u) {
-        if (l < s) {
-            sPartial[l] += sPartial[l + s];
-            sPartial[kPoissonMaxGroupSize + l] += sPartial[kPoissonMaxGroupSize + l + s];
-            sPartial[2u * kPoissonMaxGroupSize + l] += sPartial[2u * kPoissonMaxGroupSize + l + s];
-        }
-        barrier();
+    vec3 s = subgroupAdd(v);
+    uint groups = pc.groups;  // slot stride: the fine level's full-width workgroup count
+    uint g = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+    if (gl_NumSubgroups == 1u) {
+        if (subgroupElect())
+            for (uint c = 0u; c < 3u; ++c) Partials[(slot * 3u + c) * groups + g] = s[c];
+        return;
     }
-    if (l == 0u) {
-        uint groups = gl_NumWorkGroups.x * gl_NumWorkGroups.y;
-        uint g = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-        for (uint c = 0u; c < 3u; ++c)
-            Partials[(slot * 3u + c) * groups + g] = sPartial[c * kPoissonMaxGroupSize];
+    if (subgroupElect()) sPartial[gl_SubgroupID] = s;
+    barrier();
+    if (gl_LocalInvocationIndex == 0u) {
+        vec3 total = vec3(0.0);
+        for (uint k = 0u; k < gl_NumSubgroups; ++k) total += sPartial[k];
+        for (uint c = 0u; c < 3u; ++c) Partials[(slot * 3u + c) * groups + g] = total[c];
     }
 }
 

@@ -48,7 +48,8 @@ GDPT_ENUM_BEGIN(PoissonSlot)
     kPoissonSlotRZ = 2u,      // r·z (preconditioned)
     kPoissonSlotPAP = 3u,     // p·Ap
     kPoissonSlotWeight = 4u,  // Σ IRLS weights (channel 0 only meaningful)
-    kPoissonSlotCount = 5u
+    kPoissonSlotSum = 5u,     // Σ b (mean removal for singular systems)
+    kPoissonSlotCount = 6u
 GDPT_ENUM_END();
 
 // PoissonPush.flags bits.
@@ -63,6 +64,7 @@ GDPT_CONST uint kPoissonFlagZIsR = 128u;      // CG: z = r (no preconditioner)
 GDPT_CONST uint kPoissonFlagFirst = 256u;     // CG direction: p = z (ignore the old p)
 GDPT_CONST uint kPoissonFlagIrls = 512u;      // setup: multiply by IRLS weights·scale
 GDPT_CONST uint kPoissonFlagFromSol = 1024u;  // residual kernel: x = Sol, b = Rhs, r -> B
+GDPT_CONST uint kPoissonFlagProject = 2048u;  // residual kernel: use b − mean(b) (singular A)
 
 // poisson_scalars modes.
 GDPT_ENUM_BEGIN(PoissonScalarMode)
@@ -71,7 +73,8 @@ GDPT_ENUM_BEGIN(PoissonScalarMode)
     kPoissonModeBeta = 2u,    // history[k] = rr; convergence; β = rz_new / rz
     kPoissonModeRecord = 3u,  // stationary solvers: history[k] = rr; convergence
     kPoissonModeFinal = 4u,   // finalRr = rr (true residual)
-    kPoissonModeIrls = 5u     // irlsScale = value / Σ weights
+    kPoissonModeIrls = 5u,    // irlsScale = value / Σ weights
+    kPoissonModeMean = 6u     // bMean = Σ b / value (value = pixel count)
 GDPT_ENUM_END();
 
 GDPT_CONST uint kPoissonMaxHistory = 4096u;   // residual history entries (per channel)
@@ -107,7 +110,7 @@ struct PoissonPush {
 };
 
 // Device-side solver state (binding kPoissonBindScalars), followed by the residual history
-// history[k·3 + c] = ‖r_k‖² of channel c after iteration k. 100 bytes.
+// history[k·3 + c] = ‖r_k‖² of channel c after iteration k. 136 bytes.
 struct PoissonScalars {
     float bb[3];         // ‖b‖² per channel
     float rr[3];         // ‖r‖² of the latest iterate
@@ -119,6 +122,8 @@ struct PoissonScalars {
     uint done[3];        // 1 once channel c converged (or CG broke down)
     uint iterations[3];  // iterations until convergence (or performed)
     float irlsScale;     // IRLS normalisation: kept rows / Σ weights
+    float bMean[3];      // mean of b per channel (projection onto range(A) when α = 0)
+    float rrMin[3];      // smallest ‖r‖² so far (divergence guard for singular A)
 };
 
 #ifdef __cplusplus

@@ -23,6 +23,9 @@ int main(int argc, char** argv) {
         addDevicesCommand(app),
         addBenchCommand(app),
         addConvergeCommand(app),
+        addSolveCommand(app),
+        addCloneCommand(app),
+        addBenchPoissonCommand(app),
     };
 
     try {

@@ -20,5 +20,8 @@ Subcommand addInfoCommand(CLI::App& app);
 Subcommand addDevicesCommand(CLI::App& app);
 Subcommand addBenchCommand(CLI::App& app);
 Subcommand addConvergeCommand(CLI::App& app);
+Subcommand addSolveCommand(CLI::App& app);
+Subcommand addCloneCommand(CLI::App& app);
+Subcommand addBenchPoissonCommand(CLI::App& app);
 
 }  // namespace gdpt

@@ -116,7 +116,7 @@ void PoissonSolverGpu::readHistory(int count, SolveReport& report) {
 }
 
 PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o, double tolerance, bool irls,
-                                                           SolveReport& report) {
+                                                           bool singular, SolveReport& report) {
     // irls: the IRLS weights and their scale have been recorded/computed already by the caller
     // into this batch's command buffer (see solve()).
     PoissonGpuEngine& e = engine_;
@@ -130,8 +130,12 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
 
     e.recordSetup(cmd, static_cast<float>(o.alpha * o.alpha), irls, timer);
     if (o.solver != GpuSolver::Cg && o.solver != GpuSolver::Jacobi) e.recordCoarsenAll(cmd, timer);
+    // Singular A (α = 0): CG works on b − mean(b), the consistent part (poisson_residual).
+    const std::uint32_t project = singular && cgFamily ? kPoissonFlagProject : 0u;
+    if (project)
+        e.recordScalars(cmd, kPoissonModeMean, 0u, 0u, 0.0f, static_cast<float>(e.pixels()), timer);
     if (cgFamily) {
-        e.recordResidual(cmd, 0, kPoissonFlagFromSol | kPoissonFlagDot, timer);
+        e.recordResidual(cmd, 0, kPoissonFlagFromSol | kPoissonFlagDot | project, timer);
         if (pcg) e.recordVcycle(cmd, o.vcycle, true, true, timer);
     } else {
         PoissonGpuEngine::recordCopy(cmd, e.rhs, e.b, fine);
@@ -167,7 +171,7 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
                 e.recordScalars(cmd, kPoissonModeAlpha, zIsR, it, tol, 0.0f, timer);
                 e.recordCgUpdate(cmd, pNew, timer);
                 if (pcg) e.recordVcycle(cmd, o.vcycle, true, true, timer);
-                e.recordScalars(cmd, kPoissonModeBeta, zIsR, it, tol, 0.0f, timer);
+                e.recordScalars(cmd, kPoissonModeBeta, zIsR | project, it, tol, 0.0f, timer);
             } else if (o.solver == GpuSolver::Mg) {
                 e.recordVcycle(cmd, o.vcycle, false, false, timer);
                 e.recordResidual(cmd, 0, kPoissonFlagDot, timer);
@@ -189,7 +193,7 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
     cmd = stream_.begin();
     if (timer) timer->reset(cmd);
     if (!cgFamily) PoissonGpuEngine::recordCopy(cmd, e.x, e.sol, fine);
-    e.recordResidual(cmd, 0, kPoissonFlagFromSol | kPoissonFlagDot, timer);
+    e.recordResidual(cmd, 0, kPoissonFlagFromSol | kPoissonFlagDot | project, timer);
     e.recordScalars(cmd, kPoissonModeFinal, zIsR, 0, tol, 0.0f, timer);
     stream_.submit();
     stream_.waitAll();
@@ -203,8 +207,10 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
     for (int c = 0; c < 3; ++c) {
         const int its = static_cast<int>(sc.iterations[c]) * (o.solver == GpuSolver::Jacobi ? 2 : 1);
         result.iterations = std::max(result.iterations, its);
-        result.converged = result.converged && sc.done[c] != 0;
         const double rel = sc.bb[c] > 0.0f ? std::sqrt(double(sc.finalRr[c]) / sc.bb[c]) : std::sqrt(double(sc.finalRr[c]));
+        // Done by the recursive residual, and the true residual agrees (within 2x: the
+        // recursion drifts from b − A x by float rounding).
+        result.converged = result.converged && sc.done[c] != 0 && rel <= 2.0 * tolerance;
         worst = std::max(worst, rel);
     }
     report.residual = worst;
@@ -298,7 +304,7 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
     VkCommandBuffer cmd = stream_.begin();
     if (o.timer) o.timer->reset(cmd);
     if (o.method != Reconstruction::L1) {
-        const InnerResult r = innerSolve(o, o.tolerance, false, report);
+        const InnerResult r = innerSolve(o, o.tolerance, false, singular, report);
         report.iterations = r.iterations;
         report.converged = r.converged;
         report.irlsIterations = 1;
@@ -317,7 +323,7 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
                 engine_.recordScalars(cmd, kPoissonModeIrls, 0u, 0u, 0.0f, static_cast<float>(rows), o.timer);
                 reg *= o.irlsRegIter;
             }
-            const InnerResult r = innerSolve(o, tol, k > 0, report);
+            const InnerResult r = innerSolve(o, tol, k > 0, false, report);
             report.iterations += r.iterations;
             report.converged = r.converged;
             ++report.irlsIterations;

@@ -113,7 +113,7 @@ private:
         int iterations = 0;
         bool converged = false;
     };
-    InnerResult innerSolve(const SolveOptions& o, double tolerance, bool irls, SolveReport& report);
+    InnerResult innerSolve(const SolveOptions& o, double tolerance, bool irls, bool singular, SolveReport& report);
     void readHistory(int count, SolveReport& report);
 
     PoissonGpuEngine engine_;

@@ -36,8 +36,10 @@ vk::KernelDesc describe(vk::KernelDesc d, std::uint32_t gx, std::uint32_t gy, bo
     return d;
 }
 
-PoissonPush levelPush(const PoissonLevel& l) {
+// groups: the fine-level workgroup count, the stride of the partial-sum slots.
+PoissonPush levelPush(const PoissonLevel& l, std::uint32_t groups) {
     PoissonPush p{};
+    p.groups = groups;
     p.width = static_cast<std::uint32_t>(l.width);
     p.height = static_cast<std::uint32_t>(l.height);
     p.xOff = p.bOff = p.rOff = p.cOff = l.offset;
@@ -145,7 +147,7 @@ void PoissonGpuEngine::dispatch(VkCommandBuffer cmd, const vk::Kernel& kernel, i
 }
 
 void PoissonGpuEngine::recordSetup(VkCommandBuffer cmd, float alpha2, bool irlsWeights, vk::GpuTimer* timer) {
-    PoissonPush push = levelPush(levels_[0]);
+    PoissonPush push = levelPush(levels_[0], groups());
     push.alpha2 = alpha2;
     push.flags = gpu::kPoissonFlagDot | (irlsWeights ? gpu::kPoissonFlagIrls : 0u);
     dispatch(cmd, kernels_->setup, width(), height(), &push, timer);
@@ -153,14 +155,14 @@ void PoissonGpuEngine::recordSetup(VkCommandBuffer cmd, float alpha2, bool irlsW
 
 void PoissonGpuEngine::recordCoarsenAll(VkCommandBuffer cmd, vk::GpuTimer* timer) {
     for (std::size_t l = 0; l + 1 < levels_.size(); ++l) {
-        PoissonPush push = levelPush(levels_[l]);
+        PoissonPush push = levelPush(levels_[l], groups());
         withCoarse(push, levels_[l + 1]);
         dispatch(cmd, kernels_->coarsen, levels_[l + 1].width, levels_[l + 1].height, &push, timer);
     }
 }
 
 void PoissonGpuEngine::recordResidual(VkCommandBuffer cmd, int level, std::uint32_t flags, vk::GpuTimer* timer) {
-    PoissonPush push = levelPush(levels_.at(static_cast<std::size_t>(level)));
+    PoissonPush push = levelPush(levels_.at(static_cast<std::size_t>(level)), groups());
     push.flags = flags;
     dispatch(cmd, kernels_->residual, push.width, push.height, &push, timer);
 }
@@ -168,17 +170,18 @@ void PoissonGpuEngine::recordResidual(VkCommandBuffer cmd, int level, std::uint3
 void PoissonGpuEngine::recordSmooth(VkCommandBuffer cmd, int level, std::uint32_t flags, std::uint32_t colour,
                                     float omega, vk::GpuTimer* timer) {
     const std::size_t l = static_cast<std::size_t>(level);
-    PoissonPush push = levelPush(levels_.at(l));
+    PoissonPush push = levelPush(levels_.at(l), groups());
     if (l + 1 < levels_.size()) withCoarse(push, levels_[l + 1]);
     push.flags = flags;
     push.colour = colour;
     push.omega = omega;
-    dispatch(cmd, kernels_->smooth, push.width, push.height, &push, timer);
+    // One invocation per horizontal pixel pair (see poisson_smooth.comp).
+    dispatch(cmd, kernels_->smooth, (levels_[l].width + 1) / 2, push.height, &push, timer);
 }
 
 void PoissonGpuEngine::recordRestrict(VkCommandBuffer cmd, int level, std::uint32_t flags, vk::GpuTimer* timer) {
     const std::size_t l = static_cast<std::size_t>(level);
-    PoissonPush push = levelPush(levels_.at(l));
+    PoissonPush push = levelPush(levels_.at(l), groups());
     withCoarse(push, levels_.at(l + 1));
     push.flags = flags;
     dispatch(cmd, kernels_->restrictResidual, push.coarseWidth, push.coarseHeight, &push, timer);
@@ -186,13 +189,13 @@ void PoissonGpuEngine::recordRestrict(VkCommandBuffer cmd, int level, std::uint3
 
 void PoissonGpuEngine::recordProlong(VkCommandBuffer cmd, int level, vk::GpuTimer* timer) {
     const std::size_t l = static_cast<std::size_t>(level);
-    PoissonPush push = levelPush(levels_.at(l));
+    PoissonPush push = levelPush(levels_.at(l), groups());
     withCoarse(push, levels_.at(l + 1));
     dispatch(cmd, kernels_->prolong, push.width, push.height, &push, timer);
 }
 
 void PoissonGpuEngine::recordCoarsest(VkCommandBuffer cmd, bool zeroGuess, vk::GpuTimer* timer) {
-    PoissonPush push = levelPush(levels_.back());
+    PoissonPush push = levelPush(levels_.back(), groups());
     push.flags = zeroGuess ? gpu::kPoissonFlagZeroGuess : 0u;
     kernels_->coarsest.dispatch(cmd, 1, 1, 1, &push, timer);
     vk::computeBarrier(cmd);
@@ -200,7 +203,7 @@ void PoissonGpuEngine::recordCoarsest(VkCommandBuffer cmd, bool zeroGuess, vk::G
 
 void PoissonGpuEngine::recordCgDirection(VkCommandBuffer cmd, std::uint32_t flags, std::uint32_t pOld,
                                          std::uint32_t pNew, vk::GpuTimer* timer) {
-    PoissonPush push = levelPush(levels_[0]);
+    PoissonPush push = levelPush(levels_[0], groups());
     push.flags = flags;
     push.pOld = pOld;
     push.pNew = pNew;
@@ -208,14 +211,14 @@ void PoissonGpuEngine::recordCgDirection(VkCommandBuffer cmd, std::uint32_t flag
 }
 
 void PoissonGpuEngine::recordCgUpdate(VkCommandBuffer cmd, std::uint32_t pNew, vk::GpuTimer* timer) {
-    PoissonPush push = levelPush(levels_[0]);
+    PoissonPush push = levelPush(levels_[0], groups());
     push.pNew = pNew;
     dispatch(cmd, kernels_->cgUpdate, width(), height(), &push, timer);
 }
 
 void PoissonGpuEngine::recordScalars(VkCommandBuffer cmd, std::uint32_t mode, std::uint32_t flags,
                                      std::uint32_t iteration, float tolerance, float value, vk::GpuTimer* timer) {
-    PoissonPush push = levelPush(levels_[0]);
+    PoissonPush push = levelPush(levels_[0], groups());
     push.mode = mode;
     push.flags = flags;
     push.iteration = iteration;
@@ -227,7 +230,7 @@ void PoissonGpuEngine::recordScalars(VkCommandBuffer cmd, std::uint32_t mode, st
 }
 
 void PoissonGpuEngine::recordIrlsWeights(VkCommandBuffer cmd, float alpha2, float reg, vk::GpuTimer* timer) {
-    PoissonPush push = levelPush(levels_[0]);
+    PoissonPush push = levelPush(levels_[0], groups());
     push.alpha2 = alpha2;
     push.reg = reg;
     dispatch(cmd, kernels_->irlsWeights, width(), height(), &push, timer);

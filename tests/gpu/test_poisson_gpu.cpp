@@ -516,7 +516,7 @@ TEST_F(PoissonGpu, AlphaZeroFixesTheMeanFromThePrimal) {
     const Image dx = randomImage(29, 22, 42, -0.2, 0.2), dy = randomImage(29, 22, 43, -0.2, 0.2);
     SolveOptions o;
     o.alpha = 0.0;
-    o.tolerance = 1e-6;
+    o.tolerance = 1e-5;  // singular A: the float32 floor is ~1e-6 here
     Image out;
     const SolveReport r = solve(primal, dx, dy, o, out);
     EXPECT_TRUE(r.converged);
