@@ -28,6 +28,9 @@ struct BenchPoissonArgs {
     double tolerance = 1e-4;
     int maxIterations = 5000;
     std::string workgroup = "16x16";
+    int preSmooth = 1;
+    int postSmooth = 1;
+    bool jacobiSmoother = false;
     std::string device;
     bool profile = false;
 };
@@ -94,6 +97,8 @@ int runBenchPoisson(const BenchPoissonArgs& a) {
     json out = {{"device", ctx.info().name},    {"driver", ctx.info().driverInfo},
                 {"repeats", a.repeats},         {"alpha", a.alpha},
                 {"tolerance", a.tolerance},     {"workgroup", a.workgroup},
+                {"pre_smooth", a.preSmooth},    {"post_smooth", a.postSmooth},
+                {"smoother", a.jacobiSmoother ? "jacobi" : "rb-gs"},
                 {"results", json::array()}};
     for (const std::string& sizeText : splitList(a.sizes)) {
         const auto [w, h] = parseSize(sizeText);
@@ -118,6 +123,9 @@ int runBenchPoisson(const BenchPoissonArgs& a) {
             o.alpha = a.alpha;
             o.tolerance = a.tolerance;
             o.maxIterations = a.maxIterations;
+            o.vcycle.preSmooth = a.preSmooth;
+            o.vcycle.postSmooth = a.postSmooth;
+            o.vcycle.jacobi = a.jacobiSmoother;
             if (method == "l1") {
                 o.method = Reconstruction::L1;
             } else if (method.rfind("l2-", 0) == 0) {
@@ -180,6 +188,13 @@ Subcommand addBenchPoissonCommand(CLI::App& app) {
         ->check(CLI::Range(1, 1000000))
         ->capture_default_str();
     sub->add_option("--workgroup", args->workgroup, "Workgroup WxH (power-of-two size <= 256)")->capture_default_str();
+    sub->add_option("--pre-smooth", args->preSmooth, "V-cycle sweeps before the coarse correction")
+        ->check(CLI::Range(0, 8))
+        ->capture_default_str();
+    sub->add_option("--post-smooth", args->postSmooth, "V-cycle sweeps after it")
+        ->check(CLI::Range(1, 8))
+        ->capture_default_str();
+    sub->add_flag("--jacobi-smoother", args->jacobiSmoother, "Damped Jacobi smoother instead of red-black Gauss-Seidel");
     sub->add_option("--device", args->device, "Vulkan device index or name substring");
     sub->add_flag("--profile", args->profile, "Add per-kernel GPU ms (last repeat) to the JSON");
     return {sub, [args] { return runBenchPoisson(*args); }};

@@ -21,6 +21,7 @@
 #include "poisson/poisson_gpu.h"
 #include "poisson/poisson_irls.h"
 #include "poisson_shared.h"
+#include "util/error.h"
 #include "vk/commands.h"
 
 namespace gdpt {
@@ -644,6 +645,22 @@ TEST_F(PoissonGpu, SeamlessCloneKeepsTargetAndMatchesSourceLaplacian) {
     const Image mixed = seamlessClone(ctx(), source, target, mask, o);
     for (int c = 0; c < 3; ++c)
         for (std::size_t i = 0; i < mixed.pixelCount(); ++i) ASSERT_TRUE(std::isfinite(mixed.plane(c)[i]));
+}
+
+
+// Sizes whose multigrid field exceeds one storage buffer are refused before any allocation,
+// with a message naming the device limit (4096x4096 RGB needs ~256 MiB per field on
+// lavapipe's 128 MiB maxStorageBufferRange).
+TEST_F(PoissonGpu, OversizedImageIsRefusedWithTheLimitNamed) {
+    const std::uint64_t limit = ctx().info().maxStorageBufferRange;
+    const std::uint64_t need = 4ull * 4096 * 4096 * 3 * 4 / 3;
+    if (need <= limit) GTEST_SKIP() << "device takes 4096x4096 in one buffer";
+    try {
+        PoissonSolverGpu solver(ctx(), 4096, 4096, &sharedKernels());
+        FAIL() << "4096x4096 accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("maxStorageBufferRange"), std::string::npos) << e.what();
+    }
 }
 
 }  // namespace
