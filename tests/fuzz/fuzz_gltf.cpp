@@ -1,0 +1,26 @@
+// fuzz_gltf.cpp — libFuzzer harness for the glTF loader. Any input must either load or
+// throw gdpt::Error; a crash, hang, sanitizer report or other exception is a bug.
+// Build: configure with clang and -DGDPT_FUZZ=ON (see tests/fuzz/README.md).
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+#include "scene/gltf_loader.h"
+#include "util/error.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    // The loader reads files (relative URIs resolve next to it); give it a private one.
+    static const std::string path = "/tmp/gdpt_fuzz_gltf_" + std::to_string(getpid()) + ".gltf";
+    FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f) return 0;
+    std::fwrite(data, 1, size, f);
+    std::fclose(f);
+    try {
+        (void)gdpt::loadGltf(path);
+    } catch (const gdpt::Error&) {
+        // The expected way to reject malformed input.
+    }
+    return 0;
+}
