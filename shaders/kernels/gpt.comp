@@ -65,56 +65,7 @@ vec3 cameraRay(vec2 pixelPos) {
     return normalize(d);
 }
 
-// One offset path. For kShiftNotConnected `hit` is the offset's own current vertex; after
-// reconnection the offset's vertex is the base's and only woWorld (its own incoming
-// direction at that shared vertex) differs.
-struct OffsetPath {
-    SurfaceHit hit;   // current vertex (NOT_CONNECTED only)
-    vec3 woWorld;     // unit, from the current vertex back towards the previous one
-    vec3 beta;        // f'/p: offset throughput over the base path's pdf (Jacobians included)
-    float r;          // J·p'/p: offset density in the base's measure over the base's density
-    float rLight;     // ratio applying to the light strategy of the current vertex's emission
-    uint state;       // kShiftNotConnected / kShiftRecentlyConnected / kShiftConnected
-    bool alive;       // false: pair absent (image border) or shift failed -> base-only weights
-    vec3 baseSum;     // Σ w·f_base over this pair (part of central)
-    vec3 offSum;      // Σ w·f_offset over this pair (neighbor_i)
-};
-
-// The pair (p, p + δ_i) exists only inside the image; at borders p has fewer pairs.
-bool gptPairExists(uint px, uint py, uint i) {
-    ivec2 q = ivec2(px, py) + kOffsetDelta[i];
-    return q.x >= 0 && q.y >= 0 && q.x < int(scene.width) && q.y < int(scene.height);
-}
-
-// Vertex classification; a scene without glossy/specular vertices (kHasGlossy false) has
-// every vertex rough, which the compiler folds away with the half-vector branch.
-//
-// Deviation from the reference (GPT_REFERENCE §1.3), which classifies the base's current
-// vertex by the component it sampled and the offset's by that same component: the sampled
-// component is not a function of the path (a mixture reaches one direction through several
-// lobes), and an offset may lack the component altogether (base samples the diffuse lobe of
-// a wall, the offset sits on a metal), so the forward and the reverse shift of one pair can
-// pick different shift types and the pair's MIS weights stop summing to one. Here every
-// vertex is classified by its lowest roughness over all components (shiftRoughnessAll), a
-// property of the vertex alone, so the rule is symmetric. Cost: a diffuse lobe under a
-// smooth coat never reconnects (half-vector copies instead). On the test scenes (metals and
-// Lambertian walls) both rules pass the same tests; the difference is argued, not measured.
-bool roughAll(BsdfParams m) {
-    return !kHasGlossy || shiftIsRough(shiftRoughnessAll(m), frame.shiftThreshold);
-}
-bool roughSmooth(BsdfParams m) {
-    return !kHasGlossy || shiftIsRough(shiftRoughnessSmooth(m), frame.shiftThreshold);
-}
-
-bool oneSidedBack(SurfaceHit h) {
-    return !h.frontFace && (materials[h.material].flags & kMatFlagDoubleSided) == 0u;
-}
-
-// Adds one estimator sample of a pair with MIS weight w (GPT_REFERENCE §1.6).
-void addPair(inout OffsetPath op, float w, vec3 fBase, vec3 fOffset) {
-    op.baseSum += w * fBase;
-    op.offSum += w * fOffset;
-}
+#include "lib/gpt_path.glsl"
 
 // Base + 4 offsets for one camera sample at pixelPos (continuous pixel coordinates).
 void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays, out vec3 direct,
@@ -474,29 +425,6 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
         sh = nextSh;
         d = wi;
     }
-}
-
-// Welford accumulator of one quantity over this batch.
-struct Welford {
-    vec3 mean;
-    vec3 m2;
-};
-
-void welfordAdd(inout Welford a, vec3 x, uint n) {
-    vec3 delta = x - a.mean;
-    a.mean += delta / float(n);
-    a.m2 += delta * (x - a.mean);
-}
-
-// Chan et al. 1979 pairwise merge of a batch (n samples) into stored statistics.
-PixelStats chanMerge(PixelStats acc, Welford a, uint n) {
-    uint total = acc.count + n;
-    vec3 delta = a.mean - acc.mean;
-    float fb = float(n) / float(total);
-    acc.mean += delta * fb;
-    acc.m2 += a.m2 + delta * delta * float(acc.count) * fb;
-    acc.count = total;
-    return acc;
 }
 
 void main() {
