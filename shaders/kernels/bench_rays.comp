@@ -49,7 +49,7 @@ void main() {
             vec3 t, b;
             makeBasis(n, t, b);
             d = toWorld(sampleCosineHemisphere(rngNext2(rng)), t, b, n);
-            o = offsetRayOrigin(p, n);
+            o = offsetRayOriginScaled(p, n, scene.sceneRadius);
         }
     }
     atomicAdd(counters.raysTraced, rays);

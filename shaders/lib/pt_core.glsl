@@ -73,7 +73,7 @@ void ptProcessHit(inout PathState s, Hit hit) {
     vec3 t, b;
     makeBasis(sh.ns, t, b);
     vec3 woLocal = toLocal(-d, t, b, sh.ns);
-    vec3 origin = offsetRayOrigin(sh.p, sh.ng);
+    vec3 origin = offsetRayOriginScaled(sh.p, sh.ng, scene.sceneRadius);
 
     // Next-event estimation (the three numbers are drawn even when unused, so that the
     // random stream does not depend on the material).

@@ -17,16 +17,26 @@ GDPT_CONST float kRayFloatScale = 1.0f / 65536.0f;
 GDPT_CONST float kRayIntScale = 256.0f;          // ulps moved per unit of normal
 
 // Offsets component c of p by `ulps` units in the last place in the direction of sign(n).
-GDPT_INLINE float offsetComponent(float p, float n) {
+// Near the origin, where ulps are tiny, a fixed offset is used instead; Wächter & Binder's
+// constants assume scenes of unit size, so that fixed offset and its threshold are scaled
+// by the scene's size (found by the stress suite: a Cornell box scaled to 0.2 mm was
+// visibly wrong with a fixed 1/65536 offset).
+GDPT_INLINE float offsetComponent(float p, float n, float sceneScale) {
     int ulps = int(kRayIntScale * n);
     float moved = intBitsToFloat(floatBitsToInt(p) + (p < 0.0f ? -ulps : ulps));
-    return abs(p) < kRayOrigin ? p + kRayFloatScale * n : moved;
+    return abs(p) < kRayOrigin * sceneScale ? p + kRayFloatScale * sceneScale * n : moved;
 }
 
-// Origin for a ray leaving the surface at p on the side of the (unit) geometric normal n.
-// Callers pass n flipped towards the side the new ray travels into.
+// Origin for a ray leaving the surface at p on the side of the (unit) geometric normal n,
+// in a scene of about `sceneScale` units (e.g. its bounding radius; 1 = the published
+// constants). Callers pass n flipped towards the side the new ray travels into.
+GDPT_INLINE vec3 offsetRayOriginScaled(vec3 p, vec3 n, float sceneScale) {
+    return vec3(offsetComponent(p.x, n.x, sceneScale), offsetComponent(p.y, n.y, sceneScale),
+                offsetComponent(p.z, n.z, sceneScale));
+}
+
 GDPT_INLINE vec3 offsetRayOrigin(vec3 p, vec3 n) {
-    return vec3(offsetComponent(p.x, n.x), offsetComponent(p.y, n.y), offsetComponent(p.z, n.z));
+    return offsetRayOriginScaled(p, n, 1.0f);
 }
 
 GDPT_NAMESPACE_END
