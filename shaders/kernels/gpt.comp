@@ -422,6 +422,11 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
                 }
             }
         }
+        // Nothing left to carry (e.g. the base and all offsets sit on a black emitter): every
+        // later contribution of every pair would be w·0, so stop tracing.
+        bool carries = maxComponent(beta) > 0.0;
+        for (uint i = 0u; i < 4u; ++i) carries = carries || (offs[i].alive && maxComponent(offs[i].beta) > 0.0);
+        if (!carries) break;
         sh = nextSh;
         d = wi;
     }
