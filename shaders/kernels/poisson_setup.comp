@@ -47,7 +47,6 @@ void main() {
     }
     if ((pc.flags & kPoissonFlagDot) != 0u) {
         writePartials(bb, kPoissonSlotBB);
-        barrier();  // writePartials reuses its shared scratch
         writePartials(bsum, kPoissonSlotSum);
     }
 }

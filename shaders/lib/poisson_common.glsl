@@ -60,30 +60,17 @@ float applyStencil(Stencil s, float xi, float xW, float xE, float xN, float xS) 
     return s.cp * xi + s.cW * (xi - xW) + s.cE * (xi - xE) + s.cN * (xi - xN) + s.cS * (xi - xS);
 }
 
-// Deterministic per-workgroup partial sums of three values (one per channel), written to
-// Partials[(slot·3 + c)·G + g] (G = pc.groups ≥ this dispatch's workgroup count): subgroupAdd inside each subgroup (a fixed reduction order of
-// the implementation), then invocation 0 adds the subgroup sums in subgroup order. One
-// barrier at most: on lavapipe every barrier switches all of a workgroup's SIMD "threads"
-// (coroutines), so the former 8-level shared-memory tree cost as much as the stencil itself.
-// Every invocation of the workgroup must call it.
-shared vec3 sPartial[kPoissonMaxGroupSize];
-
+// Deterministic partial sums of three values (one per channel): subgroupAdd inside each
+// subgroup (a fixed reduction order of the implementation), and one partial per subgroup,
+// Partials[(slot·3 + c)·G + g·S + subgroup] with S = gl_NumSubgroups and G·S = pc.groups
+// (≥ this dispatch's count; unused entries stay 0). No shared memory and no barrier: on
+// lavapipe a barrier anywhere in a shader turns every workgroup into coroutines, which made
+// the stencil kernels several times slower. poisson_scalars adds the partials in order.
 void writePartials(vec3 v, uint slot) {
     vec3 s = subgroupAdd(v);
-    uint groups = pc.groups;  // slot stride: the fine level's full-width workgroup count
-    uint g = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-    if (gl_NumSubgroups == 1u) {
-        if (subgroupElect())
-            for (uint c = 0u; c < 3u; ++c) Partials[(slot * 3u + c) * groups + g] = s[c];
-        return;
-    }
-    if (subgroupElect()) sPartial[gl_SubgroupID] = s;
-    barrier();
-    if (gl_LocalInvocationIndex == 0u) {
-        vec3 total = vec3(0.0);
-        for (uint k = 0u; k < gl_NumSubgroups; ++k) total += sPartial[k];
-        for (uint c = 0u; c < 3u; ++c) Partials[(slot * 3u + c) * groups + g] = total[c];
-    }
+    uint g = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_NumSubgroups + gl_SubgroupID;
+    if (subgroupElect())
+        for (uint c = 0u; c < 3u; ++c) Partials[(slot * 3u + c) * pc.groups + g] = s[c];
 }
 
 #endif

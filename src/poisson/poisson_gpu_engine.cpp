@@ -2,6 +2,7 @@
 // Poisson solver (see poisson_gpu_engine.h).
 #include "poisson/poisson_gpu_engine.h"
 
+#include <algorithm>
 #include <string>
 
 #include "poisson_shared.h"
@@ -125,7 +126,10 @@ PoissonGpuEngine::PoissonGpuEngine(const vk::Context& ctx, int width, int height
 std::uint32_t PoissonGpuEngine::groups() const {
     const std::uint32_t gx = (static_cast<std::uint32_t>(width()) + kernels_->groupX() - 1) / kernels_->groupX();
     const std::uint32_t gy = (static_cast<std::uint32_t>(height()) + kernels_->groupY() - 1) / kernels_->groupY();
-    return gx * gy;
+    // One partial sum per subgroup (poisson_common.glsl writePartials).
+    const std::uint32_t sub = std::max(1u, ctx_.info().subgroupSize);
+    const std::uint32_t perGroup = (kernels_->groupX() * kernels_->groupY() + sub - 1) / sub;
+    return gx * gy * perGroup;
 }
 
 void PoissonGpuEngine::bind() {

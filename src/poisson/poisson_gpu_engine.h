@@ -69,7 +69,7 @@ public:
     [[nodiscard]] int height() const { return levels_[0].height; }
     [[nodiscard]] std::uint32_t pixels() const { return levels_[0].pixels(); }
     [[nodiscard]] const std::vector<PoissonLevel>& levels() const { return levels_; }
-    // Workgroups of a fine-level dispatch = number of partial sums per slot and channel.
+    // Partial sums per slot and channel: fine-level workgroups × subgroups per workgroup.
     [[nodiscard]] std::uint32_t groups() const;
     [[nodiscard]] const vk::Context& context() const { return ctx_; }
 
