@@ -23,16 +23,20 @@ void main() {
     vec3 pap = vec3(0.0);
     if (x < w && y < h) {
         Stencil s = loadStencil(x, y, w, h, pc.cOff);
+        // All loads before the stores (lavapipe must assume storage buffers alias).
+        vec3 p, ap;
         for (uint c = 0u; c < 3u; ++c) {
             uint o = c * n;
             float beta = sc.beta[c];
-            float p = direction(o + s.i, beta);
-            float ap = applyStencil(s, p, direction(o + s.iW, beta), direction(o + s.iE, beta),
-                                    direction(o + s.iN, beta), direction(o + s.iS, beta));
-            P[pc.pNew + o + s.i] = p;
-            Ap[o + s.i] = ap;
-            pap[c] = p * ap;
+            p[c] = direction(o + s.i, beta);
+            ap[c] = applyStencil(s, p[c], direction(o + s.iW, beta), direction(o + s.iE, beta),
+                                 direction(o + s.iN, beta), direction(o + s.iS, beta));
         }
+        for (uint c = 0u; c < 3u; ++c) {
+            P[pc.pNew + c * n + s.i] = p[c];
+            Ap[c * n + s.i] = ap[c];
+        }
+        pap = p * ap;
     }
     writePartials(pap, kPoissonSlotPAP);
 }

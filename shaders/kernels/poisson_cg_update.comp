@@ -15,14 +15,22 @@ void main() {
     vec3 rr = vec3(0.0);
     if (x < w && y < h) {
         uint i = y * w + x;
+        vec3 a = vec3(sc.alpha[0], sc.alpha[1], sc.alpha[2]);
+        vec3 xs, p, r, ap;
         for (uint c = 0u; c < 3u; ++c) {
             uint j = c * n + i;
-            float a = sc.alpha[c];
-            Sol[j] += a * P[pc.pNew + j];
-            float r = B[j] - a * Ap[j];
-            B[j] = r;
-            rr[c] = r * r;
+            xs[c] = Sol[j];
+            p[c] = P[pc.pNew + j];
+            r[c] = B[j];
+            ap[c] = Ap[j];
         }
+        xs += a * p;
+        r -= a * ap;
+        for (uint c = 0u; c < 3u; ++c) {
+            Sol[c * n + i] = xs[c];
+            B[c * n + i] = r[c];
+        }
+        rr = r * r;
     }
     writePartials(rr, kPoissonSlotRR);
 }

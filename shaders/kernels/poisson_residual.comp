@@ -21,22 +21,25 @@ void main() {
     if (x < w && y < h) {
         Stencil s = loadStencil(x, y, w, h, pc.cOff);
         bool fromSol = (pc.flags & kPoissonFlagFromSol) != 0u;
+        vec3 r;
         for (uint c = 0u; c < 3u; ++c) {
             uint o = c * n;
             float ax = applyStencil(s, loadX(o + s.i), loadX(o + s.iW), loadX(o + s.iE),
                                     loadX(o + s.iN), loadX(o + s.iS));
-            float r;
             if ((pc.flags & kPoissonFlagApplyOnly) != 0u)
-                r = ax;
+                r[c] = ax;
             else
-                r = (fromSol ? Rhs[o + s.i] : B[pc.bOff + o + s.i]) - ax;
-            if ((pc.flags & kPoissonFlagProject) != 0u) r -= sc.bMean[c];
-            if (fromSol)
-                B[o + s.i] = r;
-            else
-                R[pc.rOff + o + s.i] = r;
-            rr[c] = r * r;
+                r[c] = (fromSol ? Rhs[o + s.i] : B[pc.bOff + o + s.i]) - ax;
+            if ((pc.flags & kPoissonFlagProject) != 0u) r[c] -= sc.bMean[c];
         }
+        // Stores after all loads (lavapipe must assume storage buffers alias).
+        for (uint c = 0u; c < 3u; ++c) {
+            if (fromSol)
+                B[c * n + s.i] = r[c];
+            else
+                R[pc.rOff + c * n + s.i] = r[c];
+        }
+        rr = r * r;
     }
     if ((pc.flags & kPoissonFlagDot) != 0u) writePartials(rr, kPoissonSlotRR);
 }
