@@ -119,7 +119,7 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
         vec3 t, b;
         makeBasis(sh.ns, t, b);
         vec3 woLocal = toLocal(-d, t, b, sh.ns);
-        vec3 origin = offsetRayOrigin(sh.p, sh.ng);
+        vec3 origin = offsetRayOriginScaled(sh.p, sh.ng, scene.sceneRadius);
 
         // Offsets' own BSDFs and frames (NOT_CONNECTED only).
         BsdfParams offBsdf[4];
@@ -211,7 +211,7 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
                 // density (which enters the base's weight).
                 if (maxComponent(fo) > 0.0 || (pdfBsdfO > 0.0 && maxComponent(fBase) > 0.0)) {
                     rays++;
-                    if (!traceAny(offsetRayOrigin(oh.p, oh.ng), wiO, 0.0, distO * (1.0 - 1e-4)))
+                    if (!traceAny(offsetRayOriginScaled(oh.p, oh.ng, scene.sceneRadius), wiO, 0.0, distO * (1.0 - 1e-4)))
                         fOff = offs[i].beta * fo * (jacobianLight / ls.pdf);
                     else
                         pdfBsdfO = 0.0;
@@ -276,7 +276,7 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
             }
             SurfaceHit oh = offs[i].hit;
             BsdfParams ob = offBsdf[i];
-            vec3 ohOrigin = offsetRayOrigin(oh.p, oh.ng);
+            vec3 ohOrigin = offsetRayOriginScaled(oh.p, oh.ng, scene.sceneRadius);
             bool offCurRough = roughAll(ob);
             if (shiftUseReconnection(baseCurRough, baseNextRough, offCurRough)) {
                 // Reconnection shift: connect to the base's next vertex (or the environment
