@@ -140,12 +140,20 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
         // Whether the light strategy exists for each pair at this vertex (GPT_REFERENCE §1.5):
         // always for a lone base (failed shift) and a shared vertex; for separate vertices
         // only if both are rough (area lights; the BSDF never hits a punctual light). The
-        // BSDF-sampled emission of the next vertex then competes with it or not.
-        bool baseRoughNee = roughSmooth(bsdf);
+        // BSDF-sampled emission of the next vertex then competes with it or not. Rough means
+        // rough over ALL components (not only the smooth ones NEE evaluates, the reference's
+        // choice): only then does the BSDF step reconnect to the light point, so NEE and BSDF
+        // sampling use the same shift and their pair weights sum to one (the smooth-only rule,
+        // combined with the all-components classification above, made a diffuse lobe under
+        // a mirror coat count its light twice: NEE with four strategies, and again through
+        // the half-vector branch, which has no light strategy).
+        bool baseRoughNee = roughAll(bsdf);
         bool lightActive[4];
         for (uint i = 0u; i < 4u; ++i) {
+            // A Dirac-only offset vertex fails every shift of both techniques, so its pair is
+            // the lone base's (PT weights, light strategy included).
             lightActive[i] = !offs[i].alive || offs[i].state != kShiftNotConnected ||
-                             (baseRoughNee && roughSmooth(offBsdf[i]));
+                             bsdfIsDeltaOnly(offBsdf[i]) || (baseRoughNee && roughAll(offBsdf[i]));
         }
 
         // ---- Next-event estimation with the same light point for all (§1.5) ----

@@ -42,9 +42,6 @@ bool gptPairExists(uint px, uint py, uint i) {
 bool roughAll(BsdfParams m) {
     return !kHasGlossy || shiftIsRough(shiftRoughnessAll(m), frame.shiftThreshold);
 }
-bool roughSmooth(BsdfParams m) {
-    return !kHasGlossy || shiftIsRough(shiftRoughnessSmooth(m), frame.shiftThreshold);
-}
 
 bool oneSidedBack(SurfaceHit h) {
     return !h.frontFace && (materials[h.material].flags & kMatFlagDoubleSided) == 0u;
