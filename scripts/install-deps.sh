@@ -9,7 +9,7 @@ packages=(
   libglm-dev libtinygltf-dev libopenexr-dev libimath-dev libstb-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libeigen3-dev
-  gnuplot-nox python3 clang libclang-rt-dev rsync
+  gnuplot-nox python3 clang libclang-rt-dev
 )
 missing=()
 for p in "${packages[@]}"; do
