@@ -7,10 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
-
-#include <nlohmann/json.hpp>
 
 #include "app/subcommand.h"
 #include "poisson/poisson_gpu.h"
@@ -94,10 +93,14 @@ int runBenchPoisson(const BenchPoissonArgs& a) {
     PoissonKernels kernels(ctx, gx, gy);
     std::unique_ptr<vk::GpuTimer> timer;
     if (a.profile) timer = std::make_unique<vk::GpuTimer>(ctx, 16384);
-    json out = {{"device", ctx.info().name},    {"driver", ctx.info().driverInfo},
-                {"repeats", a.repeats},         {"alpha", a.alpha},
-                {"tolerance", a.tolerance},     {"workgroup", a.workgroup},
-                {"pre_smooth", a.preSmooth},    {"post_smooth", a.postSmooth},
+    json out = {{"device", ctx.info().name},
+                {"driver", ctx.info().driverInfo},
+                {"repeats", a.repeats},
+                {"alpha", a.alpha},
+                {"tolerance", a.tolerance},
+                {"workgroup", a.workgroup},
+                {"pre_smooth", a.preSmooth},
+                {"post_smooth", a.postSmooth},
                 {"smoother", a.jacobiSmoother ? "jacobi" : "rb-gs"},
                 {"results", json::array()}};
     for (const std::string& sizeText : splitList(a.sizes)) {
@@ -173,28 +176,33 @@ int runBenchPoisson(const BenchPoissonArgs& a) {
 
 Subcommand addBenchPoissonCommand(CLI::App& app) {
     auto args = std::make_shared<BenchPoissonArgs>();
-    CLI::App* sub = app.add_subcommand("bench-poisson", "Time the GPU Poisson solver on synthetic inputs (JSON)");
+    CLI::App* sub =
+        app.add_subcommand("bench-poisson", "Time the GPU Poisson solver on synthetic inputs (JSON)");
     sub->add_option("--sizes", args->sizes, "Comma-separated sizes, N or WxH")->capture_default_str();
     sub->add_option("--methods", args->methods, "Comma-separated: l2-mg-pcg, l2-cg, l2-jacobi, l2-mg, l1")
         ->capture_default_str();
     sub->add_option("--repeats", args->repeats, "Solves per size and method (median reported)")
         ->check(CLI::Range(1, 100))
         ->capture_default_str();
-    sub->add_option("--alpha", args->alpha, "Primal weight alpha")->check(CLI::Range(0.0, 1e6))->capture_default_str();
+    sub->add_option("--alpha", args->alpha, "Primal weight alpha")
+        ->check(CLI::Range(0.0, 1e6))
+        ->capture_default_str();
     sub->add_option("--tolerance", args->tolerance, "Relative residual tolerance")
         ->check(CLI::Range(1e-12, 0.5))
         ->capture_default_str();
     sub->add_option("--max-iterations", args->maxIterations, "Iteration cap per solve")
         ->check(CLI::Range(1, 1000000))
         ->capture_default_str();
-    sub->add_option("--workgroup", args->workgroup, "Workgroup WxH (power-of-two size <= 256)")->capture_default_str();
+    sub->add_option("--workgroup", args->workgroup, "Workgroup WxH (power-of-two size <= 256)")
+        ->capture_default_str();
     sub->add_option("--pre-smooth", args->preSmooth, "V-cycle sweeps before the coarse correction")
         ->check(CLI::Range(0, 8))
         ->capture_default_str();
     sub->add_option("--post-smooth", args->postSmooth, "V-cycle sweeps after it")
         ->check(CLI::Range(1, 8))
         ->capture_default_str();
-    sub->add_flag("--jacobi-smoother", args->jacobiSmoother, "Damped Jacobi smoother instead of red-black Gauss-Seidel");
+    sub->add_flag("--jacobi-smoother", args->jacobiSmoother,
+                  "Damped Jacobi smoother instead of red-black Gauss-Seidel");
     sub->add_option("--device", args->device, "Vulkan device index or name substring");
     sub->add_flag("--profile", args->profile, "Add per-kernel GPU ms (last repeat) to the JSON");
     return {sub, [args] { return runBenchPoisson(*args); }};

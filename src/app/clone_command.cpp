@@ -70,11 +70,19 @@ int runClone(const CloneArgs& a) {
 
 Subcommand addCloneCommand(CLI::App& app) {
     auto a = std::make_shared<CloneArgs>();
-    CLI::App* sub = app.add_subcommand("clone", "Seamless cloning (Perez et al. 2003) of a masked source into a target");
-    sub->add_option("--source", a->source, "Source image (PNG/JPEG/EXR)")->required()->check(CLI::ExistingFile);
-    sub->add_option("--target", a->target, "Target image (PNG/JPEG/EXR)")->required()->check(CLI::ExistingFile);
-    sub->add_option("--mask", a->mask, "Mask, source-sized; red > 0.5 selects")->required()->check(CLI::ExistingFile);
-    sub->add_option("--offset", a->offset, "Target position X,Y of the source's top-left pixel")->capture_default_str();
+    CLI::App* sub =
+        app.add_subcommand("clone", "Seamless cloning (Perez et al. 2003) of a masked source into a target");
+    sub->add_option("--source", a->source, "Source image (PNG/JPEG/EXR)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    sub->add_option("--target", a->target, "Target image (PNG/JPEG/EXR)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    sub->add_option("--mask", a->mask, "Mask, source-sized; red > 0.5 selects")
+        ->required()
+        ->check(CLI::ExistingFile);
+    sub->add_option("--offset", a->offset, "Target position X,Y of the source's top-left pixel")
+        ->capture_default_str();
     sub->add_flag("--mixed", a->mixed, "Mixed gradients: keep the stronger of source and target gradient");
     sub->add_option("--tolerance", a->tolerance, "Relative residual tolerance")
         ->check(CLI::Range(1e-12, 0.5))

@@ -62,7 +62,9 @@ int runSolve(const SolveArgs& a) {
         layers = readExr(a.input);
         auto need = [&](const char* name) -> const Image& {
             const Image* im = findLayer(layers, name);
-            if (!im) throw Error(a.input + ": no layer '" + name + "' (a gdpt gradient-domain EXR has primal, dx, dy)");
+            if (!im)
+                throw Error(a.input + ": no layer '" + name +
+                            "' (a gdpt gradient-domain EXR has primal, dx, dy)");
             return *im;
         };
         primal = need("primal");
@@ -90,14 +92,17 @@ int runSolve(const SolveArgs& a) {
             for (std::size_t i = 0; i < final.pixelCount(); ++i) final.plane(c)[i] += direct->plane(c)[i];
     writeExr(a.output, {{"", final}, {"recon", recon}});
     if (!a.quiet) {
-        std::fprintf(stderr,
-                     "gdpt: wrote %s (%dx%d, %s/%s, alpha %g: %d iterations, %d IRLS, residual %.3g%s, %.1f ms)\n",
-                     a.output.c_str(), primal.width(), primal.height(), toString(o.method), toString(o.solver), o.alpha,
-                     report.iterations, report.irlsIterations, report.residual,
-                     report.converged ? "" : " NOT converged", report.ms);
+        std::fprintf(
+            stderr,
+            "gdpt: wrote %s (%dx%d, %s/%s, alpha %g: %d iterations, %d IRLS, residual %.3g%s, %.1f ms)\n",
+            a.output.c_str(), primal.width(), primal.height(), toString(o.method), toString(o.solver),
+            o.alpha, report.iterations, report.irlsIterations, report.residual,
+            report.converged ? "" : " NOT converged", report.ms);
         if (report.nonFinite.total() > 0)
-            std::fprintf(stderr, "gdpt: warning: replaced non-finite inputs: primal %zu, dx %zu, dy %zu, variance %zu\n",
-                         report.nonFinite.primal, report.nonFinite.dx, report.nonFinite.dy, report.nonFinite.variance);
+            std::fprintf(
+                stderr,
+                "gdpt: warning: replaced non-finite inputs: primal %zu, dx %zu, dy %zu, variance %zu\n",
+                report.nonFinite.primal, report.nonFinite.dx, report.nonFinite.dy, report.nonFinite.variance);
     }
     return 0;
 }
@@ -106,10 +111,13 @@ int runSolve(const SolveArgs& a) {
 
 Subcommand addSolveCommand(CLI::App& app) {
     auto a = std::make_shared<SolveArgs>();
-    CLI::App* sub = app.add_subcommand("solve", "Screened Poisson reconstruction of a gradient-domain EXR (GPU)");
-    sub->add_option("input", a->input, "gdpt EXR with layers primal, dx, dy [, direct, var_primal, var_dx, var_dy]")
+    CLI::App* sub =
+        app.add_subcommand("solve", "Screened Poisson reconstruction of a gradient-domain EXR (GPU)");
+    sub->add_option("input", a->input,
+                    "gdpt EXR with layers primal, dx, dy [, direct, var_primal, var_dx, var_dy]")
         ->check(CLI::ExistingFile);
-    sub->add_option("-o,--output", a->output, "Output EXR (final image + 'recon' layer)")->capture_default_str();
+    sub->add_option("-o,--output", a->output, "Output EXR (final image + 'recon' layer)")
+        ->capture_default_str();
     sub->add_option("--recon", a->recon, "Reconstruction: l1, l2 or wl2 (inverse-variance weighted)")
         ->check(CLI::IsMember({"l1", "l2", "wl2"}))
         ->capture_default_str();

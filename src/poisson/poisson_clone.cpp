@@ -13,7 +13,8 @@ Image seamlessClone(const vk::Context& ctx, const Image& source, const Image& ta
                     const CloneOptions& o, SolveReport* report) {
     if (!source.sameSize(mask))
         throw Error("clone: mask is " + std::to_string(mask.width()) + "x" + std::to_string(mask.height()) +
-                    " but the source is " + std::to_string(source.width()) + "x" + std::to_string(source.height()));
+                    " but the source is " + std::to_string(source.width()) + "x" +
+                    std::to_string(source.height()));
     if (target.empty() || source.empty()) throw Error("clone: empty source or target image");
     const int w = target.width(), h = target.height();
     const std::size_t n = target.pixelCount();
@@ -72,7 +73,8 @@ Image seamlessClone(const vk::Context& ctx, const Image& source, const Image& ta
             }
         }
     std::vector<float> weightPrimal(n);
-    for (std::size_t i = 0; i < n; ++i) weightPrimal[i] = inside[i] ? 0.0f : static_cast<float>(kClonePinWeight);
+    for (std::size_t i = 0; i < n; ++i)
+        weightPrimal[i] = inside[i] ? 0.0f : static_cast<float>(kClonePinWeight);
 
     // Solve for the correction y = f − target: its primal is 0 and its guidance v − ∇target
     // vanishes away from Ω, so ‖b‖ measures the cloning problem itself and the relative

@@ -21,9 +21,9 @@ namespace gdpt {
 constexpr double kClonePinWeight = 1e6;
 
 struct CloneOptions {
-    int offsetX = 0;      // target pixel of source pixel (0, 0)
+    int offsetX = 0;  // target pixel of source pixel (0, 0)
     int offsetY = 0;
-    bool mixed = false;   // mixed gradients (Pérez et al. 2003, §3.2)
+    bool mixed = false;  // mixed gradients (Pérez et al. 2003, §3.2)
     double tolerance = 1e-5;
     GpuSolver solver = GpuSolver::MgPcg;
 };

@@ -57,7 +57,9 @@ float inverseVariance(const Image& var, std::size_t i, double eps, std::size_t& 
     return static_cast<float>(1.0 / (v + eps));
 }
 
-int growBatch(int batch, int cap) { return std::min(batch * 2, cap); }
+int growBatch(int batch, int cap) {
+    return std::min(batch * 2, cap);
+}
 
 }  // namespace
 
@@ -78,19 +80,26 @@ GpuSolver parseGpuSolver(const std::string& t) {
 
 const char* toString(Reconstruction r) {
     switch (r) {
-        case Reconstruction::L2: return "l2";
-        case Reconstruction::WeightedL2: return "wl2";
-        case Reconstruction::L1: return "l1";
+        case Reconstruction::L2:
+            return "l2";
+        case Reconstruction::WeightedL2:
+            return "wl2";
+        case Reconstruction::L1:
+            return "l1";
     }
     return "?";
 }
 
 const char* toString(GpuSolver s) {
     switch (s) {
-        case GpuSolver::MgPcg: return "mg-pcg";
-        case GpuSolver::Cg: return "cg";
-        case GpuSolver::Jacobi: return "jacobi";
-        case GpuSolver::Mg: return "mg";
+        case GpuSolver::MgPcg:
+            return "mg-pcg";
+        case GpuSolver::Cg:
+            return "cg";
+        case GpuSolver::Jacobi:
+            return "jacobi";
+        case GpuSolver::Mg:
+            return "mg";
     }
     return "?";
 }
@@ -109,7 +118,8 @@ void PoissonSolverGpu::readHistory(int count, SolveReport& report) {
         std::array<double, 3> rel{};
         for (int c = 0; c < 3; ++c) {
             const double rr = raw[static_cast<std::size_t>(k) * 3 + static_cast<std::size_t>(c)];
-            rel[static_cast<std::size_t>(c)] = sc.bb[c] > 0.0f ? std::sqrt(rr / double(sc.bb[c])) : std::sqrt(rr);
+            rel[static_cast<std::size_t>(c)] =
+                sc.bb[c] > 0.0f ? std::sqrt(rr / double(sc.bb[c])) : std::sqrt(rr);
         }
         report.history.push_back(rel);
     }
@@ -132,8 +142,7 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
     if (o.solver != GpuSolver::Cg && o.solver != GpuSolver::Jacobi) e.recordCoarsenAll(cmd, timer);
     // Singular A (α = 0): CG works on b − mean(b), the consistent part (poisson_residual).
     const std::uint32_t project = singular && cgFamily ? kPoissonFlagProject : 0u;
-    if (project)
-        e.recordScalars(cmd, kPoissonModeMean, 0u, 0u, 0.0f, static_cast<float>(e.pixels()), timer);
+    if (project) e.recordScalars(cmd, kPoissonModeMean, 0u, 0u, 0.0f, static_cast<float>(e.pixels()), timer);
     if (cgFamily) {
         e.recordResidual(cmd, 0, kPoissonFlagFromSol | kPoissonFlagDot | project, timer);
         if (pcg) e.recordVcycle(cmd, o.vcycle, true, true, timer);
@@ -182,8 +191,8 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
                 ++k;
                 e.recordSmooth(cmd, 0, kPoissonFlagJacobi, 0u, o.vcycle.omega, timer);
                 e.recordResidual(cmd, 0, kPoissonFlagDot, timer);
-                e.recordScalars(cmd, kPoissonModeRecord, kPoissonFlagZIsR, static_cast<std::uint32_t>(k / 2), tol,
-                                0.0f, timer);
+                e.recordScalars(cmd, kPoissonModeRecord, kPoissonFlagZIsR, static_cast<std::uint32_t>(k / 2),
+                                tol, 0.0f, timer);
                 ++j;
             }
         }
@@ -207,7 +216,8 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
     for (int c = 0; c < 3; ++c) {
         const int its = static_cast<int>(sc.iterations[c]) * (o.solver == GpuSolver::Jacobi ? 2 : 1);
         result.iterations = std::max(result.iterations, its);
-        const double rel = sc.bb[c] > 0.0f ? std::sqrt(double(sc.finalRr[c]) / sc.bb[c]) : std::sqrt(double(sc.finalRr[c]));
+        const double rel =
+            sc.bb[c] > 0.0f ? std::sqrt(double(sc.finalRr[c]) / sc.bb[c]) : std::sqrt(double(sc.finalRr[c]));
         // Done by the recursive residual, and the true residual agrees (within 2x: the
         // recursion drifts from b − A x by float rounding).
         result.converged = result.converged && sc.done[c] != 0 && rel <= 2.0 * tolerance;
@@ -225,10 +235,11 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
     for (const Image* im : {in.primal, in.dx, in.dy, in.varPrimal, in.varDx, in.varDy})
         if (im && (im->width() != w || im->height() != h))
             throw Error("Poisson solve: input of size " + std::to_string(im->width()) + "x" +
-                        std::to_string(im->height()) + " does not match the solver's " + std::to_string(w) + "x" +
-                        std::to_string(h));
+                        std::to_string(im->height()) + " does not match the solver's " + std::to_string(w) +
+                        "x" + std::to_string(h));
     if (!std::isfinite(o.alpha) || o.alpha < 0.0) throw Error("Poisson solve: alpha must be finite and >= 0");
-    if (!(o.tolerance > 0.0) || !(o.tolerance < 1.0)) throw Error("Poisson solve: tolerance must be in (0, 1)");
+    if (!(o.tolerance > 0.0) || !(o.tolerance < 1.0))
+        throw Error("Poisson solve: tolerance must be in (0, 1)");
     if (o.maxIterations < 1) throw Error("Poisson solve: max iterations must be >= 1");
     if (o.method == Reconstruction::L1 && !(o.alpha > 0.0))
         throw Error("Poisson solve: L1 (IRLS) needs alpha > 0 (the primal rows anchor each iterate)");
@@ -273,8 +284,10 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
     std::size_t rows = 0;
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
-            const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-            const float rowW[3] = {weights[i], x + 1 < w ? weights[n + i] : 0.0f, y + 1 < h ? weights[2 * n + i] : 0.0f};
+            const std::size_t i =
+                static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+            const float rowW[3] = {weights[i], x + 1 < w ? weights[n + i] : 0.0f,
+                                   y + 1 < h ? weights[2 * n + i] : 0.0f};
             for (float v : rowW)
                 if (v > 0.0f) {
                     sum += v;
@@ -319,7 +332,8 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
                 // weights, their mean-1 scale and the next solve's set-up.
                 cmd = stream_.begin();
                 if (o.timer) o.timer->reset(cmd);
-                engine_.recordIrlsWeights(cmd, static_cast<float>(o.alpha * o.alpha), static_cast<float>(reg), o.timer);
+                engine_.recordIrlsWeights(cmd, static_cast<float>(o.alpha * o.alpha), static_cast<float>(reg),
+                                          o.timer);
                 engine_.recordScalars(cmd, kPoissonModeIrls, 0u, 0u, 0.0f, static_cast<float>(rows), o.timer);
                 reg *= o.irlsRegIter;
             }
@@ -351,8 +365,8 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
             const double shift = sw > 0.0 ? swd / sw : sd / double(n);
             for (std::size_t i = 0; i < n; ++i) sol[o0 + i] = static_cast<float>(sol[o0 + i] + shift);
         }
-        std::copy(sol.begin() + static_cast<std::ptrdiff_t>(o0), sol.begin() + static_cast<std::ptrdiff_t>(o0 + n),
-                  out.plane(c).begin());
+        std::copy(sol.begin() + static_cast<std::ptrdiff_t>(o0),
+                  sol.begin() + static_cast<std::ptrdiff_t>(o0 + n), out.plane(c).begin());
     }
     if (o.timer) report.kernels = o.timer->totals();
     report.ms = wall.ms();

@@ -50,9 +50,9 @@ const char* toString(GpuSolver s);
 struct SolveOptions {
     Reconstruction method = Reconstruction::L2;
     GpuSolver solver = GpuSolver::MgPcg;
-    double alpha = 0.2;            // primal rows are α (I − t): energy weight α²
-    double tolerance = 1e-4;       // relative residual per channel
-    int maxIterations = 2000;      // per (inner) solve: CG steps, V-cycles or Jacobi sweeps
+    double alpha = 0.2;        // primal rows are α (I − t): energy weight α²
+    double tolerance = 1e-4;   // relative residual per channel
+    int maxIterations = 2000;  // per (inner) solve: CG steps, V-cycles or Jacobi sweeps
     // IRLS (L1): the published default schedule (regInit 0.05, regIter 0.5), fewer rounds
     // because each inner solve is converged instead of a fixed 50 CG steps.
     int irlsIterations = 8;
@@ -72,12 +72,12 @@ struct NonFiniteCounts {
 };
 
 struct SolveReport {
-    int iterations = 0;          // inner iterations, summed over IRLS rounds
-    int irlsIterations = 0;      // 1 for L2/WL2
-    int batches = 0;             // command buffers submitted (host round trips)
-    double residual = 0.0;       // true final relative residual, max over channels
-    bool converged = false;      // every channel of the last solve reached the tolerance
-    double ms = 0.0;             // wall time of the solve (upload to download)
+    int iterations = 0;      // inner iterations, summed over IRLS rounds
+    int irlsIterations = 0;  // 1 for L2/WL2
+    int batches = 0;         // command buffers submitted (host round trips)
+    double residual = 0.0;   // true final relative residual, max over channels
+    bool converged = false;  // every channel of the last solve reached the tolerance
+    double ms = 0.0;         // wall time of the solve (upload to download)
     NonFiniteCounts nonFinite;
     // Test mode: relative residual ‖r_k‖/‖b‖ per channel after iteration k of the last
     // solve (k = 0 is the initial guess; Jacobi records every second sweep).
@@ -113,7 +113,8 @@ private:
         int iterations = 0;
         bool converged = false;
     };
-    InnerResult innerSolve(const SolveOptions& o, double tolerance, bool irls, bool singular, SolveReport& report);
+    InnerResult innerSolve(const SolveOptions& o, double tolerance, bool irls, bool singular,
+                           SolveReport& report);
     void readHistory(int count, SolveReport& report);
 
     PoissonGpuEngine engine_;
@@ -123,7 +124,7 @@ private:
 // One-call reconstruction for the renderer: primal, gradients and optional variances (WL2
 // uses them when options.method == WeightedL2).
 Image reconstruct(const vk::Context& ctx, const Image& primal, const Image& dx, const Image& dy,
-                  const Image* varPrimal, const Image* varDx, const Image* varDy,
-                  const SolveOptions& options, SolveReport* report = nullptr);
+                  const Image* varPrimal, const Image* varDx, const Image* varDy, const SolveOptions& options,
+                  SolveReport* report = nullptr);
 
 }  // namespace gdpt

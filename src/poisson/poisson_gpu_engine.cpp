@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <string>
 
-#include "poisson_shared.h"
 #include "poisson_cg_direction.spv.h"
 #include "poisson_cg_update.spv.h"
 #include "poisson_coarsen.spv.h"
@@ -16,6 +15,7 @@
 #include "poisson_restrict.spv.h"
 #include "poisson_scalars.spv.h"
 #include "poisson_setup.spv.h"
+#include "poisson_shared.h"
 #include "poisson_smooth.spv.h"
 #include "util/error.h"
 #include "vk/commands.h"
@@ -60,13 +60,16 @@ PoissonKernels::PoissonKernels(const vk::Context& ctx, std::uint32_t gx, std::ui
       coarsen(ctx, describe(vk::kernelDesc("poisson_coarsen", kSpv_poisson_coarsen), gx, gy, true)),
       residual(ctx, describe(vk::kernelDesc("poisson_residual", kSpv_poisson_residual), gx, gy, true)),
       smooth(ctx, describe(vk::kernelDesc("poisson_smooth", kSpv_poisson_smooth), gx, gy, true)),
-      restrictResidual(ctx, describe(vk::kernelDesc("poisson_restrict", kSpv_poisson_restrict), gx, gy, true)),
+      restrictResidual(ctx,
+                       describe(vk::kernelDesc("poisson_restrict", kSpv_poisson_restrict), gx, gy, true)),
       prolong(ctx, describe(vk::kernelDesc("poisson_prolong", kSpv_poisson_prolong), gx, gy, true)),
       coarsest(ctx, describe(vk::kernelDesc("poisson_coarsest", kSpv_poisson_coarsest), gx, gy, false)),
-      cgDirection(ctx, describe(vk::kernelDesc("poisson_cg_direction", kSpv_poisson_cg_direction), gx, gy, true)),
+      cgDirection(ctx,
+                  describe(vk::kernelDesc("poisson_cg_direction", kSpv_poisson_cg_direction), gx, gy, true)),
       cgUpdate(ctx, describe(vk::kernelDesc("poisson_cg_update", kSpv_poisson_cg_update), gx, gy, true)),
       scalars(ctx, describe(vk::kernelDesc("poisson_scalars", kSpv_poisson_scalars), gx, gy, false)),
-      irlsWeights(ctx, describe(vk::kernelDesc("poisson_irls_weights", kSpv_poisson_irls_weights), gx, gy, true)),
+      irlsWeights(ctx,
+                  describe(vk::kernelDesc("poisson_irls_weights", kSpv_poisson_irls_weights), gx, gy, true)),
       groupX_(gx),
       groupY_(gy) {
     const std::uint32_t size = gx * gy;
@@ -75,8 +78,7 @@ PoissonKernels::PoissonKernels(const vk::Context& ctx, std::uint32_t gx, std::ui
                     " must have a power-of-two size <= 256");
 }
 
-PoissonGpuEngine::PoissonGpuEngine(const vk::Context& ctx, int width, int height,
-                                   PoissonKernels* kernels)
+PoissonGpuEngine::PoissonGpuEngine(const vk::Context& ctx, int width, int height, PoissonKernels* kernels)
     : ctx_(ctx) {
     if (width <= 0 || height <= 0)
         throw Error("Poisson solver: invalid size " + std::to_string(width) + "x" + std::to_string(height));
@@ -92,7 +94,9 @@ PoissonGpuEngine::PoissonGpuEngine(const vk::Context& ctx, int width, int height
     for (;;) {
         levels_.push_back({w, h, static_cast<std::uint32_t>(offset)});
         offset += 3ull * static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
-        if (w <= static_cast<int>(gpu::kPoissonCoarsestMax) && h <= static_cast<int>(gpu::kPoissonCoarsestMax)) break;
+        if (w <= static_cast<int>(gpu::kPoissonCoarsestMax) &&
+            h <= static_cast<int>(gpu::kPoissonCoarsestMax))
+            break;
         w = (w + 1) / 2;
         h = (h + 1) / 2;
     }
@@ -118,14 +122,15 @@ PoissonGpuEngine::PoissonGpuEngine(const vk::Context& ctx, int width, int height
     partials = vk::Buffer(ctx, std::uint64_t{gpu::kPoissonSlotCount} * 3 * groups() * sizeof(float),
                           "poissonPartials");
     // Defined contents everywhere (no stale NaN can leak through a 0 coefficient).
-    for (vk::Buffer* buf : {&coef, &x, &b, &r, &p, &ap, &sol, &rhs, &irls, &scalars, &partials})
-        buf->zero();
+    for (vk::Buffer* buf : {&coef, &x, &b, &r, &p, &ap, &sol, &rhs, &irls, &scalars, &partials}) buf->zero();
     bind();
 }
 
 std::uint32_t PoissonGpuEngine::groups() const {
-    const std::uint32_t gx = (static_cast<std::uint32_t>(width()) + kernels_->groupX() - 1) / kernels_->groupX();
-    const std::uint32_t gy = (static_cast<std::uint32_t>(height()) + kernels_->groupY() - 1) / kernels_->groupY();
+    const std::uint32_t gx =
+        (static_cast<std::uint32_t>(width()) + kernels_->groupX() - 1) / kernels_->groupX();
+    const std::uint32_t gy =
+        (static_cast<std::uint32_t>(height()) + kernels_->groupY() - 1) / kernels_->groupY();
     // One partial sum per subgroup (poisson_common.glsl writePartials).
     const std::uint32_t sub = std::max(1u, ctx_.info().subgroupSize);
     const std::uint32_t perGroup = (kernels_->groupX() * kernels_->groupY() + sub - 1) / sub;
@@ -133,13 +138,12 @@ std::uint32_t PoissonGpuEngine::groups() const {
 }
 
 void PoissonGpuEngine::bind() {
-    const vk::Buffer* buffers[gpu::kPoissonBindCount] = {&coef, &x,   &b,      &r,  &p,
-                                                         &ap,   &sol, &rhs,    &primal, &dx,
-                                                         &dy,   &weights, &irls, &scalars, &partials};
-    for (vk::Kernel* k : {&kernels_->setup, &kernels_->coarsen, &kernels_->residual, &kernels_->smooth,
-                          &kernels_->restrictResidual, &kernels_->prolong, &kernels_->coarsest,
-                          &kernels_->cgDirection, &kernels_->cgUpdate, &kernels_->scalars,
-                          &kernels_->irlsWeights})
+    const vk::Buffer* buffers[gpu::kPoissonBindCount] = {
+        &coef, &x, &b, &r, &p, &ap, &sol, &rhs, &primal, &dx, &dy, &weights, &irls, &scalars, &partials};
+    for (vk::Kernel* k :
+         {&kernels_->setup, &kernels_->coarsen, &kernels_->residual, &kernels_->smooth,
+          &kernels_->restrictResidual, &kernels_->prolong, &kernels_->coarsest, &kernels_->cgDirection,
+          &kernels_->cgUpdate, &kernels_->scalars, &kernels_->irlsWeights})
         for (std::uint32_t i = 0; i < gpu::kPoissonBindCount; ++i) k->bind(i, *buffers[i]);
 }
 
@@ -165,7 +169,8 @@ void PoissonGpuEngine::recordCoarsenAll(VkCommandBuffer cmd, vk::GpuTimer* timer
     }
 }
 
-void PoissonGpuEngine::recordResidual(VkCommandBuffer cmd, int level, std::uint32_t flags, vk::GpuTimer* timer) {
+void PoissonGpuEngine::recordResidual(VkCommandBuffer cmd, int level, std::uint32_t flags,
+                                      vk::GpuTimer* timer) {
     PoissonPush push = levelPush(levels_.at(static_cast<std::size_t>(level)), groups());
     push.flags = flags;
     dispatch(cmd, kernels_->residual, push.width, push.height, &push, timer);
@@ -183,7 +188,8 @@ void PoissonGpuEngine::recordSmooth(VkCommandBuffer cmd, int level, std::uint32_
     dispatch(cmd, kernels_->smooth, (levels_[l].width + 1) / 2, push.height, &push, timer);
 }
 
-void PoissonGpuEngine::recordRestrict(VkCommandBuffer cmd, int level, std::uint32_t flags, vk::GpuTimer* timer) {
+void PoissonGpuEngine::recordRestrict(VkCommandBuffer cmd, int level, std::uint32_t flags,
+                                      vk::GpuTimer* timer) {
     const std::size_t l = static_cast<std::size_t>(level);
     PoissonPush push = levelPush(levels_.at(l), groups());
     withCoarse(push, levels_.at(l + 1));
@@ -221,7 +227,8 @@ void PoissonGpuEngine::recordCgUpdate(VkCommandBuffer cmd, std::uint32_t pNew, v
 }
 
 void PoissonGpuEngine::recordScalars(VkCommandBuffer cmd, std::uint32_t mode, std::uint32_t flags,
-                                     std::uint32_t iteration, float tolerance, float value, vk::GpuTimer* timer) {
+                                     std::uint32_t iteration, float tolerance, float value,
+                                     vk::GpuTimer* timer) {
     PoissonPush push = levelPush(levels_[0], groups());
     push.mode = mode;
     push.flags = flags;
@@ -240,8 +247,8 @@ void PoissonGpuEngine::recordIrlsWeights(VkCommandBuffer cmd, float alpha2, floa
     dispatch(cmd, kernels_->irlsWeights, width(), height(), &push, timer);
 }
 
-void PoissonGpuEngine::recordVcycle(VkCommandBuffer cmd, const VcycleParams& params, bool zeroGuess, bool dotOut,
-                                    vk::GpuTimer* timer) {
+void PoissonGpuEngine::recordVcycle(VkCommandBuffer cmd, const VcycleParams& params, bool zeroGuess,
+                                    bool dotOut, vk::GpuTimer* timer) {
     vcycleLevel(cmd, 0, params, zeroGuess, dotOut, timer);
 }
 

@@ -8,11 +8,11 @@
 // be chained freely in one command buffer. Field layout: shaders/shared/poisson_shared.h.
 #pragma once
 
+#include <vulkan/vulkan.h>
+
 #include <cstdint>
 #include <memory>
 #include <vector>
-
-#include <vulkan/vulkan.h>
 
 #include "vk/buffer.h"
 #include "vk/kernel.h"
@@ -33,8 +33,8 @@ public:
     [[nodiscard]] std::uint32_t groupX() const { return groupX_; }
     [[nodiscard]] std::uint32_t groupY() const { return groupY_; }
 
-    vk::Kernel setup, coarsen, residual, smooth, restrictResidual, prolong, coarsest,
-        cgDirection, cgUpdate, scalars, irlsWeights;
+    vk::Kernel setup, coarsen, residual, smooth, restrictResidual, prolong, coarsest, cgDirection, cgUpdate,
+        scalars, irlsWeights;
 
 private:
     std::uint32_t groupX_, groupY_;
@@ -51,10 +51,10 @@ struct PoissonLevel {
 
 // V-cycle parameters (Briggs et al., "A Multigrid Tutorial", ch. 3).
 struct VcycleParams {
-    bool jacobi = false;   // smoother: damped Jacobi (else red-black Gauss-Seidel)
-    int preSmooth = 1;     // sweeps before the coarse-grid correction (Jacobi: rounded to even)
-    int postSmooth = 1;    // sweeps after it (≥ 1)
-    float omega = 0.8f;    // Jacobi damping
+    bool jacobi = false;  // smoother: damped Jacobi (else red-black Gauss-Seidel)
+    int preSmooth = 1;    // sweeps before the coarse-grid correction (Jacobi: rounded to even)
+    int postSmooth = 1;   // sweeps after it (≥ 1)
+    float omega = 0.8f;   // Jacobi damping
 };
 
 class PoissonGpuEngine {
@@ -62,8 +62,7 @@ public:
     // Allocates every buffer for a width x height RGB problem; uses `kernels` if given (it
     // must outlive the engine), else creates its own. Throws gdpt::Error naming the device
     // limit if a field exceeds maxStorageBufferRange.
-    PoissonGpuEngine(const vk::Context& ctx, int width, int height,
-                     PoissonKernels* kernels = nullptr);
+    PoissonGpuEngine(const vk::Context& ctx, int width, int height, PoissonKernels* kernels = nullptr);
 
     [[nodiscard]] int width() const { return levels_[0].width; }
     [[nodiscard]] int height() const { return levels_[0].height; }
@@ -83,16 +82,16 @@ public:
     void recordSetup(VkCommandBuffer cmd, float alpha2, bool irlsWeights, vk::GpuTimer* timer);
     void recordCoarsenAll(VkCommandBuffer cmd, vk::GpuTimer* timer);
     void recordResidual(VkCommandBuffer cmd, int level, std::uint32_t flags, vk::GpuTimer* timer);
-    void recordSmooth(VkCommandBuffer cmd, int level, std::uint32_t flags, std::uint32_t colour,
-                      float omega, vk::GpuTimer* timer);
+    void recordSmooth(VkCommandBuffer cmd, int level, std::uint32_t flags, std::uint32_t colour, float omega,
+                      vk::GpuTimer* timer);
     void recordRestrict(VkCommandBuffer cmd, int level, std::uint32_t flags, vk::GpuTimer* timer);
     void recordProlong(VkCommandBuffer cmd, int level, vk::GpuTimer* timer);
     void recordCoarsest(VkCommandBuffer cmd, bool zeroGuess, vk::GpuTimer* timer);
-    void recordCgDirection(VkCommandBuffer cmd, std::uint32_t flags, std::uint32_t pOld,
-                           std::uint32_t pNew, vk::GpuTimer* timer);
+    void recordCgDirection(VkCommandBuffer cmd, std::uint32_t flags, std::uint32_t pOld, std::uint32_t pNew,
+                           vk::GpuTimer* timer);
     void recordCgUpdate(VkCommandBuffer cmd, std::uint32_t pNew, vk::GpuTimer* timer);
-    void recordScalars(VkCommandBuffer cmd, std::uint32_t mode, std::uint32_t flags,
-                       std::uint32_t iteration, float tolerance, float value, vk::GpuTimer* timer);
+    void recordScalars(VkCommandBuffer cmd, std::uint32_t mode, std::uint32_t flags, std::uint32_t iteration,
+                       float tolerance, float value, vk::GpuTimer* timer);
     void recordIrlsWeights(VkCommandBuffer cmd, float alpha2, float reg, vk::GpuTimer* timer);
 
     // One V-cycle on level 0 for X₀ ≈ A⁻¹ B₀ (zeroGuess: X₀ starts at 0). dotOut: the last
@@ -104,10 +103,10 @@ public:
                            std::uint64_t floats);
 
 private:
-    void vcycleLevel(VkCommandBuffer cmd, int level, const VcycleParams& params, bool zeroGuess,
-                     bool dotOut, vk::GpuTimer* timer);
-    void dispatch(VkCommandBuffer cmd, const vk::Kernel& kernel, int itemsX, int itemsY,
-                  const void* push, vk::GpuTimer* timer);
+    void vcycleLevel(VkCommandBuffer cmd, int level, const VcycleParams& params, bool zeroGuess, bool dotOut,
+                     vk::GpuTimer* timer);
+    void dispatch(VkCommandBuffer cmd, const vk::Kernel& kernel, int itemsX, int itemsY, const void* push,
+                  vk::GpuTimer* timer);
 
     const vk::Context& ctx_;
     std::unique_ptr<PoissonKernels> ownKernels_;

@@ -2,12 +2,12 @@
 // input/runtime error, 2 usage), one-line errors naming the file, outputs with the
 // documented layers, and a reconstruction that reproduces the image its exact gradients
 // came from.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "image/exr_io.h"
 #include "image/png_preview.h"
@@ -38,7 +38,8 @@ class PoissonCli : public ::testing::Test {
 protected:
     void SetUp() override {
         dir_ = fs::temp_directory_path() /
-               ("gdpt_poisson_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+               ("gdpt_poisson_cli_" +
+                std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
         fs::remove_all(dir_);
         fs::create_directories(dir_);
     }
@@ -97,8 +98,8 @@ TEST_F(PoissonCli, SolveFromSeparateFilesAndErrors) {
     writeExr(path("p.exr"), readExrLayer(path("in.exr"), "primal"));
     writeExr(path("dx.exr"), readExrLayer(path("in.exr"), "dx"));
     writeExr(path("dy.exr"), readExrLayer(path("in.exr"), "dy"));
-    RunResult r = runGdpt("solve --primal " + path("p.exr") + " --dx " + path("dx.exr") + " --dy " + path("dy.exr") +
-                          " -o " + path("sep.exr") + " --solver cg");
+    RunResult r = runGdpt("solve --primal " + path("p.exr") + " --dx " + path("dx.exr") + " --dy " +
+                          path("dy.exr") + " -o " + path("sep.exr") + " --solver cg");
     EXPECT_EQ(r.code, 0) << r.output;
     EXPECT_TRUE(fs::exists(path("sep.exr")));
     // Usage errors: nothing to read, unknown method.
@@ -127,17 +128,17 @@ TEST_F(PoissonCli, CloneWritesPngAndExr) {
     // A constant source has zero gradients: the clone region takes the boundary value.
     const Image out = readExrLayer(path("out.exr"));
     EXPECT_NEAR(out.at(10, 10, 0), 0.1f, 1e-4);
-    r = runGdpt("clone --source " + path("s.exr") + " --target " + path("t.exr") + " --mask " + path("m.exr") +
-                " --offset 5,6 --mixed -o " + path("out.png"));
+    r = runGdpt("clone --source " + path("s.exr") + " --target " + path("t.exr") + " --mask " +
+                path("m.exr") + " --offset 5,6 --mixed -o " + path("out.png"));
     EXPECT_EQ(r.code, 0) << r.output;
     EXPECT_TRUE(fs::exists(path("out.png")));
-    EXPECT_EQ(runGdpt("clone --source " + path("s.exr") + " --target " + path("t.exr") + " --mask " + path("m.exr") +
-                      " --offset 5 -o " + path("bad.png"))
+    EXPECT_EQ(runGdpt("clone --source " + path("s.exr") + " --target " + path("t.exr") + " --mask " +
+                      path("m.exr") + " --offset 5 -o " + path("bad.png"))
                   .code,
               2);
     // Mask size must match the source.
-    r = runGdpt("clone --source " + path("t.exr") + " --target " + path("t.exr") + " --mask " + path("m.exr") +
-                " -o " + path("bad.exr"));
+    r = runGdpt("clone --source " + path("t.exr") + " --target " + path("t.exr") + " --mask " +
+                path("m.exr") + " -o " + path("bad.exr"));
     EXPECT_EQ(r.code, 1);
     EXPECT_FALSE(fs::exists(path("bad.exr")));
 }

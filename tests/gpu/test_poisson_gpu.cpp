@@ -9,11 +9,11 @@
 // relative 2-norm at 1e-4 after converging to a relative residual of 1e-6: float32 floors
 // the residual near 1e-7, and the error is bounded by cond(A)·residual with cond(A) ≲ 100
 // for these small grids.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstring>
 #include <random>
-
-#include <gtest/gtest.h>
 
 #include "gpu_fixture.h"
 #include "poisson/poisson_clone.h"
@@ -78,7 +78,9 @@ void gradients(const Image& im, Image& dx, Image& dy) {
             }
 }
 
-Field channel(const Image& im, int c) { return Field(im.plane(c).begin(), im.plane(c).end()); }
+Field channel(const Image& im, int c) {
+    return Field(im.plane(c).begin(), im.plane(c).end());
+}
 
 PoissonProblem channelProblem(const Image& primal, const Image& dx, const Image& dy, double alpha, int c) {
     PoissonProblem p;
@@ -138,8 +140,8 @@ protected:
         s.submitAndWait();
     }
 
-    SolveReport solve(const Image& primal, const Image& dx, const Image& dy, const SolveOptions& o, Image& out,
-                      const PoissonInput* extra = nullptr) {
+    SolveReport solve(const Image& primal, const Image& dx, const Image& dy, const SolveOptions& o,
+                      Image& out, const PoissonInput* extra = nullptr) {
         PoissonSolverGpu solver(ctx(), primal.width(), primal.height(), &sharedKernels());
         PoissonInput in = extra ? *extra : PoissonInput{};
         in.primal = &primal;
@@ -190,8 +192,8 @@ TEST_F(PoissonGpu, SetupAndCoarseningMatchCpu) {
     PoissonOperator op = makeOperator(oc.problems[0]);
     const std::vector<float> rhs = downloadFloats(e.rhs, 0, 3 * e.pixels());
     for (int c = 0; c < 3; ++c)
-        expectNear(rhs, static_cast<std::size_t>(c) * e.pixels(), computeRhs(oc.problems[static_cast<std::size_t>(c)]),
-                   1e-5, "rhs");
+        expectNear(rhs, static_cast<std::size_t>(c) * e.pixels(),
+                   computeRhs(oc.problems[static_cast<std::size_t>(c)]), 1e-5, "rhs");
     for (const PoissonLevel& l : e.levels()) {
         const std::vector<float> coef = downloadFloats(e.coef, l.offset, 3 * l.pixels());
         expectNear(coef, 0, op.cx, 1e-5, "cx");
@@ -216,7 +218,8 @@ TEST_F(PoissonGpu, ApplyResidualSmoothersRestrictProlongMatchCpu) {
     for (int c = 0; c < 3; ++c) {
         x[static_cast<std::size_t>(c)] = randomField(oc.w, oc.h, 40u + static_cast<unsigned>(c), -2.0, 2.0);
         b[static_cast<std::size_t>(c)] = randomField(oc.w, oc.h, 50u + static_cast<unsigned>(c), -2.0, 2.0);
-        xc[static_cast<std::size_t>(c)] = randomField(op1.width, op1.height, 60u + static_cast<unsigned>(c), -1.0, 1.0);
+        xc[static_cast<std::size_t>(c)] =
+            randomField(op1.width, op1.height, 60u + static_cast<unsigned>(c), -1.0, 1.0);
     }
     const PoissonLevel& l1 = e.levels()[1];
     auto reset = [&] {
@@ -443,7 +446,8 @@ TEST_F(PoissonGpu, CgErrorAndMultigridResidualAreMonotone) {
     const SolveReport r = solve(primal, dx, dy, o, out);
     ASSERT_GE(r.history.size(), 3u);
     for (std::size_t k = 1; k < r.history.size(); ++k)
-        for (std::size_t c = 0; c < 3; ++c) EXPECT_LT(r.history[k][c], r.history[k - 1][c]) << "V-cycle " << k;
+        for (std::size_t c = 0; c < 3; ++c)
+            EXPECT_LT(r.history[k][c], r.history[k - 1][c]) << "V-cycle " << k;
 }
 
 // L1 (IRLS) shrugs off a few grossly wrong gradients that L2 smears over the image.
@@ -494,7 +498,8 @@ TEST_F(PoissonGpu, StableAcrossScalesAlphasAndShapes) {
                 Image primal = truth;
                 for (int c = 0; c < 3; ++c)
                     for (std::size_t i = 0; i < primal.pixelCount(); ++i)
-                        primal.plane(c)[i] *= 1.0f + 0.1f * static_cast<float>((i * 7 + static_cast<std::size_t>(c)) % 5);
+                        primal.plane(c)[i] *=
+                            1.0f + 0.1f * static_cast<float>((i * 7 + static_cast<std::size_t>(c)) % 5);
                 SolveOptions o;
                 o.alpha = alpha;
                 o.tolerance = 1e-6;
@@ -603,7 +608,6 @@ TEST_F(PoissonGpu, SolvesAreBitReproducible) {
     }
 }
 
-
 // Seamless cloning (Pérez et al. 2003, eq. 7): the target is untouched outside Ω and the
 // discrete Laplacian of the result equals the source's at every pixel of Ω. The solve stops
 // at relative residual 1e-5 of ‖b‖ (b ~ O(1) per pixel here), so per-pixel Laplacians
@@ -631,10 +635,11 @@ TEST_F(PoissonGpu, SeamlessCloneKeepsTargetAndMatchesSourceLaplacian) {
                     ASSERT_EQ(result.at(x, y, c), target.at(x, y, c)) << x << "," << y;
                     continue;
                 }
-                const double lapF = 4.0 * result.at(x, y, c) - result.at(x - 1, y, c) - result.at(x + 1, y, c) -
-                                    result.at(x, y - 1, c) - result.at(x, y + 1, c);
+                const double lapF = 4.0 * result.at(x, y, c) - result.at(x - 1, y, c) -
+                                    result.at(x + 1, y, c) - result.at(x, y - 1, c) - result.at(x, y + 1, c);
                 const double lapS = 4.0 * source.at(sx, sy, c) - source.at(sx - 1, sy, c) -
-                                    source.at(sx + 1, sy, c) - source.at(sx, sy - 1, c) - source.at(sx, sy + 1, c);
+                                    source.at(sx + 1, sy, c) - source.at(sx, sy - 1, c) -
+                                    source.at(sx, sy + 1, c);
                 EXPECT_NEAR(lapF, lapS, 1e-3) << x << "," << y << " c " << c;
             }
             insideCount += inside ? 1 : 0;
@@ -646,7 +651,6 @@ TEST_F(PoissonGpu, SeamlessCloneKeepsTargetAndMatchesSourceLaplacian) {
     for (int c = 0; c < 3; ++c)
         for (std::size_t i = 0; i < mixed.pixelCount(); ++i) ASSERT_TRUE(std::isfinite(mixed.plane(c)[i]));
 }
-
 
 // Sizes whose multigrid field exceeds one storage buffer are refused before any allocation,
 // with a message naming the device limit (4096x4096 RGB needs ~256 MiB per field on
