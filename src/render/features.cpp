@@ -34,7 +34,9 @@ SceneFeatures analyzeScene(const Scene& scene, glm::vec3 envRadiance, float shif
             f.maxRoughness = std::max(f.maxRoughness, m.roughness);
         }
     }
-    f.hasGlossy = f.hasSpecularLayer && f.minRoughness <= shiftThreshold;
+    // Below roughness 0.01 (GGX alpha < kDeltaAlpha = 1e-4) the lobe is a Dirac mirror,
+    // which is "glossy" for the shift mappings whatever the threshold.
+    f.hasGlossy = f.hasSpecularLayer && f.minRoughness <= std::max(shiftThreshold, 0.01f);
     if (!f.hasSpecularLayer) f.minRoughness = f.maxRoughness = 1.0f;
     return f;
 }

@@ -1,0 +1,58 @@
+#include "render/batch_loop.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <string>
+
+#include "util/progress.h"
+
+namespace gdpt {
+
+void runBatchLoop(const RenderOptions& options, const char* label, const Timer& total, RenderStats& stats,
+                  const TraceBatchFn& traceBatch) {
+    const bool timed = options.timeBudget > 0.0;
+    const double budget = options.timeBudget - options.elapsedBefore;
+    Progress progress(label, timed ? budget : static_cast<double>(options.spp), options.quiet);
+    Timer phase;
+    std::uint32_t done = 0;
+    std::uint32_t batch = 1;
+    double secondsPerSpp = 0.0;  // measured on the last batch
+    while (true) {
+        if (options.cancel && options.cancel->load()) {
+            stats.cancelled = true;
+            break;
+        }
+        std::uint32_t n = batch;
+        if (!timed) {
+            if (done >= options.spp) break;
+            n = std::min(batch, options.spp - done);
+        } else if (done > 0) {
+            // Shrink the next batch to what fits the remaining budget; stop when not even one
+            // sample per pixel fits (at least one batch always runs).
+            const double left = budget - total.seconds();
+            const auto fits = static_cast<std::uint32_t>(std::max(0.0, left / std::max(secondsPerSpp, 1e-9)));
+            if (fits == 0) break;
+            n = std::min(n, fits);
+        }
+        Timer batchTimer;
+        const gpu::Counters c = traceBatch(done, n, [&] {
+            if (timed) progress.update(total.seconds());
+        });
+        stats.raysTraced += c.raysTraced;
+        stats.pathsCompleted += c.pathsCompleted;
+        stats.nanSamples += c.nanSamples;
+        done += n;
+        ++stats.batches;
+        secondsPerSpp = batchTimer.seconds() / n;
+        const double mraysPerS = static_cast<double>(stats.raysTraced) / std::max(1e-9, phase.seconds()) * 1e-6;
+        char rate[64];
+        std::snprintf(rate, sizeof rate, "%u spp, %.2f Mrays/s", done, mraysPerS);
+        progress.update(timed ? total.seconds() : static_cast<double>(done), rate);
+        batch = std::min(batch * 2, options.maxBatchSpp);
+    }
+    stats.samplingMs = phase.ms();
+    stats.spp = done;
+    progress.finish(std::to_string(done) + " spp");
+}
+
+}  // namespace gdpt

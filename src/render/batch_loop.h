@@ -1,0 +1,28 @@
+// batch_loop.h — the sampling loop shared by the PT and G-PT renderers: a deterministic
+// batch schedule (1, 2, 4, ... maxBatchSpp samples per pixel), stopping at --spp or when the
+// time budget would be overrun, cancellation between batches, progress from completed GPU
+// work, and the ray/path/NaN counters. Sample s of pixel p always uses the random stream
+// (p, s, seed) and the merge order depends only on spp and maxBatchSpp, so a render is
+// bit-reproducible for a given scene, seed, spp, image size and device.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+#include "gdpt_shared.h"
+#include "render/renderer.h"
+#include "util/timer.h"
+
+namespace gdpt {
+
+// Traces samples [first, first + count) of every pixel, waits for them (calling onWait while
+// the device works) and returns the counters of that batch.
+using TraceBatchFn = std::function<gpu::Counters(std::uint32_t first, std::uint32_t count,
+                                                 const std::function<void()>& onWait)>;
+
+// Runs the loop; fills stats.spp, batches, samplingMs, raysTraced, pathsCompleted,
+// nanSamples and cancelled. `total` measures the whole render (for --time).
+void runBatchLoop(const RenderOptions& options, const char* label, const Timer& total, RenderStats& stats,
+                  const TraceBatchFn& traceBatch);
+
+}  // namespace gdpt
