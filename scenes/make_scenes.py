@@ -8,6 +8,12 @@ Outputs (see scenes/README.md):
   glossy_cornell.gltf the same room, tall box rough metal (roughness 0.3), a mirror sphere
                       (roughness 0) in place of the short box
   furnace.gltf        closed inward-facing sphere, albedo 0.5, emission 0.5, camera at centre
+  small_light.gltf    the Cornell box with the ceiling light shrunk to 5 % of its area and
+                      20x its radiance (same power)
+  indirect_gap.gltf   a Cornell room lit only through a door-like slit in its back wall from a
+                      hidden light in a compartment behind it ("Veach ajar door")
+  textured.gltf       the Cornell box with a fine sRGB checker/noise PNG texture on the floor
+                      and back wall (texels ~1.2-1.6 pixels at 256x256)
 
 Python standard library only, so that anyone can regenerate the files. Conventions follow
 ../shared/scenes/README.md: Y up, metres, radiance = emissiveFactor x emissive_strength,
@@ -19,9 +25,11 @@ import math
 import os
 import struct
 import sys
+import zlib
 
 FLOAT, UINT = 5126, 5125
 ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
+LINEAR, REPEAT = 9729, 10497
 
 
 class GltfWriter:
@@ -34,21 +42,25 @@ class GltfWriter:
                     "materials": [], "accessors": [], "bufferViews": [], "cameras": []}
         self.extensions = set()
 
-    def _view(self, data, target):
+    def _view(self, data, target=None):
         while len(self.blob) % 4:
             self.blob.append(0)
-        self.doc["bufferViews"].append({"buffer": 0, "byteOffset": len(self.blob),
-                                        "byteLength": len(data), "target": target})
+        view = {"buffer": 0, "byteOffset": len(self.blob), "byteLength": len(data)}
+        if target is not None:
+            view["target"] = target
+        self.doc["bufferViews"].append(view)
         self.blob += data
         return len(self.doc["bufferViews"]) - 1
 
     def _accessor(self, values, kind):
-        if kind == "VEC3":
+        if kind in ("VEC2", "VEC3"):
+            n = int(kind[3])
             flat = [c for v in values for c in v]
             view = self._view(struct.pack("<%df" % len(flat), *flat), ARRAY_BUFFER)
-            acc = {"bufferView": view, "componentType": FLOAT, "count": len(values), "type": "VEC3",
-                   "min": [min(v[i] for v in values) for i in range(3)],
-                   "max": [max(v[i] for v in values) for i in range(3)]}
+            acc = {"bufferView": view, "componentType": FLOAT, "count": len(values), "type": kind}
+            if kind == "VEC3":  # min/max are required for POSITION only
+                acc["min"] = [min(v[i] for v in values) for i in range(n)]
+                acc["max"] = [max(v[i] for v in values) for i in range(n)]
         else:
             view = self._view(struct.pack("<%dI" % len(values), *values), ELEMENT_ARRAY_BUFFER)
             acc = {"bufferView": view, "componentType": UINT, "count": len(values), "type": "SCALAR"}
@@ -59,11 +71,27 @@ class GltfWriter:
         self.doc["accessors"].append(acc)
         return len(self.doc["accessors"]) - 1
 
-    def material(self, name, base, metallic=0.0, roughness=1.0, specular=0.0, emission=None):
-        """specular=None leaves KHR_materials_specular out (its default factor is 1)."""
+    def texture(self, name, png):
+        """An embedded PNG (sRGB when used as baseColorTexture) with a REPEAT/linear sampler."""
+        self.doc.setdefault("images", []).append({"name": name, "mimeType": "image/png",
+                                                  "bufferView": self._view(png)})
+        samplers = self.doc.setdefault("samplers", [])
+        if not samplers:
+            samplers.append({"magFilter": LINEAR, "minFilter": LINEAR,
+                             "wrapS": REPEAT, "wrapT": REPEAT})
+        self.doc.setdefault("textures", []).append(
+            {"name": name, "sampler": 0, "source": len(self.doc["images"]) - 1})
+        return len(self.doc["textures"]) - 1
+
+    def material(self, name, base, metallic=0.0, roughness=1.0, specular=0.0, emission=None,
+                 texture=None):
+        """specular=None leaves KHR_materials_specular out (its default factor is 1).
+        texture: index of a baseColorTexture (TEXCOORD_0), multiplied by base."""
         m = {"name": name, "doubleSided": False,
              "pbrMetallicRoughness": {"baseColorFactor": list(base) + [1.0],
                                       "metallicFactor": metallic, "roughnessFactor": roughness}}
+        if texture is not None:
+            m["pbrMetallicRoughness"]["baseColorTexture"] = {"index": texture}
         ext = {}
         if specular is not None:
             ext["KHR_materials_specular"] = {"specularFactor": specular}
@@ -78,10 +106,12 @@ class GltfWriter:
         self.doc["materials"].append(m)
         return len(self.doc["materials"]) - 1
 
-    def mesh(self, name, positions, normals, indices, material):
+    def mesh(self, name, positions, normals, indices, material, uvs=None):
         prim = {"attributes": {"POSITION": self._accessor(positions, "VEC3"),
                                "NORMAL": self._accessor(normals, "VEC3")},
                 "indices": self._accessor(indices, "SCALAR"), "material": material, "mode": 4}
+        if uvs is not None:
+            prim["attributes"]["TEXCOORD_0"] = self._accessor(uvs, "VEC2")
         self.doc["meshes"].append({"name": name, "primitives": [prim]})
         self.node({"name": name, "mesh": len(self.doc["meshes"]) - 1})
 
@@ -177,15 +207,93 @@ def icosphere(level):
     return verts, tris
 
 
-def cornell(glossy):
+def png_rgb(width, height, rows):
+    """8-bit RGB PNG bytes (no interlace, filter type 1 'Sub' on every row) of rows of
+    (r, g, b) tuples, written with zlib and struct only."""
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data +
+                struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+    raw = bytearray()
+    for row in rows:
+        raw.append(1)
+        prev = (0, 0, 0)
+        for px in row:
+            raw += bytes((px[i] - prev[i]) & 0xFF for i in range(3))
+            prev = px
+    return (b"\x89PNG\r\n\x1a\n" +
+            chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(bytes(raw), 9)) + chunk(b"IEND", b""))
+
+
+def hash32(x):
+    """A fixed integer hash (lowbias32), so the texture never depends on Python's RNG."""
+    x &= 0xFFFFFFFF
+    x ^= x >> 16
+    x = (x * 0x7FEB352D) & 0xFFFFFFFF
+    x ^= x >> 15
+    x = (x * 0x846CA68B) & 0xFFFFFFFF
+    return x ^ (x >> 16)
+
+
+TEX_SIZE = 256
+# Texture repeats per metre: a texel is 1 / (0.3 * 256) = 1.3 cm, about 1.24 pixels on the
+# back wall (7.8 m from the camera, 2 * 7.8 * tan(9.75 deg) = 2.68 m over 256 pixels) and
+# 1.2-1.6 pixels across the floor, whose depth is foreshortened to a fraction of a pixel.
+TEX_PER_METRE = 0.3
+
+
+def detail_texture():
+    """256 x 256 sRGB texels: a checkerboard of 4-texel cells (warm light / cool dark) times
+    per-texel hashed noise (four levels, 0.78..1.0) and a 1-texel dark line every 32 texels.
+    Every period divides 256, so the texture tiles seamlessly under REPEAT."""
+    light, dark = (225, 212, 190), (70, 84, 110)
+    rows = []
+    for y in range(TEX_SIZE):
+        row = []
+        for x in range(TEX_SIZE):
+            base = light if ((x >> 2) + (y >> 2)) & 1 == 0 else dark
+            k = 0.78 + 0.0733 * (hash32(y * TEX_SIZE + x) & 3)
+            if x % 32 == 0 or y % 32 == 0:
+                k *= 0.45
+            row.append(tuple(min(255, int(round(c * k))) for c in base))
+        rows.append(row)
+    return png_rgb(TEX_SIZE, TEX_SIZE, rows)
+
+
+# Ceiling light of the Cornell box (cbox.gltf) and its radiance, W/(m^2 sr).
+CORNELL_LIGHT = [(-0.235, 1.98, -0.22), (0.235, 1.98, -0.22), (0.235, 1.98, 0.16),
+                 (-0.235, 1.98, 0.16)]
+CORNELL_RADIANCE = (17.0, 12.0, 4.0)
+
+
+def cornell(glossy, light_area=1.0, textured=False):
+    """light_area: fraction of the original light's area; the light shrinks about its centre
+    and its radiance grows by 1 / light_area, so its power stays the same.
+    textured: floor and back wall get detail_texture() (white factor) instead of white."""
     w = GltfWriter()
     white = w.material("white", (0.725, 0.71, 0.68))
     red = w.material("red", (0.63, 0.065, 0.05))
     green = w.material("green", (0.14, 0.45, 0.091))
-    light = w.material("light", (0.0, 0.0, 0.0), emission=(17.0, 12.0, 4.0))
-    w.mesh("floor", *quads([[(-1, 0, 1), (1, 0, 1), (1, 0, -1), (-1, 0, -1)]]), white)
+    light = w.material("light", (0.0, 0.0, 0.0),
+                       emission=[c / light_area for c in CORNELL_RADIANCE])
+    floor = quads([[(-1, 0, 1), (1, 0, 1), (1, 0, -1), (-1, 0, -1)]])
+    back = quads([[(-1, 0, -1), (1, 0, -1), (1, 2, -1), (-1, 2, -1)]])
+    if textured:
+        detail = w.material("white_detail", (1.0, 1.0, 1.0),
+                            texture=w.texture("checker_noise", detail_texture()))
+        # uv = world * TEX_PER_METRE; v runs down the back wall and on towards the camera
+        # across the floor, so the pattern folds continuously over the edge between them.
+        # u crosses 0 at x = 0, so REPEAT wrapping is used.
+        w.mesh("floor", *floor, detail,
+               uvs=[(TEX_PER_METRE * p[0], TEX_PER_METRE * (3.0 + p[2])) for p in floor[0]])
+    else:
+        w.mesh("floor", *floor, white)
     w.mesh("ceiling", *quads([[(-1, 2, -1), (1, 2, -1), (1, 2, 1), (-1, 2, 1)]]), white)
-    w.mesh("back", *quads([[(-1, 0, -1), (1, 0, -1), (1, 2, -1), (-1, 2, -1)]]), white)
+    if textured:
+        w.mesh("back", *back, detail,
+               uvs=[(TEX_PER_METRE * p[0], TEX_PER_METRE * (2.0 - p[1])) for p in back[0]])
+    else:
+        w.mesh("back", *back, white)
     w.mesh("left", *quads([[(-1, 0, 1), (-1, 0, -1), (-1, 2, -1), (-1, 2, 1)]]), red)
     w.mesh("right", *quads([[(1, 0, -1), (1, 0, 1), (1, 2, 1), (1, 2, -1)]]), green)
     if glossy:
@@ -202,8 +310,69 @@ def cornell(glossy):
     else:
         w.mesh("shortbox", *box(SHORT_BOX), white)
         w.mesh("tallbox", *box(TALL_BOX), white)
-    w.mesh("light", *quads([[(-0.235, 1.98, -0.22), (0.235, 1.98, -0.22), (0.235, 1.98, 0.16),
-                             (-0.235, 1.98, 0.16)]]), light)
+    s = math.sqrt(light_area)
+    centre = [sum(p[i] for p in CORNELL_LIGHT) / 4.0 for i in range(3)]
+    w.mesh("light", *quads([[[centre[i] + s * (p[i] - centre[i]) for i in range(3)]
+                             for p in CORNELL_LIGHT]]), light)
+    w.camera("camera", (0.0, 1.0, 6.8), math.radians(19.5))
+    return w
+
+
+# indirect_gap: a door-like slit in the back wall (x in GAP_X, floor to GAP_TOP) of a Cornell
+# room; behind the wall (thickness WALL) lies a closed compartment (z down to COMP_BACK).
+GAP_X, GAP_TOP, WALL, COMP_BACK = (0.46, 0.54), 1.6, 0.02, -1.6
+
+
+def wall_with_gap(z, facing_back):
+    """The wall plane z (x in [-1, 1], y in [0, 2]) minus the slit, as three quads facing
+    +Z (into the room), or -Z (into the compartment) when facing_back."""
+    g0, g1 = GAP_X
+    rects = [(-1, g0, 0, 2), (g1, 1, 0, 2), (g0, g1, GAP_TOP, 2)]
+    out = []
+    for x0, x1, y0, y1 in rects:
+        q = [(x0, y0, z), (x1, y0, z), (x1, y1, z), (x0, y1, z)]
+        out.append(q[::-1] if facing_back else q)
+    return out
+
+
+def indirect_gap():
+    """Veach's "ajar door" situation: the only light hangs on the compartment side of the
+    back wall, facing away from the room, and lights the compartment; light reaches the room
+    only through the slit, after at least one bounce in the compartment. The camera sees
+    through the slit to the lit compartment wall but never sees the light."""
+    w = GltfWriter()
+    white = w.material("white", (0.725, 0.71, 0.68))
+    red = w.material("red", (0.63, 0.065, 0.05))
+    green = w.material("green", (0.14, 0.45, 0.091))
+    light = w.material("light", (0.0, 0.0, 0.0), emission=(1275.0, 900.0, 300.0))
+    g0, g1 = GAP_X
+    zb = -1.0 - WALL  # compartment side of the wall
+    w.mesh("floor", *quads([[(-1, 0, 1), (1, 0, 1), (1, 0, -1), (-1, 0, -1)]]), white)
+    w.mesh("ceiling", *quads([[(-1, 2, -1), (1, 2, -1), (1, 2, 1), (-1, 2, 1)]]), white)
+    w.mesh("back", *quads(wall_with_gap(-1.0, False)), white)
+    w.mesh("left", *quads([[(-1, 0, 1), (-1, 0, -1), (-1, 2, -1), (-1, 2, 1)]]), red)
+    w.mesh("right", *quads([[(1, 0, -1), (1, 0, 1), (1, 2, 1), (1, 2, -1)]]), green)
+    w.mesh("shortbox", *box(SHORT_BOX), white)
+    w.mesh("tallbox", *box(TALL_BOX), white)
+    # The slit's jambs and lintel close the wall's thickness.
+    w.mesh("gap_jambs", *quads([[(g0, 0, -1), (g0, 0, zb), (g0, GAP_TOP, zb), (g0, GAP_TOP, -1)],
+                                [(g1, 0, zb), (g1, 0, -1), (g1, GAP_TOP, -1), (g1, GAP_TOP, zb)],
+                                [(g0, GAP_TOP, -1), (g0, GAP_TOP, zb), (g1, GAP_TOP, zb),
+                                 (g1, GAP_TOP, -1)]]), white)
+    # The compartment: its walls span z in [COMP_BACK, -1], which also closes the wall's
+    # thickness along its outer edges.
+    c = COMP_BACK
+    w.mesh("compartment", *quads(wall_with_gap(zb, True) + [
+        [(-1, 0, -1), (1, 0, -1), (1, 0, c), (-1, 0, c)],      # floor (+Y)
+        [(-1, 2, c), (1, 2, c), (1, 2, -1), (-1, 2, -1)],      # ceiling (-Y)
+        [(-1, 0, c), (1, 0, c), (1, 2, c), (-1, 2, c)],        # back wall (+Z)
+        [(-1, 0, -1), (-1, 0, c), (-1, 2, c), (-1, 2, -1)],    # left (+X)
+        [(1, 0, c), (1, 0, -1), (1, 2, -1), (1, 2, c)]]), white)  # right (-X)
+    # The light: 5 mm in front of the compartment side of the wall, facing -Z, left of the
+    # slit so that no camera ray through the slit can touch it.
+    zl = zb - 0.005
+    w.mesh("light", *quads([[(0.2, 1.2, zl), (-0.8, 1.2, zl), (-0.8, 1.8, zl), (0.2, 1.8, zl)]]),
+           light)
     w.camera("camera", (0.0, 1.0, 6.8), math.radians(19.5))
     return w
 
@@ -224,6 +393,9 @@ def main():
     cornell(False).write(os.path.join(out, "cornell_box.gltf"))
     cornell(True).write(os.path.join(out, "glossy_cornell.gltf"))
     furnace().write(os.path.join(out, "furnace.gltf"))
+    cornell(False, light_area=0.05).write(os.path.join(out, "small_light.gltf"))
+    indirect_gap().write(os.path.join(out, "indirect_gap.gltf"))
+    cornell(False, textured=True).write(os.path.join(out, "textured.gltf"))
 
 
 if __name__ == "__main__":
