@@ -8,25 +8,13 @@
 
 namespace gdpt {
 namespace {
-vk::KernelDesc benchDesc(const SceneGpu& scene, WorkgroupSize wg) {
-    vk::KernelDesc d = vk::kernelDesc("bench_rays", kSpv_bench_rays);
-    d.bindings = SceneGpu::sceneBindings();
-    d.bindings.push_back(gpu::kBindCounters);
-    d.pushConstantBytes = sizeof(gpu::FrameParams);
-    d.specConstants = scene.specConstants();
-    d.specConstants.push_back({gpu::kSpecWorkgroupX, wg.x});
-    d.specConstants.push_back({gpu::kSpecWorkgroupY, wg.y});
-    d.localSizeX = wg.x;
-    d.localSizeY = wg.y;
-    return d;
-}
 }  // namespace
 
 BenchRaysPass::BenchRaysPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg)
     : ctx_(ctx),
       width_(scene.constants().width),
       height_(scene.constants().height),
-      kernel_(ctx, benchDesc(scene, wg)),
+      kernel_(ctx, scene.kernelDesc(vk::kernelDesc("bench_rays", kSpv_bench_rays), wg, {gpu::kBindCounters})),
       counters_(ctx, sizeof(gpu::Counters), "bench counters") {
     scene.bindTo(kernel_);
     kernel_.bind(gpu::kBindCounters, counters_);

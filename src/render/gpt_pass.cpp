@@ -24,8 +24,8 @@ const char* const kStatNames[kNumStats] = {"gpt central",    "gpt neighbor right
 
 // Whether some vertex can be classified glossy: a specular layer at or below the threshold,
 // or one below bsdf.glsl's Dirac cutoff (perceptual roughness 0.01), which
-// bsdfRoughnessForShift reports as 0 whatever the threshold. features.cpp's hasGlossy only
-// tests the first, so the kernel's kHasGlossy is recomputed here.
+// bsdfRoughnessForShift reports as 0 whatever the threshold. Same rule as features.cpp's
+// hasGlossy, evaluated here for the pass's own threshold (GptPassOptions::shiftThreshold).
 bool needsHalfVector(const SceneGpu& scene, float threshold) {
     const SceneFeatures& f = scene.features();
     constexpr float kDiracRoughness = 0.01f;  // sqrt(kDeltaAlpha)
@@ -33,17 +33,11 @@ bool needsHalfVector(const SceneGpu& scene, float threshold) {
 }
 
 vk::KernelDesc gptDesc(const SceneGpu& scene, WorkgroupSize wg, bool halfVector) {
-    vk::KernelDesc d = vk::kernelDesc("gpt", kSpv_gpt);
-    d.bindings = SceneGpu::sceneBindings();
-    d.bindings.push_back(gpu::kBindCounters);
-    for (std::uint32_t i = 0; i < kNumStats; ++i) d.bindings.push_back(gpu::kBindGptCentral + i);
-    d.pushConstantBytes = sizeof(gpu::GptFrameParams);
-    for (const auto& [id, value] : scene.specConstants())
-        d.specConstants.push_back({id, id == gpu::kSpecHasGlossy ? (halfVector ? 1u : 0u) : value});
-    d.specConstants.push_back({gpu::kSpecWorkgroupX, wg.x});
-    d.specConstants.push_back({gpu::kSpecWorkgroupY, wg.y});
-    d.localSizeX = wg.x;
-    d.localSizeY = wg.y;
+    std::vector<std::uint32_t> extra = {gpu::kBindCounters};
+    for (std::uint32_t i = 0; i < kNumStats; ++i) extra.push_back(gpu::kBindGptCentral + i);
+    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("gpt", kSpv_gpt), wg, extra, sizeof(gpu::GptFrameParams));
+    for (auto& [id, value] : d.specConstants)
+        if (id == gpu::kSpecHasGlossy) value = halfVector ? 1u : 0u;
     return d;
 }
 

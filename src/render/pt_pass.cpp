@@ -13,26 +13,13 @@ namespace {
 // box); keeps every dispatch far below a GPU driver's watchdog timeout.
 constexpr std::uint64_t kMaxPixelSamplesPerDispatch = 1u << 20;
 
-vk::KernelDesc ptDesc(const SceneGpu& scene, WorkgroupSize wg) {
-    vk::KernelDesc d = vk::kernelDesc("pt", kSpv_pt);
-    d.bindings = SceneGpu::sceneBindings();
-    d.bindings.push_back(gpu::kBindAccum);
-    d.bindings.push_back(gpu::kBindCounters);
-    d.pushConstantBytes = sizeof(gpu::FrameParams);
-    d.specConstants = scene.specConstants();
-    d.specConstants.push_back({gpu::kSpecWorkgroupX, wg.x});
-    d.specConstants.push_back({gpu::kSpecWorkgroupY, wg.y});
-    d.localSizeX = wg.x;
-    d.localSizeY = wg.y;
-    return d;
-}
 }  // namespace
 
 PtPass::PtPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg)
     : ctx_(ctx),
       width_(scene.constants().width),
       height_(scene.constants().height),
-      kernel_(ctx, ptDesc(scene, wg)),
+      kernel_(ctx, scene.kernelDesc(vk::kernelDesc("pt", kSpv_pt), wg, {gpu::kBindAccum, gpu::kBindCounters})),
       accum_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats), "pt pixel statistics"),
       counters_(ctx, sizeof(gpu::Counters), "pt counters") {
     ctx.checkStorageBufferSize(accum_.size(), "the per-pixel statistics of a " + std::to_string(width_) + "x" +

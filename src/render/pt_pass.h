@@ -7,21 +7,16 @@
 
 #include "gdpt_shared.h"
 #include "image/image.h"
+#include "render/scene_gpu.h"
 #include "vk/buffer.h"
 #include "vk/kernel.h"
 
 namespace gdpt {
 
-class SceneGpu;
 namespace vk {
 class Context;
 class GpuTimer;
 }  // namespace vk
-
-struct WorkgroupSize {
-    std::uint32_t x = 8;
-    std::uint32_t y = 8;
-};
 
 class PtPass {
 public:

@@ -188,6 +188,19 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> SceneGpu::specConstants() c
             {gpu::kSpecMaxDepth, maxDepthSpec_}};
 }
 
+vk::KernelDesc SceneGpu::kernelDesc(vk::KernelDesc base, WorkgroupSize wg,
+                                    const std::vector<std::uint32_t>& extraBindings, std::uint32_t pushBytes) const {
+    base.bindings = sceneBindings();
+    base.bindings.insert(base.bindings.end(), extraBindings.begin(), extraBindings.end());
+    base.pushConstantBytes = pushBytes;
+    base.specConstants = specConstants();
+    base.specConstants.push_back({gpu::kSpecWorkgroupX, wg.x});
+    base.specConstants.push_back({gpu::kSpecWorkgroupY, wg.y});
+    base.localSizeX = wg.x;
+    base.localSizeY = wg.y;
+    return base;
+}
+
 std::uint64_t SceneGpu::deviceBytes() const {
     return triGeom_.size() + triShading_.size() + bvh_.size() + materials_.size() + texInfo_.size() +
            texels_.size() + lightTris_.size() + punctual_.size() + sceneConst_.size();

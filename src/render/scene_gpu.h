@@ -11,13 +11,19 @@
 #include "render/features.h"
 #include "scene/scene.h"
 #include "vk/buffer.h"
+#include "vk/kernel.h"
 
 namespace gdpt {
 
 namespace vk {
 class Context;
-class Kernel;
 }  // namespace vk
+
+// Compute workgroup size (a specialisation constant of every scene kernel).
+struct WorkgroupSize {
+    std::uint32_t x = 8;
+    std::uint32_t y = 8;
+};
 
 struct SceneGpuOptions {
     int width = 256;
@@ -44,6 +50,12 @@ public:
     // Specialisation constants for the scene features (ids from gdpt_shared.h).
     [[nodiscard]] std::vector<std::pair<std::uint32_t, std::uint32_t>> specConstants() const;
     [[nodiscard]] static std::vector<std::uint32_t> sceneBindings();
+    // Completes `base` (name + SPIR-V) into the descriptor of a kernel that reads this scene:
+    // the scene bindings plus `extraBindings`, `pushBytes` of push constants, the scene's
+    // feature specialisation constants and the workgroup size.
+    [[nodiscard]] vk::KernelDesc kernelDesc(vk::KernelDesc base, WorkgroupSize wg,
+                                            const std::vector<std::uint32_t>& extraBindings,
+                                            std::uint32_t pushBytes = sizeof(gpu::FrameParams)) const;
 
     [[nodiscard]] const SceneFeatures& features() const { return features_; }
     [[nodiscard]] const gpu::SceneConstants& constants() const { return constants_; }

@@ -14,30 +14,16 @@ namespace {
 
 constexpr std::uint32_t kBouncesPerSubmit = 6;
 
-template <std::size_t N>
-vk::KernelDesc wfDesc(const char* name, const std::uint32_t (&spirv)[N], const SceneGpu& scene, WorkgroupSize wg,
-                      std::vector<std::uint32_t> extra) {
-    vk::KernelDesc d = vk::kernelDesc(name, spirv);
-    d.bindings = SceneGpu::sceneBindings();
-    d.bindings.insert(d.bindings.end(), extra.begin(), extra.end());
-    d.pushConstantBytes = sizeof(gpu::FrameParams);
-    d.specConstants = scene.specConstants();
-    d.specConstants.push_back({gpu::kSpecWorkgroupX, wg.x});
-    d.specConstants.push_back({gpu::kSpecWorkgroupY, wg.y});
-    d.localSizeX = wg.x;
-    d.localSizeY = wg.y;
-    return d;
-}
-
 }  // namespace
 
 WavefrontPass::WavefrontPass(const vk::Context& ctx, const SceneGpu& scene, const PtPass& pt, WorkgroupSize wg)
     : ctx_(ctx),
       width_(scene.constants().width),
       height_(scene.constants().height),
-      extend_(ctx, wfDesc("wf_extend", kSpv_wf_extend, scene, wg, {gpu::kBindPathState, gpu::kBindPathHits})),
-      shade_(ctx, wfDesc("wf_shade", kSpv_wf_shade, scene, wg,
-                         {gpu::kBindAccum, gpu::kBindCounters, gpu::kBindPathState, gpu::kBindPathHits})),
+      extend_(ctx, scene.kernelDesc(vk::kernelDesc("wf_extend", kSpv_wf_extend), wg,
+                                    {gpu::kBindPathState, gpu::kBindPathHits})),
+      shade_(ctx, scene.kernelDesc(vk::kernelDesc("wf_shade", kSpv_wf_shade), wg,
+                                   {gpu::kBindAccum, gpu::kBindCounters, gpu::kBindPathState, gpu::kBindPathHits})),
       paths_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::PathState), "wavefront path state"),
       hits_(ctx, std::uint64_t{width_} * height_ * sizeof(glm::vec4), "wavefront hits"),
       counters_(pt.counters()) {
