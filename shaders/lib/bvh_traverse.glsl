@@ -161,6 +161,32 @@ bool intersectTriangle(vec3 orig, vec3 dir, uint tri, float tMin, inout float tM
     return intersectTriangleGeom(orig, dir, g.v0, g.e1, g.e2, tMin, tMax, u, v);
 }
 
+// Leaf [first, first + count): shrinks `hit` to the closest accepted triangle.
+void intersectLeafClosest(vec3 orig, vec3 dir, uint first, uint count, float tMin, inout Hit hit) {
+    for (uint i = first; i < first + count; ++i) {
+        float tCand = hit.t;
+        float u;
+        float v;
+        if (intersectTriangle(orig, dir, i, tMin, tCand, u, v) && GDPT_ANYHIT_FILTER(i, u, v)) {
+            hit.t = tCand;
+            hit.u = u;
+            hit.v = v;
+            hit.triangle = i;
+        }
+    }
+}
+
+// Leaf [first, first + count): true if any triangle is hit (and accepted) in (tMin, tMax).
+bool intersectLeafAny(vec3 orig, vec3 dir, uint first, uint count, float tMin, float tMax) {
+    for (uint i = first; i < first + count; ++i) {
+        float tCand = tMax;
+        float u;
+        float v;
+        if (intersectTriangle(orig, dir, i, tMin, tCand, u, v) && GDPT_ANYHIT_FILTER(i, u, v)) return true;
+    }
+    return false;
+}
+
 // Closest hit with tMin < t < tMax. Stack-based, nearest child first; leaf children are
 // intersected when their parent is visited, so a node fetch tests two boxes and the
 // stack only ever holds inner nodes (at most one per level: depth <= kBvhMaxDepth <
@@ -194,36 +220,14 @@ Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
         uint next = kInvalidIndex;
         if (hit0) {
             if (count0 > 0u) {
-                for (uint i = c0; i < c0 + count0; ++i) {
-                    float tCand = hit.t;
-                    float u;
-                    float v;
-                    if (intersectTriangle(orig, dir, i, tMin, tCand, u, v) &&
-                        GDPT_ANYHIT_FILTER(i, u, v)) {
-                        hit.t = tCand;
-                        hit.u = u;
-                        hit.v = v;
-                        hit.triangle = i;
-                    }
-                }
+                intersectLeafClosest(orig, dir, c0, count0, tMin, hit);
             } else {
                 next = c0;
             }
         }
         if (hit1) {
             if (count1 > 0u) {
-                for (uint i = c1; i < c1 + count1; ++i) {
-                    float tCand = hit.t;
-                    float u;
-                    float v;
-                    if (intersectTriangle(orig, dir, i, tMin, tCand, u, v) &&
-                        GDPT_ANYHIT_FILTER(i, u, v)) {
-                        hit.t = tCand;
-                        hit.u = u;
-                        hit.v = v;
-                        hit.triangle = i;
-                    }
-                }
+                intersectLeafClosest(orig, dir, c1, count1, tMin, hit);
             } else if (next == kInvalidIndex) {
                 next = c1;
             } else {
@@ -261,30 +265,14 @@ bool traceAny(vec3 orig, vec3 dir, float tMin, float tMax) {
         uint next = kInvalidIndex;
         if (hitL) {
             if (n.leftCount > 0u) {
-                for (uint i = n.left; i < n.left + n.leftCount; ++i) {
-                    float tCand = tMax;
-                    float u;
-                    float v;
-                    if (intersectTriangle(orig, dir, i, tMin, tCand, u, v) &&
-                        GDPT_ANYHIT_FILTER(i, u, v)) {
-                        return true;
-                    }
-                }
+                if (intersectLeafAny(orig, dir, n.left, n.leftCount, tMin, tMax)) return true;
             } else {
                 next = n.left;
             }
         }
         if (hitR) {
             if (n.rightCount > 0u) {
-                for (uint i = n.right; i < n.right + n.rightCount; ++i) {
-                    float tCand = tMax;
-                    float u;
-                    float v;
-                    if (intersectTriangle(orig, dir, i, tMin, tCand, u, v) &&
-                        GDPT_ANYHIT_FILTER(i, u, v)) {
-                        return true;
-                    }
-                }
+                if (intersectLeafAny(orig, dir, n.right, n.rightCount, tMin, tMax)) return true;
             } else if (next == kInvalidIndex) {
                 next = n.right;
             } else {

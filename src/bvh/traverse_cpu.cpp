@@ -20,6 +20,37 @@ bool intersectTriangleCpu(const gpu::TriangleGeom& g, glm::vec3 orig, glm::vec3 
     return gpu::intersectTriangleGeom(orig, dir, g.v0, g.e1, g.e2, tMin, tMax, u, v);
 }
 
+namespace {
+
+// Mirrors intersectLeafClosest / intersectLeafAny of the GLSL.
+void intersectLeafClosest(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
+                          uint32_t first, uint32_t count, float tMin, Hit& hit) {
+    for (uint32_t i = first; i < first + count; ++i) {
+        float tCand = hit.t;
+        float u;
+        float v;
+        if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) && anyHitFilter(i, u, v)) {
+            hit.t = tCand;
+            hit.u = u;
+            hit.v = v;
+            hit.triangle = i;
+        }
+    }
+}
+
+bool intersectLeafAny(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
+                      uint32_t first, uint32_t count, float tMin, float tMax) {
+    for (uint32_t i = first; i < first + count; ++i) {
+        float tCand = tMax;
+        float u;
+        float v;
+        if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) && anyHitFilter(i, u, v)) return true;
+    }
+    return false;
+}
+
+}  // namespace
+
 Hit traceClosestCpu(const std::vector<gpu::BvhNode>& nodes,
                     const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
                     float tMin, float tMax) {
@@ -53,36 +84,14 @@ Hit traceClosestCpu(const std::vector<gpu::BvhNode>& nodes,
         uint32_t next = gpu::kInvalidIndex;
         if (hit0) {
             if (count0 > 0u) {
-                for (uint32_t i = c0; i < c0 + count0; ++i) {
-                    float tCand = hit.t;
-                    float u;
-                    float v;
-                    if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) &&
-                        anyHitFilter(i, u, v)) {
-                        hit.t = tCand;
-                        hit.u = u;
-                        hit.v = v;
-                        hit.triangle = i;
-                    }
-                }
+                intersectLeafClosest(geoms, orig, dir, c0, count0, tMin, hit);
             } else {
                 next = c0;
             }
         }
         if (hit1) {
             if (count1 > 0u) {
-                for (uint32_t i = c1; i < c1 + count1; ++i) {
-                    float tCand = hit.t;
-                    float u;
-                    float v;
-                    if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) &&
-                        anyHitFilter(i, u, v)) {
-                        hit.t = tCand;
-                        hit.u = u;
-                        hit.v = v;
-                        hit.triangle = i;
-                    }
-                }
+                intersectLeafClosest(geoms, orig, dir, c1, count1, tMin, hit);
             } else if (next == gpu::kInvalidIndex) {
                 next = c1;
             } else {
@@ -123,30 +132,14 @@ bool traceAnyCpu(const std::vector<gpu::BvhNode>& nodes,
         uint32_t next = gpu::kInvalidIndex;
         if (hitL) {
             if (n.leftCount > 0u) {
-                for (uint32_t i = n.left; i < n.left + n.leftCount; ++i) {
-                    float tCand = tMax;
-                    float u;
-                    float v;
-                    if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) &&
-                        anyHitFilter(i, u, v)) {
-                        return true;
-                    }
-                }
+                if (intersectLeafAny(geoms, orig, dir, n.left, n.leftCount, tMin, tMax)) return true;
             } else {
                 next = n.left;
             }
         }
         if (hitR) {
             if (n.rightCount > 0u) {
-                for (uint32_t i = n.right; i < n.right + n.rightCount; ++i) {
-                    float tCand = tMax;
-                    float u;
-                    float v;
-                    if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) &&
-                        anyHitFilter(i, u, v)) {
-                        return true;
-                    }
-                }
+                if (intersectLeafAny(geoms, orig, dir, n.right, n.rightCount, tMin, tMax)) return true;
             } else if (next == gpu::kInvalidIndex) {
                 next = n.right;
             } else {
