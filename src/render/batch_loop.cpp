@@ -53,6 +53,9 @@ void runBatchLoop(const RenderOptions& options, const char* label, const Timer& 
     stats.samplingMs = phase.ms();
     stats.spp = done;
     progress.finish(std::to_string(done) + " spp");
+    if (stats.nanSamples > 0 && !options.quiet)
+        std::fprintf(stderr, "gdpt: warning: %s: %llu samples were NaN/Inf and were counted as zero\n", label,
+                     static_cast<unsigned long long>(stats.nanSamples));
 }
 
 }  // namespace gdpt

@@ -21,7 +21,8 @@ using TraceBatchFn = std::function<gpu::Counters(std::uint32_t first, std::uint3
                                                  const std::function<void()>& onWait)>;
 
 // Runs the loop; fills stats.spp, batches, samplingMs, raysTraced, pathsCompleted,
-// nanSamples and cancelled. `total` measures the whole render (for --time).
+// nanSamples and cancelled, and warns about NaN/Inf samples (unless quiet). `total` measures
+// the whole render (for --time).
 void runBatchLoop(const RenderOptions& options, const char* label, const Timer& total, RenderStats& stats,
                   const TraceBatchFn& traceBatch);
 

@@ -1,7 +1,6 @@
 #include "render/gpt_renderer.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <string>
 
 #include "render/batch_loop.h"
@@ -64,9 +63,6 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     result.varDirect = std::move(images.varDirect);
     stats.readbackMs = phase.ms();
     stats.kernels = timer.totals();
-    if (stats.nanSamples > 0 && !options.quiet)
-        std::fprintf(stderr, "gdpt: warning: %llu G-PT samples were NaN/Inf and were counted as zero\n",
-                     static_cast<unsigned long long>(stats.nanSamples));
     return result;
 }
 

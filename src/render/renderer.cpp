@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <memory>
-#include <cstdio>
 
 #include "render/batch_loop.h"
 #include "render/wavefront_pass.h"
@@ -52,9 +51,6 @@ RenderResult renderPt(const vk::Context& ctx, const Scene& scene, const RenderOp
     pass.readback(result.image, result.varianceOfMean);
     stats.readbackMs = phase.ms();
     stats.kernels = timer.totals();
-    if (stats.nanSamples > 0 && !options.quiet)
-        std::fprintf(stderr, "gdpt: warning: %llu samples were NaN/Inf and were counted as zero\n",
-                     static_cast<unsigned long long>(stats.nanSamples));
     return result;
 }
 
