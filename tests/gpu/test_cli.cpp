@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_runner.h"
 #include "image/exr_io.h"
 
 namespace gdpt {
@@ -16,35 +17,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct RunResult {
-    int code = -1;
-    std::string output;  // stdout + stderr
-};
+using test::RunResult;
 
-RunResult run(const std::string& args) {
-    const std::string cmd = std::string(GDPT_BINARY) + " " + args + " 2>&1";
-    RunResult r;
-    FILE* pipe = popen(cmd.c_str(), "r");
-    if (!pipe) return r;
-    char buf[4096];
-    while (std::fgets(buf, sizeof buf, pipe)) r.output += buf;
-    const int status = pclose(pipe);
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-}
+RunResult run(const std::string& args) { return test::runGdpt(args); }
 
-class Cli : public ::testing::Test {
-protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               ("gdpt_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
-    fs::path dir_;
-};
+class Cli : public test::TempDirTest {};
 
 const std::string kScene = std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.gltf";
 

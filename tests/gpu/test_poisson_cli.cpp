@@ -9,44 +9,19 @@
 #include <filesystem>
 #include <string>
 
+#include "cli_runner.h"
 #include "image/exr_io.h"
 #include "image/png_preview.h"
 
 namespace gdpt {
 namespace {
 
+
 namespace fs = std::filesystem;
+using test::RunResult;
+using test::runGdpt;
 
-struct RunResult {
-    int code = -1;
-    std::string output;
-};
-
-RunResult runGdpt(const std::string& args) {
-    const std::string cmd = std::string(GDPT_BINARY) + " " + args + " 2>&1";
-    RunResult r;
-    FILE* pipe = popen(cmd.c_str(), "r");
-    if (!pipe) return r;
-    char buf[4096];
-    while (std::fgets(buf, sizeof buf, pipe)) r.output += buf;
-    const int status = pclose(pipe);
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-}
-
-class PoissonCli : public ::testing::Test {
-protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               ("gdpt_poisson_cli_" +
-                std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
-    fs::path dir_;
-};
+class PoissonCli : public test::TempDirTest {};
 
 // A small gradient-domain EXR: primal = image + offset noise, exact dx/dy, a direct layer.
 Image writeGradientExr(const std::string& file, bool withVariance) {

@@ -1,0 +1,48 @@
+// cli_runner.h — end-to-end CLI tests: run the gdpt binary (GDPT_BINARY, set by the build)
+// and capture its exit code and output; a fixture with a private temporary directory.
+#pragma once
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace gdpt::test {
+
+struct RunResult {
+    int code = -1;
+    std::string output;  // stdout + stderr
+};
+
+// Runs `gdpt <args>` through the shell.
+inline RunResult runGdpt(const std::string& args) {
+    const std::string cmd = std::string(GDPT_BINARY) + " " + args + " 2>&1";
+    RunResult r;
+    FILE* pipe = popen(cmd.c_str(), "r");
+    if (!pipe) return r;
+    char buf[4096];
+    while (std::fgets(buf, sizeof buf, pipe)) r.output += buf;
+    const int status = pclose(pipe);
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+}
+
+// Each test gets an empty directory named after the suite and test, removed afterwards.
+class TempDirTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir_ = std::filesystem::temp_directory_path() /
+               ("gdpt_" + std::string(info->test_suite_name()) + "_" + info->name());
+        std::filesystem::remove_all(dir_);
+        std::filesystem::create_directories(dir_);
+    }
+    void TearDown() override { std::filesystem::remove_all(dir_); }
+    [[nodiscard]] std::string path(const std::string& name) const { return (dir_ / name).string(); }
+    std::filesystem::path dir_;
+};
+
+}  // namespace gdpt::test
