@@ -13,8 +13,8 @@ layout(local_size_x_id = kSpecWorkgroupX, local_size_y_id = kSpecWorkgroupY) in;
 #include "lib/poisson_common.glsl"
 
 float direction(uint j, float beta) {
-    float z = (pc.flags & kPoissonFlagZIsR) != 0u ? B[j] : X[j];
-    return (pc.flags & kPoissonFlagFirst) != 0u ? z : z + beta * P[pc.pOld + j];
+    float z = flag(kPoissonFlagZIsR) ? B[j] : X[j];
+    return flag(kPoissonFlagFirst) ? z : z + beta * P[pc.pOld + j];
 }
 
 void main() {

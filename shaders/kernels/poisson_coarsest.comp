@@ -32,7 +32,7 @@ void main() {
     Stencil s = loadStencil(px, py, w, h, pc.cOff);
     float d = inside ? stencilDiag(s) : 0.0;
     vec3 b = vec3(0.0);
-    bool zero = (pc.flags & kPoissonFlagZeroGuess) != 0u || !inside;
+    bool zero = flag(kPoissonFlagZeroGuess) || !inside;
     for (uint c = 0u; c < 3u; ++c) {
         b[c] = inside ? B[pc.bOff + c * n + l] : 0.0;
         sX[c * 64u + l] = zero ? 0.0 : X[pc.xOff + c * n + l];

@@ -12,7 +12,7 @@
 layout(local_size_x_id = kSpecWorkgroupX, local_size_y_id = kSpecWorkgroupY) in;
 #include "lib/poisson_common.glsl"
 
-float loadX(uint j) { return (pc.flags & kPoissonFlagFromSol) != 0u ? Sol[j] : X[pc.xOff + j]; }
+float loadX(uint j) { return flag(kPoissonFlagFromSol) ? Sol[j] : X[pc.xOff + j]; }
 
 void main() {
     uint x = gl_GlobalInvocationID.x, y = gl_GlobalInvocationID.y;
@@ -20,17 +20,17 @@ void main() {
     vec3 rr = vec3(0.0);
     if (x < w && y < h) {
         Stencil s = loadStencil(x, y, w, h, pc.cOff);
-        bool fromSol = (pc.flags & kPoissonFlagFromSol) != 0u;
+        bool fromSol = flag(kPoissonFlagFromSol);
         vec3 r;
         for (uint c = 0u; c < 3u; ++c) {
             uint o = c * n;
             float ax = applyStencil(s, loadX(o + s.i), loadX(o + s.iW), loadX(o + s.iE),
                                     loadX(o + s.iN), loadX(o + s.iS));
-            if ((pc.flags & kPoissonFlagApplyOnly) != 0u)
+            if (flag(kPoissonFlagApplyOnly))
                 r[c] = ax;
             else
                 r[c] = (fromSol ? Rhs[o + s.i] : B[pc.bOff + o + s.i]) - ax;
-            if ((pc.flags & kPoissonFlagProject) != 0u) r[c] -= sc.bMean[c];
+            if (flag(kPoissonFlagProject)) r[c] -= sc.bMean[c];
         }
         // Stores after all loads (lavapipe must assume storage buffers alias).
         for (uint c = 0u; c < 3u; ++c) {
@@ -41,5 +41,5 @@ void main() {
         }
         rr = r * r;
     }
-    if ((pc.flags & kPoissonFlagDot) != 0u) writePartials(rr, kPoissonSlotRR);
+    if (flag(kPoissonFlagDot)) writePartials(rr, kPoissonSlotRR);
 }

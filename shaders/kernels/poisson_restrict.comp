@@ -14,7 +14,7 @@ void main() {
     uint cw = pc.coarseWidth, ch = pc.coarseHeight;
     if (cx >= cw || cy >= ch) return;
     uint w = pc.width, h = pc.height, n = w * h, cn = cw * ch;
-    bool plain = (pc.flags & kPoissonFlagPlain) != 0u;
+    bool plain = flag(kPoissonFlagPlain);
     vec3 sum = vec3(0.0);
     for (uint dy = 0u; dy < 2u; ++dy)
         for (uint dx = 0u; dx < 2u; ++dx) {

@@ -46,7 +46,7 @@ void recordHistory(uint c, float rr) {
 
 void main() {
     bool lead = gl_LocalInvocationIndex == 0u;
-    bool precond = (pc.flags & kPoissonFlagZIsR) == 0u;
+    bool precond = !flag(kPoissonFlagZIsR);
     for (uint c = 0u; c < 3u; ++c) {
         if (pc.mode == kPoissonModeInit) {
             float bb = sumSlot(kPoissonSlotBB, c);
@@ -83,7 +83,7 @@ void main() {
                     // Singular A at the float32 floor: rounding leaves a component CG cannot
                     // remove and the recurrences lose conjugacy; stop once the residual has
                     // grown 10x past its best instead of diverging.
-                    if ((pc.flags & kPoissonFlagProject) != 0u && rr > 100.0 * sc.rrMin[c]) sc.done[c] = 1u;
+                    if (flag(kPoissonFlagProject) && rr > 100.0 * sc.rrMin[c]) sc.done[c] = 1u;
                 }
                 sc.rrMin[c] = min(sc.rrMin[c], rr);
                 if (pc.mode == kPoissonModeBeta) {

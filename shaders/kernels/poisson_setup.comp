@@ -15,7 +15,7 @@ layout(local_size_x_id = kSpecWorkgroupX, local_size_y_id = kSpecWorkgroupY) in;
 // Row weight of plane k (0 primal, 1 dx, 2 dy) at pixel j.
 float rowWeight(uint k, uint j, uint n) {
     float w = Wt[k * n + j];
-    if ((pc.flags & kPoissonFlagIrls) != 0u) w *= Irls[k * n + j] * sc.irlsScale;
+    if (flag(kPoissonFlagIrls)) w *= Irls[k * n + j] * sc.irlsScale;
     return w;
 }
 
@@ -45,7 +45,7 @@ void main() {
             bsum[c] = b;
         }
     }
-    if ((pc.flags & kPoissonFlagDot) != 0u) {
+    if (flag(kPoissonFlagDot)) {
         writePartials(bb, kPoissonSlotBB);
         writePartials(bsum, kPoissonSlotSum);
     }

@@ -20,8 +20,6 @@
 layout(local_size_x_id = kSpecWorkgroupX, local_size_y_id = kSpecWorkgroupY) in;
 #include "lib/poisson_common.glsl"
 
-bool flag(uint f) { return (pc.flags & f) != 0u; }
-
 // Value of x at level index j (channel offset included) plus, with kPoissonFlagCorrect, the
 // coarse correction of pixel (px, py); `src` selects X (0) or R (1). Only for the Jacobi
 // path; the RB-GS path below is written out per flag combination, because lavapipe's

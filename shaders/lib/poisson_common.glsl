@@ -28,6 +28,10 @@ layout(set = 0, binding = kPoissonBindPartials, scalar) buffer PartialBuf { floa
 
 layout(push_constant, scalar) uniform Push { PoissonPush pc; };
 
+// The kPoissonFlag* bits of this pipeline variant (see poisson_shared.h).
+layout(constant_id = kSpecPoissonFlags) const uint kFlags = 0u;
+bool flag(uint f) { return (kFlags & f) != 0u; }
+
 // The 5-point stencil of pixel (x, y) on a level: edge weights to the four neighbours
 // (0 where the neighbour does not exist, its index then repeats i) and the screening term.
 struct Stencil {

@@ -239,7 +239,8 @@ GDPT_ENUM_BEGIN(SpecId)
     kSpecHasEnv = 5u,
     kSpecHasGlossy = 6u,
     kSpecHasAlphaMask = 7u,
-    kSpecMaxDepth = 8u
+    kSpecMaxDepth = 8u,
+    kSpecPoissonFlags = 9u  // poisson_*.comp: the kPoissonFlag* bits of this pipeline variant
 GDPT_ENUM_END();
 
 // A ray of the BVH tests (tests/gpu/test_bvh_gpu.cpp). 32 bytes.

@@ -52,7 +52,10 @@ GDPT_ENUM_BEGIN(PoissonSlot)
     kPoissonSlotCount = 6u
 GDPT_ENUM_END();
 
-// PoissonPush.flags bits.
+// Flag bits of a poisson_* pipeline variant. They are the specialisation constant
+// kSpecPoissonFlags, not a push constant: lavapipe executes both sides of every branch under
+// lane masks (and still walks the lanes of masked-off loads), so a runtime flag paid for every
+// path it did not take; specialised, the untaken paths are compiled out.
 GDPT_CONST uint kPoissonFlagZeroGuess = 1u;   // smoother: the current x is 0 (not read)
 GDPT_CONST uint kPoissonFlagCorrect = 2u;     // smoother: add the coarse correction P x_H first
 GDPT_CONST uint kPoissonFlagJacobi = 4u;      // smoother: damped Jacobi instead of RB-GS
@@ -95,7 +98,7 @@ struct PoissonPush {
     uint coarseXOff;   // float offset of the coarser level's x in X
     uint coarseBOff;   // ... its b in B
     uint coarseCOff;   // ... its coefficients in Coef
-    uint flags;        // kPoissonFlag*
+    uint flags;        // copy of the variant's kPoissonFlag* (the kernels read kFlags)
     uint colour;       // RB-GS colour updated by this half-sweep: (x + y) mod 2
     uint mode;         // poisson_scalars: kPoissonMode*
     uint iteration;    // iteration number recorded by poisson_scalars

@@ -56,26 +56,54 @@ void withCoarse(PoissonPush& p, const PoissonLevel& c) {
 }  // namespace
 
 PoissonKernels::PoissonKernels(const vk::Context& ctx, std::uint32_t gx, std::uint32_t gy)
-    : setup(ctx, describe(vk::kernelDesc("poisson_setup", kSpv_poisson_setup), gx, gy, true)),
-      coarsen(ctx, describe(vk::kernelDesc("poisson_coarsen", kSpv_poisson_coarsen), gx, gy, true)),
-      residual(ctx, describe(vk::kernelDesc("poisson_residual", kSpv_poisson_residual), gx, gy, true)),
-      smooth(ctx, describe(vk::kernelDesc("poisson_smooth", kSpv_poisson_smooth), gx, gy, true)),
-      restrictResidual(ctx,
-                       describe(vk::kernelDesc("poisson_restrict", kSpv_poisson_restrict), gx, gy, true)),
-      prolong(ctx, describe(vk::kernelDesc("poisson_prolong", kSpv_poisson_prolong), gx, gy, true)),
-      coarsest(ctx, describe(vk::kernelDesc("poisson_coarsest", kSpv_poisson_coarsest), gx, gy, false)),
-      cgDirection(ctx,
-                  describe(vk::kernelDesc("poisson_cg_direction", kSpv_poisson_cg_direction), gx, gy, true)),
-      cgUpdate(ctx, describe(vk::kernelDesc("poisson_cg_update", kSpv_poisson_cg_update), gx, gy, true)),
-      scalars(ctx, describe(vk::kernelDesc("poisson_scalars", kSpv_poisson_scalars), gx, gy, false)),
-      irlsWeights(ctx,
-                  describe(vk::kernelDesc("poisson_irls_weights", kSpv_poisson_irls_weights), gx, gy, true)),
-      groupX_(gx),
-      groupY_(gy) {
+    : ctx_(ctx), groupX_(gx), groupY_(gy) {
     const std::uint32_t size = gx * gy;
     if (size == 0 || size > gpu::kPoissonMaxGroupSize || (size & (size - 1)) != 0)
         throw Error("Poisson solver: workgroup " + std::to_string(gx) + "x" + std::to_string(gy) +
                     " must have a power-of-two size <= 256");
+    auto set = [&](PoissonOp op, vk::KernelDesc d, bool grid) {
+        descs_[static_cast<std::size_t>(op)] = describe(std::move(d), gx, gy, grid);
+    };
+    set(PoissonOp::Setup, vk::kernelDesc("poisson_setup", kSpv_poisson_setup), true);
+    set(PoissonOp::Coarsen, vk::kernelDesc("poisson_coarsen", kSpv_poisson_coarsen), true);
+    set(PoissonOp::Residual, vk::kernelDesc("poisson_residual", kSpv_poisson_residual), true);
+    set(PoissonOp::Smooth, vk::kernelDesc("poisson_smooth", kSpv_poisson_smooth), true);
+    set(PoissonOp::Restrict, vk::kernelDesc("poisson_restrict", kSpv_poisson_restrict), true);
+    set(PoissonOp::Prolong, vk::kernelDesc("poisson_prolong", kSpv_poisson_prolong), true);
+    set(PoissonOp::Coarsest, vk::kernelDesc("poisson_coarsest", kSpv_poisson_coarsest), false);
+    set(PoissonOp::CgDirection, vk::kernelDesc("poisson_cg_direction", kSpv_poisson_cg_direction), true);
+    set(PoissonOp::CgUpdate, vk::kernelDesc("poisson_cg_update", kSpv_poisson_cg_update), true);
+    set(PoissonOp::Scalars, vk::kernelDesc("poisson_scalars", kSpv_poisson_scalars), false);
+    set(PoissonOp::IrlsWeights, vk::kernelDesc("poisson_irls_weights", kSpv_poisson_irls_weights), true);
+}
+
+PoissonKernels::~PoissonKernels() = default;
+
+const vk::Kernel& PoissonKernels::get(PoissonOp op, std::uint32_t flags) {
+    auto& variants = variants_[static_cast<std::size_t>(op)];
+    auto it = variants.find(flags);
+    if (it == variants.end()) {
+        vk::KernelDesc d = descs_[static_cast<std::size_t>(op)];
+        d.specConstants.emplace_back(gpu::kSpecPoissonFlags, flags);
+        auto kernel = std::make_unique<vk::Kernel>(ctx_, d);
+        for (std::uint32_t i = 0; i < gpu::kPoissonBindCount; ++i)
+            if (bound_[i]) kernel->bind(i, *bound_[i]);
+        it = variants.emplace(flags, std::move(kernel)).first;
+    }
+    return *it->second;
+}
+
+void PoissonKernels::bindAll(const Buffers& buffers) {
+    bound_ = buffers;
+    for (auto& variants : variants_)
+        for (auto& [flags, kernel] : variants)
+            for (std::uint32_t i = 0; i < gpu::kPoissonBindCount; ++i) kernel->bind(i, *buffers[i]);
+}
+
+std::size_t PoissonKernels::variantCount() const {
+    std::size_t n = 0;
+    for (const auto& variants : variants_) n += variants.size();
+    return n;
 }
 
 PoissonGpuEngine::PoissonGpuEngine(const vk::Context& ctx, int width, int height, PoissonKernels* kernels)
@@ -138,13 +166,8 @@ std::uint32_t PoissonGpuEngine::groups() const {
 }
 
 void PoissonGpuEngine::bind() {
-    const vk::Buffer* buffers[gpu::kPoissonBindCount] = {
-        &coef, &x, &b, &r, &p, &ap, &sol, &rhs, &primal, &dx, &dy, &weights, &irls, &scalars, &partials};
-    for (vk::Kernel* k :
-         {&kernels_->setup, &kernels_->coarsen, &kernels_->residual, &kernels_->smooth,
-          &kernels_->restrictResidual, &kernels_->prolong, &kernels_->coarsest, &kernels_->cgDirection,
-          &kernels_->cgUpdate, &kernels_->scalars, &kernels_->irlsWeights})
-        for (std::uint32_t i = 0; i < gpu::kPoissonBindCount; ++i) k->bind(i, *buffers[i]);
+    kernels_->bindAll(
+        {&coef, &x, &b, &r, &p, &ap, &sol, &rhs, &primal, &dx, &dy, &weights, &irls, &scalars, &partials});
 }
 
 void PoissonGpuEngine::dispatch(VkCommandBuffer cmd, const vk::Kernel& kernel, int itemsX, int itemsY,
@@ -158,14 +181,15 @@ void PoissonGpuEngine::recordSetup(VkCommandBuffer cmd, float alpha2, bool irlsW
     PoissonPush push = levelPush(levels_[0], groups());
     push.alpha2 = alpha2;
     push.flags = gpu::kPoissonFlagDot | (irlsWeights ? gpu::kPoissonFlagIrls : 0u);
-    dispatch(cmd, kernels_->setup, width(), height(), &push, timer);
+    dispatch(cmd, kernels_->get(PoissonOp::Setup, push.flags), width(), height(), &push, timer);
 }
 
 void PoissonGpuEngine::recordCoarsenAll(VkCommandBuffer cmd, vk::GpuTimer* timer) {
     for (std::size_t l = 0; l + 1 < levels_.size(); ++l) {
         PoissonPush push = levelPush(levels_[l], groups());
         withCoarse(push, levels_[l + 1]);
-        dispatch(cmd, kernels_->coarsen, levels_[l + 1].width, levels_[l + 1].height, &push, timer);
+        dispatch(cmd, kernels_->get(PoissonOp::Coarsen, 0u), levels_[l + 1].width, levels_[l + 1].height,
+                 &push, timer);
     }
 }
 
@@ -173,7 +197,7 @@ void PoissonGpuEngine::recordResidual(VkCommandBuffer cmd, int level, std::uint3
                                       vk::GpuTimer* timer) {
     PoissonPush push = levelPush(levels_.at(static_cast<std::size_t>(level)), groups());
     push.flags = flags;
-    dispatch(cmd, kernels_->residual, push.width, push.height, &push, timer);
+    dispatch(cmd, kernels_->get(PoissonOp::Residual, flags), push.width, push.height, &push, timer);
 }
 
 void PoissonGpuEngine::recordSmooth(VkCommandBuffer cmd, int level, std::uint32_t flags, std::uint32_t colour,
@@ -185,7 +209,8 @@ void PoissonGpuEngine::recordSmooth(VkCommandBuffer cmd, int level, std::uint32_
     push.colour = colour;
     push.omega = omega;
     // One invocation per horizontal pixel pair (see poisson_smooth.comp).
-    dispatch(cmd, kernels_->smooth, (levels_[l].width + 1) / 2, push.height, &push, timer);
+    dispatch(cmd, kernels_->get(PoissonOp::Smooth, flags), (levels_[l].width + 1) / 2, push.height, &push,
+             timer);
 }
 
 void PoissonGpuEngine::recordRestrict(VkCommandBuffer cmd, int level, std::uint32_t flags,
@@ -194,20 +219,21 @@ void PoissonGpuEngine::recordRestrict(VkCommandBuffer cmd, int level, std::uint3
     PoissonPush push = levelPush(levels_.at(l), groups());
     withCoarse(push, levels_.at(l + 1));
     push.flags = flags;
-    dispatch(cmd, kernels_->restrictResidual, push.coarseWidth, push.coarseHeight, &push, timer);
+    dispatch(cmd, kernels_->get(PoissonOp::Restrict, flags), push.coarseWidth, push.coarseHeight, &push,
+             timer);
 }
 
 void PoissonGpuEngine::recordProlong(VkCommandBuffer cmd, int level, vk::GpuTimer* timer) {
     const std::size_t l = static_cast<std::size_t>(level);
     PoissonPush push = levelPush(levels_.at(l), groups());
     withCoarse(push, levels_.at(l + 1));
-    dispatch(cmd, kernels_->prolong, push.width, push.height, &push, timer);
+    dispatch(cmd, kernels_->get(PoissonOp::Prolong, 0u), push.width, push.height, &push, timer);
 }
 
 void PoissonGpuEngine::recordCoarsest(VkCommandBuffer cmd, bool zeroGuess, vk::GpuTimer* timer) {
     PoissonPush push = levelPush(levels_.back(), groups());
     push.flags = zeroGuess ? gpu::kPoissonFlagZeroGuess : 0u;
-    kernels_->coarsest.dispatch(cmd, 1, 1, 1, &push, timer);
+    kernels_->get(PoissonOp::Coarsest, push.flags).dispatch(cmd, 1, 1, 1, &push, timer);
     vk::computeBarrier(cmd);
 }
 
@@ -217,13 +243,13 @@ void PoissonGpuEngine::recordCgDirection(VkCommandBuffer cmd, std::uint32_t flag
     push.flags = flags;
     push.pOld = pOld;
     push.pNew = pNew;
-    dispatch(cmd, kernels_->cgDirection, width(), height(), &push, timer);
+    dispatch(cmd, kernels_->get(PoissonOp::CgDirection, flags), width(), height(), &push, timer);
 }
 
 void PoissonGpuEngine::recordCgUpdate(VkCommandBuffer cmd, std::uint32_t pNew, vk::GpuTimer* timer) {
     PoissonPush push = levelPush(levels_[0], groups());
     push.pNew = pNew;
-    dispatch(cmd, kernels_->cgUpdate, width(), height(), &push, timer);
+    dispatch(cmd, kernels_->get(PoissonOp::CgUpdate, 0u), width(), height(), &push, timer);
 }
 
 void PoissonGpuEngine::recordScalars(VkCommandBuffer cmd, std::uint32_t mode, std::uint32_t flags,
@@ -236,7 +262,7 @@ void PoissonGpuEngine::recordScalars(VkCommandBuffer cmd, std::uint32_t mode, st
     push.tolerance = tolerance;
     push.value = value;
     push.groups = groups();
-    kernels_->scalars.dispatch(cmd, 1, 1, 1, &push, timer);
+    kernels_->get(PoissonOp::Scalars, flags).dispatch(cmd, 1, 1, 1, &push, timer);
     vk::computeBarrier(cmd);
 }
 
@@ -244,7 +270,7 @@ void PoissonGpuEngine::recordIrlsWeights(VkCommandBuffer cmd, float alpha2, floa
     PoissonPush push = levelPush(levels_[0], groups());
     push.alpha2 = alpha2;
     push.reg = reg;
-    dispatch(cmd, kernels_->irlsWeights, width(), height(), &push, timer);
+    dispatch(cmd, kernels_->get(PoissonOp::IrlsWeights, 0u), width(), height(), &push, timer);
 }
 
 void PoissonGpuEngine::recordVcycle(VkCommandBuffer cmd, const VcycleParams& params, bool zeroGuess,

@@ -10,10 +10,13 @@
 
 #include <vulkan/vulkan.h>
 
+#include <array>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <vector>
 
+#include "poisson_shared.h"
 #include "vk/buffer.h"
 #include "vk/kernel.h"
 
@@ -24,20 +27,54 @@ class GpuTimer;
 
 namespace gdpt {
 
-// The compiled poisson_* pipelines for one workgroup shape (2D kernels; reductions need
-// x·y to be a power of two ≤ 256). Pipeline creation dominates set-up on lavapipe, so
-// callers that solve many sizes keep one PoissonKernels and pass it to each engine.
+// The poisson_*.comp kernels.
+enum class PoissonOp {
+    Setup,
+    Coarsen,
+    Residual,
+    Smooth,
+    Restrict,
+    Prolong,
+    Coarsest,
+    CgDirection,
+    CgUpdate,
+    Scalars,
+    IrlsWeights,
+    Count
+};
+
+// The poisson_* pipelines for one workgroup shape (2D kernels; reductions need x·y to be a
+// power of two ≤ 256). Each kernel has one pipeline variant per set of kPoissonFlag* bits
+// (the specialisation constant kSpecPoissonFlags, so that untaken paths are compiled out),
+// created on first use and kept. Pipeline creation dominates set-up on lavapipe, so callers
+// that solve many sizes keep one PoissonKernels and pass it to each engine.
 class PoissonKernels {
 public:
+    using Buffers = std::array<const vk::Buffer*, gpu::kPoissonBindCount>;
+
     PoissonKernels(const vk::Context& ctx, std::uint32_t groupX = 16, std::uint32_t groupY = 16);
+    ~PoissonKernels();
+    PoissonKernels(const PoissonKernels&) = delete;
+    PoissonKernels& operator=(const PoissonKernels&) = delete;
+
     [[nodiscard]] std::uint32_t groupX() const { return groupX_; }
     [[nodiscard]] std::uint32_t groupY() const { return groupY_; }
 
-    vk::Kernel setup, coarsen, residual, smooth, restrictResidual, prolong, coarsest, cgDirection, cgUpdate,
-        scalars, irlsWeights;
+    // The variant of `op` for `flags`, bound to the buffers of the last bindAll().
+    const vk::Kernel& get(PoissonOp op, std::uint32_t flags);
+    // Points every variant (existing and future) at `buffers`, indexed by kPoissonBind*.
+    void bindAll(const Buffers& buffers);
+    // Number of pipelines created so far (for tests and set-up cost reports).
+    [[nodiscard]] std::size_t variantCount() const;
 
 private:
+    const vk::Context& ctx_;
     std::uint32_t groupX_, groupY_;
+    std::array<vk::KernelDesc, static_cast<std::size_t>(PoissonOp::Count)> descs_;
+    std::array<std::map<std::uint32_t, std::unique_ptr<vk::Kernel>>,
+               static_cast<std::size_t>(PoissonOp::Count)>
+        variants_;
+    Buffers bound_{};
 };
 
 struct PoissonLevel {
