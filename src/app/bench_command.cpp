@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/bench_util.h"
 #include "app/subcommand.h"
 #include "bvh/builder.h"
 #include "render/bench_pass.h"
@@ -32,12 +33,6 @@ struct BenchArgs {
     std::string device;
     std::string output = "-";
 };
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
-}
 
 Scene benchScene(const std::string& name) {
     if (name == "cbox") return makeCornellBox();

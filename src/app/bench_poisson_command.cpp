@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 
+#include "app/bench_util.h"
 #include "app/subcommand.h"
 #include "poisson/poisson_gpu.h"
 #include "util/error.h"
@@ -33,21 +34,6 @@ struct BenchPoissonArgs {
     std::string device;
     bool profile = false;
 };
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
-}
-
-std::vector<std::string> splitList(const std::string& text) {
-    std::vector<std::string> out;
-    std::stringstream in(text);
-    std::string item;
-    while (std::getline(in, item, ','))
-        if (!item.empty()) out.push_back(item);
-    return out;
-}
 
 // "N" (square) or "WxH".
 std::pair<int, int> parseSize(const std::string& s) {

@@ -2,6 +2,7 @@
 
 #include <memory>
 
+#include "app/bench_util.h"
 #include "app/subcommand.h"
 
 #include <algorithm>
@@ -34,17 +35,6 @@ using nlohmann::json;
 std::atomic<bool> gInterrupted{false};
 
 extern "C" void onInterrupt(int) { gInterrupted.store(true); }
-
-// Largest batch (samples per pixel per submission) such that one batch is about 2^19
-// pixel-samples of PT work (G-PT: a quarter, it costs more per sample). Depends only on the
-// image size, so the batch schedule -- and hence the bits of the result -- is the same on
-// every run, and a batch stays well under a second on lavapipe, so an interrupt is served
-// promptly.
-std::uint32_t batchLimit(int width, int height, bool gpt) {
-    const std::uint64_t pixels = std::uint64_t(width) * std::uint64_t(height);
-    const std::uint64_t budget = gpt ? (1u << 16) : (1u << 18);
-    return static_cast<std::uint32_t>(std::clamp<std::uint64_t>(budget / pixels, 1, 16));
-}
 
 WorkgroupSize parseWorkgroup(const std::string& text) {
     unsigned x = 0, y = 0;
@@ -190,20 +180,15 @@ int runRender(const RenderArgs& args) {
             stats.reconstructionMs += report.ms;
             return recon;
         };
-        auto plus = [](Image a, const Image& b) {
-            for (int c = 0; c < 3; ++c)
-                for (std::size_t i = 0; i < a.pixelCount(); ++i) a.plane(c)[i] += b.plane(c)[i];
-            return a;
-        };
         const Image recon = solve(args.recon);
-        layers = {{"", plus(recon, g.direct)}, {"recon_" + args.recon, recon}};
+        layers = {{"", addImages(recon, g.direct)}, {"recon_" + args.recon, recon}};
         if (args.allRecon)
             for (const char* other : {"l1", "l2", "wl2"})
                 if (args.recon != other) layers.push_back({std::string("recon_") + other, solve(other)});
         const std::vector<NamedLayer> buffers = {
             {"primal", g.primal}, {"dx", g.dx},         {"dy", g.dy},         {"direct", g.direct},
             {"var_primal", g.varPrimal}, {"var_dx", g.varDx}, {"var_dy", g.varDy}, {"var_direct", g.varDirect},
-            {"primal_plus_direct", plus(g.primal, g.direct)}};
+            {"primal_plus_direct", addImages(g.primal, g.direct)}};
         layers.insert(layers.end(), buffers.begin(), buffers.end());
     } else {
         RenderResult r = renderPt(ctx, scene, options);

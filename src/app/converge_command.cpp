@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/bench_util.h"
 #include "app/subcommand.h"
 #include "image/exr_io.h"
 #include "image/metrics.h"
@@ -47,21 +48,6 @@ struct ConvergeArgs {
     std::string device;
 };
 
-std::vector<std::string> splitList(const std::string& s) {
-    std::vector<std::string> out;
-    std::stringstream in(s);
-    std::string item;
-    while (std::getline(in, item, ','))
-        if (!item.empty()) out.push_back(item);
-    return out;
-}
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
-}
-
 // FNV-1a of the scene file's bytes and the render settings: the cache key of a made reference.
 std::string referenceKey(const std::string& scenePath, int w, int h, std::uint32_t spp) {
     std::ifstream in(scenePath, std::ios::binary);
@@ -73,13 +59,6 @@ std::string referenceKey(const std::string& scenePath, int w, int h, std::uint32
     char buf[32];
     std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(hash));
     return buf;
-}
-
-Image addImages(const Image& a, const Image& b) {
-    Image out = a;
-    for (int c = 0; c < 3; ++c)
-        for (std::size_t i = 0; i < out.pixelCount(); ++i) out.plane(c)[i] += b.plane(c)[i];
-    return out;
 }
 
 struct Run {
@@ -117,7 +96,7 @@ public:
             SolveOptions so = solveOptions(method);
             // Sampling gets what is left after the (measured) reconstruction time.
             o.timeBudget = std::max(0.05 * budget, budget - reconSeconds(method, so));
-            o.maxBatchSpp = std::max<std::uint32_t>(1, static_cast<std::uint32_t>((1u << 16) / (a_.width * a_.height)));
+            o.maxBatchSpp = batchLimit(a_.width, a_.height, true);
             RenderResultGpt g = renderGpt(ctx_, scene_, o);
             Timer recon;
             const Image solved = solve(g.primal, g.dx, g.dy, &g.varPrimal, &g.varDx, &g.varDy, so);

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
         addSolveCommand(app),
         addCloneCommand(app),
         addBenchPoissonCommand(app),
+        addBenchFeaturesCommand(app),
     };
 
     try {

@@ -23,5 +23,6 @@ Subcommand addConvergeCommand(CLI::App& app);
 Subcommand addSolveCommand(CLI::App& app);
 Subcommand addCloneCommand(CLI::App& app);
 Subcommand addBenchPoissonCommand(CLI::App& app);
+Subcommand addBenchFeaturesCommand(CLI::App& app);
 
 }  // namespace gdpt

@@ -30,4 +30,13 @@ double Image::grayMean() const {
     return (m[0] + m[1] + m[2]) / 3.0;
 }
 
+Image addImages(Image a, const Image& b) {
+    if (!a.sameSize(b))
+        throw Error("cannot add a " + std::to_string(b.width()) + "x" + std::to_string(b.height()) +
+                    " image to a " + std::to_string(a.width()) + "x" + std::to_string(a.height()) + " one");
+    for (int c = 0; c < Image::kChannels; ++c)
+        for (std::size_t i = 0; i < a.pixelCount(); ++i) a.plane(c)[i] += b.plane(c)[i];
+    return a;
+}
+
 }  // namespace gdpt

@@ -51,4 +51,8 @@ private:
     std::array<std::vector<float>, kChannels> planes_;
 };
 
+// a + b per pixel and channel (e.g. reconstruction + very-direct image). Throws gdpt::Error
+// if the sizes differ.
+[[nodiscard]] Image addImages(Image a, const Image& b);
+
 }  // namespace gdpt

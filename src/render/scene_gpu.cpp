@@ -153,6 +153,7 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     // Kernels loop to min(spec max depth, scene.maxDepth); a small user depth is also
     // compiled in so that the loop bound is a constant the compiler can see.
     maxDepthSpec_ = std::min<std::uint32_t>(options.maxDepth + 1, 1024);
+    genericFeatures_ = options.genericFeatures;
 
     triGeom_ = makeBuffer(ctx, geoms, "triangle geometry");
     triShading_ = makeBuffer(ctx, shading, "triangle shading");
@@ -179,13 +180,14 @@ void SceneGpu::bindTo(vk::Kernel& kernel) const {
 
 std::vector<std::pair<std::uint32_t, std::uint32_t>> SceneGpu::specConstants() const {
     auto b = [](bool v) { return v ? 1u : 0u; };
-    return {{gpu::kSpecHasTextures, b(features_.hasTextures)},
-            {gpu::kSpecHasPunctual, b(features_.hasPunctual)},
-            {gpu::kSpecHasLightTris, b(features_.hasLightTris)},
-            {gpu::kSpecHasEnv, b(features_.hasEnv)},
-            {gpu::kSpecHasGlossy, b(features_.hasGlossy)},
-            {gpu::kSpecHasAlphaMask, b(features_.hasAlphaMask)},
-            {gpu::kSpecMaxDepth, maxDepthSpec_}};
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> spec = {
+        {gpu::kSpecHasTextures, b(features_.hasTextures)}, {gpu::kSpecHasPunctual, b(features_.hasPunctual)},
+        {gpu::kSpecHasLightTris, b(features_.hasLightTris)}, {gpu::kSpecHasEnv, b(features_.hasEnv)},
+        {gpu::kSpecHasGlossy, b(features_.hasGlossy)},     {gpu::kSpecHasAlphaMask, b(features_.hasAlphaMask)},
+        {gpu::kSpecMaxDepth, maxDepthSpec_}};
+    for (auto& [id, value] : spec)
+        if (genericFeatures_ & (1u << id)) value = id == gpu::kSpecMaxDepth ? 1024u : 1u;
+    return spec;
 }
 
 vk::KernelDesc SceneGpu::kernelDesc(vk::KernelDesc base, WorkgroupSize wg,

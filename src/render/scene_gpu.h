@@ -33,6 +33,10 @@ struct SceneGpuOptions {
     glm::vec3 envRadiance{0.0f};
     int camera = -1;  // index into Scene::cameras; -1 = first, or a framing default
     float shiftThreshold = 0.001f;
+    // Bits (1u << kSpec*) of scene features to compile in whatever the scene needs (the
+    // generic kernel; kSpecMaxDepth: the 1024-bounce cap). For `gdpt bench-features`, which
+    // measures what each specialisation saves; renders leave it 0.
+    std::uint32_t genericFeatures = 0;
 };
 
 struct BvhBuildInfo {
@@ -67,6 +71,7 @@ private:
     gpu::SceneConstants constants_{};
     BvhBuildInfo bvhInfo_;
     std::uint32_t maxDepthSpec_ = 1024;
+    std::uint32_t genericFeatures_ = 0;
     vk::Buffer triGeom_, triShading_, bvh_, materials_, texInfo_, texels_, lightTris_, punctual_,
         sceneConst_;
 };

@@ -74,6 +74,16 @@ TEST(Metrics, SizeMismatchThrows) {
     EXPECT_THROW(relMse(Image(3, 1), Image(1, 3)), Error);
 }
 
+TEST(Image, AddImagesSumsEveryChannelAndRefusesOtherSizes) {
+    Image a(2, 1, 1.0f), b(2, 1, 0.0f);
+    b.at(1, 0, 2) = 2.5f;
+    const Image sum = addImages(a, b);
+    EXPECT_EQ(sum.at(0, 0, 2), 1.0f);
+    EXPECT_EQ(sum.at(1, 0, 2), 3.5f);
+    EXPECT_EQ(sum.at(1, 0, 0), 1.0f);
+    EXPECT_THROW((void)addImages(a, Image(1, 2)), Error);
+}
+
 TEST(Metrics, CboxReferenceAgainstItselfAndReadmeMean) {
     const std::string file = std::string(GDPT_SHARED_DIR) + "/scenes/cbox/reference.exr";
     if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " not present";

@@ -1,0 +1,180 @@
+// bench_features_command.cpp — `gdpt bench-features SCENE...`: what each specialisation
+// constant saves (JSON, not a test). For every scene and method (pt, gpt) it renders the
+// kernel variant gdpt picks for the scene ("specialised"), the variant with one feature the
+// scene lacks compiled in anyway (one per such feature), and the variant with every feature
+// compiled in ("generic"). Repeats are interleaved across variants so that a load change on
+// the shared machine hits all of them alike; each figure is the median samples/s over the
+// repeats, and ratio = specialised samples/s / variant samples/s (> 1: the specialisation
+// pays); an untimed 1-spp render of every variant comes first. image_rel_mse compares each variant's image
+// with the specialised one rendered with the same seed (Kettunen relMSE): a feature that is absent must not
+// change the estimator, so it is 0 or at the float-rounding level.
+#include <cstdio>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "app/bench_util.h"
+#include "app/subcommand.h"
+#include "image/metrics.h"
+#include "render/features.h"
+#include "render/gpt_renderer.h"
+#include "render/renderer.h"
+#include "scene/gltf_loader.h"
+#include "util/error.h"
+#include "vk/context.h"
+
+namespace gdpt {
+namespace {
+
+struct BenchFeaturesArgs {
+    std::vector<std::string> scenes;
+    std::string methods = "pt,gpt";
+    int width = 128;
+    int height = 128;
+    std::uint32_t spp = 4;
+    int repeats = 3;
+    std::string device;
+    std::string output = "-";
+};
+
+struct Feature {
+    const char* name;
+    std::uint32_t specId;
+    bool (*needed)(const SceneFeatures&, bool gpt);
+};
+
+// kHasGlossy only exists in the G-PT kernel (the half-vector shift); PT compiles the same
+// code either way, so it is never "lacking" there. kMaxDepth is always specialised (the
+// scene's own depth cap), so its generic variant is the 1024-bounce loop bound.
+const Feature kFeatures[] = {
+    {"textures", gpu::kSpecHasTextures, [](const SceneFeatures& f, bool) { return f.hasTextures; }},
+    {"punctual", gpu::kSpecHasPunctual, [](const SceneFeatures& f, bool) { return f.hasPunctual; }},
+    {"light_tris", gpu::kSpecHasLightTris, [](const SceneFeatures& f, bool) { return f.hasLightTris; }},
+    {"env", gpu::kSpecHasEnv, [](const SceneFeatures& f, bool) { return f.hasEnv; }},
+    {"glossy", gpu::kSpecHasGlossy, [](const SceneFeatures& f, bool gpt) { return f.hasGlossy || !gpt; }},
+    {"alpha_mask", gpu::kSpecHasAlphaMask, [](const SceneFeatures& f, bool) { return f.hasAlphaMask; }},
+    {"max_depth", gpu::kSpecMaxDepth, [](const SceneFeatures&, bool) { return false; }},
+};
+
+struct Variant {
+    std::string name;
+    std::uint32_t generic = 0;  // SceneGpuOptions::genericFeatures
+    std::vector<double> samplesPerS;
+    Image image;  // first repeat's image (seed 0)
+};
+
+// One render of `method` with the variant's generic features; returns samples/s and the
+// image (G-PT: primal + direct, the estimator before reconstruction).
+double renderOnce(const vk::Context& ctx, const Scene& scene, const BenchFeaturesArgs& a, bool gpt,
+                  std::uint32_t generic, std::uint32_t seed, Image* image) {
+    RenderOptions ro;
+    ro.scene.width = a.width;
+    ro.scene.height = a.height;
+    ro.scene.genericFeatures = generic;
+    ro.spp = a.spp;
+    ro.seed = seed;
+    ro.quiet = true;
+    ro.maxBatchSpp = batchLimit(a.width, a.height, gpt);
+    if (!gpt) {
+        RenderResult r = renderPt(ctx, scene, ro);
+        if (image) *image = std::move(r.image);
+        return static_cast<double>(r.stats.pathsCompleted) / (r.stats.samplingMs * 1e-3);
+    }
+    GptPassOptions go;
+    go.forceHalfVector = (generic & (1u << gpu::kSpecHasGlossy)) != 0;
+    RenderResultGpt r = renderGpt(ctx, scene, ro, go);
+    if (image) *image = addImages(r.primal, r.direct);
+    return static_cast<double>(r.stats.pathsCompleted) / (r.stats.samplingMs * 1e-3);
+}
+
+int runBenchFeatures(const BenchFeaturesArgs& a) {
+    using nlohmann::json;
+    const std::vector<std::string> methods = splitList(a.methods);
+    for (const std::string& m : methods)
+        if (m != "pt" && m != "gpt") throw UsageError("--methods: unknown method '" + m + "' (pt, gpt)");
+    vk::ContextOptions co;
+    co.device = a.device;
+    vk::Context ctx(co);
+    json out = {{"device", ctx.info().name},
+                {"driver", ctx.info().driverInfo},
+                {"width", a.width},
+                {"height", a.height},
+                {"spp", a.spp},
+                {"repeats", a.repeats},
+                {"results", json::array()}};
+    for (const std::string& path : a.scenes) {
+        const Scene scene = loadGltf(path);
+        const SceneFeatures f = analyzeScene(scene, glm::vec3(0.0f));
+        for (const std::string& method : methods) {
+            const bool gpt = method == "gpt";
+            std::vector<Variant> variants = {{"specialised", 0, {}, {}}};
+            std::uint32_t all = 0;
+            for (const Feature& feat : kFeatures) {
+                if (feat.needed(f, gpt)) continue;
+                variants.push_back({std::string("+") + feat.name, 1u << feat.specId, {}, {}});
+                all |= 1u << feat.specId;
+            }
+            variants.push_back({"generic", all, {}, {}});
+            // Untimed warm-up: lavapipe compiles a pipeline at its first dispatch (later
+            // renders of the same variant hit Mesa's shader cache), which would otherwise
+            // land in the first repeat's sampling time.
+            BenchFeaturesArgs warm = a;
+            warm.spp = 1;
+            for (const Variant& v : variants) renderOnce(ctx, scene, warm, gpt, v.generic, 0, nullptr);
+            for (int r = 0; r < a.repeats; ++r)
+                for (Variant& v : variants) {
+                    std::fprintf(stderr, "gdpt bench-features: %s %s %s (repeat %d)\n", path.c_str(),
+                                 method.c_str(), v.name.c_str(), r + 1);
+                    v.samplesPerS.push_back(renderOnce(ctx, scene, a, gpt, v.generic,
+                                                       static_cast<std::uint32_t>(r),
+                                                       r == 0 ? &v.image : nullptr));
+                }
+            const double base = median(variants[0].samplesPerS);
+            json rows = json::array();
+            for (const Variant& v : variants) {
+                const double sps = median(v.samplesPerS);
+                rows.push_back({{"variant", v.name},
+                                {"samples_per_s", sps},
+                                {"all_samples_per_s", v.samplesPerS},
+                                {"ratio", base / sps},
+                                {"image_rel_mse", relMse(v.image, variants[0].image)}});
+            }
+            out["results"].push_back({{"scene", path}, {"method", method}, {"variants", rows}});
+        }
+    }
+    const std::string text = out.dump(2) + "\n";
+    if (a.output == "-") {
+        std::fputs(text.c_str(), stdout);
+    } else {
+        FILE* file = std::fopen(a.output.c_str(), "w");
+        if (!file) throw Error(a.output + ": cannot write");
+        std::fputs(text.c_str(), file);
+        std::fclose(file);
+    }
+    return 0;
+}
+
+}  // namespace
+
+Subcommand addBenchFeaturesCommand(CLI::App& app) {
+    auto args = std::make_shared<BenchFeaturesArgs>();
+    CLI::App* b = app.add_subcommand(
+        "bench-features",
+        "What each specialisation constant saves: samples/s of specialised vs generic kernels (JSON)");
+    b->add_option("scenes", args->scenes, "glTF 2.0 scenes")->required()->check(CLI::ExistingFile);
+    b->add_option("--methods", args->methods, "Comma-separated: pt, gpt")->capture_default_str();
+    b->add_option("--width", args->width, "Image width")->capture_default_str()->check(CLI::Range(1, 4096));
+    b->add_option("--height", args->height, "Image height")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 4096));
+    b->add_option("--spp", args->spp, "Samples per pixel per render")
+        ->capture_default_str()
+        ->check(CLI::Range(1u, 4096u));
+    b->add_option("--repeats", args->repeats, "Interleaved repeats per variant (median reported)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 100));
+    b->add_option("--device", args->device, "Vulkan device index or name substring");
+    b->add_option("-o,--output", args->output, "Write the JSON here ('-' = stdout)")->capture_default_str();
+    return {b, [args] { return runBenchFeatures(*args); }};
+}
+
+}  // namespace gdpt
