@@ -33,6 +33,9 @@ struct RenderArgs {
     double alpha = 0.2;
     double tolerance = 1e-4;
     bool allRecon = false;
+    std::string checkpoint;        // write the sampler state here on interrupt / periodically / at the end
+    double checkpointEvery = 0.0;  // seconds between periodic checkpoints (0 = only at the end)
+    std::string resume;            // continue from this checkpoint
 };
 
 struct DiffArgs {

@@ -10,13 +10,16 @@
 #include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "app/render_checkpoint.h"
 #include "image/exr_io.h"
 #include "image/metrics.h"
 #include "image/png_preview.h"
+#include "render/checkpoint.h"
 #include "render/features.h"
 #include "poisson/poisson_gpu.h"
 #include "render/gpt_renderer.h"
@@ -144,6 +147,31 @@ int runRender(const RenderArgs& args) {
     options.scene.shiftThreshold = args.shiftThreshold;
     options.maxBatchSpp = batchLimit(args.width, args.height, args.method == "gpt");
     options.cancel = &gInterrupted;
+
+    // Checkpoints: the identity of this render is recorded in every checkpoint written, and a
+    // checkpoint resumed from must have the same (render_checkpoint.h).
+    const ExrAttributes identity = renderIdentity(args, scene, options.maxBatchSpp);
+    std::optional<Checkpoint> resumed;
+    if (!args.resume.empty()) {
+        resumed = readCheckpoint(args.resume);
+        checkIdentity(args.resume, resumed->identity, identity);
+        if (args.time <= 0.0 && resumed->state.spp > args.spp)
+            throw Error(args.resume + ": checkpoint already has " + std::to_string(resumed->state.spp) +
+                        " spp, more than --spp " + std::to_string(args.spp));
+        if (!args.quiet && resumed->info.count("device") && resumed->info["device"] != ctx.info().name)
+            std::fprintf(stderr,
+                         "gdpt: warning: %s was rendered on '%s'; continuing on '%s' (same statistics, "
+                         "not the same bits)\n",
+                         args.resume.c_str(), resumed->info["device"].c_str(), ctx.info().name.c_str());
+        options.resume = &resumed->state;
+    }
+    if (!args.checkpoint.empty()) {
+        const ExrAttributes info = {{"device", ctx.info().name}, {"scene_file", args.scene}};
+        options.checkpoint = [&args, identity, info](const SamplerState& state) {
+            writeCheckpoint(args.checkpoint, identity, info, state);
+        };
+        options.checkpointEvery = args.checkpointEvery;
+    }
     std::signal(SIGINT, onInterrupt);
     std::signal(SIGTERM, onInterrupt);
 
@@ -197,7 +225,13 @@ int runRender(const RenderArgs& args) {
     }
 
     if (stats.cancelled) {
-        std::fprintf(stderr, "gdpt: interrupted after %u spp; no output written\n", stats.spp);
+        if (args.checkpoint.empty())
+            std::fprintf(stderr, "gdpt: interrupted after %u spp; no output written\n", stats.spp);
+        else
+            std::fprintf(
+                stderr,
+                "gdpt: interrupted after %u spp; checkpoint written to %s (continue with --resume %s)\n",
+                stats.spp, args.checkpoint.c_str(), args.checkpoint.c_str());
         return 130;
     }
     Timer writeTimer;
@@ -376,6 +410,21 @@ Subcommand addRenderCommand(CLI::App& app) {
     r->add_option("--json", render.json, "Write render statistics as JSON to this file");
     r->add_flag("--quiet", render.quiet, "No progress output");
     r->add_flag("--validate", render.validate, "Enable Vulkan validation layers (errors make the run fail)");
+    CLI::Option* checkpoint = r->add_option(
+        "--checkpoint", render.checkpoint,
+        "Write the samples so far and the state to continue them to this EXR (tmp + rename) when "
+        "interrupted (SIGINT/SIGTERM, exit 130), every --checkpoint-every seconds, and at the end");
+    r->add_option(
+         "--checkpoint-every", render.checkpointEvery,
+         "Seconds between periodic checkpoints, at batch boundaries (0 = only on interrupt and at the end)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1e7))
+        ->needs(checkpoint);
+    r->add_option("--resume", render.resume,
+                  "Continue from a checkpoint of the same scene, method, size, seed, depth, env, camera and "
+                  "schedule; --spp is the total including its samples (bit-identical to an uninterrupted run "
+                  "when it was written by an interrupt or a periodic checkpoint)")
+        ->check(CLI::ExistingFile);
 
     return {r, [args] { return runRender(*args); }};
 }

@@ -18,6 +18,7 @@
 
 #include "app/bench_util.h"
 #include "app/subcommand.h"
+#include "image/atomic_write.h"
 #include "image/exr_io.h"
 #include "image/metrics.h"
 #include "poisson/poisson_gpu.h"
@@ -46,6 +47,7 @@ struct ConvergeArgs {
     double target = 0.0;
     std::string output = "converge";
     std::string device;
+    bool validate = false;
 };
 
 // FNV-1a of the scene file's bytes and the render settings: the cache key of a made reference.
@@ -218,10 +220,20 @@ double timeToReach(const json& summary, const std::string& method, double target
     return -1.0;
 }
 
+void writeTextFile(const std::string& path, const std::string& text) {
+    writeFileAtomically(path, [&](const std::string& tmp) {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        out << text;
+        out.close();
+        if (!out) throw Error("write failed");
+    });
+}
+
 int runConverge(const ConvergeArgs& a) {
     const Scene scene = loadGltf(a.scene);
     vk::ContextOptions co;
     co.device = a.device;
+    co.validation = a.validate;
     vk::Context ctx(co);
     const fs::path dir(a.output);
     fs::create_directories(dir);
@@ -317,7 +329,7 @@ int runConverge(const ConvergeArgs& a) {
     for (const auto& m : methods) reach[m] = timeToReach(summary, m, target);
 
     json runsJson = json::array();
-    std::ofstream csv(dir / "results.csv");
+    std::ostringstream csv;
     csv << "method,budget_s,repeat,seconds,recon_seconds,spp,relmse,mse,mae,mean_bias\n";
     for (std::size_t i = 0; i < runs.size(); ++i) {
         const Run& r = runs[i];
@@ -343,7 +355,9 @@ int runConverge(const ConvergeArgs& a) {
                           {"equal_time", equalTime},
                           {"target_relmse", target},
                           {"time_to_target_s", reach}};
-    std::ofstream(dir / "results.json") << results.dump(2) << "\n";
+    // Written via name.tmp + rename, so an interrupted run never leaves a truncated table.
+    writeTextFile((dir / "results.json").string(), results.dump(2) + "\n");
+    writeTextFile((dir / "results.csv").string(), csv.str());
     writePlot(dir, methods, summary);
 
     std::printf("%-10s", "budget(s)");
@@ -357,6 +371,10 @@ int runConverge(const ConvergeArgs& a) {
     std::printf("time to relMSE %.4g:", target);
     for (const auto& m : methods) std::printf("  %s %.3gs", m.c_str(), reach[m].get<double>());
     std::printf("\nwrote %s/results.json, results.csv, error_vs_time.png\n", dir.c_str());
+    if (ctx.validationErrors() > 0) {
+        std::fprintf(stderr, "gdpt converge: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
+        return 1;
+    }
     return 0;
 }
 
@@ -379,6 +397,7 @@ Subcommand addConvergeCommand(CLI::App& app) {
                                          "the largest budget)");
     c->add_option("-o,--output", a->output, "Output directory")->capture_default_str();
     c->add_option("--device", a->device, "Vulkan device index or name substring");
+    c->add_flag("--validate", a->validate, "Enable Vulkan validation layers (errors make the run fail)");
     return {c, [a] { return runConverge(*a); }};
 }
 

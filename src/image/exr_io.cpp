@@ -7,6 +7,7 @@
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStdIO.h>
+#include <OpenEXR/ImfStringAttribute.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -31,11 +32,13 @@ struct LayerChannels {
     std::map<std::string, std::string> bySuffix;  // suffix -> full channel name
 };
 
-void writeLayers(const std::string& tmpPath, const std::vector<NamedLayer>& layers) {
+void writeLayers(const std::string& tmpPath, const std::vector<NamedLayer>& layers,
+                 const ExrAttributes& attributes) {
     const int width = layers.front().image.width();
     const int height = layers.front().image.height();
     Imf::Header header(width, height);
     header.compression() = Imf::ZIP_COMPRESSION;
+    for (const auto& [name, value] : attributes) header.insert(name, Imf::StringAttribute(value));
     Imf::FrameBuffer frameBuffer;
     static const char* const kSuffix[3] = {"R", "G", "B"};
     const std::size_t xStride = sizeof(float);
@@ -147,12 +150,17 @@ std::vector<NamedLayer> readLayers(const std::string& path) {
 }  // namespace
 
 void writeExr(const std::string& path, const std::vector<NamedLayer>& layers) {
+    writeExr(path, layers, ExrAttributes{});
+}
+
+void writeExr(const std::string& path, const std::vector<NamedLayer>& layers,
+              const ExrAttributes& attributes) {
     try {
         validateLayers(layers);
     } catch (const Error& e) {
         throw e.withContext(path);
     }
-    writeFileAtomically(path, [&](const std::string& tmpPath) { writeLayers(tmpPath, layers); });
+    writeFileAtomically(path, [&](const std::string& tmpPath) { writeLayers(tmpPath, layers, attributes); });
 }
 
 void writeExr(const std::string& path, const Image& image) {
@@ -169,6 +177,19 @@ std::vector<NamedLayer> readExr(const std::string& path) {
         throw Error(path + ": cannot read EXR: " + e.what());
     } catch (...) {
         throw Error(path + ": cannot read EXR: unknown error");
+    }
+}
+
+ExrAttributes readExrAttributes(const std::string& path) {
+    try {
+        Imf::InputFile file(path.c_str());
+        ExrAttributes out;
+        for (auto it = file.header().begin(); it != file.header().end(); ++it)
+            if (const auto* text = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
+                out[it.name()] = text->value();
+        return out;
+    } catch (const std::exception& e) {
+        throw Error(path + ": cannot read EXR: " + e.what());
     }
 }
 

@@ -5,6 +5,7 @@
 // scan-line, with data window = display window = [0, w-1] x [0, h-1].
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,15 @@ struct NamedLayer {
 // must have the same non-zero size and distinct names. Throws gdpt::Error naming the file.
 void writeExr(const std::string& path, const std::vector<NamedLayer>& layers);
 
+// Text attributes stored in an EXR header (name -> value), e.g. the render state that a gdpt
+// checkpoint records. Names must not collide with OpenEXR's standard attributes; gdpt uses
+// the prefix "gdpt.".
+using ExrAttributes = std::map<std::string, std::string>;
+
+// Same, with `attributes` added to the header as string attributes.
+void writeExr(const std::string& path, const std::vector<NamedLayer>& layers,
+              const ExrAttributes& attributes);
+
 // Convenience: one image into the default R,G,B channels.
 void writeExr(const std::string& path, const Image& image);
 
@@ -34,6 +44,10 @@ void writeExr(const std::string& path, const Image& image);
 // sorted by name, so "" comes first. Throws gdpt::Error naming the file and the problem;
 // OpenEXR exceptions (corrupt or truncated files) are caught and wrapped.
 std::vector<NamedLayer> readExr(const std::string& path);
+
+// Reads the string attributes of the header (other attribute types are skipped). Throws
+// gdpt::Error naming the file for unreadable files, like readExr.
+ExrAttributes readExrAttributes(const std::string& path);
 
 // Reads the layer `name` (default: the unnamed R,G,B layer); throws gdpt::Error listing
 // the available layers if it is missing.

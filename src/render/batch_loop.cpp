@@ -9,13 +9,29 @@
 namespace gdpt {
 
 void runBatchLoop(const RenderOptions& options, const char* label, const Timer& total, RenderStats& stats,
-                  const TraceBatchFn& traceBatch) {
+                  const TraceBatchFn& traceBatch, const SnapshotFn& snapshot) {
     const bool timed = options.timeBudget > 0.0;
     const double budget = options.timeBudget - options.elapsedBefore;
     Progress progress(label, timed ? budget : static_cast<double>(options.spp), options.quiet);
     Timer phase;
     std::uint32_t done = 0;
     std::uint32_t batch = 1;
+    if (options.resume) {
+        // Same schedule position as the run that wrote the state, so that the merge order
+        // (and hence every bit) matches a run that was never interrupted.
+        done = options.resume->spp;
+        batch = std::clamp(options.resume->nextBatch, 1u, options.maxBatchSpp);
+        stats.batches = options.resume->batches;
+    }
+    const auto emitCheckpoint = [&] {
+        SamplerState state;
+        state.spp = done;
+        state.nextBatch = batch;
+        state.batches = stats.batches;
+        snapshot(state);
+        options.checkpoint(state);
+    };
+    Timer sinceCheckpoint;
     double secondsPerSpp = 0.0;  // measured on the last batch
     while (true) {
         if (options.cancel && options.cancel->load()) {
@@ -49,7 +65,13 @@ void runBatchLoop(const RenderOptions& options, const char* label, const Timer& 
         std::snprintf(rate, sizeof rate, "%u spp, %.2f Mrays/s", done, mraysPerS);
         progress.update(timed ? total.seconds() : static_cast<double>(done), rate);
         batch = std::min(batch * 2, options.maxBatchSpp);
+        if (options.checkpoint && options.checkpointEvery > 0.0 &&
+            sinceCheckpoint.seconds() >= options.checkpointEvery) {
+            emitCheckpoint();
+            sinceCheckpoint.restart();
+        }
     }
+    if (options.checkpoint) emitCheckpoint();
     stats.samplingMs = phase.ms();
     stats.spp = done;
     progress.finish(std::to_string(done) + " spp");

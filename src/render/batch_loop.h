@@ -20,10 +20,14 @@ namespace gdpt {
 using TraceBatchFn = std::function<gpu::Counters(std::uint32_t first, std::uint32_t count,
                                                  const std::function<void()>& onWait)>;
 
+// Fills state.buffers and state.preview from the device (after the last batch's fence).
+using SnapshotFn = std::function<void(SamplerState& state)>;
+
 // Runs the loop; fills stats.spp, batches, samplingMs, raysTraced, pathsCompleted,
 // nanSamples and cancelled, and warns about NaN/Inf samples (unless quiet). `total` measures
-// the whole render (for --time).
+// the whole render (for --time). With options.resume the schedule continues from it (the
+// caller has uploaded its statistics); options.checkpoint receives snapshots.
 void runBatchLoop(const RenderOptions& options, const char* label, const Timer& total, RenderStats& stats,
-                  const TraceBatchFn& traceBatch);
+                  const TraceBatchFn& traceBatch, const SnapshotFn& snapshot);
 
 }  // namespace gdpt

@@ -6,6 +6,7 @@
 #include "gpt.spv.h"
 #include "gpt_resolve.spv.h"
 #include "render/scene_gpu.h"
+#include "util/error.h"
 #include "vk/commands.h"
 #include "vk/context.h"
 
@@ -123,6 +124,23 @@ gpu::Counters GptPass::takeCounters() {
     counters_.download(&c, sizeof c);
     counters_.zero();
     return c;
+}
+
+std::vector<std::vector<gpu::PixelStats>> GptPass::downloadStats() const {
+    std::vector<std::vector<gpu::PixelStats>> out;
+    for (const auto& b : stats_)
+        out.push_back(b.downloadVector<gpu::PixelStats>(std::size_t{width_} * height_));
+    return out;
+}
+
+void GptPass::uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats) {
+    const std::size_t pixels = std::size_t{width_} * height_;
+    bool sizesMatch = stats.size() == stats_.size();
+    for (std::size_t i = 0; sizesMatch && i < stats.size(); ++i) sizesMatch = stats[i].size() == pixels;
+    if (!sizesMatch)
+        throw Error("gpt pixel statistics: expected " + std::to_string(stats_.size()) + " buffers of " +
+                    std::to_string(pixels) + " entries");
+    for (std::size_t i = 0; i < stats_.size(); ++i) stats_[i].uploadVector(stats[i]);
 }
 
 GptImages GptPass::readback() const {

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "gpt_shared.h"
 #include "image/image.h"
@@ -49,6 +50,10 @@ public:
     gpu::Counters takeCounters();
     // Reads the resolved images (after the fence of a resolve()).
     [[nodiscard]] GptImages readback() const;
+    // The raw per-pixel statistics of the 10 buffers, in binding order (after the fence),
+    // and their replacement (before the next record()) to continue a checkpointed render.
+    [[nodiscard]] std::vector<std::vector<gpu::PixelStats>> downloadStats() const;
+    void uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats);
     // Whether the half-vector branch is compiled in (kHasGlossy as specialised).
     [[nodiscard]] bool halfVectorCompiled() const { return halfVector_; }
 

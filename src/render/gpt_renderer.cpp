@@ -27,7 +27,29 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     GptPass pass(ctx, sceneGpu, options.workgroup, gpt);
     vk::GpuTimer timer(ctx);
     vk::CommandStream stream(ctx, "gpt");
+    if (options.resume) pass.uploadStats(options.resume->buffers);
     stats.uploadMs = phase.ms() - stats.bvhBuildMs;
+
+    // A snapshot resolves the statistics so far (resolve only writes the resolved buffer, so
+    // sampling can continue afterwards) for a primal + direct preview.
+    const auto resolveNow = [&] {
+        VkCommandBuffer cmd = stream.begin();
+        if (options.profile) timer.reset(cmd);
+        pass.resolve(cmd, options.profile ? &timer : nullptr);
+        stream.setWhat("gpt resolve");
+        stream.submit();
+        stream.waitAll();
+        if (options.profile) timer.collect();
+    };
+    const auto snapshot = [&](SamplerState& state) {
+        state.buffers = pass.downloadStats();
+        resolveNow();
+        GptImages images = pass.readback();
+        state.preview = std::move(images.primal);
+        for (int c = 0; c < 3; ++c)
+            for (std::size_t i = 0; i < state.preview.pixelCount(); ++i)
+                state.preview.plane(c)[i] += images.direct.plane(c)[i];
+    };
 
     runBatchLoop(options, "render gpt", total, stats,
                  [&](std::uint32_t first, std::uint32_t n, const std::function<void()>& onWait) {
@@ -41,17 +63,12 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
                      stream.waitAll(onWait);
                      if (options.profile) timer.collect();
                      return pass.takeCounters();
-                 });
+                 },
+                 snapshot);
 
     // Gather the neighbours' terms (a separate submission so its time is its own).
     phase.restart();
-    VkCommandBuffer cmd = stream.begin();
-    if (options.profile) timer.reset(cmd);
-    pass.resolve(cmd, options.profile ? &timer : nullptr);
-    stream.setWhat("gpt resolve");
-    stream.submit();
-    stream.waitAll();
-    if (options.profile) timer.collect();
+    resolveNow();
     GptImages images = pass.readback();
     result.primal = std::move(images.primal);
     result.dx = std::move(images.dx);

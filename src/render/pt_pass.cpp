@@ -4,6 +4,7 @@
 
 #include "pt.spv.h"
 #include "render/scene_gpu.h"
+#include "util/error.h"
 #include "vk/commands.h"
 #include "vk/context.h"
 
@@ -59,8 +60,19 @@ gpu::Counters PtPass::takeCounters() {
     return c;
 }
 
+std::vector<gpu::PixelStats> PtPass::downloadStats() const {
+    return accum_.downloadVector<gpu::PixelStats>(std::size_t{width_} * height_);
+}
+
+void PtPass::uploadStats(const std::vector<gpu::PixelStats>& stats) {
+    if (stats.size() != std::size_t{width_} * height_)
+        throw Error("pt pixel statistics: " + std::to_string(stats.size()) + " entries for a " +
+                    std::to_string(width_) + "x" + std::to_string(height_) + " image");
+    accum_.uploadVector(stats);
+}
+
 void PtPass::readback(Image& mean, Image& varianceOfMean) const {
-    const auto stats = accum_.downloadVector<gpu::PixelStats>(std::size_t{width_} * height_);
+    const auto stats = downloadStats();
     mean = Image(static_cast<int>(width_), static_cast<int>(height_));
     varianceOfMean = Image(static_cast<int>(width_), static_cast<int>(height_));
     for (std::size_t i = 0; i < stats.size(); ++i) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "gdpt_shared.h"
 #include "image/image.h"
@@ -31,6 +32,10 @@ public:
     gpu::Counters takeCounters();
     // Mean radiance and the variance of that mean, per pixel (after the fence).
     void readback(Image& mean, Image& varianceOfMean) const;
+    // The raw per-pixel statistics (after the fence), and their replacement (before the next
+    // record()) to continue a checkpointed render. uploadStats needs width*height entries.
+    [[nodiscard]] std::vector<gpu::PixelStats> downloadStats() const;
+    void uploadStats(const std::vector<gpu::PixelStats>& stats);
     // The statistics and counters, shared with the wavefront schedule.
     [[nodiscard]] const vk::Buffer& accum() const { return accum_; }
     [[nodiscard]] const vk::Buffer& counters() const { return counters_; }

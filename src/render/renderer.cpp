@@ -25,7 +25,13 @@ RenderResult renderPt(const vk::Context& ctx, const Scene& scene, const RenderOp
         wavefront = std::make_unique<WavefrontPass>(ctx, sceneGpu, pass, options.workgroup);
     vk::GpuTimer timer(ctx);
     vk::CommandStream stream(ctx, "pt");
+    if (options.resume) pass.uploadStats(options.resume->buffers.at(0));
     stats.uploadMs = phase.ms() - stats.bvhBuildMs;
+    const auto snapshot = [&](SamplerState& state) {
+        state.buffers = {pass.downloadStats()};
+        Image variance;
+        pass.readback(state.preview, variance);
+    };
 
     runBatchLoop(options, "render", total, stats,
                  [&](std::uint32_t first, std::uint32_t n, const std::function<void()>& onWait) {
@@ -45,7 +51,8 @@ RenderResult renderPt(const vk::Context& ctx, const Scene& scene, const RenderOp
                          if (options.profile) timer.collect();
                      }
                      return pass.takeCounters();
-                 });
+                 },
+                 snapshot);
 
     phase.restart();
     pass.readback(result.image, result.varianceOfMean);

@@ -5,11 +5,13 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 
 #include "image/image.h"
 #include "render/pt_pass.h"
+#include "render/sampler_state.h"
 #include "render/scene_gpu.h"
 #include "scene/scene.h"
 #include "vk/timing.h"
@@ -36,6 +38,14 @@ struct RenderOptions {
     Schedule schedule = Schedule::Megakernel;
     std::uint32_t maxBatchSpp = 16;  // largest batch (samples per pixel per submission)
     const std::atomic<bool>* cancel = nullptr;  // set asynchronously to stop between batches
+    // Continue from this state (its statistics and batch-schedule position) instead of from
+    // zero samples; the caller has checked that it belongs to this scene, size, seed and
+    // method. spp / timeBudget then count the total / this run's time as usual.
+    const SamplerState* resume = nullptr;
+    // If set, called with the current state at a batch boundary every checkpointEvery
+    // seconds (0 = never) and once when sampling ends, finished or cancelled.
+    std::function<void(const SamplerState&)> checkpoint;
+    double checkpointEvery = 0.0;
 };
 
 struct RenderStats {

@@ -57,6 +57,24 @@ TEST_F(ExrIo, RoundTripOfSeveralLayersIsBitExact) {
     EXPECT_THROW(readExrLayer(file, "missing"), Error);
 }
 
+// String attributes survive a round trip (values with spaces, commas and an empty one) and
+// a file written without any has none of gdpt's.
+TEST_F(ExrIo, StringAttributesRoundTrip) {
+    const ExrAttributes attributes = {
+        {"gdpt.a", "1"}, {"gdpt.env", "0.5,0.25,1"}, {"gdpt.empty", ""}, {"gdpt.text", "two words"}};
+    const std::string file = path("attr.exr");
+    writeExr(file, {{"", randomImage(3, 2, 4)}}, attributes);
+    ExrAttributes back = readExrAttributes(file);
+    for (const auto& [name, value] : attributes) {
+        ASSERT_TRUE(back.count(name)) << name;
+        EXPECT_EQ(back[name], value) << name;
+    }
+    writeExr(path("plain.exr"), randomImage(3, 2, 5));
+    for (const auto& [name, value] : readExrAttributes(path("plain.exr")))
+        EXPECT_NE(name.rfind("gdpt.", 0), 0u) << name;
+    EXPECT_THROW(readExrAttributes(path("missing.exr")), Error);
+}
+
 TEST_F(ExrIo, WriterRejectsMismatchedLayers) {
     EXPECT_THROW(writeExr(path("a.exr"), {{"", Image(2, 2)}, {"x", Image(3, 2)}}), Error);
     EXPECT_THROW(writeExr(path("b.exr"), {{"x", Image(2, 2)}, {"x", Image(2, 2)}}), Error);

@@ -1,0 +1,195 @@
+// `gdpt render --checkpoint/--resume` end to end: an interrupted render leaves a checkpoint
+// from which a resumed render reaches exactly (bit for bit) the image of a render that was
+// never interrupted, for PT and G-PT; a checkpoint of another render, a corrupt one and a
+// plain EXR are refused with one line naming the file (exit 1) and no output.
+//
+// Why bit-identity must hold: sample s of pixel p always uses the random stream (p, s, seed),
+// and with --spp the batch schedule (1, 2, 4, ... 16 spp per batch here) is a function of
+// the samples done; a checkpoint is written at a batch boundary with the next batch size,
+// so the resumed run merges the same batches in the same order into the same float32
+// statistics (restored bit for bit from FLOAT EXR channels).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "cli_runner.h"
+#include "image/exr_io.h"
+
+namespace gdpt {
+namespace {
+
+namespace fs = std::filesystem;
+using test::RunResult;
+
+const std::string kScene = std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.gltf";
+// 16x16: the largest batch is 16 spp for PT and G-PT alike (commands.cpp batchLimit).
+const std::string kSize = " --width 16 --height 16 ";
+
+class CheckpointCli : public test::TempDirTest, public ::testing::WithParamInterface<std::string> {
+protected:
+    std::string render(const std::string& extra) const {
+        return "render " + kScene + kSize + " --method " + GetParam() + " --seed 7 --quiet --validate " +
+               extra;
+    }
+};
+
+// Every layer of two EXRs has the same name and the same bits.
+void expectSameLayers(const std::string& a, const std::string& b) {
+    const auto la = readExr(a), lb = readExr(b);
+    ASSERT_EQ(la.size(), lb.size());
+    for (std::size_t i = 0; i < la.size(); ++i) {
+        EXPECT_EQ(la[i].name, lb[i].name);
+        ASSERT_TRUE(la[i].image.sameSize(lb[i].image)) << la[i].name;
+        for (int c = 0; c < 3; ++c)
+            EXPECT_EQ(std::memcmp(la[i].image.plane(c).data(), lb[i].image.plane(c).data(),
+                                  la[i].image.pixelCount() * sizeof(float)),
+                      0)
+                << "layer '" << la[i].name << "' channel " << c;
+    }
+}
+
+std::uint64_t pathsCompleted(const std::string& jsonPath) {
+    std::ifstream in(jsonPath);
+    return nlohmann::json::parse(in)["paths_completed"].get<std::uint64_t>();
+}
+
+// A finished 15 spp render (batches 1+2+4+8, none truncated) continued to 63 spp equals a
+// 63 spp render; the resumed run traced only the 48 new samples per pixel, so the state
+// was used rather than re-rendered.
+TEST_P(CheckpointCli, ResumedRenderEqualsUninterruptedRender) {
+    ASSERT_EQ(test::runGdpt(render("--spp 15 --checkpoint " + path("c.exr") + " -o " + path("a.exr"))).code,
+              0);
+    ASSERT_TRUE(fs::exists(path("c.exr")));
+    EXPECT_EQ(readExrAttributes(path("c.exr")).at("gdpt.spp"), "15");
+    const RunResult resumed = test::runGdpt(
+        render("--spp 63 --resume " + path("c.exr") + " -o " + path("r.exr") + " --json " + path("r.json")));
+    ASSERT_EQ(resumed.code, 0) << resumed.output;
+    ASSERT_EQ(test::runGdpt(render("--spp 63 -o " + path("u.exr"))).code, 0);
+    expectSameLayers(path("r.exr"), path("u.exr"));
+    EXPECT_EQ(pathsCompleted(path("r.json")), 16u * 16u * 48u);
+}
+
+// SIGINT during a long render (polled until the first periodic checkpoint exists, so the
+// signal handler is installed) exits 130 and leaves a checkpoint with D spp and no output;
+// resuming to D + 32 spp equals an uninterrupted D + 32 spp render.
+TEST_P(CheckpointCli, InterruptedRenderResumesToTheUninterruptedResult) {
+    const std::string ckpt = path("i.exr");
+    const std::string cmd =
+        std::string(GDPT_BINARY) + " " +
+        render("--spp 1000000 --checkpoint " + ckpt + " --checkpoint-every 0.2 -o " + path("never.exr")) +
+        " 2>/dev/null & pid=$!; for k in $(seq 1200); do [ -e " + ckpt +
+        " ] && break; sleep 0.05; done; sleep 0.3; kill -INT $pid; wait $pid; echo $?";
+    FILE* pipe = popen(cmd.c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    int rc = -1;
+    ASSERT_EQ(std::fscanf(pipe, "%d", &rc), 1);
+    pclose(pipe);
+    ASSERT_EQ(rc, 130);
+    EXPECT_FALSE(fs::exists(path("never.exr")));
+    EXPECT_FALSE(fs::exists(ckpt + ".tmp"));
+    const ExrAttributes a = readExrAttributes(ckpt);
+    const unsigned long done = std::stoul(a.at("gdpt.spp"));
+    ASSERT_GT(done, 0u);
+    ASSERT_LT(done, 1000000u) << "the render finished before the interrupt";
+    EXPECT_EQ(a.at("gdpt.id.method"), GetParam());
+    // The checkpoint is a valid EXR whose default channels are the image so far.
+    EXPECT_EQ(readExrLayer(ckpt).width(), 16);
+
+    const std::string total = std::to_string(done + 32);
+    const RunResult resumed =
+        test::runGdpt(render("--spp " + total + " --resume " + ckpt + " -o " + path("r.exr")));
+    ASSERT_EQ(resumed.code, 0) << resumed.output;
+    ASSERT_EQ(test::runGdpt(render("--spp " + total + " -o " + path("u.exr"))).code, 0);
+    expectSameLayers(path("r.exr"), path("u.exr"));
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, CheckpointCli, ::testing::Values("pt", "gpt"));
+
+class CheckpointRefusal : public test::TempDirTest {
+protected:
+    void SetUp() override {
+        TempDirTest::SetUp();
+        const RunResult r =
+            test::runGdpt("render " + kScene + kSize + "--spp 3 --seed 7 --quiet --checkpoint " +
+                          path("c.exr") + " -o " + path("a.exr"));
+        ASSERT_EQ(r.code, 0) << r.output;
+    }
+    // Resuming with `flags` (default: the checkpoint's own settings) fails with exit 1, one
+    // line naming `file` and containing `why`, and no output file.
+    void expectRefused(const std::string& file, const std::string& flags, const std::string& why) {
+        const std::string out = path("out.exr");
+        const RunResult r =
+            test::runGdpt("render " + kScene + " --quiet --resume " + file + " -o " + out + " " + flags);
+        EXPECT_EQ(r.code, 1) << flags << ": " << r.output;
+        EXPECT_NE(r.output.find(file), std::string::npos) << r.output;
+        EXPECT_NE(r.output.find(why), std::string::npos) << "expected '" << why << "' in: " << r.output;
+        EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << "one line: " << r.output;
+        EXPECT_FALSE(fs::exists(out));
+    }
+};
+
+TEST_F(CheckpointRefusal, CheckpointOfAnotherRenderIsRefused) {
+    const std::string c = path("c.exr");
+    const std::string same = kSize + "--spp 8 --seed 7";
+    expectRefused(c, kSize + "--spp 8 --seed 8", "seed");
+    expectRefused(c, " --width 16 --height 15 --spp 8 --seed 7", "height");
+    expectRefused(c, same + " --method gpt", "method");
+    expectRefused(c, same + " --max-depth 3", "max_depth");
+    expectRefused(c, same + " --env 0.5", "env");
+    expectRefused(c, kSize + "--spp 2 --seed 7", "more than --spp 2");
+    // Another scene: the same file name and geometry, a slightly wider camera.
+    const std::string other = path("cornell_box.gltf");
+    std::ifstream in(kScene);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string fov = "\"yfov\": 0.34";
+    const auto pos = text.find(fov);
+    ASSERT_NE(pos, std::string::npos) << "the scene's camera has yfov 0.34...";
+    text.replace(pos, fov.size(), "\"yfov\": 0.35");
+    std::ofstream(other) << text;
+    const RunResult r =
+        test::runGdpt("render " + other + " --quiet --resume " + c + " -o " + path("out.exr") + same);
+    EXPECT_EQ(r.code, 1) << r.output;
+    EXPECT_NE(r.output.find("scene_fingerprint"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(path("out.exr")));
+}
+
+TEST_F(CheckpointRefusal, CorruptOrForeignCheckpointIsRefused) {
+    const std::string flags = kSize + "--spp 8 --seed 7";
+    // Truncated.
+    std::ifstream in(path("c.exr"), std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream(path("cut.exr"), std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+    expectRefused(path("cut.exr"), flags, "cannot read EXR");
+    // A valid EXR that is not a checkpoint (the render's output).
+    expectRefused(path("a.exr"), flags, "not a gdpt checkpoint");
+    // A checkpoint whose header claims fewer samples than its counts hold.
+    ExrAttributes attributes = readExrAttributes(path("c.exr"));
+    attributes["gdpt.spp"] = "2";
+    writeExr(path("lie.exr"), readExr(path("c.exr")), attributes);
+    expectRefused(path("lie.exr"), flags, "sample count");
+    // A missing state layer.
+    auto layers = readExr(path("c.exr"));
+    layers.erase(std::remove_if(layers.begin(), layers.end(),
+                                [](const NamedLayer& l) { return l.name == "state0.m2"; }),
+                 layers.end());
+    writeExr(path("nolayer.exr"), layers, readExrAttributes(path("c.exr")));
+    expectRefused(path("nolayer.exr"), flags, "state0.m2");
+}
+
+TEST_F(CheckpointRefusal, HelpDocumentsTheFlagsAndCheckpointEveryNeedsCheckpoint) {
+    const RunResult help = test::runGdpt("render --help");
+    for (const char* flag : {"--checkpoint", "--checkpoint-every", "--resume"})
+        EXPECT_NE(help.output.find(flag), std::string::npos) << flag;
+    EXPECT_EQ(test::runGdpt("render " + kScene + " --checkpoint-every 5 -o " + path("x.exr")).code, 2);
+}
+
+}  // namespace
+}  // namespace gdpt
