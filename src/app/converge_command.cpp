@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/bench_util.h"
+#include "app/recon_reserve.h"
 #include "app/subcommand.h"
 #include "image/atomic_write.h"
 #include "image/exr_io.h"
@@ -166,22 +167,8 @@ private:
     double reconSeconds(const std::string& method, const SolveOptions& so) {
         auto it = reconCache_.find(method);
         if (it != reconCache_.end()) return it->second;
-        Image primal(a_.width, a_.height, 0.5f), dx(a_.width, a_.height, 0.0f), dy(a_.width, a_.height, 0.0f);
-        for (int c = 0; c < 3; ++c)
-            for (std::size_t i = 0; i < primal.pixelCount(); ++i)
-                primal.plane(c)[i] = 0.5f + 0.25f * std::sin(0.37f * static_cast<float>(i % 97));
-        // Low-spp-like noise in the gradients (a fixed hash, so the estimate is repeatable).
-        for (int c = 0; c < 3; ++c)
-            for (std::size_t i = 0; i < dx.pixelCount(); ++i) {
-                const std::uint32_t h = static_cast<std::uint32_t>((i * 2654435761u) ^ (c * 40503u));
-                dx.plane(c)[i] = 0.2f * (static_cast<float>(h % 1000u) / 1000.0f - 0.5f);
-                dy.plane(c)[i] = 0.2f * (static_cast<float>((h >> 10) % 1000u) / 1000.0f - 0.5f);
-            }
-        Image var(a_.width, a_.height, 1e-3f);
-        (void)solve(primal, dx, dy, &var, &var, &var, so);
-        Timer t;
-        (void)solve(primal, dx, dy, &var, &var, &var, so);
-        return reconCache_[method] = t.seconds();
+        if (!solver_) solver_ = std::make_unique<PoissonSolverGpu>(ctx_, a_.width, a_.height);
+        return reconCache_[method] = calibrateReconSeconds(*solver_, so, /*warmUp=*/true);
     }
 
     const vk::Context& ctx_;

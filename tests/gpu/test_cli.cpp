@@ -21,6 +21,11 @@ using test::RunResult;
 
 RunResult run(const std::string& args) { return test::runGdpt(args); }
 
+// gdpt with environment assignments ("NAME=value ") before it, through the shell.
+RunResult runWithEnv(const std::string& env, const std::string& args) {
+    return test::runGdpt(args, env);
+}
+
 class Cli : public test::TempDirTest {};
 
 const std::string kScene = std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.gltf";
@@ -76,6 +81,37 @@ TEST_F(Cli, SmallValidatedRenderWritesExrPngAndJson) {
     EXPECT_GT(j["rays_traced"].get<double>(), 0.0);
     EXPECT_TRUE(j["kernels"].contains("pt"));
     EXPECT_NE(r.output.find("pt"), std::string::npos) << "--profile prints the kernel table";
+}
+
+// A timed G-PT render reserves its reconstruction time: the first run of a configuration
+// measures it (calibration solve) and remembers the real reconstruction's time in the cache
+// ($GDPT_CACHE_DIR/recon_times.json); the next run reserves exactly the remembered value.
+TEST_F(Cli, TimedGptRenderReservesTheRememberedReconstructionTime) {
+    const std::string env = "GDPT_CACHE_DIR=" + path("cache") + " ";
+    const std::string cmd = "render " + kScene + " --method gpt -o " + path("g.exr") +
+                            " --width 16 --height 16 --time 1 --quiet --validate --json " + path("g.json");
+    auto readJson = [&](const std::string& file) {
+        std::ifstream in(file);
+        return nlohmann::json::parse(in);
+    };
+    RunResult r = run(cmd);  // whatever cache the environment names: must work either way
+    ASSERT_EQ(r.code, 0) << r.output;
+    const std::string cached = path("cache/recon_times.json");
+    r = runWithEnv(env, cmd);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_GT(readJson(path("g.json"))["time_s"]["reconstruction_reserved"].get<double>(), 0.0);
+    ASSERT_TRUE(fs::exists(cached));
+    nlohmann::json entries = readJson(cached);
+    ASSERT_EQ(entries.size(), 1u);
+    const std::string key = entries.begin().key();
+    EXPECT_NE(key.find("16x16"), std::string::npos) << key;
+    EXPECT_NE(key.find("l1"), std::string::npos) << key;
+    entries[key] = 0.125;  // a value no measurement produces, to see it come back
+    std::ofstream(cached) << entries.dump();
+    r = runWithEnv(env, cmd);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_DOUBLE_EQ(readJson(path("g.json"))["time_s"]["reconstruction_reserved"].get<double>(), 0.125);
+    EXPECT_NE(readJson(cached)[key].get<double>(), 0.125) << "the real reconstruction time replaces it";
 }
 
 TEST_F(Cli, DiffOfAnImageWithItselfIsZero) {

@@ -17,9 +17,9 @@ struct RunResult {
     std::string output;  // stdout + stderr
 };
 
-// Runs `gdpt <args>` through the shell.
-inline RunResult runGdpt(const std::string& args) {
-    const std::string cmd = std::string(GDPT_BINARY) + " " + args + " 2>&1";
+// Runs `gdpt <args>` through the shell; `env` ("NAME=value ..."), if given, is set for it.
+inline RunResult runGdpt(const std::string& args, const std::string& env = "") {
+    const std::string cmd = (env.empty() ? "" : "env " + env + " ") + std::string(GDPT_BINARY) + " " + args + " 2>&1";
     RunResult r;
     FILE* pipe = popen(cmd.c_str(), "r");
     if (!pipe) return r;

@@ -1,0 +1,48 @@
+// recon_reserve.h — how long the screened Poisson reconstruction after a timed G-PT render
+// will take, so that `render --time` and `converge` can stop sampling early enough for the
+// whole run to fit its budget (the reconstruction is part of what the user waits for).
+//
+// The estimate is a measurement: a solve of a synthetic noisy problem of the render's size
+// (calibrate), or the time of the last real reconstruction with the same device, driver,
+// size and settings, remembered in a small cache file (ReconTimeCache). The first timed
+// render of a configuration pays for one calibration solve; later ones pay nothing.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "image/image.h"
+#include "poisson/poisson_gpu.h"
+
+namespace gdpt {
+
+// A repeatable stand-in for a low-spp G-PT output: smooth primal, hash-noise gradients and
+// a small constant variance, width x height.
+struct SyntheticReconProblem {
+    Image primal, dx, dy, variance;
+};
+SyntheticReconProblem syntheticReconProblem(int width, int height);
+
+// Seconds of one `options` solve of the synthetic problem with `solver` (the solver's size).
+// warmUp: after an untimed solve that compiles its pipeline variants (the steady-state time,
+// for benchmarks); without it the figure includes that one-off cost and the calibration
+// costs one solve, not two (for a render about to solve once for real).
+double calibrateReconSeconds(PoissonSolverGpu& solver, const SolveOptions& options, bool warmUp);
+
+// Remembered reconstruction times, one JSON object in `path` (key -> seconds). Read and
+// write failures are ignored: the cache only saves a calibration solve.
+class ReconTimeCache {
+public:
+    // $GDPT_CACHE_DIR/recon_times.json, else $XDG_CACHE_HOME/gdpt/..., else
+    // $HOME/.cache/gdpt/...; empty (no cache) if none is set.
+    static std::string defaultPath();
+
+    explicit ReconTimeCache(std::string path) : path_(std::move(path)) {}
+    [[nodiscard]] std::optional<double> get(const std::string& key) const;
+    void put(const std::string& key, double seconds) const;
+
+private:
+    std::string path_;
+};
+
+}  // namespace gdpt
