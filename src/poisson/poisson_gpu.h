@@ -58,7 +58,7 @@ struct SolveOptions {
     int irlsIterations = 8;
     double irlsRegInit = 0.05;
     double irlsRegIter = 0.5;
-    double irlsInnerTolerance = 1e-3;  // inner tolerance before the last IRLS round
+    double irlsInnerTolerance = 1e-2;  // inner tolerance before the last IRLS round
     double varianceEpsilon = 1e-4;     // WL2: w = 1/(var + ε)
     VcycleParams vcycle{};             // smoother and sweeps of mg / mg-pcg
     bool keepHistory = false;          // fill SolveReport::history (test mode)
