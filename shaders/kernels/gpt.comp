@@ -73,6 +73,7 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
     direct = vec3(0.0);
     for (uint i = 0u; i < 4u; ++i) {
         offs[i].alive = gptPairExists(px, py, i);
+        offs[i].shifted = false;
         offs[i].baseSum = vec3(0.0);
         offs[i].offSum = vec3(0.0);
         offs[i].beta = vec3(1.0);  // pinhole, box filter: camera weight 1 for every pixel
@@ -93,6 +94,7 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
     SurfaceHit sh = makeSurfaceHit(hit.triangle, hit.u, hit.v, d);
     if (kHasLightTris) direct += surfaceEmission(sh);
     for (uint i = 0u; i < 4u; ++i) {
+        offs[i].shifted = offs[i].alive;
         if (!offs[i].alive) continue;
         vec3 di = cameraRay(pixelPos + vec2(kOffsetDelta[i]));
         Hit hi = traceClosest(o, di, 0.0, kInf);
@@ -455,6 +457,7 @@ void main() {
     uint n = 0u;
     uint rays = 0u;
     uint nan = 0u;
+    uint shiftPairs = 0u, shiftFailures = 0u;
     OffsetPath offs[4];
     for (uint s = 0u; s < frame.samplesPerPixel; ++s) {
         // Same stream as pt.comp's sample s: the base path is PT's path.
@@ -462,6 +465,10 @@ void main() {
         vec2 jitter = rngNext2(rng);
         vec3 direct;
         traceSample(rng, vec2(x, y) + jitter, x, y, rays, direct, offs);
+        for (uint i = 0u; i < 4u; ++i) {
+            shiftPairs += offs[i].shifted ? 1u : 0u;
+            shiftFailures += offs[i].shifted && !offs[i].alive ? 1u : 0u;
+        }
         vec3 central = vec3(0.0);
         bool finite = isFinite(direct);
         for (uint i = 0u; i < 4u; ++i) {
@@ -498,4 +505,6 @@ void main() {
     atomicAdd(counters.raysTraced, rays);
     atomicAdd(counters.pathsCompleted, n);
     if (nan > 0u) atomicAdd(counters.nanSamples, nan);
+    atomicAdd(counters.shiftPairs, shiftPairs);
+    if (shiftFailures > 0u) atomicAdd(counters.shiftFailures, shiftFailures);
 }

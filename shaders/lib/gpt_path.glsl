@@ -16,6 +16,7 @@ struct OffsetPath {
     float rLight;     // ratio applying to the light strategy of the current vertex's emission
     uint state;       // kShiftNotConnected / kShiftRecentlyConnected / kShiftConnected
     bool alive;       // false: pair absent (image border) or shift failed -> base-only weights
+    bool shifted;     // the pair exists and the base's primary ray hit: a shift was attempted
     vec3 baseSum;     // Σ w·f_base over this pair (part of central)
     vec3 offSum;      // Σ w·f_offset over this pair (neighbor_i)
 };

@@ -199,7 +199,9 @@ struct Counters {
     uint raysTraced;      // low 32 bits; host accumulates into 64-bit per batch
     uint pathsCompleted;
     uint nanSamples;      // samples dropped because they were NaN/Inf
-    uint pad;
+    uint pad;             // wavefront schedule: paths still alive (wf_shade.comp)
+    uint shiftPairs;      // G-PT: offsets inside the image whose base's primary ray hit
+    uint shiftFailures;   // G-PT: of those, offsets whose shift failed (pair fell back to the base)
 };
 
 // ---------------------------------------------------------------------------------------------

@@ -57,6 +57,8 @@ void runBatchLoop(const RenderOptions& options, const char* label, const Timer& 
         stats.raysTraced += c.raysTraced;
         stats.pathsCompleted += c.pathsCompleted;
         stats.nanSamples += c.nanSamples;
+        stats.shiftPairs += c.shiftPairs;
+        stats.shiftFailures += c.shiftFailures;
         done += n;
         ++stats.batches;
         secondsPerSpp = batchTimer.seconds() / n;

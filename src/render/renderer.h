@@ -59,6 +59,8 @@ struct RenderStats {
     std::uint64_t raysTraced = 0;
     std::uint64_t pathsCompleted = 0;
     std::uint64_t nanSamples = 0;
+    std::uint64_t shiftPairs = 0;     // G-PT: shifts attempted (offsets in the image, base hit)
+    std::uint64_t shiftFailures = 0;  // G-PT: shifts that failed (pair fell back to the base)
     bool cancelled = false;
     std::map<std::string, vk::KernelTime> kernels;
     SceneFeatures features;

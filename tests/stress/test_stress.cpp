@@ -3,14 +3,17 @@
 // where it is known (in standard errors estimated from the per-pixel variance), and
 // reports the NaN/Inf sample count. GDPT_STRESS_LONG=1 runs the long variants locally.
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 #include <gtest/gtest.h>
 
 #include "gpu_fixture.h"
 #include "image/metrics.h"
+#include "render/features.h"
 #include "render/gpt_renderer.h"
 #include "render/renderer.h"
+#include "scene/gltf_loader.h"
 #include "scene/procedural.h"
 
 namespace gdpt {
@@ -143,6 +146,47 @@ TEST_F(Stress, GradientDomainAtExtremeRadiance) {
         EXPECT_EQ(g.stats.nanSamples, 0u) << "Le scale " << le;
         for (const Image* img : {&g.primal, &g.dx, &g.dy, &g.direct, &g.varPrimal, &g.varDx, &g.varDy})
             expectAllFinite(*img);
+    }
+}
+
+// G-PT shift corner cases on the glossy Cornell box: the shift threshold exactly at the
+// scene's smallest roughness (vertices on the reconnection / half-vector boundary), and a
+// camera 1 cm above the floor looking along it (offset rays at grazing incidence). Every
+// buffer finite and no NaN samples; the shift failure rate is reported, and must be a
+// proper fraction of the shifts attempted (a count of zero attempts would mean the counter
+// is broken, not that the case is easy).
+TEST_F(Stress, GradientDomainShiftCornerCases) {
+    const Scene glossy = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/glossy_cornell.gltf");
+    const float atThreshold = analyzeScene(glossy, glm::vec3(0.0f)).minRoughness;
+    Scene grazing = glossy;
+    Camera& cam = grazing.cameras.at(0);
+    cam.position = glm::vec3(0.0f, 0.01f, 0.9f);
+    cam.forward = glm::normalize(glm::vec3(0.0f, -0.002f, -1.0f));
+    const glm::vec3 right = glm::normalize(glm::cross(cam.forward, glm::vec3(0.0f, 1.0f, 0.0f)));
+    cam.up = glm::cross(right, cam.forward);
+    struct Case {
+        const char* name;
+        const Scene* scene;
+        float threshold;
+    };
+    for (const Case& k : {Case{"threshold at the roughness", &glossy, atThreshold},
+                          Case{"grazing camera", &grazing, 0.001f}}) {
+        RenderOptions o;
+        o.scene.width = 24;
+        o.scene.height = 16;
+        o.scene.shiftThreshold = k.threshold;
+        o.spp = 4;
+        o.seed = 9;
+        o.quiet = true;
+        const RenderResultGpt g = renderGpt(ctx(), *k.scene, o);
+        EXPECT_EQ(g.stats.nanSamples, 0u) << k.name;
+        for (const Image* img : {&g.primal, &g.dx, &g.dy, &g.direct, &g.varPrimal, &g.varDx, &g.varDy})
+            expectAllFinite(*img);
+        ASSERT_GT(g.stats.shiftPairs, 0u) << k.name;
+        EXPECT_LE(g.stats.shiftFailures, g.stats.shiftPairs) << k.name;
+        std::printf("[ stress ] %s: %llu shifts, failure rate %.4f\n", k.name,
+                    static_cast<unsigned long long>(g.stats.shiftPairs),
+                    double(g.stats.shiftFailures) / double(g.stats.shiftPairs));
     }
 }
 

@@ -28,7 +28,8 @@ static_assert(sizeof(SceneConstants) == 112);
 static_assert(offsetof(SceneConstants, envRadiance) == 64 && offsetof(SceneConstants, pad) == 108);
 static_assert(sizeof(FrameParams) == 32 && sizeof(FrameParams) <= 128);
 static_assert(sizeof(PixelStats) == 32);
-static_assert(sizeof(Counters) == 16);
+static_assert(sizeof(Counters) == 24);
+static_assert(offsetof(Counters, shiftFailures) == 20);
 static_assert(sizeof(TestRay) == 32);
 
 TEST(SharedLayout, BindingsAreDistinct) {
