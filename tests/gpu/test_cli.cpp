@@ -1,6 +1,7 @@
 // The gdpt program as a user meets it: exit codes (0 ok, 1 input/runtime error, 2 usage),
 // one clear error line naming the file, no output file left behind on failure, complete
 // --help, and a small validated render that writes EXR + PNG + JSON.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -112,6 +113,27 @@ TEST_F(Cli, TimedGptRenderReservesTheRememberedReconstructionTime) {
     ASSERT_EQ(r.code, 0) << r.output;
     EXPECT_DOUBLE_EQ(readJson(path("g.json"))["time_s"]["reconstruction_reserved"].get<double>(), 0.125);
     EXPECT_NE(readJson(cached)[key].get<double>(), 0.125) << "the real reconstruction time replaces it";
+}
+
+// A 4096x4096 render: on a device whose maxStorageBufferRange cannot hold its per-pixel
+// statistics (lavapipe: 128 MiB < 512 MiB) it is refused with one line naming the limit and
+// leaves no file behind; on a device that can, it renders a finite image.
+TEST_F(Cli, HugeImageRendersOrIsRefusedNamingTheDeviceLimit) {
+    const std::string out = path("huge.exr");
+    const RunResult r = run("render " + kScene + " --width 4096 --height 4096 --spp 1 --max-depth 1 --quiet -o " + out);
+    if (r.code == 0) {
+        const auto layers = readExr(out);
+        ASSERT_FALSE(layers.empty());
+        EXPECT_EQ(layers[0].image.width(), 4096);
+        for (int c = 0; c < 3; ++c)
+            for (float v : layers[0].image.plane(c)) ASSERT_TRUE(std::isfinite(v));
+        return;
+    }
+    EXPECT_EQ(r.code, 1) << r.output;
+    EXPECT_NE(r.output.find("maxStorageBufferRange"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_FALSE(fs::exists(out + ".tmp"));
+    EXPECT_FALSE(fs::exists(path("huge.png")));
 }
 
 TEST_F(Cli, DiffOfAnImageWithItselfIsZero) {

@@ -4,6 +4,7 @@
 // reports the NaN/Inf sample count. GDPT_STRESS_LONG=1 runs the long variants locally.
 #include <cmath>
 #include <cstdio>
+#include <utility>
 #include <cstdlib>
 
 #include <gtest/gtest.h>
@@ -147,6 +148,31 @@ TEST_F(Stress, GradientDomainAtExtremeRadiance) {
         for (const Image* img : {&g.primal, &g.dx, &g.dy, &g.direct, &g.varPrimal, &g.varDx, &g.varDy})
             expectAllFinite(*img);
     }
+}
+
+// Camera inside closed geometry: the furnace sphere with its winding (and normals) turned
+// outwards, so the camera at its centre sees only back faces, which are opaque black and
+// emit nothing (one-sided materials), under a white environment that any ray leaking
+// through the shell would see. Every PT pixel and every G-PT buffer is exactly 0.
+TEST_F(Stress, CameraInsideClosedGeometrySeesBlack) {
+    Scene s = makeFurnaceSphere(0.5f, glm::vec3(1.0f), 1);
+    for (glm::uvec3& t : s.triangles) std::swap(t.y, t.z);
+    for (glm::vec3& n : s.normals) n = -n;
+    RenderOptions o;
+    o.scene.width = 16;
+    o.scene.height = 16;
+    o.scene.envRadiance = glm::vec3(1.0f);
+    o.spp = 4;
+    o.quiet = true;
+    const RenderResult pt = renderPt(ctx(), s, o);
+    for (int c = 0; c < 3; ++c)
+        for (float v : pt.image.plane(c)) ASSERT_EQ(v, 0.0f);
+    EXPECT_EQ(pt.stats.nanSamples, 0u);
+    o.spp = 2;
+    const RenderResultGpt g = renderGpt(ctx(), s, o);
+    for (const Image* img : {&g.primal, &g.dx, &g.dy, &g.direct})
+        for (int c = 0; c < 3; ++c)
+            for (float v : img->plane(c)) ASSERT_EQ(v, 0.0f);
 }
 
 // G-PT shift corner cases on the glossy Cornell box: the shift threshold exactly at the
