@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Error against time for the whole benchmark scene set, in one command: runs `gdpt converge`
+# on the Cornell box of ../shared/scenes/cbox (against its independent reference) and on each
+# scene of scenes/ (against a PT reference made and cached with --make-reference), each into
+# OUT/<scene>/ (results.json, results.csv, error_vs_time.png), then prints every scene's
+# equal-time table. Not a test: a long benchmark (hours with the defaults on 2 cores).
+#
+#   scripts/converge-set.sh [-o OUT] [--times 4,8,16,32] [--repeats 3] [--reference-spp 4096]
+#                           [--methods pt,gpt-l1,gpt-l2,gpt-wl2] [--size 256] [--scenes a,b,...]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=converge-set times=4,8,16,32 repeats=3 refspp=4096 methods=pt,gpt-l1,gpt-l2,gpt-wl2 size=256
+scenes=cbox,cornell_box,glossy_cornell,small_light,indirect_gap,textured
+while (($#)); do
+  case "$1" in
+    -o) out=$2; shift 2 ;;
+    --times) times=$2; shift 2 ;;
+    --repeats) repeats=$2; shift 2 ;;
+    --reference-spp) refspp=$2; shift 2 ;;
+    --methods) methods=$2; shift 2 ;;
+    --size) size=$2; shift 2 ;;
+    --scenes) scenes=$2; shift 2 ;;
+    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
+    *) echo "converge-set.sh: unknown option '$1' (try --help)" >&2; exit 2 ;;
+  esac
+done
+[ -x build/gdpt ] || { echo "converge-set.sh: build/gdpt missing; run scripts/build.sh first" >&2; exit 1; }
+common=(--methods "$methods" --times "$times" --repeats "$repeats" --width "$size" --height "$size")
+IFS=, read -ra list <<< "$scenes"
+for s in "${list[@]}"; do
+  if [ "$s" = cbox ]; then
+    ref=../shared/scenes/cbox/reference.exr
+    [ "$size" = 256 ] || { echo "converge-set.sh: cbox's reference is 256x256; skipping it at --size $size" >&2; continue; }
+    build/gdpt converge ../shared/scenes/cbox/cbox.gltf --reference "$ref" "${common[@]}" -o "$out/$s"
+  else
+    build/gdpt converge "scenes/$s.gltf" --make-reference "$refspp" "${common[@]}" -o "$out/$s"
+  fi
+done
+for s in "${list[@]}"; do
+  [ -f "$out/$s/results.json" ] || continue
+  echo "== $s"
+  python3 - "$out/$s/results.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+rows = d["summary"]
+methods = list(dict.fromkeys(r["method"] for r in rows))
+budgets = sorted({r["budget_s"] for r in rows})
+print("budget_s " + " ".join(f"{m:>12}" for m in methods))
+for b in budgets:
+    cells = {r["method"]: r["relmse_median"] for r in rows if r["budget_s"] == b}
+    print(f"{b:8g} " + " ".join(f"{cells.get(m, float('nan')):12.5g}" for m in methods))
+PY
+done
