@@ -124,15 +124,7 @@ int runBench(const BenchArgs& a) {
                                  {"pt_sampling_ms", median(ptMs)},
                                  {"pt_kernels", kernels}});
     }
-    const std::string text = out.dump(2) + "\n";
-    if (a.output == "-") {
-        std::fputs(text.c_str(), stdout);
-    } else {
-        FILE* f = std::fopen(a.output.c_str(), "w");
-        if (!f) throw Error(a.output + ": cannot write");
-        std::fputs(text.c_str(), f);
-        std::fclose(f);
-    }
+    writeTextOutput(a.output, out.dump(2) + "\n");
     return 0;
 }
 

@@ -141,15 +141,7 @@ int runBenchFeatures(const BenchFeaturesArgs& a) {
             out["results"].push_back({{"scene", path}, {"method", method}, {"variants", rows}});
         }
     }
-    const std::string text = out.dump(2) + "\n";
-    if (a.output == "-") {
-        std::fputs(text.c_str(), stdout);
-    } else {
-        FILE* file = std::fopen(a.output.c_str(), "w");
-        if (!file) throw Error(a.output + ": cannot write");
-        std::fputs(text.c_str(), file);
-        std::fclose(file);
-    }
+    writeTextOutput(a.output, out.dump(2) + "\n");
     return 0;
 }
 

@@ -1,12 +1,15 @@
 // bench_util.h — small helpers shared by the benchmark and render subcommands: medians,
-// comma-separated lists, and the deterministic batch size of a render.
+// comma-separated lists, the deterministic batch size of a render, and text output.
 #pragma once
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdint>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "image/atomic_write.h"
 
 namespace gdpt {
 
@@ -36,6 +39,14 @@ inline std::uint32_t batchLimit(int width, int height, bool gpt) {
     const std::uint64_t pixels = std::uint64_t(width) * std::uint64_t(height);
     const std::uint64_t budget = gpt ? (1u << 16) : (1u << 18);
     return static_cast<std::uint32_t>(std::clamp<std::uint64_t>(budget / pixels, 1, 16));
+}
+
+// A command's text output: stdout for "-", else the file, written atomically (tmp + rename).
+inline void writeTextOutput(const std::string& path, const std::string& text) {
+    if (path == "-")
+        std::fputs(text.c_str(), stdout);
+    else
+        writeTextFileAtomically(path, text);
 }
 
 }  // namespace gdpt

@@ -49,24 +49,6 @@ WorkgroupSize parseWorkgroup(const std::string& text) {
     return {x, y};
 }
 
-// Writes text to path via path.tmp + rename, so a failure never leaves a partial file.
-void writeTextAtomically(const std::string& path, const std::string& text) {
-    if (path == "-") {
-        std::fputs(text.c_str(), stdout);
-        return;
-    }
-    const std::string tmp = path + ".tmp";
-    {
-        std::ofstream out(tmp);
-        out << text;
-        if (!out) throw Error(path + ": cannot write");
-    }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-        std::remove(tmp.c_str());
-        throw Error(path + ": cannot write");
-    }
-}
-
 std::string previewPath(const std::string& exrPath) {
     const auto dot = exrPath.rfind('.');
     const auto slash = exrPath.rfind('/');
@@ -303,7 +285,7 @@ int runRender(const RenderArgs& args) {
                   {"samples_per_s", double(s.pathsCompleted) / (s.samplingMs * 1e-3)},
                   {"kernels", kernelJson(s.kernels, s.samplingMs)},
                   {"validation_errors", ctx.validationErrors()}};
-        writeTextAtomically(args.json, j.dump(2) + "\n");
+        writeTextOutput(args.json, j.dump(2) + "\n");
     }
     if (ctx.validationErrors() > 0) {
         std::fprintf(stderr, "gdpt: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
@@ -327,7 +309,7 @@ int runDiff(const DiffArgs& args) {
               {"mean_reference", e.meanReference},
               {"finite_pixels", e.finitePixels},
               {"nonfinite_pixels", e.nonFinitePixels}};
-    if (!args.json.empty()) writeTextAtomically(args.json, j.dump(2) + "\n");
+    if (!args.json.empty()) writeTextOutput(args.json, j.dump(2) + "\n");
     if (args.json != "-")
         std::printf("relMSE %.6g  MSE %.6g  MAE %.6g  max %.6g  bias %.3g  (%zu pixels, %zu non-finite)\n", e.relMse,
                     e.mse, e.mae, e.maxAbsError, e.meanBias, e.finitePixels, e.nonFinitePixels);

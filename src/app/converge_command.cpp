@@ -225,15 +225,6 @@ double timeToReach(const json& summary, const std::string& method, double target
     return -1.0;
 }
 
-void writeTextFile(const std::string& path, const std::string& text) {
-    writeFileAtomically(path, [&](const std::string& tmp) {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        out << text;
-        out.close();
-        if (!out) throw Error("write failed");
-    });
-}
-
 int runConverge(const ConvergeArgs& a) {
     const Scene scene = loadGltf(a.scene);
     vk::ContextOptions co;
@@ -362,8 +353,8 @@ int runConverge(const ConvergeArgs& a) {
                           {"target_relmse", target},
                           {"time_to_target_s", reach}};
     // Written via name.tmp + rename, so an interrupted run never leaves a truncated table.
-    writeTextFile((dir / "results.json").string(), results.dump(2) + "\n");
-    writeTextFile((dir / "results.csv").string(), csv.str());
+    writeTextFileAtomically((dir / "results.json").string(), results.dump(2) + "\n");
+    writeTextFileAtomically((dir / "results.csv").string(), csv.str());
     writePlot(dir, methods, summary);
 
     std::printf("%-10s", "budget(s)");

@@ -10,7 +10,6 @@
 #include <nlohmann/json.hpp>
 
 #include "image/atomic_write.h"
-#include "util/error.h"
 #include "util/timer.h"
 
 namespace gdpt {
@@ -78,12 +77,7 @@ void ReconTimeCache::put(const std::string& key, double seconds) const {
         nlohmann::json j = readCache(path_);
         j[key] = seconds;
         std::filesystem::create_directories(std::filesystem::path(path_).parent_path());
-        const std::string text = j.dump(1) + "\n";
-        writeFileAtomically(path_, [&](const std::string& tmp) {
-            std::ofstream out(tmp);
-            out << text;
-            if (!out) throw Error("cannot write");
-        });
+        writeTextFileAtomically(path_, j.dump(1) + "\n");
     } catch (const std::exception&) {
         // A cache that cannot be written only costs the next run a calibration solve.
     }

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <fstream>
 
 #include "util/error.h"
 
@@ -27,6 +28,15 @@ void writeFileAtomically(const std::string& path,
         std::remove(tmpPath.c_str());
         throw Error(path + ": cannot rename " + tmpPath + " into place: " + reason);
     }
+}
+
+void writeTextFileAtomically(const std::string& path, const std::string& text) {
+    writeFileAtomically(path, [&](const std::string& tmp) {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        out << text;
+        out.close();
+        if (!out) throw Error("write failed");
+    });
 }
 
 }  // namespace gdpt

@@ -14,4 +14,8 @@ namespace gdpt {
 void writeFileAtomically(const std::string& path,
                          const std::function<void(const std::string& tmpPath)>& write);
 
+// writeFileAtomically for a text file: `path` ends up holding exactly `text`, or is left
+// untouched and a gdpt::Error naming it is thrown.
+void writeTextFileAtomically(const std::string& path, const std::string& text);
+
 }  // namespace gdpt
