@@ -134,33 +134,25 @@ int runRender(const RenderArgs& args) {
     if (args.allRecon)
         for (const char* other : {"l1", "l2", "wl2"})
             if (args.recon != other) recons.push_back(other);
-    auto solveOptions = [&](const std::string& name) {
+    std::vector<SolveOptions> solves;
+    for (const std::string& name : recons) {
         SolveOptions so;
         so.method = parseReconstruction(name);
         so.alpha = args.alpha;
         so.tolerance = args.tolerance;
-        return so;
-    };
+        solves.push_back(so);
+    }
     std::unique_ptr<PoissonSolverGpu> solver;
     if (gpt) solver = std::make_unique<PoissonSolverGpu>(ctx, args.width, args.height);
     const ReconTimeCache reconCache(ReconTimeCache::defaultPath());
-    std::string reconKey;
-    double reconReserve = 0.0;
+    ReconReservation reserve;
     if (gpt && args.time > 0.0) {
-        reconKey = ctx.info().name + "|" + ctx.info().driverInfo + "|" + std::to_string(args.width) + "x" +
-                   std::to_string(args.height) + "|alpha " + std::to_string(args.alpha) + "|tol " +
-                   std::to_string(args.tolerance);
-        for (const std::string& r : recons) reconKey += "|" + r;
-        if (const std::optional<double> known = reconCache.get(reconKey)) {
-            reconReserve = *known;
-        } else {
-            for (const std::string& r : recons) reconReserve += calibrateReconSeconds(*solver, solveOptions(r), /*warmUp=*/false);
-        }
-        options.timeBudget = std::max(0.05 * args.time, args.time - reconReserve);
+        reserve = reserveReconstruction(ctx, *solver, solves, reconCache);
+        options.timeBudget = std::max(0.05 * args.time, args.time - reserve.seconds);
     }
     options.elapsedBefore = total.seconds();
     options.scene.shiftThreshold = args.shiftThreshold;
-    options.maxBatchSpp = batchLimit(args.width, args.height, args.method == "gpt");
+    options.maxBatchSpp = batchLimit(args.width, args.height, gpt);
     options.cancel = &gInterrupted;
 
     // Checkpoints: the identity of this render is recorded in every checkpoint written, and a
@@ -209,19 +201,20 @@ int runRender(const RenderArgs& args) {
         input.varPrimal = &g.varPrimal;
         input.varDx = &g.varDx;
         input.varDy = &g.varDy;
-        auto solve = [&](const std::string& name) {
+        auto solve = [&](std::size_t k) {
+            const std::string& name = recons[k];
             Image recon;
-            const SolveReport report = solver->solve(input, solveOptions(name), recon);
+            const SolveReport report = solver->solve(input, solves[k], recon);
             if (!args.quiet)
                 std::fprintf(stderr, "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g, %.1f ms\n",
                              name.c_str(), report.iterations, report.irlsIterations, report.residual, report.ms);
             stats.reconstructionMs += report.ms;
             return recon;
         };
-        const Image recon = solve(args.recon);
+        const Image recon = solve(0);
         layers = {{"", addImages(recon, g.direct)}, {"recon_" + args.recon, recon}};
-        for (std::size_t k = 1; k < recons.size(); ++k) layers.push_back({"recon_" + recons[k], solve(recons[k])});
-        if (!reconKey.empty()) reconCache.put(reconKey, stats.reconstructionMs * 1e-3);
+        for (std::size_t k = 1; k < recons.size(); ++k) layers.push_back({"recon_" + recons[k], solve(k)});
+        if (!reserve.key.empty()) reconCache.put(reserve.key, stats.reconstructionMs * 1e-3);
         const std::vector<NamedLayer> buffers = {
             {"primal", g.primal}, {"dx", g.dx},         {"dy", g.dy},         {"direct", g.direct},
             {"var_primal", g.varPrimal}, {"var_dx", g.varDx}, {"var_dy", g.varDy}, {"var_direct", g.varDirect},
@@ -273,7 +266,7 @@ int runRender(const RenderArgs& args) {
                               {"sampling", s.samplingMs * 1e-3},
                               {"readback", s.readbackMs * 1e-3},
                               {"reconstruction", s.reconstructionMs * 1e-3},
-                              {"reconstruction_reserved", reconReserve},
+                              {"reconstruction_reserved", reserve.seconds},
                               {"write", writeMs * 1e-3}}},
                   {"rays_traced", s.raysTraced},
                   {"paths_completed", s.pathsCompleted},

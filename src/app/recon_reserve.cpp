@@ -6,23 +6,24 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-
 #include <nlohmann/json.hpp>
 
 #include "image/atomic_write.h"
 #include "util/timer.h"
+#include "vk/context.h"
 
 namespace gdpt {
 
 SyntheticReconProblem syntheticReconProblem(int width, int height) {
-    SyntheticReconProblem p{Image(width, height, 0.5f), Image(width, height, 0.0f), Image(width, height, 0.0f),
-                            Image(width, height, 1e-3f)};
+    SyntheticReconProblem p{Image(width, height, 0.5f), Image(width, height, 0.0f),
+                            Image(width, height, 0.0f), Image(width, height, 1e-3f)};
     for (int c = 0; c < 3; ++c)
         for (std::size_t i = 0; i < p.primal.pixelCount(); ++i) {
             p.primal.plane(c)[i] = 0.5f + 0.25f * std::sin(0.37f * static_cast<float>(i % 97));
             // Low-spp-like noise in the gradients (a fixed hash, so the estimate is repeatable):
             // smooth inputs converge in far fewer iterations than real renders.
-            const auto h = static_cast<std::uint32_t>((i * 2654435761u) ^ (static_cast<std::uint32_t>(c) * 40503u));
+            const auto h =
+                static_cast<std::uint32_t>((i * 2654435761u) ^ (static_cast<std::uint32_t>(c) * 40503u));
             p.dx.plane(c)[i] = 0.2f * (static_cast<float>(h % 1000u) / 1000.0f - 0.5f);
             p.dy.plane(c)[i] = 0.2f * (static_cast<float>((h >> 10) % 1000u) / 1000.0f - 0.5f);
         }
@@ -45,7 +46,8 @@ double calibrateReconSeconds(PoissonSolverGpu& solver, const SolveOptions& optio
 
 std::string ReconTimeCache::defaultPath() {
     namespace fs = std::filesystem;
-    if (const char* d = std::getenv("GDPT_CACHE_DIR"); d && *d) return (fs::path(d) / "recon_times.json").string();
+    if (const char* d = std::getenv("GDPT_CACHE_DIR"); d && *d)
+        return (fs::path(d) / "recon_times.json").string();
     if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d)
         return (fs::path(d) / "gdpt" / "recon_times.json").string();
     if (const char* d = std::getenv("HOME"); d && *d)
@@ -81,6 +83,23 @@ void ReconTimeCache::put(const std::string& key, double seconds) const {
     } catch (const std::exception&) {
         // A cache that cannot be written only costs the next run a calibration solve.
     }
+}
+
+ReconReservation reserveReconstruction(const vk::Context& ctx, PoissonSolverGpu& solver,
+                                       const std::vector<SolveOptions>& solves, const ReconTimeCache& cache) {
+    ReconReservation r;
+    r.key = ctx.info().name + "|" + ctx.info().driverInfo + "|" + std::to_string(solver.engine().width()) +
+            "x" + std::to_string(solver.engine().height());
+    for (const SolveOptions& so : solves)
+        r.key += std::string("|") + toString(so.method) + " alpha " + std::to_string(so.alpha) + " tol " +
+                 std::to_string(so.tolerance);
+    if (const std::optional<double> known = cache.get(r.key)) {
+        r.seconds = *known;
+    } else {
+        for (const SolveOptions& so : solves)
+            r.seconds += calibrateReconSeconds(solver, so, /*warmUp=*/false);
+    }
+    return r;
 }
 
 }  // namespace gdpt

@@ -10,9 +10,14 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "image/image.h"
 #include "poisson/poisson_gpu.h"
+
+namespace gdpt::vk {
+class Context;
+}  // namespace gdpt::vk
 
 namespace gdpt {
 
@@ -44,5 +49,15 @@ public:
 private:
     std::string path_;
 };
+
+// The reservation of a timed G-PT render: the cache key of its configuration (device,
+// driver, size, each solve's method, alpha and tolerance) and the seconds to reserve (the
+// cached time, else the sum of one calibration solve per entry of `solves`).
+struct ReconReservation {
+    std::string key;
+    double seconds = 0.0;
+};
+ReconReservation reserveReconstruction(const vk::Context& ctx, PoissonSolverGpu& solver,
+                                       const std::vector<SolveOptions>& solves, const ReconTimeCache& cache);
 
 }  // namespace gdpt
