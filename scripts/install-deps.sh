@@ -43,7 +43,11 @@ if ((backports)); then
   ((dry)) || "${APT[@]}" update -q
   "${APT[@]}" install -y -q --no-install-recommends "${packages[@]}"
   # Backports packages are never chosen by default; ask for Mesa's (its libdrm follows).
-  "${APT[@]}" install -y -q --no-install-recommends -t bookworm-backports mesa-vulkan-drivers
+  if ((dry)) && ! grep -rqs "bookworm-backports" /etc/apt/sources.list /etc/apt/sources.list.d/; then
+    echo "would run: apt-get install -t bookworm-backports mesa-vulkan-drivers"
+  else
+    "${APT[@]}" install -y -q --no-install-recommends -t bookworm-backports mesa-vulkan-drivers
+  fi
   exit 0
 fi
 missing=()
