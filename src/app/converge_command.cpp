@@ -90,7 +90,8 @@ public:
         o.quiet = true;
         // The reconstruction reserve is measured (once per method) before the clock starts:
         // it is calibration, not part of the run.
-        const double reserve = method == "pt" ? 0.0 : reconSeconds(method, solveOptions(method));
+        const SolveOptions so = method == "pt" ? SolveOptions{} : solveOptions(method);
+        const double reserve = method == "pt" ? 0.0 : reconSeconds(method, so);
         Timer total;
         Image result;
         if (method == "pt") {
@@ -99,7 +100,6 @@ public:
             result = std::move(res.image);
             r.spp = res.stats.spp;
         } else {
-            SolveOptions so = solveOptions(method);
             // Sampling gets what is left after the (measured) reconstruction time.
             o.timeBudget = std::max(0.05 * budget, budget - reserve);
             o.maxBatchSpp = batchLimit(a_.width, a_.height, true);
@@ -121,7 +121,8 @@ public:
 
     // One untimed 1-spp render of `method`: lavapipe compiles a pipeline at its first
     // dispatch (later processes hit Mesa's shader cache), which would otherwise land in the
-    // first budget's time (G-PT L1 at 4 s took 7 s on the Cornell box).
+    // first budget's sampling time (measured: a cold G-PT render at 13 k instead of
+    // 117 k samples/s).
     void warmUp(const std::string& method) {
         RenderOptions o;
         o.scene.width = a_.width;
