@@ -1,13 +1,20 @@
-# gdpt_add_shaders(<target> <kernel.comp>...)
+# gdpt_add_shaders(<target> <kernel.comp>... [SUFFIX <s>] [DEFINES <NAME>...])
 #
 # Compiles each compute shader to SPIR-V with glslangValidator and embeds it as a
 # `const uint32_t kSpv_<name>[]` array in <build>/shaders/spv/<name>.spv.h. The rule uses
 # glslangValidator's --depfile so that editing any included header (shaders/lib/*.glsl,
 # shaders/shared/gdpt_shared.h) rebuilds the SPIR-V. The headers are exposed through the
-# INTERFACE library <target>.
+# INTERFACE library <target>. With SUFFIX and DEFINES, each kernel is compiled with
+# -D<NAME> for every name into kSpv_<name><s> in <name><s>.spv.h (a second build of the same
+# source, e.g. the device-address variants of the Poisson kernels).
 find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)
 
 function(gdpt_add_shaders target)
+  cmake_parse_arguments(PARSE_ARGV 1 arg "" "SUFFIX" "DEFINES")
+  set(define_flags)
+  foreach(d ${arg_DEFINES})
+    list(APPEND define_flags -D${d})
+  endforeach()
   set(out_dir ${CMAKE_BINARY_DIR}/shaders/spv)
   file(MAKE_DIRECTORY ${out_dir})
   set(outputs)
@@ -15,13 +22,14 @@ function(gdpt_add_shaders target)
   if(CMAKE_BUILD_TYPE STREQUAL "Debug")
     set(debug_flags -g)
   endif()
-  foreach(src ${ARGN})
+  foreach(src ${arg_UNPARSED_ARGUMENTS})
     get_filename_component(name ${src} NAME_WE)
+    set(name ${name}${arg_SUFFIX})
     get_filename_component(abs ${src} ABSOLUTE)
     set(out ${out_dir}/${name}.spv.h)
     add_custom_command(
       OUTPUT ${out}
-      COMMAND ${GLSLANG_VALIDATOR} --target-env vulkan1.2 -V ${debug_flags}
+      COMMAND ${GLSLANG_VALIDATOR} --target-env vulkan1.2 -V ${debug_flags} ${define_flags}
               --vn kSpv_${name} --depfile ${out}.d
               -I${CMAKE_SOURCE_DIR}/shaders -I${CMAKE_SOURCE_DIR}/shaders/shared
               -o ${out} ${abs}

@@ -15,17 +15,28 @@
 #version 460
 #extension GL_EXT_scalar_block_layout : require
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "poisson_shared.h"
 layout(local_size_x = 256, local_size_y = 1) in;
 #include "lib/poisson_common.glsl"
 
 shared float sSum[256];
 
+// The strided per-invocation sum reads kPoissonSumUnroll entries per loop iteration, and
+// main() has no loop around the sums. llvmpipe stops any outermost loop after 65535
+// iterations, counting the iterations of loops nested in it (LP_MAX_TGSI_LOOP_ITERATIONS),
+// silently: with one entry per iteration inside main()'s channel loop, Init's nine sums over
+// G ≈ 1.9M partials (3900x3900) crossed that cap and MG-PCG diverged. The engine checks the
+// bound (PoissonGpuEngine, kPoissonSumUnroll).
+#define SUM_AT(k) if (j + (k) * 256u < g) s += PARTIAL(slot, base + j + (k) * 256u);
+#define SUM_4(k) SUM_AT(k) SUM_AT(k + 1u) SUM_AT(k + 2u) SUM_AT(k + 3u)
 float sumSlot(uint slot, uint c) {
     uint l = gl_LocalInvocationIndex;
-    uint g = pc.groups;
+    uint g = pc.groups, base = c * g;
     float s = 0.0;
-    for (uint j = l; j < g; j += 256u) s += Partials[(slot * 3u + c) * g + j];
+    for (uint j = l; j < g; j += 256u * kPoissonSumUnroll) {
+        SUM_4(0u) SUM_4(4u) SUM_4(8u) SUM_4(12u)
+    }
     sSum[l] = s;
     barrier();
     for (uint k = 128u; k > 0u; k >>= 1u) {
@@ -47,7 +58,7 @@ void recordHistory(uint c, float rr) {
 void main() {
     bool lead = gl_LocalInvocationIndex == 0u;
     bool precond = !flag(kPoissonFlagZIsR);
-    for (uint c = 0u; c < 3u; ++c) {
+    [[unroll]] for (uint c = 0u; c < 3u; ++c) {
         if (pc.mode == kPoissonModeInit) {
             float bb = sumSlot(kPoissonSlotBB, c);
             float rr = sumSlot(kPoissonSlotRR, c);
@@ -97,7 +108,7 @@ void main() {
         }
     }
     if (pc.mode == kPoissonModeMean)
-        for (uint c = 0u; c < 3u; ++c) {
+        [[unroll]] for (uint c = 0u; c < 3u; ++c) {
             float sum = sumSlot(kPoissonSlotSum, c);
             if (lead) sc.bMean[c] = sum / pc.value;
         }

@@ -7,24 +7,53 @@
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 
-layout(set = 0, binding = kPoissonBindCoef, scalar) buffer CoefBuf { float Coef[]; };
-layout(set = 0, binding = kPoissonBindX, scalar) buffer XBuf { float X[]; };
-layout(set = 0, binding = kPoissonBindB, scalar) buffer BBuf { float B[]; };
-layout(set = 0, binding = kPoissonBindR, scalar) buffer RBuf { float R[]; };
-layout(set = 0, binding = kPoissonBindP, scalar) buffer PBuf { float P[]; };
-layout(set = 0, binding = kPoissonBindAp, scalar) buffer ApBuf { float Ap[]; };
-layout(set = 0, binding = kPoissonBindSol, scalar) buffer SolBuf { float Sol[]; };
-layout(set = 0, binding = kPoissonBindRhs, scalar) buffer RhsBuf { float Rhs[]; };
-layout(set = 0, binding = kPoissonBindPrimal, scalar) readonly buffer PrimalBuf { float Primal[]; };
-layout(set = 0, binding = kPoissonBindDx, scalar) readonly buffer DxBuf { float Dx[]; };
-layout(set = 0, binding = kPoissonBindDy, scalar) readonly buffer DyBuf { float Dy[]; };
-layout(set = 0, binding = kPoissonBindWeights, scalar) readonly buffer WeightBuf { float Wt[]; };
-layout(set = 0, binding = kPoissonBindIrls, scalar) buffer IrlsBuf { float Irls[]; };
+// The field buffers (poisson_shared.h); either way each name is a float array, X[i].
+#ifdef GDPT_POISSON_DEVICE_ADDRESS
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_buffer_reference_uvec2 : require
+layout(buffer_reference, scalar, buffer_reference_align = 4) buffer PoissonFloats { float v[]; };
+layout(set = 0, binding = kPoissonBindFields, scalar) readonly restrict buffer FieldBuf {
+    uvec2 fieldAddress[kPoissonFieldCount];
+};
+#define POISSON_FIELD(f) (PoissonFloats(fieldAddress[f]).v)
+#define Coef POISSON_FIELD(kPoissonFieldCoef)
+#define X POISSON_FIELD(kPoissonFieldX)
+#define B POISSON_FIELD(kPoissonFieldB)
+#define R POISSON_FIELD(kPoissonFieldR)
+#define P POISSON_FIELD(kPoissonFieldP)
+#define Ap POISSON_FIELD(kPoissonFieldAp)
+#define Sol POISSON_FIELD(kPoissonFieldSol)
+#define Rhs POISSON_FIELD(kPoissonFieldRhs)
+#define Primal POISSON_FIELD(kPoissonFieldPrimal)
+#define Dx POISSON_FIELD(kPoissonFieldDx)
+#define Dy POISSON_FIELD(kPoissonFieldDy)
+#define Wt POISSON_FIELD(kPoissonFieldWeights)
+#define Irls POISSON_FIELD(kPoissonFieldIrls)
+#define Partials POISSON_FIELD(kPoissonFieldPartials)
+#else
+#define POISSON_BIND(f) layout(set = 0, binding = kPoissonBindFieldBase + f, scalar)
+POISSON_BIND(kPoissonFieldCoef) buffer CoefBuf { float Coef[]; };
+POISSON_BIND(kPoissonFieldX) buffer XBuf { float X[]; };
+POISSON_BIND(kPoissonFieldB) buffer BBuf { float B[]; };
+POISSON_BIND(kPoissonFieldR) buffer RBuf { float R[]; };
+POISSON_BIND(kPoissonFieldP) buffer PBuf { float P[]; };
+POISSON_BIND(kPoissonFieldAp) buffer ApBuf { float Ap[]; };
+POISSON_BIND(kPoissonFieldSol) buffer SolBuf { float Sol[]; };
+POISSON_BIND(kPoissonFieldRhs) buffer RhsBuf { float Rhs[]; };
+POISSON_BIND(kPoissonFieldPrimal) readonly buffer PrimalBuf { float Primal[]; };
+POISSON_BIND(kPoissonFieldDx) readonly buffer DxBuf { float Dx[]; };
+POISSON_BIND(kPoissonFieldDy) readonly buffer DyBuf { float Dy[]; };
+POISSON_BIND(kPoissonFieldWeights) readonly buffer WeightBuf { float Wt[]; };
+POISSON_BIND(kPoissonFieldIrls) buffer IrlsBuf { float Irls[]; };
+POISSON_BIND(kPoissonFieldPartials) buffer PartialBuf { float Partials[]; };
+#endif
+// Entry k = c·G + g of partial-sum slot `slot` (kPoissonSlot*), G = pc.groups.
+#define PARTIAL(slot, k) Partials[(slot) * 3u * pc.groups + (k)]
+
 layout(set = 0, binding = kPoissonBindScalars, scalar) buffer ScalarBuf {
     PoissonScalars sc;
     float history[];
 };
-layout(set = 0, binding = kPoissonBindPartials, scalar) buffer PartialBuf { float Partials[]; };
 
 layout(push_constant, scalar) uniform Push { PoissonPush pc; };
 
@@ -66,7 +95,7 @@ float applyStencil(Stencil s, float xi, float xW, float xE, float xN, float xS) 
 
 // Deterministic partial sums of three values (one per channel): subgroupAdd inside each
 // subgroup (a fixed reduction order of the implementation), and one partial per subgroup,
-// Partials[(slot·3 + c)·G + g·S + subgroup] with S = gl_NumSubgroups and G·S = pc.groups
+// PARTIAL(slot, c·G + g·S + subgroup) with S = gl_NumSubgroups and G·S = pc.groups
 // (≥ this dispatch's count; unused entries stay 0). No shared memory and no barrier: on
 // lavapipe a barrier anywhere in a shader turns every workgroup into coroutines, which made
 // the stencil kernels several times slower. poisson_scalars adds the partials in order.
@@ -74,7 +103,7 @@ void writePartials(vec3 v, uint slot) {
     vec3 s = subgroupAdd(v);
     uint g = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_NumSubgroups + gl_SubgroupID;
     if (subgroupElect())
-        for (uint c = 0u; c < 3u; ++c) Partials[(slot * 3u + c) * pc.groups + g] = s[c];
+        for (uint c = 0u; c < 3u; ++c) PARTIAL(slot, c * pc.groups + g) = s[c];
 }
 
 #endif

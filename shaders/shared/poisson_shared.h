@@ -19,25 +19,37 @@
 namespace gdpt::gpu {
 #endif
 
-// Descriptor bindings of every poisson_* kernel (set 0). Every kernel's layout lists all of
-// them; each buffer is bound once when the kernels are created.
+// The field buffers of the solver. Each kernel is built twice (shaders/CMakeLists.txt):
+//   descriptors (default): field f is the storage buffer at binding kPoissonBindFieldBase + f;
+//   device addresses (GDPT_POISSON_DEVICE_ADDRESS, kSpv_poisson_*_addr): the table at binding
+//       kPoissonBindFields holds each field's 64-bit address (GL_EXT_buffer_reference).
+// The second exists for fields beyond maxStorageBufferRange (a descriptor range limit; a
+// 4096x4096 solve has 200-270 MB fields, lavapipe allows 128 MiB); it is only used then,
+// because lavapipe 22.3 runs the address-based loads about 1.3x slower.
+GDPT_ENUM_BEGIN(PoissonField)
+    kPoissonFieldCoef = 0u,      // float: per level cx, cy, cp planes
+    kPoissonFieldX = 1u,         // float: per level x (V-cycle unknown; 3 planes)
+    kPoissonFieldB = 2u,         // float: per level right-hand side (level 0: CG residual r)
+    kPoissonFieldR = 3u,         // float: per level scratch (residual, Jacobi ping-pong)
+    kPoissonFieldP = 4u,         // float: two fine RGB slots, CG search direction p (ping-pong)
+    kPoissonFieldAp = 5u,        // float: fine RGB, A p
+    kPoissonFieldSol = 6u,       // float: fine RGB, the solution image being reconstructed
+    kPoissonFieldRhs = 7u,       // float: fine RGB, b = Pᵀ W target
+    kPoissonFieldPrimal = 8u,    // float: fine RGB primal t (radiance)
+    kPoissonFieldDx = 9u,        // float: fine RGB target of I(x+1,y) − I(x,y)
+    kPoissonFieldDy = 10u,       // float: fine RGB target of I(x,y+1) − I(x,y)
+    kPoissonFieldWeights = 11u,  // float: fine planes wp, wdx, wdy (input weights, ≥ 0)
+    kPoissonFieldIrls = 12u,     // float: fine planes of IRLS row weights (primal, dx, dy)
+    kPoissonFieldPartials = 13u, // float: per-subgroup partial sums, see kPoissonSlot*
+    kPoissonFieldCount = 14u
+GDPT_ENUM_END();
+
+// Descriptor bindings of the poisson_* kernels (set 0).
 GDPT_ENUM_BEGIN(PoissonBinding)
-    kPoissonBindCoef = 0u,      // float: per level cx, cy, cp planes
-    kPoissonBindX = 1u,         // float: per level x (V-cycle unknown; 3 planes)
-    kPoissonBindB = 2u,         // float: per level right-hand side (level 0: CG residual r)
-    kPoissonBindR = 3u,         // float: per level scratch (residual, Jacobi ping-pong)
-    kPoissonBindP = 4u,         // float: two fine RGB slots, CG search direction p (ping-pong)
-    kPoissonBindAp = 5u,        // float: fine RGB, A p
-    kPoissonBindSol = 6u,       // float: fine RGB, the solution image being reconstructed
-    kPoissonBindRhs = 7u,       // float: fine RGB, b = Pᵀ W target
-    kPoissonBindPrimal = 8u,    // float: fine RGB primal t (radiance)
-    kPoissonBindDx = 9u,        // float: fine RGB target of I(x+1,y) − I(x,y)
-    kPoissonBindDy = 10u,       // float: fine RGB target of I(x,y+1) − I(x,y)
-    kPoissonBindWeights = 11u,  // float: fine planes wp, wdx, wdy (input weights, ≥ 0)
-    kPoissonBindIrls = 12u,     // float: fine planes of IRLS row weights (primal, dx, dy)
-    kPoissonBindScalars = 13u,  // PoissonScalars followed by the residual history
-    kPoissonBindPartials = 14u, // float: per-workgroup partial sums, see kPoissonSlot*
-    kPoissonBindCount = 15u
+    kPoissonBindFields = 0u,     // device-address variant: uint64 address per kPoissonField*
+    kPoissonBindScalars = 1u,    // PoissonScalars followed by the residual history
+    kPoissonBindFieldBase = 2u,  // descriptor variant: field f at binding 2 + f
+    kPoissonBindCount = 16u
 GDPT_ENUM_END();
 
 // Partial-sum slots: a reduction kernel writes partials[(slot·3 + c)·G + g] for workgroup g
@@ -81,6 +93,7 @@ GDPT_ENUM_BEGIN(PoissonScalarMode)
 GDPT_ENUM_END();
 
 GDPT_CONST uint kPoissonMaxHistory = 4096u;   // residual history entries (per channel)
+GDPT_CONST uint kPoissonSumUnroll = 16u;      // partials per loop iteration in poisson_scalars
 GDPT_CONST uint kPoissonMaxGroupSize = 256u;  // reductions assume ≤ 256, a power of two
 GDPT_CONST uint kPoissonCoarsestMax = 8u;     // coarsest level: width, height ≤ 8
 GDPT_CONST uint kPoissonCoarsestSweeps = 48u; // symmetric RB-GS sweep pairs on the coarsest

@@ -33,6 +33,7 @@ struct BenchPoissonArgs {
     bool jacobiSmoother = false;
     std::string device;
     bool profile = false;
+    std::string addressing = "auto";
 };
 
 // "N" (square) or "WxH".
@@ -73,6 +74,13 @@ int runBenchPoisson(const BenchPoissonArgs& a) {
     char sep = 0;
     std::istringstream wg(a.workgroup);
     if (!(wg >> gx >> sep >> gy) || sep != 'x') throw UsageError("--workgroup must be WxH, e.g. 16x16");
+    std::optional<PoissonAddressing> addressing;
+    if (a.addressing == "descriptors")
+        addressing = PoissonAddressing::Descriptors;
+    else if (a.addressing == "device-address")
+        addressing = PoissonAddressing::DeviceAddress;
+    else if (a.addressing != "auto")
+        throw UsageError("--addressing must be auto, descriptors or device-address");
     vk::ContextOptions co;
     co.device = a.device;
     vk::Context ctx(co);
@@ -88,6 +96,7 @@ int runBenchPoisson(const BenchPoissonArgs& a) {
                 {"pre_smooth", a.preSmooth},
                 {"post_smooth", a.postSmooth},
                 {"smoother", a.jacobiSmoother ? "jacobi" : "rb-gs"},
+                {"addressing", a.addressing},
                 {"results", json::array()}};
     for (const std::string& sizeText : splitList(a.sizes)) {
         const auto [w, h] = parseSize(sizeText);
@@ -102,7 +111,7 @@ int runBenchPoisson(const BenchPoissonArgs& a) {
                     if (y + 1 < h) dy.at(x, y, c) = truth.at(x, y + 1, c) - truth.at(x, y, c);
                     primal.at(x, y, c) += noise(rng);
                 }
-        PoissonSolverGpu solver(ctx, w, h, &kernels);
+        PoissonSolverGpu solver(ctx, w, h, &kernels, addressing);
         PoissonInput in;
         in.primal = &primal;
         in.dx = &dx;
@@ -136,6 +145,9 @@ int runBenchPoisson(const BenchPoissonArgs& a) {
                           {"width", w},
                           {"height", h},
                           {"method", method},
+                          {"addressing", solver.engine().addressing() == PoissonAddressing::DeviceAddress
+                                             ? "device-address"
+                                             : "descriptors"},
                           {"median_ms", med},
                           {"all_ms", ms},
                           {"iterations", report.iterations},
@@ -191,6 +203,10 @@ Subcommand addBenchPoissonCommand(CLI::App& app) {
                   "Damped Jacobi smoother instead of red-black Gauss-Seidel");
     sub->add_option("--device", args->device, "Vulkan device index or name substring");
     sub->add_flag("--profile", args->profile, "Add per-kernel GPU ms (last repeat) to the JSON");
+    sub->add_option("--addressing", args->addressing,
+                    "How kernels reach the fields: auto (descriptors unless a field exceeds "
+                    "maxStorageBufferRange), descriptors, device-address")
+        ->capture_default_str();
     return {sub, [args] { return runBenchPoisson(*args); }};
 }
 

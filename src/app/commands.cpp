@@ -333,6 +333,7 @@ int runDevices(const DevicesArgs& args) {
                                     std::to_string(VK_API_VERSION_MINOR(d.apiVersion)) + "." +
                                     std::to_string(VK_API_VERSION_PATCH(d.apiVersion))},
                         {"max_storage_buffer_range", d.maxStorageBufferRange},
+                        {"max_memory_allocation", d.maxMemoryAllocationSize},
                         {"max_push_constants", d.maxPushConstantsSize},
                         {"max_workgroup_invocations", d.maxComputeWorkGroupInvocations},
                         {"shared_memory", d.maxComputeSharedMemorySize},

@@ -104,8 +104,9 @@ const char* toString(GpuSolver s) {
     return "?";
 }
 
-PoissonSolverGpu::PoissonSolverGpu(const vk::Context& ctx, int width, int height, PoissonKernels* kernels)
-    : engine_(ctx, width, height, kernels), stream_(ctx, "poisson solve") {}
+PoissonSolverGpu::PoissonSolverGpu(const vk::Context& ctx, int width, int height, PoissonKernels* kernels,
+                                   std::optional<PoissonAddressing> addressing)
+    : engine_(ctx, width, height, kernels, addressing), stream_(ctx, "poisson solve") {}
 
 void PoissonSolverGpu::readHistory(int count, SolveReport& report) {
     const int entries = std::min(count + 1, static_cast<int>(kPoissonMaxHistory));

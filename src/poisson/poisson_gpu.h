@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -101,7 +102,9 @@ struct PoissonInput {
 
 class PoissonSolverGpu {
 public:
-    PoissonSolverGpu(const vk::Context& ctx, int width, int height, PoissonKernels* kernels = nullptr);
+    // addressing: see PoissonGpuEngine (default: descriptors unless a field is too large).
+    PoissonSolverGpu(const vk::Context& ctx, int width, int height, PoissonKernels* kernels = nullptr,
+                     std::optional<PoissonAddressing> addressing = std::nullopt);
 
     // Reconstructs into `out` (resized). Throws gdpt::Error on size mismatch or bad options.
     SolveReport solve(const PoissonInput& in, const SolveOptions& options, Image& out);

@@ -6,17 +6,28 @@
 #include <string>
 
 #include "poisson_cg_direction.spv.h"
+#include "poisson_cg_direction_addr.spv.h"
 #include "poisson_cg_update.spv.h"
+#include "poisson_cg_update_addr.spv.h"
 #include "poisson_coarsen.spv.h"
+#include "poisson_coarsen_addr.spv.h"
 #include "poisson_coarsest.spv.h"
+#include "poisson_coarsest_addr.spv.h"
 #include "poisson_irls_weights.spv.h"
+#include "poisson_irls_weights_addr.spv.h"
 #include "poisson_prolong.spv.h"
+#include "poisson_prolong_addr.spv.h"
 #include "poisson_residual.spv.h"
+#include "poisson_residual_addr.spv.h"
 #include "poisson_restrict.spv.h"
+#include "poisson_restrict_addr.spv.h"
 #include "poisson_scalars.spv.h"
+#include "poisson_scalars_addr.spv.h"
 #include "poisson_setup.spv.h"
+#include "poisson_setup_addr.spv.h"
 #include "poisson_shared.h"
 #include "poisson_smooth.spv.h"
+#include "poisson_smooth_addr.spv.h"
 #include "util/error.h"
 #include "vk/commands.h"
 #include "vk/context.h"
@@ -26,8 +37,12 @@ namespace {
 
 using gpu::PoissonPush;
 
-vk::KernelDesc describe(vk::KernelDesc d, std::uint32_t gx, std::uint32_t gy, bool grid) {
-    for (std::uint32_t b = 0; b < gpu::kPoissonBindCount; ++b) d.bindings.push_back(b);
+vk::KernelDesc describe(vk::KernelDesc d, std::uint32_t gx, std::uint32_t gy, bool grid, bool addressed) {
+    d.bindings = {gpu::kPoissonBindScalars};
+    if (addressed)
+        d.bindings.push_back(gpu::kPoissonBindFields);
+    else
+        for (std::uint32_t f = 0; f < gpu::kPoissonFieldCount; ++f) d.bindings.push_back(gpu::kPoissonBindFieldBase + f);
     d.pushConstantBytes = sizeof(PoissonPush);
     if (grid) {
         d.specConstants = {{gpu::kSpecWorkgroupX, gx}, {gpu::kSpecWorkgroupY, gy}};
@@ -61,52 +76,61 @@ PoissonKernels::PoissonKernels(const vk::Context& ctx, std::uint32_t gx, std::ui
     if (size == 0 || size > gpu::kPoissonMaxGroupSize || (size & (size - 1)) != 0)
         throw Error("Poisson solver: workgroup " + std::to_string(gx) + "x" + std::to_string(gy) +
                     " must have a power-of-two size <= 256");
-    auto set = [&](PoissonOp op, vk::KernelDesc d, bool grid) {
-        descs_[static_cast<std::size_t>(op)] = describe(std::move(d), gx, gy, grid);
+    auto set = [&](PoissonOp op, vk::KernelDesc d, vk::KernelDesc addressed, bool grid) {
+        descs_[0][static_cast<std::size_t>(op)] = describe(std::move(d), gx, gy, grid, false);
+        descs_[1][static_cast<std::size_t>(op)] = describe(std::move(addressed), gx, gy, grid, true);
     };
-    set(PoissonOp::Setup, vk::kernelDesc("poisson_setup", kSpv_poisson_setup), true);
-    set(PoissonOp::Coarsen, vk::kernelDesc("poisson_coarsen", kSpv_poisson_coarsen), true);
-    set(PoissonOp::Residual, vk::kernelDesc("poisson_residual", kSpv_poisson_residual), true);
-    set(PoissonOp::Smooth, vk::kernelDesc("poisson_smooth", kSpv_poisson_smooth), true);
-    set(PoissonOp::Restrict, vk::kernelDesc("poisson_restrict", kSpv_poisson_restrict), true);
-    set(PoissonOp::Prolong, vk::kernelDesc("poisson_prolong", kSpv_poisson_prolong), true);
-    set(PoissonOp::Coarsest, vk::kernelDesc("poisson_coarsest", kSpv_poisson_coarsest), false);
-    set(PoissonOp::CgDirection, vk::kernelDesc("poisson_cg_direction", kSpv_poisson_cg_direction), true);
-    set(PoissonOp::CgUpdate, vk::kernelDesc("poisson_cg_update", kSpv_poisson_cg_update), true);
-    set(PoissonOp::Scalars, vk::kernelDesc("poisson_scalars", kSpv_poisson_scalars), false);
-    set(PoissonOp::IrlsWeights, vk::kernelDesc("poisson_irls_weights", kSpv_poisson_irls_weights), true);
+#define GDPT_POISSON_KERNEL(op, name, grid) \
+    set(PoissonOp::op, vk::kernelDesc(#name, kSpv_##name), vk::kernelDesc(#name, kSpv_##name##_addr), grid)
+    GDPT_POISSON_KERNEL(Setup, poisson_setup, true);
+    GDPT_POISSON_KERNEL(Coarsen, poisson_coarsen, true);
+    GDPT_POISSON_KERNEL(Residual, poisson_residual, true);
+    GDPT_POISSON_KERNEL(Smooth, poisson_smooth, true);
+    GDPT_POISSON_KERNEL(Restrict, poisson_restrict, true);
+    GDPT_POISSON_KERNEL(Prolong, poisson_prolong, true);
+    GDPT_POISSON_KERNEL(Coarsest, poisson_coarsest, false);
+    GDPT_POISSON_KERNEL(CgDirection, poisson_cg_direction, true);
+    GDPT_POISSON_KERNEL(CgUpdate, poisson_cg_update, true);
+    GDPT_POISSON_KERNEL(Scalars, poisson_scalars, false);
+    GDPT_POISSON_KERNEL(IrlsWeights, poisson_irls_weights, true);
+#undef GDPT_POISSON_KERNEL
 }
 
 PoissonKernels::~PoissonKernels() = default;
 
-const vk::Kernel& PoissonKernels::get(PoissonOp op, std::uint32_t flags) {
-    auto& variants = variants_[static_cast<std::size_t>(op)];
+const vk::Kernel& PoissonKernels::get(PoissonOp op, std::uint32_t flags, PoissonAddressing addressing) {
+    const auto mode = static_cast<std::size_t>(addressing);
+    auto& variants = variants_[mode][static_cast<std::size_t>(op)];
     auto it = variants.find(flags);
     if (it == variants.end()) {
-        vk::KernelDesc d = descs_[static_cast<std::size_t>(op)];
+        vk::KernelDesc d = descs_[mode][static_cast<std::size_t>(op)];
         d.specConstants.emplace_back(gpu::kSpecPoissonFlags, flags);
         auto kernel = std::make_unique<vk::Kernel>(ctx_, d);
-        for (std::uint32_t i = 0; i < gpu::kPoissonBindCount; ++i)
-            if (bound_[i]) kernel->bind(i, *bound_[i]);
+        for (std::uint32_t b : d.bindings)
+            if (bound_[mode][b]) kernel->bind(b, *bound_[mode][b]);
         it = variants.emplace(flags, std::move(kernel)).first;
     }
     return *it->second;
 }
 
-void PoissonKernels::bindAll(const Buffers& buffers) {
-    bound_ = buffers;
-    for (auto& variants : variants_)
-        for (auto& [flags, kernel] : variants)
-            for (std::uint32_t i = 0; i < gpu::kPoissonBindCount; ++i) kernel->bind(i, *buffers[i]);
+void PoissonKernels::bindAll(const Buffers& buffers, PoissonAddressing addressing) {
+    const auto mode = static_cast<std::size_t>(addressing);
+    bound_[mode] = buffers;
+    for (std::size_t op = 0; op < variants_[mode].size(); ++op)
+        for (auto& [flags, kernel] : variants_[mode][op])
+            for (std::uint32_t b : descs_[mode][op].bindings)
+                if (buffers[b]) kernel->bind(b, *buffers[b]);
 }
 
 std::size_t PoissonKernels::variantCount() const {
     std::size_t n = 0;
-    for (const auto& variants : variants_) n += variants.size();
+    for (const auto& mode : variants_)
+        for (const auto& variants : mode) n += variants.size();
     return n;
 }
 
-PoissonGpuEngine::PoissonGpuEngine(const vk::Context& ctx, int width, int height, PoissonKernels* kernels)
+PoissonGpuEngine::PoissonGpuEngine(const vk::Context& ctx, int width, int height, PoissonKernels* kernels,
+                                   std::optional<PoissonAddressing> addressing)
     : ctx_(ctx) {
     if (width <= 0 || height <= 0)
         throw Error("Poisson solver: invalid size " + std::to_string(width) + "x" + std::to_string(height));
@@ -131,7 +155,23 @@ PoissonGpuEngine::PoissonGpuEngine(const vk::Context& ctx, int width, int height
     const std::uint64_t fine = 3ull * pixels() * sizeof(float);
     const std::uint64_t all = offset * sizeof(float);
     const std::string what = "Poisson solve of " + std::to_string(width) + "x" + std::to_string(height);
-    ctx.checkStorageBufferSize(all, what + " (all multigrid levels of one field)");
+    // Float offsets are 32-bit in the kernels. Fields beyond maxStorageBufferRange are read
+    // through device addresses, whose limit is the allocation size.
+    if (offset > 0xffffffffull)
+        throw Error(what + ": the multigrid levels exceed 2^32 floats per field; use a smaller image");
+    const std::uint64_t partialBytes = std::uint64_t{gpu::kPoissonSlotCount} * 3 * groups() * sizeof(float);
+    const std::uint64_t largest = std::max({2 * fine, all, partialBytes});
+    ctx.checkAllocationSize(largest, what + " (largest field)");
+    // llvmpipe ends any loop nest after 65535 iterations (poisson_scalars.comp): the worst
+    // scalar dispatch (Init) runs 9 sums of G / (256·unroll) iterations plus an 8-step tree.
+    // The allocation limit keeps G far below this on lavapipe; devices without the cap pass.
+    const std::uint64_t sumIterations =
+        9ull * ((groups() + 256ull * gpu::kPoissonSumUnroll - 1) / (256ull * gpu::kPoissonSumUnroll) + 8);
+    if (ctx.info().isCpu && sumIterations > 65535)
+        throw Error(what + ": its reductions would exceed llvmpipe's 65535-iteration loop limit; use a smaller image");
+    addressing_ = addressing.value_or(largest <= ctx.info().maxStorageBufferRange
+                                          ? PoissonAddressing::Descriptors
+                                          : PoissonAddressing::DeviceAddress);
     coef = vk::Buffer(ctx, all, "poissonCoef");
     x = vk::Buffer(ctx, all, "poissonX");
     b = vk::Buffer(ctx, all, "poissonB");
@@ -145,10 +185,14 @@ PoissonGpuEngine::PoissonGpuEngine(const vk::Context& ctx, int width, int height
     dy = vk::Buffer(ctx, fine, "poissonDy");
     weights = vk::Buffer(ctx, fine, "poissonWeights");
     irls = vk::Buffer(ctx, fine, "poissonIrls");
+    partials = vk::Buffer(ctx, partialBytes, "poissonPartials");
     scalars = vk::Buffer(ctx, sizeof(gpu::PoissonScalars) + 3ull * gpu::kPoissonMaxHistory * sizeof(float),
                          "poissonScalars");
-    partials = vk::Buffer(ctx, std::uint64_t{gpu::kPoissonSlotCount} * 3 * groups() * sizeof(float),
-                          "poissonPartials");
+    std::array<std::uint64_t, gpu::kPoissonFieldCount> addresses{};
+    const auto fields = fieldBuffers();
+    for (std::uint32_t f = 0; f < gpu::kPoissonFieldCount; ++f) addresses[f] = fields[f]->deviceAddress();
+    fieldTable = vk::Buffer(ctx, sizeof(addresses), "poissonFields");
+    fieldTable.upload(addresses.data(), sizeof(addresses));
     // Defined contents everywhere (no stale NaN can leak through a 0 coefficient).
     for (vk::Buffer* buf : {&coef, &x, &b, &r, &p, &ap, &sol, &rhs, &irls, &scalars, &partials}) buf->zero();
     bind();
@@ -165,9 +209,20 @@ std::uint32_t PoissonGpuEngine::groups() const {
     return gx * gy * perGroup;
 }
 
+std::array<const vk::Buffer*, gpu::kPoissonFieldCount> PoissonGpuEngine::fieldBuffers() const {
+    return {&coef, &x, &b, &r, &p, &ap, &sol, &rhs, &primal, &dx, &dy, &weights, &irls, &partials};
+}
+
 void PoissonGpuEngine::bind() {
-    kernels_->bindAll(
-        {&coef, &x, &b, &r, &p, &ap, &sol, &rhs, &primal, &dx, &dy, &weights, &irls, &scalars, &partials});
+    PoissonKernels::Buffers buffers{};
+    buffers[gpu::kPoissonBindScalars] = &scalars;
+    if (addressing_ == PoissonAddressing::DeviceAddress) {
+        buffers[gpu::kPoissonBindFields] = &fieldTable;
+    } else {
+        const auto fields = fieldBuffers();
+        for (std::uint32_t f = 0; f < gpu::kPoissonFieldCount; ++f) buffers[gpu::kPoissonBindFieldBase + f] = fields[f];
+    }
+    kernels_->bindAll(buffers, addressing_);
 }
 
 void PoissonGpuEngine::dispatch(VkCommandBuffer cmd, const vk::Kernel& kernel, int itemsX, int itemsY,
@@ -181,14 +236,14 @@ void PoissonGpuEngine::recordSetup(VkCommandBuffer cmd, float alpha2, bool irlsW
     PoissonPush push = levelPush(levels_[0], groups());
     push.alpha2 = alpha2;
     push.flags = gpu::kPoissonFlagDot | (irlsWeights ? gpu::kPoissonFlagIrls : 0u);
-    dispatch(cmd, kernels_->get(PoissonOp::Setup, push.flags), width(), height(), &push, timer);
+    dispatch(cmd, kernel(PoissonOp::Setup, push.flags), width(), height(), &push, timer);
 }
 
 void PoissonGpuEngine::recordCoarsenAll(VkCommandBuffer cmd, vk::GpuTimer* timer) {
     for (std::size_t l = 0; l + 1 < levels_.size(); ++l) {
         PoissonPush push = levelPush(levels_[l], groups());
         withCoarse(push, levels_[l + 1]);
-        dispatch(cmd, kernels_->get(PoissonOp::Coarsen, 0u), levels_[l + 1].width, levels_[l + 1].height,
+        dispatch(cmd, kernel(PoissonOp::Coarsen, 0u), levels_[l + 1].width, levels_[l + 1].height,
                  &push, timer);
     }
 }
@@ -197,7 +252,7 @@ void PoissonGpuEngine::recordResidual(VkCommandBuffer cmd, int level, std::uint3
                                       vk::GpuTimer* timer) {
     PoissonPush push = levelPush(levels_.at(static_cast<std::size_t>(level)), groups());
     push.flags = flags;
-    dispatch(cmd, kernels_->get(PoissonOp::Residual, flags), push.width, push.height, &push, timer);
+    dispatch(cmd, kernel(PoissonOp::Residual, flags), push.width, push.height, &push, timer);
 }
 
 void PoissonGpuEngine::recordSmooth(VkCommandBuffer cmd, int level, std::uint32_t flags, std::uint32_t colour,
@@ -209,7 +264,7 @@ void PoissonGpuEngine::recordSmooth(VkCommandBuffer cmd, int level, std::uint32_
     push.colour = colour;
     push.omega = omega;
     // One invocation per horizontal pixel pair (see poisson_smooth.comp).
-    dispatch(cmd, kernels_->get(PoissonOp::Smooth, flags), (levels_[l].width + 1) / 2, push.height, &push,
+    dispatch(cmd, kernel(PoissonOp::Smooth, flags), (levels_[l].width + 1) / 2, push.height, &push,
              timer);
 }
 
@@ -219,7 +274,7 @@ void PoissonGpuEngine::recordRestrict(VkCommandBuffer cmd, int level, std::uint3
     PoissonPush push = levelPush(levels_.at(l), groups());
     withCoarse(push, levels_.at(l + 1));
     push.flags = flags;
-    dispatch(cmd, kernels_->get(PoissonOp::Restrict, flags), push.coarseWidth, push.coarseHeight, &push,
+    dispatch(cmd, kernel(PoissonOp::Restrict, flags), push.coarseWidth, push.coarseHeight, &push,
              timer);
 }
 
@@ -227,13 +282,13 @@ void PoissonGpuEngine::recordProlong(VkCommandBuffer cmd, int level, vk::GpuTime
     const std::size_t l = static_cast<std::size_t>(level);
     PoissonPush push = levelPush(levels_.at(l), groups());
     withCoarse(push, levels_.at(l + 1));
-    dispatch(cmd, kernels_->get(PoissonOp::Prolong, 0u), push.width, push.height, &push, timer);
+    dispatch(cmd, kernel(PoissonOp::Prolong, 0u), push.width, push.height, &push, timer);
 }
 
 void PoissonGpuEngine::recordCoarsest(VkCommandBuffer cmd, bool zeroGuess, vk::GpuTimer* timer) {
     PoissonPush push = levelPush(levels_.back(), groups());
     push.flags = zeroGuess ? gpu::kPoissonFlagZeroGuess : 0u;
-    kernels_->get(PoissonOp::Coarsest, push.flags).dispatch(cmd, 1, 1, 1, &push, timer);
+    kernel(PoissonOp::Coarsest, push.flags).dispatch(cmd, 1, 1, 1, &push, timer);
     vk::computeBarrier(cmd);
 }
 
@@ -243,13 +298,13 @@ void PoissonGpuEngine::recordCgDirection(VkCommandBuffer cmd, std::uint32_t flag
     push.flags = flags;
     push.pOld = pOld;
     push.pNew = pNew;
-    dispatch(cmd, kernels_->get(PoissonOp::CgDirection, flags), width(), height(), &push, timer);
+    dispatch(cmd, kernel(PoissonOp::CgDirection, flags), width(), height(), &push, timer);
 }
 
 void PoissonGpuEngine::recordCgUpdate(VkCommandBuffer cmd, std::uint32_t pNew, vk::GpuTimer* timer) {
     PoissonPush push = levelPush(levels_[0], groups());
     push.pNew = pNew;
-    dispatch(cmd, kernels_->get(PoissonOp::CgUpdate, 0u), width(), height(), &push, timer);
+    dispatch(cmd, kernel(PoissonOp::CgUpdate, 0u), width(), height(), &push, timer);
 }
 
 void PoissonGpuEngine::recordScalars(VkCommandBuffer cmd, std::uint32_t mode, std::uint32_t flags,
@@ -262,7 +317,7 @@ void PoissonGpuEngine::recordScalars(VkCommandBuffer cmd, std::uint32_t mode, st
     push.tolerance = tolerance;
     push.value = value;
     push.groups = groups();
-    kernels_->get(PoissonOp::Scalars, flags).dispatch(cmd, 1, 1, 1, &push, timer);
+    kernel(PoissonOp::Scalars, flags).dispatch(cmd, 1, 1, 1, &push, timer);
     vk::computeBarrier(cmd);
 }
 
@@ -270,7 +325,7 @@ void PoissonGpuEngine::recordIrlsWeights(VkCommandBuffer cmd, float alpha2, floa
     PoissonPush push = levelPush(levels_[0], groups());
     push.alpha2 = alpha2;
     push.reg = reg;
-    dispatch(cmd, kernels_->get(PoissonOp::IrlsWeights, 0u), width(), height(), &push, timer);
+    dispatch(cmd, kernel(PoissonOp::IrlsWeights, 0u), width(), height(), &push, timer);
 }
 
 void PoissonGpuEngine::recordVcycle(VkCommandBuffer cmd, const VcycleParams& params, bool zeroGuess,

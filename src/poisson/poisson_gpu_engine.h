@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "poisson_shared.h"
@@ -43,6 +44,10 @@ enum class PoissonOp {
     Count
 };
 
+// How the kernels reach the field buffers (poisson_shared.h): descriptors (faster on
+// lavapipe) unless a field exceeds maxStorageBufferRange, then device addresses.
+enum class PoissonAddressing { Descriptors = 0, DeviceAddress = 1 };
+
 // The poisson_* pipelines for one workgroup shape (2D kernels; reductions need x·y to be a
 // power of two ≤ 256). Each kernel has one pipeline variant per set of kPoissonFlag* bits
 // (the specialisation constant kSpecPoissonFlags, so that untaken paths are compiled out),
@@ -60,21 +65,26 @@ public:
     [[nodiscard]] std::uint32_t groupX() const { return groupX_; }
     [[nodiscard]] std::uint32_t groupY() const { return groupY_; }
 
-    // The variant of `op` for `flags`, bound to the buffers of the last bindAll().
-    const vk::Kernel& get(PoissonOp op, std::uint32_t flags);
-    // Points every variant (existing and future) at `buffers`, indexed by kPoissonBind*.
-    void bindAll(const Buffers& buffers);
+    // The variant of `op` for `flags` and `addressing`, bound to the buffers of the last
+    // bindAll() for that addressing.
+    const vk::Kernel& get(PoissonOp op, std::uint32_t flags,
+                          PoissonAddressing addressing = PoissonAddressing::Descriptors);
+    // Points every variant of `addressing` (existing and future) at `buffers`, indexed by
+    // kPoissonBind* (each variant binds only the bindings its shader declares).
+    void bindAll(const Buffers& buffers, PoissonAddressing addressing);
     // Number of pipelines created so far (for tests and set-up cost reports).
     [[nodiscard]] std::size_t variantCount() const;
 
 private:
     const vk::Context& ctx_;
     std::uint32_t groupX_, groupY_;
-    std::array<vk::KernelDesc, static_cast<std::size_t>(PoissonOp::Count)> descs_;
-    std::array<std::map<std::uint32_t, std::unique_ptr<vk::Kernel>>,
-               static_cast<std::size_t>(PoissonOp::Count)>
+    static constexpr std::size_t kModes = 2;  // PoissonAddressing values
+    std::array<std::array<vk::KernelDesc, static_cast<std::size_t>(PoissonOp::Count)>, kModes> descs_;
+    std::array<std::array<std::map<std::uint32_t, std::unique_ptr<vk::Kernel>>,
+                          static_cast<std::size_t>(PoissonOp::Count)>,
+               kModes>
         variants_;
-    Buffers bound_{};
+    std::array<Buffers, kModes> bound_{};
 };
 
 struct PoissonLevel {
@@ -98,8 +108,11 @@ class PoissonGpuEngine {
 public:
     // Allocates every buffer for a width x height RGB problem; uses `kernels` if given (it
     // must outlive the engine), else creates its own. Throws gdpt::Error naming the device
-    // limit if a field exceeds maxStorageBufferRange.
-    PoissonGpuEngine(const vk::Context& ctx, int width, int height, PoissonKernels* kernels = nullptr);
+    // limit if a field exceeds maxMemoryAllocationSize.
+    // `addressing` forces one way of reaching the fields (tests); by default descriptors
+    // when every field fits maxStorageBufferRange, else device addresses.
+    PoissonGpuEngine(const vk::Context& ctx, int width, int height, PoissonKernels* kernels = nullptr,
+                     std::optional<PoissonAddressing> addressing = std::nullopt);
 
     [[nodiscard]] int width() const { return levels_[0].width; }
     [[nodiscard]] int height() const { return levels_[0].height; }
@@ -112,8 +125,12 @@ public:
     // Points every kernel's descriptors at this engine's buffers (call before recording
     // when several engines share one PoissonKernels).
     void bind();
+    [[nodiscard]] PoissonAddressing addressing() const { return addressing_; }
 
-    vk::Buffer coef, x, b, r, p, ap, sol, rhs, primal, dx, dy, weights, irls, scalars, partials;
+    // The fields (kPoissonField*: bound as descriptors, or read through the device addresses
+    // listed in fieldTable) and the descriptor-bound scalars.
+    vk::Buffer coef, x, b, r, p, ap, sol, rhs, primal, dx, dy, weights, irls, partials;
+    vk::Buffer fieldTable, scalars;
 
     // ---- one kernel each (see the kernel files for the maths) ----
     void recordSetup(VkCommandBuffer cmd, float alpha2, bool irlsWeights, vk::GpuTimer* timer);
@@ -142,6 +159,11 @@ public:
 private:
     void vcycleLevel(VkCommandBuffer cmd, int level, const VcycleParams& params, bool zeroGuess, bool dotOut,
                      vk::GpuTimer* timer);
+    // The field buffers in kPoissonField* order.
+    [[nodiscard]] std::array<const vk::Buffer*, gpu::kPoissonFieldCount> fieldBuffers() const;
+    const vk::Kernel& kernel(PoissonOp op, std::uint32_t flags) const {
+        return kernels_->get(op, flags, addressing_);
+    }
     void dispatch(VkCommandBuffer cmd, const vk::Kernel& kernel, int itemsX, int itemsY, const void* push,
                   vk::GpuTimer* timer);
 
@@ -149,6 +171,7 @@ private:
     std::unique_ptr<PoissonKernels> ownKernels_;
     PoissonKernels* kernels_ = nullptr;
     std::vector<PoissonLevel> levels_;
+    PoissonAddressing addressing_ = PoissonAddressing::Descriptors;
 };
 
 }  // namespace gdpt

@@ -21,7 +21,9 @@ Buffer::Buffer(const Context& ctx, std::uint64_t bytes, const std::string& name)
     VkDevice device = ctx.device();
     VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
     info.size = size_;
-    info.usage = kUsage;
+    // Every buffer can be read through its device address (shaders that need ranges beyond
+    // maxStorageBufferRange use that; the feature is required, core in Vulkan 1.3).
+    info.usage = kUsage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
     info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
     VkBuffer buffer = VK_NULL_HANDLE;
     VK_CHECK(vkCreateBuffer(device, &info, nullptr, &buffer));
@@ -32,7 +34,10 @@ Buffer::Buffer(const Context& ctx, std::uint64_t bytes, const std::string& name)
     const VkMemoryPropertyFlags deviceLocal = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
     VkMemoryPropertyFlags flags = deviceLocal | kMappable;
     if (!ctx.hasMemoryType(req.memoryTypeBits, flags)) flags = deviceLocal;
+    VkMemoryAllocateFlagsInfo allocFlags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
+    allocFlags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
     VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    alloc.pNext = &allocFlags;
     alloc.allocationSize = req.size;
     alloc.memoryTypeIndex = ctx.findMemoryType(req.memoryTypeBits, flags);
     VkDeviceMemory memory = VK_NULL_HANDLE;
@@ -46,6 +51,12 @@ Buffer::Buffer(const Context& ctx, std::uint64_t bytes, const std::string& name)
     buffer_ = std::move(bufferOwner);
     if ((flags & kMappable) == kMappable) VK_CHECK(vkMapMemory(device, memory, 0, VK_WHOLE_SIZE, 0, &mapped_));
     ctx.setName(VK_OBJECT_TYPE_BUFFER, reinterpret_cast<std::uint64_t>(buffer), name);
+}
+
+std::uint64_t Buffer::deviceAddress() const {
+    VkBufferDeviceAddressInfo info{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
+    info.buffer = buffer_.get();
+    return vkGetBufferDeviceAddress(ctx_->device(), &info);
 }
 
 void Buffer::upload(const void* data, std::uint64_t bytes, std::uint64_t offset) {

@@ -26,6 +26,9 @@ public:
     [[nodiscard]] VkBuffer get() const { return buffer_.get(); }
     [[nodiscard]] std::uint64_t size() const { return size_; }
     [[nodiscard]] const std::string& name() const { return name_; }
+    // The buffer's device address (GL_EXT_buffer_reference), for access beyond
+    // maxStorageBufferRange.
+    [[nodiscard]] std::uint64_t deviceAddress() const;
 
     // Copies `bytes` bytes from host memory into the buffer at `offset`.
     void upload(const void* data, std::uint64_t bytes, std::uint64_t offset = 0);

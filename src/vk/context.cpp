@@ -71,8 +71,10 @@ DeviceInfo queryDevice(VkPhysicalDevice pd, std::uint32_t index) {
     DeviceInfo d;
     d.index = index;
     VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+    VkPhysicalDeviceMaintenance3Properties maint3{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES};
+    maint3.pNext = &driver;
     VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
-    subgroup.pNext = &driver;
+    subgroup.pNext = &maint3;
     VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
     props.pNext = &subgroup;
     vkGetPhysicalDeviceProperties2(pd, &props);
@@ -84,6 +86,7 @@ DeviceInfo queryDevice(VkPhysicalDevice pd, std::uint32_t index) {
     d.driverInfo = driver.driverInfo;
     d.apiVersion = p.apiVersion;
     d.maxStorageBufferRange = p.limits.maxStorageBufferRange;
+    d.maxMemoryAllocationSize = maint3.maxMemoryAllocationSize;
     d.maxPushConstantsSize = p.limits.maxPushConstantsSize;
     d.maxComputeWorkGroupInvocations = p.limits.maxComputeWorkGroupInvocations;
     d.maxComputeSharedMemorySize = p.limits.maxComputeSharedMemorySize;
@@ -96,6 +99,7 @@ DeviceInfo queryDevice(VkPhysicalDevice pd, std::uint32_t index) {
     f.pNext = &f12;
     vkGetPhysicalDeviceFeatures2(pd, &f);
     d.scalarBlockLayout = f12.scalarBlockLayout == VK_TRUE;
+    d.bufferDeviceAddress = f12.bufferDeviceAddress == VK_TRUE;
 
     VkPhysicalDeviceMemoryProperties mem{};
     vkGetPhysicalDeviceMemoryProperties(pd, &mem);
@@ -121,6 +125,8 @@ DeviceInfo queryDevice(VkPhysicalDevice pd, std::uint32_t index) {
         d.unsuitable = "no compute queue";
     else if (!d.scalarBlockLayout)
         d.unsuitable = "scalarBlockLayout is not supported";
+    else if (!d.bufferDeviceAddress)
+        d.unsuitable = "bufferDeviceAddress is not supported";
     else if (d.maxPushConstantsSize < 128)
         d.unsuitable = "maxPushConstantsSize < 128";
     return d;
@@ -238,6 +244,7 @@ Context::Context(const ContextOptions& options)
 
     VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
     f12.scalarBlockLayout = VK_TRUE;
+    f12.bufferDeviceAddress = VK_TRUE;  // Poisson fields beyond maxStorageBufferRange
     VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
     features.pNext = &f12;
     VkDeviceCreateInfo deviceInfo{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
@@ -292,6 +299,14 @@ void Context::setName(VkObjectType type, std::uint64_t handle, const std::string
     info.objectHandle = handle;
     info.pObjectName = name.c_str();
     setObjectName_(device_.get(), &info);
+}
+
+void Context::checkAllocationSize(std::uint64_t bytes, const std::string& what) const {
+    if (bytes > info_.maxMemoryAllocationSize)
+        throw Error(what + " needs a buffer of " + std::to_string(bytes >> 20) +
+                    " MiB, more than the device limit maxMemoryAllocationSize = " +
+                    std::to_string(info_.maxMemoryAllocationSize >> 20) + " MiB on '" + info_.name +
+                    "'; use a smaller image");
 }
 
 void Context::checkStorageBufferSize(std::uint64_t bytes, const std::string& what) const {

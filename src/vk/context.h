@@ -30,7 +30,8 @@ struct DeviceInfo {
     std::string driverInfo;  // e.g. "Mesa 22.3.6 (LLVM 15.0.6)"
     std::uint32_t apiVersion = 0;
     bool isCpu = false;
-    std::uint64_t maxStorageBufferRange = 0;
+    std::uint64_t maxStorageBufferRange = 0;    // largest descriptor range
+    std::uint64_t maxMemoryAllocationSize = 0;  // largest buffer (device-address access)
     std::uint32_t maxPushConstantsSize = 0;
     std::uint32_t maxComputeWorkGroupInvocations = 0;
     std::uint32_t maxComputeSharedMemorySize = 0;
@@ -39,6 +40,7 @@ struct DeviceInfo {
     float timestampPeriodNs = 0.0f;
     std::uint64_t deviceLocalHeapBytes = 0;
     bool scalarBlockLayout = false;
+    bool bufferDeviceAddress = false;  // required (core in Vulkan 1.3)
     bool timestamps = false;
     std::string unsuitable;  // why gdpt cannot use it ("" = usable)
 };
@@ -73,6 +75,9 @@ public:
     // Throws gdpt::Error naming the limit if a single storage buffer of `bytes` bytes
     // (what: "triangle geometry") exceeds the device's maxStorageBufferRange.
     void checkStorageBufferSize(std::uint64_t bytes, const std::string& what) const;
+    // The same for a buffer read through its device address (no descriptor range limit):
+    // throws if `bytes` exceeds maxMemoryAllocationSize.
+    void checkAllocationSize(std::uint64_t bytes, const std::string& what) const;
 
 private:
     static VkBool32 VKAPI_PTR messengerCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
