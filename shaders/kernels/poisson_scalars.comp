@@ -20,6 +20,9 @@
 layout(local_size_x = 256, local_size_y = 1) in;
 #include "lib/poisson_common.glsl"
 
+// Indirect group counts of the gated dispatches (PoissonGpuEngine::setGated).
+layout(set = 0, binding = kPoissonBindGate, scalar) buffer GateBuf { uint gateArgs[]; };
+
 shared float sSum[256];
 
 // The strided per-invocation sum reads kPoissonSumUnroll entries per loop iteration, and
@@ -112,6 +115,10 @@ void main() {
             float sum = sumSlot(kPoissonSlotSum, c);
             if (lead) sc.bMean[c] = sum / pc.value;
         }
+    // Every channel converged: the rest of the recorded batch becomes empty dispatches.
+    if (lead && (pc.mode == kPoissonModeBeta || pc.mode == kPoissonModeRecord) && sc.done[0] != 0u &&
+        sc.done[1] != 0u && sc.done[2] != 0u)
+        for (uint i = 0u; i < gateArgs.length(); ++i) gateArgs[i] = 0u;
     if (pc.mode == kPoissonModeIrls) {
         float sum = sumSlot(kPoissonSlotWeight, 0u);
         if (lead) sc.irlsScale = sum > 0.0 ? pc.value / sum : 1.0;

@@ -49,7 +49,8 @@ GDPT_ENUM_BEGIN(PoissonBinding)
     kPoissonBindFields = 0u,     // device-address variant: uint64 address per kPoissonField*
     kPoissonBindScalars = 1u,    // PoissonScalars followed by the residual history
     kPoissonBindFieldBase = 2u,  // descriptor variant: field f at binding 2 + f
-    kPoissonBindCount = 16u
+    kPoissonBindGate = 16u,      // uint: indirect group counts (x, y, z) of gated dispatches
+    kPoissonBindCount = 17u
 GDPT_ENUM_END();
 
 // Partial-sum slots: a reduction kernel writes partials[(slot·3 + c)·G + g] for workgroup g

@@ -155,9 +155,10 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
     e.recordScalars(cmd, kPoissonModeInit, zIsR, 0, tol, 0.0f, timer);
 
     int batch = 4, cap = 32;
-    if (o.solver == GpuSolver::Cg) batch = 16, cap = 128;
+    if (o.solver == GpuSolver::Cg) batch = 32, cap = 128;
     if (o.solver == GpuSolver::Jacobi) batch = 64, cap = 1024;
     int k = 0;
+    bool armed = false;
     PoissonScalars sc{};
     for (;;) {
         // Close the open command buffer (set-up or previous batch), run it, check the flags.
@@ -168,8 +169,11 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
         e.scalars.download(&sc, sizeof(sc));
         const bool done = sc.done[0] && sc.done[1] && sc.done[2];
         if (done || k >= o.maxIterations) break;
+        if (!armed) e.armGate();  // the device is idle; the batches below are gated
+        armed = true;
         cmd = stream_.begin();
         if (timer) timer->reset(cmd);
+        e.setGated(true);
         const int count = std::min(batch, o.maxIterations - k);
         for (int j = 0; j < count; ++j) {
             ++k;
@@ -197,6 +201,7 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
                 ++j;
             }
         }
+        e.setGated(false);
         batch = growBatch(batch, cap);
     }
     // True residual of the returned x.
@@ -225,7 +230,10 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
         worst = std::max(worst, rel);
     }
     report.residual = worst;
-    if (o.keepHistory) readHistory(o.solver == GpuSolver::Jacobi ? k / 2 : k, report);
+    // History entries exist up to the last iteration that ran (the gate skips the rest).
+    std::uint32_t ran = 0;
+    for (int c = 0; c < 3; ++c) ran = std::max(ran, sc.iterations[c]);
+    if (o.keepHistory) readHistory(static_cast<int>(ran), report);
     return result;
 }
 

@@ -38,7 +38,7 @@ namespace {
 using gpu::PoissonPush;
 
 vk::KernelDesc describe(vk::KernelDesc d, std::uint32_t gx, std::uint32_t gy, bool grid, bool addressed) {
-    d.bindings = {gpu::kPoissonBindScalars};
+    d.bindings = {gpu::kPoissonBindScalars, gpu::kPoissonBindGate};
     if (addressed)
         d.bindings.push_back(gpu::kPoissonBindFields);
     else
@@ -193,6 +193,19 @@ PoissonGpuEngine::PoissonGpuEngine(const vk::Context& ctx, int width, int height
     for (std::uint32_t f = 0; f < gpu::kPoissonFieldCount; ++f) addresses[f] = fields[f]->deviceAddress();
     fieldTable = vk::Buffer(ctx, sizeof(addresses), "poissonFields");
     fieldTable.upload(addresses.data(), sizeof(addresses));
+    // The gate: indirect group counts of every dispatch shape of an iteration (each level's
+    // grid, its half-width smoothing grid, one workgroup), zeroed by poisson_scalars once
+    // every channel has converged so that the rest of a recorded batch costs nothing.
+    const auto groupsOf = [&](int items, std::uint32_t size) {
+        return (static_cast<std::uint32_t>(items) + size - 1) / size;
+    };
+    for (const PoissonLevel& l : levels_) {
+        addGateShape(groupsOf(l.width, kernels_->groupX()), groupsOf(l.height, kernels_->groupY()));
+        addGateShape(groupsOf((l.width + 1) / 2, kernels_->groupX()), groupsOf(l.height, kernels_->groupY()));
+    }
+    addGateShape(1, 1);
+    gate = vk::Buffer(ctx, gateArgs_.size() * sizeof(std::uint32_t), "poissonGate");
+    armGate();
     // Defined contents everywhere (no stale NaN can leak through a 0 coefficient).
     for (vk::Buffer* buf : {&coef, &x, &b, &r, &p, &ap, &sol, &rhs, &irls, &scalars, &partials}) buf->zero();
     bind();
@@ -216,6 +229,7 @@ std::array<const vk::Buffer*, gpu::kPoissonFieldCount> PoissonGpuEngine::fieldBu
 void PoissonGpuEngine::bind() {
     PoissonKernels::Buffers buffers{};
     buffers[gpu::kPoissonBindScalars] = &scalars;
+    buffers[gpu::kPoissonBindGate] = &gate;
     if (addressing_ == PoissonAddressing::DeviceAddress) {
         buffers[gpu::kPoissonBindFields] = &fieldTable;
     } else {
@@ -227,10 +241,28 @@ void PoissonGpuEngine::bind() {
 
 void PoissonGpuEngine::dispatch(VkCommandBuffer cmd, const vk::Kernel& kernel, int itemsX, int itemsY,
                                 const void* push, vk::GpuTimer* timer) {
-    kernel.dispatchItems(cmd, static_cast<std::uint32_t>(itemsX), static_cast<std::uint32_t>(itemsY), push,
-                         timer);
+    dispatchGroups(cmd, kernel, (static_cast<std::uint32_t>(itemsX) + kernels_->groupX() - 1) / kernels_->groupX(),
+                   (static_cast<std::uint32_t>(itemsY) + kernels_->groupY() - 1) / kernels_->groupY(), push, timer);
+}
+
+void PoissonGpuEngine::dispatchGroups(VkCommandBuffer cmd, const vk::Kernel& kernel, std::uint32_t gx,
+                                      std::uint32_t gy, const void* push, vk::GpuTimer* timer) {
+    if (gated_) {
+        const auto it = gateEntry_.find({gx, gy});
+        GDPT_CHECK(it != gateEntry_.end());
+        kernel.dispatchIndirect(cmd, gate, std::uint64_t{it->second} * 3 * sizeof(std::uint32_t), push, timer);
+    } else {
+        kernel.dispatch(cmd, gx, gy, 1, push, timer);
+    }
     vk::computeBarrier(cmd);
 }
+
+void PoissonGpuEngine::addGateShape(std::uint32_t gx, std::uint32_t gy) {
+    if (gateEntry_.emplace(std::make_pair(gx, gy), static_cast<std::uint32_t>(gateArgs_.size() / 3)).second)
+        gateArgs_.insert(gateArgs_.end(), {gx, gy, 1u});
+}
+
+void PoissonGpuEngine::armGate() { gate.upload(gateArgs_.data(), gateArgs_.size() * sizeof(std::uint32_t)); }
 
 void PoissonGpuEngine::recordSetup(VkCommandBuffer cmd, float alpha2, bool irlsWeights, vk::GpuTimer* timer) {
     PoissonPush push = levelPush(levels_[0], groups());
@@ -288,8 +320,7 @@ void PoissonGpuEngine::recordProlong(VkCommandBuffer cmd, int level, vk::GpuTime
 void PoissonGpuEngine::recordCoarsest(VkCommandBuffer cmd, bool zeroGuess, vk::GpuTimer* timer) {
     PoissonPush push = levelPush(levels_.back(), groups());
     push.flags = zeroGuess ? gpu::kPoissonFlagZeroGuess : 0u;
-    kernel(PoissonOp::Coarsest, push.flags).dispatch(cmd, 1, 1, 1, &push, timer);
-    vk::computeBarrier(cmd);
+    dispatchGroups(cmd, kernel(PoissonOp::Coarsest, push.flags), 1, 1, &push, timer);
 }
 
 void PoissonGpuEngine::recordCgDirection(VkCommandBuffer cmd, std::uint32_t flags, std::uint32_t pOld,
@@ -317,8 +348,7 @@ void PoissonGpuEngine::recordScalars(VkCommandBuffer cmd, std::uint32_t mode, st
     push.tolerance = tolerance;
     push.value = value;
     push.groups = groups();
-    kernel(PoissonOp::Scalars, flags).dispatch(cmd, 1, 1, 1, &push, timer);
-    vk::computeBarrier(cmd);
+    dispatchGroups(cmd, kernel(PoissonOp::Scalars, flags), 1, 1, &push, timer);
 }
 
 void PoissonGpuEngine::recordIrlsWeights(VkCommandBuffer cmd, float alpha2, float reg, vk::GpuTimer* timer) {

@@ -130,7 +130,15 @@ public:
     // The fields (kPoissonField*: bound as descriptors, or read through the device addresses
     // listed in fieldTable) and the descriptor-bound scalars.
     vk::Buffer coef, x, b, r, p, ap, sol, rhs, primal, dx, dy, weights, irls, partials;
-    vk::Buffer fieldTable, scalars;
+    vk::Buffer fieldTable, scalars, gate;
+
+    // Early exit inside a recorded batch. While gated, every dispatch reads its group counts
+    // from `gate`, which poisson_scalars zeroes once all channels have converged (Beta and
+    // Record modes), so iterations recorded past convergence cost only their dispatch
+    // overhead. armGate() restores the counts; call it while the device is idle, before
+    // submitting gated work.
+    void setGated(bool gated) { gated_ = gated; }
+    void armGate();
 
     // ---- one kernel each (see the kernel files for the maths) ----
     void recordSetup(VkCommandBuffer cmd, float alpha2, bool irlsWeights, vk::GpuTimer* timer);
@@ -166,12 +174,18 @@ private:
     }
     void dispatch(VkCommandBuffer cmd, const vk::Kernel& kernel, int itemsX, int itemsY, const void* push,
                   vk::GpuTimer* timer);
+    void dispatchGroups(VkCommandBuffer cmd, const vk::Kernel& kernel, std::uint32_t gx, std::uint32_t gy,
+                        const void* push, vk::GpuTimer* timer);
+    void addGateShape(std::uint32_t gx, std::uint32_t gy);
 
     const vk::Context& ctx_;
     std::unique_ptr<PoissonKernels> ownKernels_;
     PoissonKernels* kernels_ = nullptr;
     std::vector<PoissonLevel> levels_;
     PoissonAddressing addressing_ = PoissonAddressing::Descriptors;
+    bool gated_ = false;
+    std::vector<std::uint32_t> gateArgs_;                                      // 3 per shape
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> gateEntry_;  // shape -> entry
 };
 
 }  // namespace gdpt

@@ -114,10 +114,7 @@ void Kernel::bind(std::uint32_t binding, const Buffer& buffer) {
     vkUpdateDescriptorSets(ctx_.device(), 1, &write, 0, nullptr);
 }
 
-void Kernel::dispatch(VkCommandBuffer cmd, std::uint32_t x, std::uint32_t y, std::uint32_t z,
-                      const void* push, GpuTimer* timer) const {
-    if (x == 0 || y == 0 || z == 0) return;
-    if (timer) timer->begin(cmd, desc_.name);
+void Kernel::bindState(VkCommandBuffer cmd, const void* push) const {
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.get());
     if (set_ != VK_NULL_HANDLE)
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelineLayout_.get(), 0, 1,
@@ -125,7 +122,22 @@ void Kernel::dispatch(VkCommandBuffer cmd, std::uint32_t x, std::uint32_t y, std
     if (push && desc_.pushConstantBytes)
         vkCmdPushConstants(cmd, pipelineLayout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0,
                            desc_.pushConstantBytes, push);
+}
+
+void Kernel::dispatch(VkCommandBuffer cmd, std::uint32_t x, std::uint32_t y, std::uint32_t z,
+                      const void* push, GpuTimer* timer) const {
+    if (x == 0 || y == 0 || z == 0) return;
+    if (timer) timer->begin(cmd, desc_.name);
+    bindState(cmd, push);
     vkCmdDispatch(cmd, x, y, z);
+    if (timer) timer->end(cmd);
+}
+
+void Kernel::dispatchIndirect(VkCommandBuffer cmd, const Buffer& args, std::uint64_t offset, const void* push,
+                              GpuTimer* timer) const {
+    if (timer) timer->begin(cmd, desc_.name);
+    bindState(cmd, push);
+    vkCmdDispatchIndirect(cmd, args.get(), offset);
     if (timer) timer->end(cmd);
 }
 

@@ -51,12 +51,18 @@ public:
     // dispatch is wrapped in a named timestamp scope.
     void dispatch(VkCommandBuffer cmd, std::uint32_t x, std::uint32_t y, std::uint32_t z,
                   const void* push = nullptr, GpuTimer* timer = nullptr) const;
+    // Dispatch with the group counts read by the device from `args` at `offset` (three
+    // uint32; zeros make it a no-op), so that device code can cancel recorded work.
+    void dispatchIndirect(VkCommandBuffer cmd, const Buffer& args, std::uint64_t offset,
+                          const void* push = nullptr, GpuTimer* timer = nullptr) const;
     // Dispatch enough workgroups to cover itemsX × itemsY invocations.
     void dispatchItems(VkCommandBuffer cmd, std::uint32_t itemsX, std::uint32_t itemsY,
                        const void* push = nullptr, GpuTimer* timer = nullptr) const;
     [[nodiscard]] const std::string& name() const { return desc_.name; }
 
 private:
+    void bindState(VkCommandBuffer cmd, const void* push) const;  // pipeline, set, push constants
+
     const Context& ctx_;
     KernelDesc desc_;
     Handle<VkShaderModule> module_;
