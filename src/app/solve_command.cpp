@@ -9,6 +9,8 @@
 #include "image/exr_io.h"
 #include "poisson/poisson_gpu.h"
 #include "util/error.h"
+#include "util/progress.h"
+#include "util/timer.h"
 #include "vk/context.h"
 
 namespace gdpt {
@@ -85,7 +87,24 @@ int runSolve(const SolveArgs& a) {
     co.device = a.device;
     vk::Context ctx(co);
     SolveReport report;
+    // Progress once a solve has run for 2 s (a 4096x4096 L1 solve takes about a minute).
+    Progress progress("gdpt: solve", 1.0, a.quiet);
+    Timer started;
+    bool shown = false;
+    o.progress = [&](int roundsDone, int rounds, int iterations) {
+        if (started.seconds() < 2.0) return;
+        shown = true;
+        progress.update(double(roundsDone) / rounds, (o.method == Reconstruction::L1
+                                                          ? "IRLS round " + std::to_string(roundsDone) + "/" +
+                                                                std::to_string(rounds) + ", "
+                                                          : std::string()) +
+                                                         std::to_string(iterations) + " iterations");
+    };
     const Image recon = reconstruct(ctx, primal, dx, dy, varP, varX, varY, o, &report);
+    if (shown) {
+        progress.update(1.0);
+        progress.finish(std::to_string(report.iterations) + " iterations");
+    }
     Image final = recon;
     if (direct)
         for (int c = 0; c < 3; ++c)

@@ -167,6 +167,7 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
         ++report.batches;
         if (timer) timer->collect();
         e.scalars.download(&sc, sizeof(sc));
+        if (o.progress) o.progress(roundsDone_, rounds_, report.iterations + k);
         const bool done = sc.done[0] && sc.done[1] && sc.done[2];
         if (done || k >= o.maxIterations) break;
         if (!armed) e.armGate();  // the device is idle; the batches below are gated
@@ -325,6 +326,8 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
 
     VkCommandBuffer cmd = stream_.begin();
     if (o.timer) o.timer->reset(cmd);
+    roundsDone_ = 0;
+    rounds_ = o.method == Reconstruction::L1 ? std::max(1, o.irlsIterations) : 1;
     if (o.method != Reconstruction::L1) {
         const InnerResult r = innerSolve(o, o.tolerance, false, singular, report);
         report.iterations = r.iterations;
@@ -350,6 +353,7 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
             report.iterations += r.iterations;
             report.converged = r.converged;
             ++report.irlsIterations;
+            roundsDone_ = k + 1;
         }
     }
     // Download and fix the weighted mean from the primal. Summing the rows of A x = b gives

@@ -26,6 +26,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -65,6 +66,9 @@ struct SolveOptions {
     bool keepHistory = false;          // fill SolveReport::history (test mode)
     bool warmStart = true;             // start from the primal (else from 0)
     vk::GpuTimer* timer = nullptr;     // per-kernel GPU times (capacity: scopes per batch)
+    // Called after every submitted batch: IRLS rounds finished (L2: 0, then 1), rounds in
+    // all, inner iterations recorded so far. For progress reports on long solves.
+    std::function<void(int roundsDone, int rounds, int iterations)> progress;
 };
 
 struct NonFiniteCounts {
@@ -122,6 +126,7 @@ private:
 
     PoissonGpuEngine engine_;
     vk::CommandStream stream_;
+    int roundsDone_ = 0, rounds_ = 1;  // for SolveOptions::progress
 };
 
 // One-call reconstruction for the renderer: primal, gradients and optional variances (WL2
