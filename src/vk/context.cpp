@@ -301,20 +301,25 @@ void Context::setName(VkObjectType type, std::uint64_t handle, const std::string
     setObjectName_(device_.get(), &info);
 }
 
+namespace {
+// Throws naming the limit when `bytes` exceeds it.
+void checkLimit(std::uint64_t bytes, std::uint64_t limit, const char* kind, const char* limitName,
+                const std::string& device, const std::string& what, const char* advice) {
+    if (bytes > limit)
+        throw Error(what + " needs " + kind + " of " + std::to_string(bytes >> 20) +
+                    " MiB, more than the device limit " + limitName + " = " + std::to_string(limit >> 20) +
+                    " MiB on '" + device + "'; " + advice);
+}
+}  // namespace
+
 void Context::checkAllocationSize(std::uint64_t bytes, const std::string& what) const {
-    if (bytes > info_.maxMemoryAllocationSize)
-        throw Error(what + " needs a buffer of " + std::to_string(bytes >> 20) +
-                    " MiB, more than the device limit maxMemoryAllocationSize = " +
-                    std::to_string(info_.maxMemoryAllocationSize >> 20) + " MiB on '" + info_.name +
-                    "'; use a smaller image");
+    checkLimit(bytes, info_.maxMemoryAllocationSize, "a buffer", "maxMemoryAllocationSize", info_.name, what,
+               "use a smaller image");
 }
 
 void Context::checkStorageBufferSize(std::uint64_t bytes, const std::string& what) const {
-    if (bytes > info_.maxStorageBufferRange)
-        throw Error(what + " needs a storage buffer of " + std::to_string(bytes >> 20) +
-                    " MiB, more than the device limit maxStorageBufferRange = " +
-                    std::to_string(info_.maxStorageBufferRange >> 20) + " MiB on '" + info_.name +
-                    "'; use a smaller scene or image");
+    checkLimit(bytes, info_.maxStorageBufferRange, "a storage buffer", "maxStorageBufferRange", info_.name, what,
+               "use a smaller scene or image");
 }
 
 }  // namespace gdpt::vk
