@@ -127,7 +127,7 @@ void PoissonSolverGpu::readHistory(int count, SolveReport& report) {
 }
 
 PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o, double tolerance, bool irls,
-                                                           bool singular, SolveReport& report) {
+                                                           bool singular, bool trueResidual, SolveReport& report) {
     // irls: the IRLS weights and their scale have been recorded/computed already by the caller
     // into this batch's command buffer (see solve()).
     PoissonGpuEngine& e = engine_;
@@ -158,24 +158,14 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
     if (o.solver == GpuSolver::Cg) batch = 32, cap = 128;
     if (o.solver == GpuSolver::Jacobi) batch = 64, cap = 1024;
     int k = 0;
-    bool armed = false;
     PoissonScalars sc{};
+    // The device is idle here (every earlier batch was waited for), so the gate can be
+    // re-armed; Init zeroes it again if the start already meets the tolerance, which lets the
+    // first iterations ride in the set-up's command buffer.
+    e.armGate();
     for (;;) {
-        // Close the open command buffer (set-up or previous batch), run it, check the flags.
-        stream_.submit();
-        stream_.waitAll();
-        ++report.batches;
-        if (timer) timer->collect();
-        e.scalars.download(&sc, sizeof(sc));
-        if (o.progress) o.progress(roundsDone_, rounds_, report.iterations + k);
-        const bool done = sc.done[0] && sc.done[1] && sc.done[2];
-        if (done || k >= o.maxIterations) break;
-        if (!armed) e.armGate();  // the device is idle; the batches below are gated
-        armed = true;
-        cmd = stream_.begin();
-        if (timer) timer->reset(cmd);
-        e.setGated(true);
         const int count = std::min(batch, o.maxIterations - k);
+        e.setGated(true);
         for (int j = 0; j < count; ++j) {
             ++k;
             const std::uint32_t it = static_cast<std::uint32_t>(k);
@@ -203,19 +193,36 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
             }
         }
         e.setGated(false);
+        // Run the open command buffer (set-up and/or iterations) and check the flags.
+        stream_.submit();
+        stream_.waitAll();
+        ++report.batches;
+        if (timer) timer->collect();
+        e.scalars.download(&sc, sizeof(sc));
+        if (o.progress) o.progress(roundsDone_, rounds_, report.iterations + k);
+        const bool done = sc.done[0] && sc.done[1] && sc.done[2];
+        if (done || k >= o.maxIterations) break;
+        cmd = stream_.begin();
+        if (timer) timer->reset(cmd);
         batch = growBatch(batch, cap);
     }
-    // True residual of the returned x.
-    cmd = stream_.begin();
-    if (timer) timer->reset(cmd);
-    if (!cgFamily) PoissonGpuEngine::recordCopy(cmd, e.x, e.sol, fine);
-    e.recordResidual(cmd, 0, kPoissonFlagFromSol | kPoissonFlagDot | project, timer);
-    e.recordScalars(cmd, kPoissonModeFinal, zIsR, 0, tol, 0.0f, timer);
-    stream_.submit();
-    stream_.waitAll();
-    ++report.batches;
-    if (timer) timer->collect();
-    e.scalars.download(&sc, sizeof(sc));
+    // Stationary solvers iterate in X: copy it to Sol. With trueResidual, recompute b − A x
+    // for the returned x (the recursion drifts from it by float rounding); IRLS rounds before
+    // the last skip that pass, their residual is the recursive one.
+    if (!cgFamily || trueResidual) {
+        cmd = stream_.begin();
+        if (timer) timer->reset(cmd);
+        if (!cgFamily) PoissonGpuEngine::recordCopy(cmd, e.x, e.sol, fine);
+        if (trueResidual) {
+            e.recordResidual(cmd, 0, kPoissonFlagFromSol | kPoissonFlagDot | project, timer);
+            e.recordScalars(cmd, kPoissonModeFinal, zIsR, 0, tol, 0.0f, timer);
+        }
+        stream_.submit();
+        stream_.waitAll();
+        ++report.batches;
+        if (timer) timer->collect();
+        e.scalars.download(&sc, sizeof(sc));
+    }
 
     InnerResult result;
     result.converged = true;
@@ -223,8 +230,8 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
     for (int c = 0; c < 3; ++c) {
         const int its = static_cast<int>(sc.iterations[c]) * (o.solver == GpuSolver::Jacobi ? 2 : 1);
         result.iterations = std::max(result.iterations, its);
-        const double rel =
-            sc.bb[c] > 0.0f ? std::sqrt(double(sc.finalRr[c]) / sc.bb[c]) : std::sqrt(double(sc.finalRr[c]));
+        const double rr = trueResidual ? sc.finalRr[c] : sc.rr[c];
+        const double rel = sc.bb[c] > 0.0f ? std::sqrt(rr / sc.bb[c]) : std::sqrt(rr);
         // Done by the recursive residual, and the true residual agrees (within 2x: the
         // recursion drifts from b − A x by float rounding).
         result.converged = result.converged && sc.done[c] != 0 && rel <= 2.0 * tolerance;
@@ -329,7 +336,7 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
     roundsDone_ = 0;
     rounds_ = o.method == Reconstruction::L1 ? std::max(1, o.irlsIterations) : 1;
     if (o.method != Reconstruction::L1) {
-        const InnerResult r = innerSolve(o, o.tolerance, false, singular, report);
+        const InnerResult r = innerSolve(o, o.tolerance, false, singular, true, report);
         report.iterations = r.iterations;
         report.converged = r.converged;
         report.irlsIterations = 1;
@@ -349,7 +356,7 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
                 engine_.recordScalars(cmd, kPoissonModeIrls, 0u, 0u, 0.0f, static_cast<float>(rows), o.timer);
                 reg *= o.irlsRegIter;
             }
-            const InnerResult r = innerSolve(o, tol, k > 0, false, report);
+            const InnerResult r = innerSolve(o, tol, k > 0, false, last, report);
             report.iterations += r.iterations;
             report.converged = r.converged;
             ++report.irlsIterations;

@@ -120,7 +120,8 @@ private:
         int iterations = 0;
         bool converged = false;
     };
-    InnerResult innerSolve(const SolveOptions& o, double tolerance, bool irls, bool singular,
+    // trueResidual: finish with b − A x recomputed (else the recursive residual is reported).
+    InnerResult innerSolve(const SolveOptions& o, double tolerance, bool irls, bool singular, bool trueResidual,
                            SolveReport& report);
     void readHistory(int count, SolveReport& report);
 
