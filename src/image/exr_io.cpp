@@ -8,12 +8,14 @@
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStdIO.h>
 #include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfThreading.h>
 
 #include <algorithm>
 #include <cstdint>
 #include <fstream>
 #include <map>
 #include <set>
+#include <thread>
 
 #include "image/atomic_write.h"
 #include "util/error.h"
@@ -31,6 +33,17 @@ std::string channelPrefix(const std::string& layer) { return layer.empty() ? "" 
 struct LayerChannels {
     std::map<std::string, std::string> bySuffix;  // suffix -> full channel name
 };
+
+// Worker threads for OpenEXR's ZIP (de)compression of line blocks: one per core, so a
+// G-PT result (a dozen RGB float layers) is not compressed on one core while the other idles.
+int exrThreads() {
+    static const int threads = [] {
+        const int n = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+        Imf::setGlobalThreadCount(n);
+        return n;
+    }();
+    return threads;
+}
 
 void writeLayers(const std::string& tmpPath, const std::vector<NamedLayer>& layers,
                  const ExrAttributes& attributes) {
@@ -59,7 +72,7 @@ void writeLayers(const std::string& tmpPath, const std::vector<NamedLayer>& laye
     if (!os) throw Error("cannot open " + tmpPath + " for writing");
     {
         Imf::StdOFStream stream(os, tmpPath.c_str());
-        Imf::OutputFile file(stream, header);
+        Imf::OutputFile file(stream, header, exrThreads());
         file.setFrameBuffer(frameBuffer);
         file.writePixels(height);
     }
@@ -101,7 +114,7 @@ std::map<std::string, LayerChannels> groupChannels(const Imf::ChannelList& chann
 }
 
 std::vector<NamedLayer> readLayers(const std::string& path) {
-    Imf::InputFile file(path.c_str());
+    Imf::InputFile file(path.c_str(), exrThreads());
     const Imf::Header& header = file.header();
     const Imath::Box2i dataWindow = header.dataWindow();
     const std::int64_t width = std::int64_t{dataWindow.max.x} - dataWindow.min.x + 1;
