@@ -154,6 +154,19 @@ TEST_F(Cli, DevicesListsAtLeastOneUsableDevice) {
     bool usable = false;
     for (const auto& d : j) usable = usable || d["usable"].get<bool>();
     EXPECT_TRUE(usable);
+    // The text listing shows the same devices and their limits (a printf whose arguments
+    // did not match its format crashed here once).
+    const RunResult text = run("devices");
+    ASSERT_EQ(text.code, 0) << text.output;
+    EXPECT_NE(text.output.find(j[0]["name"].get<std::string>()), std::string::npos) << text.output;
+    EXPECT_NE(text.output.find("maxStorageBufferRange " +
+                               std::to_string(j[0]["max_storage_buffer_range"].get<std::uint64_t>() >> 20) + " MiB"),
+              std::string::npos)
+        << text.output;
+    EXPECT_NE(text.output.find("maxMemoryAllocationSize " +
+                               std::to_string(j[0]["max_memory_allocation"].get<std::uint64_t>() >> 20) + " MiB"),
+              std::string::npos)
+        << text.output;
 }
 
 TEST_F(Cli, UnknownDeviceIsAnError) {
