@@ -116,9 +116,9 @@ void main() {
             if (lead) sc.bMean[c] = sum / pc.value;
         }
     // Every channel converged: the rest of the recorded batch becomes empty dispatches.
-    if (lead && (pc.mode == kPoissonModeInit || pc.mode == kPoissonModeBeta || pc.mode == kPoissonModeRecord) &&
-        sc.done[0] != 0u &&
-        sc.done[1] != 0u && sc.done[2] != 0u)
+    bool testsConvergence =
+        pc.mode == kPoissonModeInit || pc.mode == kPoissonModeBeta || pc.mode == kPoissonModeRecord;
+    if (lead && testsConvergence && sc.done[0] != 0u && sc.done[1] != 0u && sc.done[2] != 0u)
         for (uint i = 0u; i < gateArgs.length(); ++i) gateArgs[i] = 0u;
     if (pc.mode == kPoissonModeIrls) {
         float sum = sumSlot(kPoissonSlotWeight, 0u);

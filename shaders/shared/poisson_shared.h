@@ -25,7 +25,7 @@ namespace gdpt::gpu {
 //       kPoissonBindFields holds each field's 64-bit address (GL_EXT_buffer_reference).
 // The second exists for fields beyond maxStorageBufferRange (a descriptor range limit; a
 // 4096x4096 solve has 200-270 MB fields, lavapipe allows 128 MiB); it is only used then,
-// because lavapipe 22.3 runs the address-based loads about 1.3x slower.
+// because lavapipe 22.3 runs the address-based loads about 1.2x slower.
 GDPT_ENUM_BEGIN(PoissonField)
     kPoissonFieldCoef = 0u,      // float: per level cx, cy, cp planes
     kPoissonFieldX = 1u,         // float: per level x (V-cycle unknown; 3 planes)

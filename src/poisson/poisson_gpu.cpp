@@ -341,10 +341,9 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
         report.converged = r.converged;
         report.irlsIterations = 1;
     } else {
-        const int rounds = std::max(1, o.irlsIterations);
         double reg = o.irlsRegInit;
-        for (int k = 0; k < rounds; ++k) {
-            const bool last = k + 1 == rounds;
+        for (int k = 0; k < rounds_; ++k) {
+            const bool last = k + 1 == rounds_;
             const double tol = last ? o.tolerance : std::max(o.tolerance, o.irlsInnerTolerance);
             if (k > 0) {
                 // The previous inner solve submitted its buffers: open a new one for the

@@ -188,22 +188,21 @@ PoissonGpuEngine::PoissonGpuEngine(const vk::Context& ctx, int width, int height
     partials = vk::Buffer(ctx, partialBytes, "poissonPartials");
     scalars = vk::Buffer(ctx, sizeof(gpu::PoissonScalars) + 3ull * gpu::kPoissonMaxHistory * sizeof(float),
                          "poissonScalars");
-    std::array<std::uint64_t, gpu::kPoissonFieldCount> addresses{};
-    const auto fields = fieldBuffers();
-    for (std::uint32_t f = 0; f < gpu::kPoissonFieldCount; ++f) addresses[f] = fields[f]->deviceAddress();
-    fieldTable = vk::Buffer(ctx, sizeof(addresses), "poissonFields");
-    fieldTable.upload(addresses.data(), sizeof(addresses));
+    if (addressing_ == PoissonAddressing::DeviceAddress) {
+        std::array<std::uint64_t, gpu::kPoissonFieldCount> addresses{};
+        const auto fields = fieldBuffers();
+        for (std::uint32_t f = 0; f < gpu::kPoissonFieldCount; ++f) addresses[f] = fields[f]->deviceAddress();
+        fieldTable = vk::Buffer(ctx, sizeof(addresses), "poissonFields");
+        fieldTable.upload(addresses.data(), sizeof(addresses));
+    }
     // The gate: indirect group counts of every dispatch shape of an iteration (each level's
     // grid, its half-width smoothing grid, one workgroup), zeroed by poisson_scalars once
     // every channel has converged so that the rest of a recorded batch costs nothing.
-    const auto groupsOf = [&](int items, std::uint32_t size) {
-        return (static_cast<std::uint32_t>(items) + size - 1) / size;
-    };
     for (const PoissonLevel& l : levels_) {
-        addGateShape(groupsOf(l.width, kernels_->groupX()), groupsOf(l.height, kernels_->groupY()));
-        addGateShape(groupsOf((l.width + 1) / 2, kernels_->groupX()), groupsOf(l.height, kernels_->groupY()));
+        addGateShape(gridGroups(l.width, l.height));
+        addGateShape(gridGroups((l.width + 1) / 2, l.height));
     }
-    addGateShape(1, 1);
+    addGateShape({1u, 1u});
     gate = vk::Buffer(ctx, gateArgs_.size() * sizeof(std::uint32_t), "poissonGate");
     armGate();
     // Defined contents everywhere (no stale NaN can leak through a 0 coefficient).
@@ -211,11 +210,13 @@ PoissonGpuEngine::PoissonGpuEngine(const vk::Context& ctx, int width, int height
     bind();
 }
 
+std::pair<std::uint32_t, std::uint32_t> PoissonGpuEngine::gridGroups(int itemsX, int itemsY) const {
+    return {(static_cast<std::uint32_t>(itemsX) + kernels_->groupX() - 1) / kernels_->groupX(),
+            (static_cast<std::uint32_t>(itemsY) + kernels_->groupY() - 1) / kernels_->groupY()};
+}
+
 std::uint32_t PoissonGpuEngine::groups() const {
-    const std::uint32_t gx =
-        (static_cast<std::uint32_t>(width()) + kernels_->groupX() - 1) / kernels_->groupX();
-    const std::uint32_t gy =
-        (static_cast<std::uint32_t>(height()) + kernels_->groupY() - 1) / kernels_->groupY();
+    const auto [gx, gy] = gridGroups(width(), height());
     // One partial sum per subgroup (poisson_common.glsl writePartials).
     const std::uint32_t sub = std::max(1u, ctx_.info().subgroupSize);
     const std::uint32_t perGroup = (kernels_->groupX() * kernels_->groupY() + sub - 1) / sub;
@@ -241,8 +242,8 @@ void PoissonGpuEngine::bind() {
 
 void PoissonGpuEngine::dispatch(VkCommandBuffer cmd, const vk::Kernel& kernel, int itemsX, int itemsY,
                                 const void* push, vk::GpuTimer* timer) {
-    dispatchGroups(cmd, kernel, (static_cast<std::uint32_t>(itemsX) + kernels_->groupX() - 1) / kernels_->groupX(),
-                   (static_cast<std::uint32_t>(itemsY) + kernels_->groupY() - 1) / kernels_->groupY(), push, timer);
+    const auto [gx, gy] = gridGroups(itemsX, itemsY);
+    dispatchGroups(cmd, kernel, gx, gy, push, timer);
 }
 
 void PoissonGpuEngine::dispatchGroups(VkCommandBuffer cmd, const vk::Kernel& kernel, std::uint32_t gx,
@@ -257,9 +258,9 @@ void PoissonGpuEngine::dispatchGroups(VkCommandBuffer cmd, const vk::Kernel& ker
     vk::computeBarrier(cmd);
 }
 
-void PoissonGpuEngine::addGateShape(std::uint32_t gx, std::uint32_t gy) {
-    if (gateEntry_.emplace(std::make_pair(gx, gy), static_cast<std::uint32_t>(gateArgs_.size() / 3)).second)
-        gateArgs_.insert(gateArgs_.end(), {gx, gy, 1u});
+void PoissonGpuEngine::addGateShape(std::pair<std::uint32_t, std::uint32_t> groups) {
+    if (gateEntry_.emplace(groups, static_cast<std::uint32_t>(gateArgs_.size() / 3)).second)
+        gateArgs_.insert(gateArgs_.end(), {groups.first, groups.second, 1u});
 }
 
 void PoissonGpuEngine::armGate() { gate.upload(gateArgs_.data(), gateArgs_.size() * sizeof(std::uint32_t)); }

@@ -15,6 +15,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "poisson_shared.h"
@@ -130,7 +131,7 @@ public:
     // The fields (kPoissonField*: bound as descriptors, or read through the device addresses
     // listed in fieldTable) and the descriptor-bound scalars.
     vk::Buffer coef, x, b, r, p, ap, sol, rhs, primal, dx, dy, weights, irls, partials;
-    vk::Buffer fieldTable, scalars, gate;
+    vk::Buffer fieldTable, scalars, gate;  // fieldTable: device-address build only
 
     // Early exit inside a recorded batch. While gated, every dispatch reads its group counts
     // from `gate`, which poisson_scalars zeroes once all channels have converged (Beta and
@@ -176,7 +177,9 @@ private:
                   vk::GpuTimer* timer);
     void dispatchGroups(VkCommandBuffer cmd, const vk::Kernel& kernel, std::uint32_t gx, std::uint32_t gy,
                         const void* push, vk::GpuTimer* timer);
-    void addGateShape(std::uint32_t gx, std::uint32_t gy);
+    // Workgroups covering itemsX × itemsY invocations with the kernels' workgroup size.
+    [[nodiscard]] std::pair<std::uint32_t, std::uint32_t> gridGroups(int itemsX, int itemsY) const;
+    void addGateShape(std::pair<std::uint32_t, std::uint32_t> groups);
 
     const vk::Context& ctx_;
     std::unique_ptr<PoissonKernels> ownKernels_;
