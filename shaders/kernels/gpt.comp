@@ -67,6 +67,20 @@ vec3 cameraRay(vec2 pixelPos) {
 
 #include "lib/gpt_path.glsl"
 
+// Split bounce loop (GDPT_GPT_SPLIT_BOUNCE: a second build of this kernel, gpt_split; the
+// host picks one per device, splitBounceDefault in gpt_pass.cpp). Once every live offset
+// shares the base's vertices (in a scene without glossy vertices: every bounce after the
+// first), the remaining bounces run in a second loop compiled without the code for offsets
+// with vertices of their own. Lavapipe with Mesa 22.3 runs every branch under lane masks,
+// also one that no lane takes, so that code costs its time at every bounce there: the split
+// loop is 15-25 % faster on it, neutral on Mesa 25 (which skips such branches), and its
+// pipeline takes about 0.45 s longer to create. A second build rather than a specialisation
+// constant, because lavapipe spends that time on the dead loop too. The image is the same
+// bit for bit either way (bench/RESULTS.md, fourth session).
+
+// Offset i has a vertex of its own (NOT_CONNECTED); never in the fast form (general false).
+bool ownVertex(OffsetPath o, bool general) { return general && o.state == kShiftNotConnected; }
+
 // Base + 4 offsets for one camera sample at pixelPos (continuous pixel coordinates).
 void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays, out vec3 direct,
                  inout OffsetPath offs[4]) {
@@ -108,338 +122,28 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
     }
 
     vec3 beta = vec3(1.0);  // base f/p
-    for (uint depth = 0u; depth < kMaxDepth && depth < scene.maxDepth; ++depth) {
-        // One-sided back faces absorb: the base path ends; an offset there cannot continue
-        // (its reverse shift does not exist), so its pair falls back to the base alone.
-        if (oneSidedBack(sh)) break;
-        for (uint i = 0u; i < 4u; ++i) {
-            if (offs[i].alive && offs[i].state == kShiftNotConnected && oneSidedBack(offs[i].hit))
-                offs[i].alive = false;
-        }
-
-        BsdfParams bsdf = materialBsdf(sh.material, sh.uv);
-        vec3 t, b;
-        makeBasis(sh.ns, t, b);
-        vec3 woLocal = toLocal(-d, t, b, sh.ns);
-        vec3 origin = offsetRayOriginScaled(sh.p, sh.ng, scene.sceneRadius);
-
-        // Offsets' own BSDFs and frames (NOT_CONNECTED only).
-        BsdfParams offBsdf[4];
-        vec3 offT[4], offB[4], offWo[4];
-        for (uint i = 0u; i < 4u; ++i) {
-            offBsdf[i] = bsdf;  // placeholder for shared / dead offsets (never read)
-            if (!offs[i].alive) continue;
-            if (offs[i].state == kShiftNotConnected) {
-                SurfaceHit oh = offs[i].hit;
-                offBsdf[i] = materialBsdf(oh.material, oh.uv);
-                makeBasis(oh.ns, offT[i], offB[i]);
-                offWo[i] = toLocal(offs[i].woWorld, offT[i], offB[i], oh.ns);
-            } else {
-                offWo[i] = toLocal(offs[i].woWorld, t, b, sh.ns);  // shared vertex, own wo
-            }
-        }
-
-        // Whether the light strategy exists for each pair at this vertex (GPT_REFERENCE §1.5):
-        // always for a lone base (failed shift) and a shared vertex; for separate vertices
-        // only if both are rough (area lights; the BSDF never hits a punctual light). The
-        // BSDF-sampled emission of the next vertex then competes with it or not. Rough means
-        // rough over ALL components (not only the smooth ones NEE evaluates, the reference's
-        // choice): only then does the BSDF step reconnect to the light point, so NEE and BSDF
-        // sampling use the same shift and their pair weights sum to one (the smooth-only rule,
-        // combined with the all-components classification above, made a diffuse lobe under
-        // a mirror coat count its light twice: NEE with four strategies, and again through
-        // the half-vector branch, which has no light strategy).
-        bool baseRoughNee = roughAll(bsdf);
-        bool lightActive[4];
-        for (uint i = 0u; i < 4u; ++i) {
-            // A Dirac-only offset vertex fails every shift of both techniques, so its pair is
-            // the lone base's (PT weights, light strategy included).
-            lightActive[i] = !offs[i].alive || offs[i].state != kShiftNotConnected ||
-                             bsdfIsDeltaOnly(offBsdf[i]) || (baseRoughNee && roughAll(offBsdf[i]));
-        }
-
-        // ---- Next-event estimation with the same light point for all (§1.5) ----
-        // Densities are visibility-aware: a path whose last segment is occluded cannot be
-        // produced by BSDF sampling (its BSDF density is 0) but can by light sampling. This
-        // keeps the four weights of a path equal whichever technique sampled it.
-        vec3 ul = rngNext3(rng);
-        LightSample ls;
-        if (!bsdfIsDeltaOnly(bsdf) && sampleLight(sh.p, ul, ls) && dot(ls.wi, sh.ng) > 0.0) {
-            vec3 wiLocal = toLocal(ls.wi, t, b, sh.ns);
-            vec3 f = bsdfEval(bsdf, woLocal, wiLocal);
-            float pdfBsdf = ls.isDelta != 0u ? 0.0 : bsdfPdf(bsdf, woLocal, wiLocal);
-            rays++;
-            bool visible = !traceAny(origin, ls.wi, 0.0, ls.dist * (1.0 - 1e-4));
-            vec3 fBase = visible ? beta * f * ls.Li / ls.pdf : vec3(0.0);
-            float pdfBsdfV = visible ? pdfBsdf : 0.0;  // BSDF density including visibility
-            for (uint i = 0u; i < 4u; ++i) {
-                if (!gptPairExists(px, py, i)) continue;
-                if (!offs[i].alive) {
-                    // Failed shift: the base alone, with PT's weight.
-                    addPair(offs[i], gptMisWeight(ls.pdf, pdfBsdfV, 0.0, 0.0), fBase, vec3(0.0));
-                    continue;
-                }
-                if (offs[i].state != kShiftNotConnected) {
-                    // Shared vertex: same light point and visibility; the offset's own
-                    // incoming direction only changes the BSDF (§1.5 RECENTLY_CONNECTED).
-                    vec3 fo = f;
-                    float pdfBsdfO = pdfBsdfV;
-                    if (offs[i].state == kShiftRecentlyConnected) {
-                        fo = bsdfEval(bsdf, offWo[i], wiLocal);
-                        pdfBsdfO = (ls.isDelta != 0u || !visible) ? 0.0 : bsdfPdf(bsdf, offWo[i], wiLocal);
-                    }
-                    vec3 fOff = visible ? offs[i].beta * fo * ls.Li / ls.pdf : vec3(0.0);
-                    float w = gptMisWeight(ls.pdf, pdfBsdfV, offs[i].r * ls.pdf, offs[i].r * pdfBsdfO);
-                    addPair(offs[i], w, fBase, fOff);
-                    continue;
-                }
-                // NOT_CONNECTED: reconnect the offset vertex to the same light point, only if
-                // both vertices are rough or the light is punctual; otherwise this NEE sample
-                // counts for neither (weight 0, the reference's choice).
-                if (ls.isDelta == 0u && !lightActive[i]) continue;
-                BsdfParams ob = offBsdf[i];
-                SurfaceHit oh = offs[i].hit;
-                vec3 toLight = ls.pLight - oh.p;
-                float distO = length(toLight);
-                vec3 wiO = toLight / distO;
-                // Densities of the offset path under the reverse technique: zero where the
-                // base sampler at p+δ would have rejected it (light behind the surface, light
-                // facing away, Dirac-only vertex), which makes the shift fail.
-                vec3 liO;
-                float jacobianLight;
-                bool valid = distO > 0.0 && dot(wiO, oh.ng) > 0.0 && !bsdfIsDeltaOnly(ob) &&
-                             gptOffsetLight(ls, ul, sh.p, oh.p, wiO, distO, liO, jacobianLight);
-                if (!valid) {
-                    addPair(offs[i], gptMisWeight(ls.pdf, pdfBsdfV, 0.0, 0.0), fBase, vec3(0.0));
-                    continue;
-                }
-                vec3 wiLocalO = toLocal(wiO, offT[i], offB[i], oh.ns);
-                vec3 fo = bsdfEval(ob, offWo[i], wiLocalO) * liO;
-                float pdfBsdfO = ls.isDelta != 0u ? 0.0 : bsdfPdf(ob, offWo[i], wiLocalO);
-                vec3 fOff = vec3(0.0);
-                // The offset's visibility matters for its contribution and for its BSDF
-                // density (which enters the base's weight).
-                if (maxComponent(fo) > 0.0 || (pdfBsdfO > 0.0 && maxComponent(fBase) > 0.0)) {
-                    rays++;
-                    if (!traceAny(offsetRayOriginScaled(oh.p, oh.ng, scene.sceneRadius), wiO, 0.0, distO * (1.0 - 1e-4)))
-                        fOff = offs[i].beta * fo * (jacobianLight / ls.pdf);
-                    else
-                        pdfBsdfO = 0.0;
-                }
-                // Light strategy of the offset in the base's measure: p'_L J = p_L (same light
-                // point, area measure); BSDF strategy p'_B J.
-                float w = gptMisWeight(ls.pdf, pdfBsdfV, offs[i].r * ls.pdf,
-                                       offs[i].r * pdfBsdfO * jacobianLight);
-                addPair(offs[i], w, fBase, fOff);
-            }
-        }
-
-        // ---- BSDF sampling continues the base path ----
-        BsdfSample bs;
-        if (!bsdfSample(bsdf, woLocal, rngNext3(rng), bs)) break;
-        vec3 wi = toWorld(bs.wi, t, b, sh.ns);
-        if (dot(wi, sh.ng) <= 0.0) break;
-        beta *= bs.weight;
-        bool prevSpecular = bs.lobe == kLobeSpecular;
-        vec3 prevP = sh.p;
-
-        // Russian roulette from the base, shared by the offsets (§1.4).
-        float rrInv = 1.0;
-        if (depth + 1u >= scene.rrDepth) {
-            float q = min(maxComponent(beta), 0.95);
-            if (rngNext(rng) >= q) break;
-            rrInv = 1.0 / q;
-            beta *= rrInv;
-        }
-        if (depth + 1u >= kMaxDepth) break;  // pt.comp would not trace this segment either
-
-        Hit next = traceClosest(origin, wi, 0.0, kInf);
-        rays++;
-        bool baseMissed = next.triangle == kInvalidIndex;
-        if (baseMissed && !kHasEnv) break;
-        SurfaceHit nextSh;
-        bool baseNextRough = true;
-        if (!baseMissed) {
-            nextSh = makeSurfaceHit(next.triangle, next.u, next.v, wi);
-            if (kHasGlossy) baseNextRough = roughAll(materialBsdf(nextSh.material, nextSh.uv));
-        }
-        bool baseCurRough = roughAll(bsdf);
-
-        // ---- Shift every live offset over this segment (§1.4) ----
-        for (uint i = 0u; i < 4u; ++i) {
-            if (!offs[i].alive) continue;
-            if (offs[i].state == kShiftConnected) {
-                offs[i].beta *= bs.weight * rrInv;  // shares the vertex: same f and p
-                offs[i].rLight = offs[i].r;
-                continue;
-            }
-            if (offs[i].state == kShiftRecentlyConnected) {
-                // Shared vertex, own incoming direction: re-evaluate f and p (never Dirac: a
-                // reconnection target has no Dirac lobe, shiftRoughnessAll).
-                vec3 fo = bsdfEval(bsdf, offWo[i], bs.wi);
-                float po = bsdfPdf(bsdf, offWo[i], bs.wi);
-                offs[i].beta *= fo * (rrInv / bs.pdf);
-                offs[i].r *= po / bs.pdf;
-                offs[i].rLight = offs[i].r;
-                offs[i].state = kShiftConnected;
-                continue;
-            }
-            SurfaceHit oh = offs[i].hit;
-            BsdfParams ob = offBsdf[i];
-            vec3 ohOrigin = offsetRayOriginScaled(oh.p, oh.ng, scene.sceneRadius);
-            bool offCurRough = roughAll(ob);
-            if (shiftUseReconnection(baseCurRough, baseNextRough, offCurRough)) {
-                // Reconnection shift: connect to the base's next vertex (or the environment
-                // in the same direction, J = 1); occlusion = failure.
-                vec3 wiO = wi;
-                float jacobianShift = 1.0;
-                bool ok;
-                float dist = kInf;
-                if (baseMissed) {
-                    ok = dot(wiO, oh.ng) > 0.0;
-                } else {
-                    vec3 e = nextSh.p - oh.p;
-                    dist = length(e);
-                    wiO = e / dist;
-                    jacobianShift = reconnectionJacobian(sh.p, oh.p, nextSh.p, nextSh.ng);
-                    // Same side of the target as the base (else it is another surface point
-                    // for BSDF and emission), leaving above the offset's geometric surface.
-                    ok = dist > 0.0 && jacobianShift > 0.0 && dot(wiO, oh.ng) > 0.0 &&
-                         dot(wiO, nextSh.ng) < 0.0;
-                }
-                if (!ok) {
-                    offs[i].alive = false;  // no offset path: the reverse never maps here
-                    continue;
-                }
-                float rPrefix = offs[i].r;
-                // Light strategy at the target: p'_L J = p_L, so the offset's light density in
-                // the base's measure is rPrefix·p_L (zero if the offset vertex cannot do NEE).
-                offs[i].rLight = bsdfIsDeltaOnly(ob) ? 0.0 : rPrefix;
-                offs[i].woWorld = -wiO;
-                offs[i].state = kShiftRecentlyConnected;
-                // Visibility from the offset vertex (for the environment too: the 2019 fix).
-                rays++;
-                if (traceAny(ohOrigin, wiO, 0.0, baseMissed ? kInf : dist * (1.0 - 1e-4))) {
-                    // Occluded: the offset path has no BSDF density and no contribution, but
-                    // light sampling could still produce it, so its light density stays in
-                    // this vertex's emission weight. r = 0 and beta' = 0 then act as a failed
-                    // shift for everything after.
-                    offs[i].beta = vec3(0.0);
-                    offs[i].r = 0.0;
-                    continue;
-                }
-                vec3 wiLocalO = toLocal(wiO, offT[i], offB[i], oh.ns);
-                vec3 fo = bsdfEval(ob, offWo[i], wiLocalO);
-                float po = bsdfPdf(ob, offWo[i], wiLocalO);
-                offs[i].beta *= fo * (jacobianShift * rrInv / bs.pdf);
-                offs[i].r *= po * jacobianShift / bs.pdf;
-                continue;
-            }
-            if (!kHasGlossy) {
-                offs[i].alive = false;  // unreachable when every vertex is rough
-                continue;
-            }
-            // Half-vector copy shift (reflection only: gdpt has no transmission).
-            bool baseDirac = bs.lobe == kLobeSpecular;
-            if (baseDirac ? !bsdfHasDelta(ob) : bsdfIsDeltaOnly(ob)) {
-                offs[i].alive = false;  // Dirac and smooth never shift into each other
-                continue;
-            }
-            vec3 wiLocalO;
-            vec3 fo;
-            float po;
-            float jacobianShift = 1.0;
-            if (baseDirac) {
-                // Mirror: h = n; Dirac weight F(cos_o) and discrete pdf P(mirror lobe), J = 1.
-                wiLocalO = vec3(-offWo[i].x, -offWo[i].y, offWo[i].z);
-                fo = glossyFresnel(ob, offWo[i].z);
-                po = offWo[i].z > 0.0 ? glossySelectProb(ob, offWo[i]) : 0.0;
-            } else {
-                if (!halfVectorReflect(woLocal, bs.wi, offWo[i], wiLocalO, jacobianShift)) {
-                    offs[i].alive = false;
-                    continue;
-                }
-                fo = bsdfEval(ob, offWo[i], wiLocalO);
-                po = bsdfPdf(ob, offWo[i], wiLocalO);
-            }
-            vec3 wiO = toWorld(wiLocalO, offT[i], offB[i], oh.ns);
-            if (!(po > 0.0) || !(wiLocalO.z > 0.0) || dot(wiO, oh.ng) <= 0.0) {
-                offs[i].alive = false;
-                continue;
-            }
-            offs[i].beta *= fo * (jacobianShift * rrInv / bs.pdf);
-            offs[i].r *= po * jacobianShift / bs.pdf;
-            Hit ho = traceClosest(ohOrigin, wiO, 0.0, kInf);
-            rays++;
-            bool offMissed = ho.triangle == kInvalidIndex;
-            if (offMissed != baseMissed) {
-                offs[i].alive = false;  // environment / surface mismatch
-                continue;
-            }
-            bool offNextRough = true;
-            if (!offMissed) {
-                offs[i].hit = makeSurfaceHit(ho.triangle, ho.u, ho.v, wiO);
-                offNextRough = roughAll(materialBsdf(offs[i].hit.material, offs[i].hit.uv));
-            }
-            // Invertibility: the reverse shift would have reconnected (§1.4).
-            if (!shiftHalfVectorInvertible(baseCurRough, offCurRough, offNextRough)) {
-                offs[i].alive = false;
-                continue;
-            }
-            offs[i].woWorld = -wiO;
-        }
-
-        // ---- Emission reached by the BSDF sample: environment or an emitter (§1.6) ----
-        if (baseMissed) {
-            vec3 le = scene.envRadiance;
-            for (uint i = 0u; i < 4u; ++i) {
-                if (!gptPairExists(px, py, i)) continue;
-                if (!offs[i].alive) {
-                    addPair(offs[i], 1.0, beta * le, vec3(0.0));
-                } else {
-                    // Not light-sampled: two strategies, base and offset.
-                    addPair(offs[i], gptMisWeightPair(offs[i].r), beta * le, offs[i].beta * le);
-                }
-            }
-            break;
-        }
-        if (kHasLightTris) {
-            vec3 le = surfaceEmission(nextSh);
-            float pdfLight = 0.0;
-            if (!prevSpecular && maxComponent(le) > 0.0) {
-                vec3 nl = normalize(cross(triGeoms[nextSh.triangle].e1, triGeoms[nextSh.triangle].e2));
-                pdfLight = lightTrianglePdf(nextSh.triangle, prevP, nextSh.p, nl);
-            }
-            for (uint i = 0u; i < 4u; ++i) {
-                if (!gptPairExists(px, py, i)) continue;
-                // The light strategy competes only where NEE counted for this pair.
-                float pdfLightPair = lightActive[i] ? pdfLight : 0.0;
-                if (!offs[i].alive) {
-                    // Failed shift (before or at this bounce): the base alone. After a failed
-                    // half-vector step the pair had no NEE, so the base takes full weight.
-                    if (maxComponent(le) > 0.0)
-                        addPair(offs[i], gptMisWeight(bs.pdf, pdfLightPair, 0.0, 0.0), beta * le, vec3(0.0));
-                } else if (offs[i].state == kShiftNotConnected) {
-                    // Half-vector branch: BSDF sampling only, w = p²/(p² + (J p')²).
-                    vec3 leO = surfaceEmission(offs[i].hit);
-                    if (maxComponent(le) > 0.0 || maxComponent(leO) > 0.0)
-                        addPair(offs[i], gptMisWeightPair(offs[i].r), beta * le, offs[i].beta * leO);
-                } else if (maxComponent(le) > 0.0) {
-                    // Reconnected (this bounce or before): four strategies.
-                    float w = gptMisWeight(bs.pdf, pdfLightPair, offs[i].r * bs.pdf,
-                                           offs[i].rLight * pdfLightPair);
-                    addPair(offs[i], w, beta * le, offs[i].beta * le);
-                }
-            }
-        }
-        // Nothing left to carry (e.g. the base and all offsets sit on a black emitter): every
-        // later contribution of every pair would be w·0, so stop tracing.
-        bool carries = maxComponent(beta) > 0.0;
-        for (uint i = 0u; i < 4u; ++i) carries = carries || (offs[i].alive && maxComponent(offs[i].beta) > 0.0);
-        if (!carries) break;
-        sh = nextSh;
-        d = wi;
+    uint depth = 0u;
+    bool pathEnded = false;
+    // General bounces; in the split build only while some live offset has a vertex of its
+    // own (the first bounce always, if any offset hit), then the fast form.
+    for (; depth < kMaxDepth && depth < scene.maxDepth; ++depth) {
+#ifdef GDPT_GPT_SPLIT_BOUNCE
+        bool own = false;
+        for (uint i = 0u; i < 4u; ++i) own = own || (offs[i].alive && offs[i].state == kShiftNotConnected);
+        if (!own) break;
+#endif
+#define GDPT_GPT_GENERAL true
+#include "lib/gpt_bounce.glsl"
+#undef GDPT_GPT_GENERAL
     }
+#ifdef GDPT_GPT_SPLIT_BOUNCE
+    if (pathEnded) return;
+    for (; depth < kMaxDepth && depth < scene.maxDepth; ++depth) {
+#define GDPT_GPT_GENERAL false
+#include "lib/gpt_bounce.glsl"
+#undef GDPT_GPT_GENERAL
+    }
+#endif
 }
 
 void main() {

@@ -29,6 +29,7 @@ struct RenderArgs {
     std::string workgroup = "8x8";
     std::string schedule = "megakernel";
     float shiftThreshold = 0.001f;
+    std::string splitBounce = "auto";  // G-PT: auto, on, off (GptPassOptions::SplitBounce)
     std::string recon = "l1";
     double alpha = 0.2;
     double tolerance = 1e-4;

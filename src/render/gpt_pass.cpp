@@ -4,6 +4,7 @@
 #include <string>
 
 #include "gpt.spv.h"
+#include "gpt_split.spv.h"
 #include "gpt_resolve.spv.h"
 #include "render/scene_gpu.h"
 #include "util/error.h"
@@ -33,10 +34,16 @@ bool needsHalfVector(const SceneGpu& scene, float threshold) {
     return f.hasSpecularLayer && (f.minRoughness <= threshold || f.minRoughness < kDiracRoughness);
 }
 
-vk::KernelDesc gptDesc(const SceneGpu& scene, WorkgroupSize wg, bool halfVector) {
+bool splitBounceFor(const vk::DeviceInfo& device, GptPassOptions::SplitBounce s) {
+    if (s == GptPassOptions::SplitBounce::Auto) return splitBounceDefault(device);
+    return s == GptPassOptions::SplitBounce::On;
+}
+
+vk::KernelDesc gptDesc(const SceneGpu& scene, WorkgroupSize wg, bool halfVector, bool splitBounce) {
     std::vector<std::uint32_t> extra = {gpu::kBindCounters};
     for (std::uint32_t i = 0; i < kNumStats; ++i) extra.push_back(gpu::kBindGptCentral + i);
-    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("gpt", kSpv_gpt), wg, extra, sizeof(gpu::GptFrameParams));
+    vk::KernelDesc d = scene.kernelDesc(splitBounce ? vk::kernelDesc("gpt", kSpv_gpt_split) : vk::kernelDesc("gpt", kSpv_gpt),
+                                        wg, extra, sizeof(gpu::GptFrameParams));
     for (auto& [id, value] : d.specConstants)
         if (id == gpu::kSpecHasGlossy) value = halfVector ? 1u : 0u;
     return d;
@@ -59,13 +66,19 @@ std::array<vk::Buffer, kNumStats> makeStats(const vk::Context& ctx, std::uint64_
 }
 }  // namespace
 
+bool splitBounceDefault(const vk::DeviceInfo& device) {
+    // Mesa encodes driverVersion as VK_MAKE_VERSION(major, minor, patch).
+    return device.driverName == "llvmpipe" && VK_API_VERSION_MAJOR(device.driverVersion) < 23;
+}
+
 GptPass::GptPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg, GptPassOptions options)
     : ctx_(ctx),
       width_(scene.constants().width),
       height_(scene.constants().height),
       options_(options),
       halfVector_(options.forceHalfVector || needsHalfVector(scene, options.shiftThreshold)),
-      kernel_(ctx, gptDesc(scene, wg, halfVector_)),
+      splitBounce_(splitBounceFor(ctx.info(), options.splitBounce)),
+      kernel_(ctx, gptDesc(scene, wg, halfVector_, splitBounce_)),
       resolveKernel_(ctx, resolveDesc(wg)),
       stats_(makeStats(ctx, std::uint64_t{width_} * height_)),
       resolved_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::GptResolved), "gpt resolved"),

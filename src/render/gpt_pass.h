@@ -13,6 +13,7 @@
 #include "image/image.h"
 #include "render/pt_pass.h"
 #include "vk/buffer.h"
+#include "vk/context.h"
 #include "vk/kernel.h"
 
 namespace gdpt {
@@ -28,7 +29,17 @@ struct GptPassOptions {
     // Compile the half-vector branch in even if the scene has no glossy/specular vertex
     // (kHasGlossy spec constant forced true; for measuring what the branch costs).
     bool forceHalfVector = false;
+    // The split bounce loop of gpt.comp (its gpt_split build): Auto = where it was measured
+    // to pay (splitBounceDefault); the image is the same either way.
+    enum class SplitBounce { Auto, On, Off };
+    SplitBounce splitBounce = SplitBounce::Auto;
 };
+
+// Whether the split bounce loop pays on this device: lavapipe with Mesa before 23, which runs
+// every branch under lane masks (15-25 % faster samples there); elsewhere the single loop,
+// as on Mesa 25's lavapipe, where the split measured no faster and only costs pipeline
+// creation time (bench/RESULTS.md, fourth session).
+bool splitBounceDefault(const vk::DeviceInfo& device);
 
 // The resolved images (see gpt_resolve.comp for the estimators).
 struct GptImages {
@@ -56,12 +67,14 @@ public:
     void uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats);
     // Whether the half-vector branch is compiled in (kHasGlossy as specialised).
     [[nodiscard]] bool halfVectorCompiled() const { return halfVector_; }
+    [[nodiscard]] bool splitBounceCompiled() const { return splitBounce_; }
 
 private:
     const vk::Context& ctx_;
     std::uint32_t width_, height_;
     GptPassOptions options_;
     bool halfVector_ = false;
+    bool splitBounce_ = false;
     vk::Kernel kernel_;
     vk::Kernel resolveKernel_;
     // central, neighbor 0..3, gradient 0..3, direct (binding kBindGptCentral + index).

@@ -25,6 +25,7 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     stats.features = sceneGpu.features();
     gpt.shiftThreshold = options.scene.shiftThreshold;
     GptPass pass(ctx, sceneGpu, options.workgroup, gpt);
+    stats.gptSplitBounce = pass.splitBounceCompiled();
     vk::GpuTimer timer(ctx);
     vk::CommandStream stream(ctx, "gpt");
     if (options.resume) pass.uploadStats(options.resume->buffers);

@@ -61,6 +61,7 @@ struct RenderStats {
     std::uint64_t nanSamples = 0;
     std::uint64_t shiftPairs = 0;     // G-PT: shifts attempted (offsets in the image, base hit)
     std::uint64_t shiftFailures = 0;  // G-PT: shifts that failed (pair fell back to the base)
+    bool gptSplitBounce = false;      // G-PT: the kernel ran the split bounce loop
     bool cancelled = false;
     std::map<std::string, vk::KernelTime> kernels;
     SceneFeatures features;

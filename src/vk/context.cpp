@@ -84,6 +84,7 @@ DeviceInfo queryDevice(VkPhysicalDevice pd, std::uint32_t index) {
     d.isCpu = p.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
     d.driverName = driver.driverName;
     d.driverInfo = driver.driverInfo;
+    d.driverVersion = p.driverVersion;
     d.apiVersion = p.apiVersion;
     d.maxStorageBufferRange = p.limits.maxStorageBufferRange;
     d.maxMemoryAllocationSize = maint3.maxMemoryAllocationSize;

@@ -28,6 +28,7 @@ struct DeviceInfo {
     std::string type;        // "cpu", "discrete-gpu", ...
     std::string driverName;  // e.g. "llvmpipe"
     std::string driverInfo;  // e.g. "Mesa 22.3.6 (LLVM 15.0.6)"
+    std::uint32_t driverVersion = 0;  // VkPhysicalDeviceProperties::driverVersion (vendor encoding)
     std::uint32_t apiVersion = 0;
     bool isCpu = false;
     std::uint64_t maxStorageBufferRange = 0;    // largest descriptor range
