@@ -1,5 +1,5 @@
-// bvh_traverse.glsl — ray traversal of the two-wide BVH of gdpt_shared.h (BvhNode) over the
-// leaf-ordered TriangleGeom array, and the ray/triangle test it uses.
+// bvh_traverse.glsl — ray traversal of the four-wide BVH of gdpt_shared.h (BvhWideNode) over
+// the leaf-ordered TriangleGeom array, and the ray/triangle test it uses.
 //
 // Two parts:
 //  * The pure part (ray/box slab test, safe inverse direction, Möller–Trumbore triangle
@@ -9,7 +9,7 @@
 //    only. src/bvh/traverse_cpu.cpp mirrors them statement for statement; change both.
 //
 // The including kernel must declare, before including this file,
-//   layout(scalar) readonly buffer ... { BvhNode bvhNodes[]; };
+//   layout(scalar) readonly buffer ... { BvhWideNode bvhNodes[]; };
 //   layout(scalar) readonly buffer ... { TriangleGeom triGeoms[]; };
 // (scene_buffers.glsl does). Triangle indices are positions in TriangleGeom (leaf) order.
 //
@@ -142,6 +142,71 @@ GDPT_INLINE bool intersectTriangleGeom(vec3 orig, vec3 dir, vec3 v0, vec3 e1, ve
     return true;
 }
 
+// Slab tests of a wide node's four children for (tMin, tFarLimit): intersectBox, four at
+// once; hit[k] is false for empty slots.
+GDPT_INLINE void wideNodeBoxes(BvhWideNode n, vec3 orig, vec3 invDir, float tMin, float tFarLimit,
+                               GDPT_OUT(vec4) tNear, GDPT_OUT(bvec4) hit) {
+    vec4 t0x = (n.minX - orig.x) * invDir.x;
+    vec4 t1x = (n.maxX - orig.x) * invDir.x;
+    vec4 t0y = (n.minY - orig.y) * invDir.y;
+    vec4 t1y = (n.maxY - orig.y) * invDir.y;
+    vec4 t0z = (n.minZ - orig.z) * invDir.z;
+    vec4 t1z = (n.maxZ - orig.z) * invDir.z;
+    tNear = max(max(min(t0x, t1x), min(t0y, t1y)), max(min(t0z, t1z), vec4(tMin)));
+    vec4 tFar = min(min(max(t0x, t1x), max(t0y, t1y)), min(max(t0z, t1z), vec4(tFarLimit))) * kBvhSlabFarScale;
+    hit = bvec4(tNear.x <= tFar.x && n.child.x != kInvalidIndex, tNear.y <= tFar.y && n.child.y != kInvalidIndex,
+                tNear.z <= tFar.z && n.child.z != kInvalidIndex, tNear.w <= tFar.w && n.child.w != kInvalidIndex);
+}
+
+// Triangle k of the hit leaf children taken in slot order, whose counts are c0..c3 (0 for a
+// slot that is not a hit leaf): one loop tests them all, so a kernel holds one inlined
+// triangle test per traversal (on llvmpipe every copy costs its code).
+GDPT_INLINE uint wideLeafTriangle(uvec4 first, uint k, uint c0, uint c1, uint c2) {
+    uint a = c0;
+    uint b = c0 + c1;
+    uint c = b + c2;
+    return k < a ? first.x + k : (k < b ? first.y + (k - a) : (k < c ? first.z + (k - b) : first.w + (k - c)));
+}
+
+// Entry distance of an absent child in wideSortInner (sorts after every real one).
+GDPT_CONST float kBvhNoEntry = 3.0e38f;
+
+// Inner children of a wide node in near-to-far order: child[k] = kInvalidIndex for absent.
+struct WideOrder {
+    uvec4 child;
+    vec4 t;
+};
+
+GDPT_INLINE void wideCompareSwap(GDPT_INOUT(uint) ca, GDPT_INOUT(float) ta, GDPT_INOUT(uint) cb,
+                                 GDPT_INOUT(float) tb) {
+    if (tb < ta) {
+        float t = ta;
+        ta = tb;
+        tb = t;
+        uint c = ca;
+        ca = cb;
+        cb = c;
+    }
+}
+
+// The inner children that the ray enters before tLimit, sorted by entry distance (a
+// five-comparator network over the four slots; absent ones last).
+GDPT_INLINE WideOrder wideSortInner(BvhWideNode n, bvec4 hit, vec4 tNear, float tLimit) {
+    WideOrder o;
+    bvec4 inner = bvec4(hit.x && n.count.x == 0u && tNear.x <= tLimit, hit.y && n.count.y == 0u && tNear.y <= tLimit,
+                        hit.z && n.count.z == 0u && tNear.z <= tLimit, hit.w && n.count.w == 0u && tNear.w <= tLimit);
+    o.child = uvec4(inner.x ? n.child.x : kInvalidIndex, inner.y ? n.child.y : kInvalidIndex,
+                    inner.z ? n.child.z : kInvalidIndex, inner.w ? n.child.w : kInvalidIndex);
+    o.t = vec4(inner.x ? tNear.x : kBvhNoEntry, inner.y ? tNear.y : kBvhNoEntry, inner.z ? tNear.z : kBvhNoEntry,
+               inner.w ? tNear.w : kBvhNoEntry);
+    wideCompareSwap(o.child.x, o.t.x, o.child.y, o.t.y);
+    wideCompareSwap(o.child.z, o.t.z, o.child.w, o.t.w);
+    wideCompareSwap(o.child.x, o.t.x, o.child.z, o.t.z);
+    wideCompareSwap(o.child.y, o.t.y, o.child.w, o.t.w);
+    wideCompareSwap(o.child.y, o.t.y, o.child.z, o.t.z);
+    return o;
+}
+
 GDPT_NAMESPACE_END
 
 #ifndef __cplusplus
@@ -161,36 +226,11 @@ bool intersectTriangle(vec3 orig, vec3 dir, uint tri, float tMin, inout float tM
     return intersectTriangleGeom(orig, dir, g.v0, g.e1, g.e2, tMin, tMax, u, v);
 }
 
-// Leaf [first, first + count): shrinks `hit` to the closest accepted triangle.
-void intersectLeafClosest(vec3 orig, vec3 dir, uint first, uint count, float tMin, inout Hit hit) {
-    for (uint i = first; i < first + count; ++i) {
-        float tCand = hit.t;
-        float u;
-        float v;
-        if (intersectTriangle(orig, dir, i, tMin, tCand, u, v) && GDPT_ANYHIT_FILTER(i, u, v)) {
-            hit.t = tCand;
-            hit.u = u;
-            hit.v = v;
-            hit.triangle = i;
-        }
-    }
-}
-
-// Leaf [first, first + count): true if any triangle is hit (and accepted) in (tMin, tMax).
-bool intersectLeafAny(vec3 orig, vec3 dir, uint first, uint count, float tMin, float tMax) {
-    for (uint i = first; i < first + count; ++i) {
-        float tCand = tMax;
-        float u;
-        float v;
-        if (intersectTriangle(orig, dir, i, tMin, tCand, u, v) && GDPT_ANYHIT_FILTER(i, u, v)) return true;
-    }
-    return false;
-}
-
-// Closest hit with tMin < t < tMax. Stack-based, nearest child first; leaf children are
-// intersected when their parent is visited, so a node fetch tests two boxes and the
-// stack only ever holds inner nodes (at most one per level: depth <= kBvhMaxDepth <
-// kBvhStackSize).
+// Closest hit with tMin < t < tMax. Per node: the four boxes, then the triangles of every hit
+// leaf child (slot order), then the inner children in reach sorted by entry distance: the
+// nearest is visited next, the others pushed farthest first (so they pop near to far) with
+// their entry distance; popped entries beyond the closest hit so far are skipped. The stack
+// never holds more than collapseToWide's maxStack <= kBvhWideStackSize.
 Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
     Hit hit;
     hit.t = tMax;
@@ -198,94 +238,97 @@ Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
     hit.v = 0.0f;
     hit.triangle = kInvalidIndex;
     vec3 invDir = bvhSafeInverse(dir);
-    uint stack[kBvhStackSize];
+    uint stackNode[kBvhWideStackSize];
+    float stackNear[kBvhWideStackSize];
     uint stackSize = 0u;
     uint node = 0u;
     while (true) {
-        BvhNode n = bvhNodes[node];
-        float dL = 0.0f;
-        float dR = 0.0f;
-        bool hitL = n.left != kInvalidIndex &&
-                    intersectBox(orig, invDir, n.lmin, n.lmax, tMin, hit.t, dL);
-        bool hitR = n.right != kInvalidIndex &&
-                    intersectBox(orig, invDir, n.rmin, n.rmax, tMin, hit.t, dR);
-        // Visit order: the child with the nearer entry distance first.
-        bool swapLR = hitR && (!hitL || dR < dL);
-        uint c0 = swapLR ? n.right : n.left;
-        uint count0 = swapLR ? n.rightCount : n.leftCount;
-        bool hit0 = swapLR ? hitR : hitL;
-        uint c1 = swapLR ? n.left : n.right;
-        uint count1 = swapLR ? n.leftCount : n.rightCount;
-        bool hit1 = swapLR ? hitL : hitR;
-        uint next = kInvalidIndex;
-        if (hit0) {
-            if (count0 > 0u) {
-                intersectLeafClosest(orig, dir, c0, count0, tMin, hit);
-            } else {
-                next = c0;
+        BvhWideNode n = bvhNodes[node];
+        vec4 tNear;
+        bvec4 h;
+        wideNodeBoxes(n, orig, invDir, tMin, hit.t, tNear, h);
+        uint c0 = h.x ? n.count.x : 0u;
+        uint c1 = h.y ? n.count.y : 0u;
+        uint c2 = h.z ? n.count.z : 0u;
+        uint c3 = h.w ? n.count.w : 0u;
+        for (uint k = 0u; k < c0 + c1 + c2 + c3; ++k) {
+            uint i = wideLeafTriangle(n.child, k, c0, c1, c2);
+            float tCand = hit.t;
+            float u;
+            float v;
+            if (intersectTriangle(orig, dir, i, tMin, tCand, u, v) && GDPT_ANYHIT_FILTER(i, u, v)) {
+                hit.t = tCand;
+                hit.u = u;
+                hit.v = v;
+                hit.triangle = i;
             }
         }
-        if (hit1) {
-            if (count1 > 0u) {
-                intersectLeafClosest(orig, dir, c1, count1, tMin, hit);
-            } else if (next == kInvalidIndex) {
-                next = c1;
-            } else {
-                stack[stackSize] = c1;  // far inner child: visit later
-                ++stackSize;
-            }
+        // Inner children still in reach, nearest first (wideSortInner); visit the nearest,
+        // push the others farthest first so that they pop in near-to-far order.
+        WideOrder o = wideSortInner(n, h, tNear, hit.t);
+        uint next = o.child.x;
+        if (o.child.w != kInvalidIndex) {
+            stackNode[stackSize] = o.child.w;
+            stackNear[stackSize] = o.t.w;
+            ++stackSize;
         }
-        if (next == kInvalidIndex) {
-            if (stackSize == 0u) {
-                break;
-            }
+        if (o.child.z != kInvalidIndex) {
+            stackNode[stackSize] = o.child.z;
+            stackNear[stackSize] = o.t.z;
+            ++stackSize;
+        }
+        if (o.child.y != kInvalidIndex) {
+            stackNode[stackSize] = o.child.y;
+            stackNear[stackSize] = o.t.y;
+            ++stackSize;
+        }
+        while (next == kInvalidIndex && stackSize > 0u) {
             --stackSize;
-            next = stack[stackSize];
+            if (stackNear[stackSize] <= hit.t) next = stackNode[stackSize];
         }
+        if (next == kInvalidIndex) break;
         node = next;
     }
     return hit;
 }
 
 // Occlusion: true as soon as any accepted hit with tMin < t < tMax is found. Same traversal
-// as traceClosest without the shrinking tMax (order does not matter, so no sorting).
+// without the shrinking tMax and the ordering (order does not change the answer).
 bool traceAny(vec3 orig, vec3 dir, float tMin, float tMax) {
     vec3 invDir = bvhSafeInverse(dir);
-    uint stack[kBvhStackSize];
+    uint stackNode[kBvhWideStackSize];
     uint stackSize = 0u;
     uint node = 0u;
     while (true) {
-        BvhNode n = bvhNodes[node];
-        float dL = 0.0f;
-        float dR = 0.0f;
-        bool hitL = n.left != kInvalidIndex &&
-                    intersectBox(orig, invDir, n.lmin, n.lmax, tMin, tMax, dL);
-        bool hitR = n.right != kInvalidIndex &&
-                    intersectBox(orig, invDir, n.rmin, n.rmax, tMin, tMax, dR);
-        uint next = kInvalidIndex;
-        if (hitL) {
-            if (n.leftCount > 0u) {
-                if (intersectLeafAny(orig, dir, n.left, n.leftCount, tMin, tMax)) return true;
-            } else {
-                next = n.left;
-            }
+        BvhWideNode n = bvhNodes[node];
+        vec4 tNear;
+        bvec4 h;
+        wideNodeBoxes(n, orig, invDir, tMin, tMax, tNear, h);
+        uint c0 = h.x ? n.count.x : 0u;
+        uint c1 = h.y ? n.count.y : 0u;
+        uint c2 = h.z ? n.count.z : 0u;
+        uint c3 = h.w ? n.count.w : 0u;
+        for (uint k = 0u; k < c0 + c1 + c2 + c3; ++k) {
+            uint i = wideLeafTriangle(n.child, k, c0, c1, c2);
+            float tCand = tMax;
+            float u;
+            float v;
+            if (intersectTriangle(orig, dir, i, tMin, tCand, u, v) && GDPT_ANYHIT_FILTER(i, u, v)) return true;
         }
-        if (hitR) {
-            if (n.rightCount > 0u) {
-                if (intersectLeafAny(orig, dir, n.right, n.rightCount, tMin, tMax)) return true;
-            } else if (next == kInvalidIndex) {
-                next = n.right;
+        uint next = kInvalidIndex;
+        for (uint j = 0u; j < 4u; ++j) {
+            if (!(h[j] && n.count[j] == 0u)) continue;
+            if (next == kInvalidIndex) {
+                next = n.child[j];
             } else {
-                stack[stackSize] = n.right;
+                stackNode[stackSize] = n.child[j];
                 ++stackSize;
             }
         }
         if (next == kInvalidIndex) {
-            if (stackSize == 0u) {
-                break;
-            }
+            if (stackSize == 0u) break;
             --stackSize;
-            next = stack[stackSize];
+            next = stackNode[stackSize];
         }
         node = next;
     }

@@ -14,7 +14,7 @@ layout(constant_id = kSpecMaxDepth) const uint kMaxDepth = 1024u;
 
 layout(set = 0, binding = kBindTriGeom, scalar) readonly buffer TriGeomBuf { TriangleGeom triGeoms[]; };
 layout(set = 0, binding = kBindTriShading, scalar) readonly buffer TriShadingBuf { TriangleShading triShading[]; };
-layout(set = 0, binding = kBindBvh, scalar) readonly buffer BvhBuf { BvhNode bvhNodes[]; };
+layout(set = 0, binding = kBindBvh, scalar) readonly buffer BvhBuf { BvhWideNode bvhNodes[]; };
 layout(set = 0, binding = kBindMaterials, scalar) readonly buffer MaterialBuf { Material materials[]; };
 layout(set = 0, binding = kBindTexInfo, scalar) readonly buffer TexInfoBuf { TextureInfo texInfos[]; };
 layout(set = 0, binding = kBindTexels, scalar) readonly buffer TexelBuf { uvec2 texels[]; };

@@ -38,6 +38,9 @@ using uint = std::uint32_t;
 GDPT_CONST uint kInvalidIndex = 0xFFFFFFFFu;
 GDPT_CONST uint kBvhStackSize = 64u;      // traversal stack entries (max BVH depth is capped below)
 GDPT_CONST uint kBvhMaxDepth = 60u;       // builder never exceeds this depth
+// Traversal stack of the wide tree: nodes waiting to be visited (collapseToWide checks that
+// its tree never needs more).
+GDPT_CONST uint kBvhWideStackSize = 128u;
 GDPT_CONST uint kMaxLeafTriangles = 255u; // leaf primitive count must fit in this
 
 // ---------------------------------------------------------------------------------------------
@@ -70,7 +73,8 @@ struct TriangleShading {
 };
 GDPT_CONST uint kTriFlagHasNormals = 1u;  // n0..n2 valid; otherwise use the geometric normal
 
-// Two-wide BVH node: stores both children's boxes so one fetch tests two boxes. 64 bytes.
+// Two-wide BVH node, what the builder writes (builder.h): stores both children's boxes. The
+// kernels traverse its four-wide collapse, BvhWideNode. 64 bytes.
 // A child with count == 0 is an inner node whose index is `left`/`right`; with count > 0
 // it is a leaf covering triangles [first, first + count) in TriangleGeom order. An absent
 // child has count == 0, index kInvalidIndex and an empty box (min > max).
@@ -83,6 +87,22 @@ struct BvhNode {
     uint right;
     vec3 rmax;
     uint rightCount;
+};
+
+// Four-wide BVH node, what the kernels traverse (src/bvh/wide_bvh.h collapses the binary
+// BvhNode tree into it; root = node 0). Child k's box is (minX[k], minY[k], minZ[k]) ..
+// (maxX[k], maxY[k], maxZ[k]): one vec4 per coordinate, so the four slab tests are vec4
+// arithmetic. 128 bytes. Measured against the binary layout on lavapipe (bench/RESULTS.md,
+// fourth session): 9 % fewer G-PT ms per sample on Mesa 22.3 and on Mesa 25.
+struct BvhWideNode {
+    vec4 minX;
+    vec4 minY;
+    vec4 minZ;
+    vec4 maxX;
+    vec4 maxY;
+    vec4 maxZ;
+    uvec4 child;  // node index (count 0) or first triangle (count > 0); kInvalidIndex = empty slot
+    uvec4 count;  // 0 = inner node, else triangle count (<= kMaxLeafTriangles)
 };
 
 // ---------------------------------------------------------------------------------------------

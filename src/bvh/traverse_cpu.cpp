@@ -1,6 +1,8 @@
-// traverse_cpu.cpp — host mirror of shaders/lib/bvh_traverse.glsl (traceClosest, traceAny).
-// Keep the control flow identical to the GLSL so both visit the same nodes and test the
-// same triangles in the same order; the arithmetic is shared through the included GLSL.
+// traverse_cpu.cpp — host mirror of shaders/lib/bvh_traverse.glsl (traceClosest, traceAny:
+// traceClosestWideCpu, traceAnyWideCpu) and the traversal of the binary tree they are
+// collapsed from (traceClosestCpu, traceAnyCpu: the builder's tests and benchmark). Keep the
+// wide control flow identical to the GLSL so both visit the same nodes and test the same
+// triangles in the same order; the arithmetic is shared through the included GLSL.
 #include "bvh/traverse_cpu.h"
 
 namespace gdpt {
@@ -153,6 +155,113 @@ bool traceAnyCpu(const std::vector<gpu::BvhNode>& nodes,
             }
             --stackSize;
             next = stack[stackSize];
+        }
+        node = next;
+    }
+    return false;
+}
+
+Hit traceClosestWideCpu(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<gpu::TriangleGeom>& geoms,
+                        glm::vec3 orig, glm::vec3 dir, float tMin, float tMax) {
+    Hit hit;
+    hit.t = tMax;
+    hit.u = 0.0f;
+    hit.v = 0.0f;
+    hit.triangle = gpu::kInvalidIndex;
+    const glm::vec3 invDir = gpu::bvhSafeInverse(dir);
+    uint32_t stackNode[gpu::kBvhWideStackSize];
+    float stackNear[gpu::kBvhWideStackSize];
+    uint32_t stackSize = 0;
+    uint32_t node = 0;
+    uint32_t visits = 0;
+    while (true) {
+        const gpu::BvhWideNode& n = nodes[node];
+        ++visits;
+        glm::vec4 tNear;
+        glm::bvec4 h;
+        gpu::wideNodeBoxes(n, orig, invDir, tMin, hit.t, tNear, h);
+        const uint32_t c0 = h.x ? n.count.x : 0u;
+        const uint32_t c1 = h.y ? n.count.y : 0u;
+        const uint32_t c2 = h.z ? n.count.z : 0u;
+        const uint32_t c3 = h.w ? n.count.w : 0u;
+        for (uint32_t k = 0u; k < c0 + c1 + c2 + c3; ++k) {
+            const uint32_t i = gpu::wideLeafTriangle(n.child, k, c0, c1, c2);
+            float tCand = hit.t;
+            float u;
+            float v;
+            if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) && anyHitFilter(i, u, v)) {
+                hit.t = tCand;
+                hit.u = u;
+                hit.v = v;
+                hit.triangle = i;
+            }
+        }
+        const gpu::WideOrder o = gpu::wideSortInner(n, h, tNear, hit.t);
+        uint32_t next = o.child.x;
+        if (o.child.w != gpu::kInvalidIndex) {
+            stackNode[stackSize] = o.child.w;
+            stackNear[stackSize] = o.t.w;
+            ++stackSize;
+        }
+        if (o.child.z != gpu::kInvalidIndex) {
+            stackNode[stackSize] = o.child.z;
+            stackNear[stackSize] = o.t.z;
+            ++stackSize;
+        }
+        if (o.child.y != gpu::kInvalidIndex) {
+            stackNode[stackSize] = o.child.y;
+            stackNear[stackSize] = o.t.y;
+            ++stackSize;
+        }
+        while (next == gpu::kInvalidIndex && stackSize > 0u) {
+            --stackSize;
+            if (stackNear[stackSize] <= hit.t) next = stackNode[stackSize];
+        }
+        if (next == gpu::kInvalidIndex) break;
+        node = next;
+    }
+    tlsNodeVisits = visits;
+    return hit;
+}
+
+bool traceAnyWideCpu(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<gpu::TriangleGeom>& geoms,
+                     glm::vec3 orig, glm::vec3 dir, float tMin, float tMax) {
+    const glm::vec3 invDir = gpu::bvhSafeInverse(dir);
+    uint32_t stackNode[gpu::kBvhWideStackSize];
+    uint32_t stackSize = 0;
+    uint32_t node = 0;
+    tlsNodeVisits = 0;
+    while (true) {
+        const gpu::BvhWideNode& n = nodes[node];
+        ++tlsNodeVisits;
+        glm::vec4 tNear;
+        glm::bvec4 h;
+        gpu::wideNodeBoxes(n, orig, invDir, tMin, tMax, tNear, h);
+        const uint32_t c0 = h.x ? n.count.x : 0u;
+        const uint32_t c1 = h.y ? n.count.y : 0u;
+        const uint32_t c2 = h.z ? n.count.z : 0u;
+        const uint32_t c3 = h.w ? n.count.w : 0u;
+        for (uint32_t k = 0u; k < c0 + c1 + c2 + c3; ++k) {
+            const uint32_t i = gpu::wideLeafTriangle(n.child, k, c0, c1, c2);
+            float tCand = tMax;
+            float u;
+            float v;
+            if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) && anyHitFilter(i, u, v)) return true;
+        }
+        uint32_t next = gpu::kInvalidIndex;
+        for (glm::length_t j = 0; j < 4; ++j) {
+            if (!(h[j] && n.count[j] == 0u)) continue;
+            if (next == gpu::kInvalidIndex) {
+                next = n.child[j];
+            } else {
+                stackNode[stackSize] = n.child[j];
+                ++stackSize;
+            }
+        }
+        if (next == gpu::kInvalidIndex) {
+            if (stackSize == 0u) break;
+            --stackSize;
+            next = stackNode[stackSize];
         }
         node = next;
     }

@@ -1,6 +1,7 @@
 // traverse_cpu.h — host reference for ray queries against the flattened BVH: closest-hit
-// and any-hit traversal (a statement-for-statement mirror of traceClosest / traceAny in
-// shaders/lib/bvh_traverse.glsl) and brute-force loops over all triangles. Used by tests and
+// and any-hit traversal of the binary tree (builder.h) and of the four-wide tree the kernels
+// use (a statement-for-statement mirror of traceClosest / traceAny in
+// shaders/lib/bvh_traverse.glsl), and brute-force loops over all triangles. Used by tests and
 // for debugging; the ray/triangle and ray/box tests are the GLSL functions themselves,
 // compiled as C++ (gdpt::gpu::intersectTriangleGeom, gdpt::gpu::intersectBox).
 #pragma once
@@ -29,13 +30,20 @@ bool traceAnyCpu(const std::vector<gpu::BvhNode>& nodes,
                  const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
                  float tMin, float tMax);
 
+// The same queries on the four-wide tree the kernels traverse (wide_bvh.h): a
+// statement-for-statement mirror of traceClosest / traceAny in bvh_traverse.glsl.
+Hit traceClosestWideCpu(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<gpu::TriangleGeom>& geoms,
+                        glm::vec3 orig, glm::vec3 dir, float tMin, float tMax);
+bool traceAnyWideCpu(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<gpu::TriangleGeom>& geoms,
+                     glm::vec3 orig, glm::vec3 dir, float tMin, float tMax);
+
 // Brute force over every triangle in index order; among equal t the lowest index wins.
 Hit traceClosestBruteForce(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig,
                            glm::vec3 dir, float tMin, float tMax);
 bool traceAnyBruteForce(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig,
                         glm::vec3 dir, float tMin, float tMax);
 
-// Number of nodes visited by the last traceClosestCpu/traceAnyCpu call on this thread
+// Number of nodes visited by the last traversal call (binary or wide) on this thread
 // (diagnostics for the benchmark).
 uint32_t lastTraversalNodeVisits();
 

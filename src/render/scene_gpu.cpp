@@ -6,6 +6,7 @@
 #include <glm/gtc/packing.hpp>
 
 #include "bvh/builder.h"
+#include "bvh/wide_bvh.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
 #include "util/timer.h"
@@ -157,7 +158,7 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
 
     triGeom_ = makeBuffer(ctx, geoms, "triangle geometry");
     triShading_ = makeBuffer(ctx, shading, "triangle shading");
-    bvh_ = makeBuffer(ctx, bvh.nodes, "BVH nodes");
+    bvh_ = makeBuffer(ctx, collapseToWide(bvh.nodes).nodes, "BVH nodes (4-wide)");
     materials_ = makeBuffer(ctx, scene.materials, "materials");
     texInfo_ = makeBuffer(ctx, texInfo, "texture table");
     texels_ = makeBuffer(ctx, texels, "texels");

@@ -11,6 +11,7 @@
 
 #include "bvh/builder.h"
 #include "bvh/traverse_cpu.h"
+#include "bvh/wide_bvh.h"
 #include "gpu_fixture.h"
 #include "trace_rays.spv.h"
 #include "vk/buffer.h"
@@ -110,12 +111,13 @@ protected:
         desc.localSizeX = 64;
         vk::Kernel kernel(ctx(), desc);
         vk::Buffer geomBuf(ctx(), geoms.size() * sizeof(gpu::TriangleGeom), "geoms");
-        vk::Buffer nodeBuf(ctx(), bvh.nodes.size() * sizeof(gpu::BvhNode), "nodes");
+        const WideBvh wide = collapseToWide(bvh.nodes);
+        vk::Buffer nodeBuf(ctx(), wide.nodes.size() * sizeof(gpu::BvhWideNode), "nodes");
         vk::Buffer rayBuf(ctx(), rays.size() * sizeof(gpu::TestRay), "rays");
         vk::Buffer hitBuf(ctx(), rays.size() * sizeof(glm::vec4), "hits");
         vk::Buffer anyBuf(ctx(), rays.size() * sizeof(std::uint32_t), "any");
         geomBuf.uploadVector(geoms);
-        nodeBuf.uploadVector(bvh.nodes);
+        nodeBuf.uploadVector(wide.nodes);
         rayBuf.uploadVector(rays);
         kernel.bind(gpu::kBindTriGeom, geomBuf);
         kernel.bind(gpu::kBindBvh, nodeBuf);

@@ -8,7 +8,7 @@
 
 layout(local_size_x = 1) in;
 layout(set = 0, binding = kBindTestInput, scalar) writeonly buffer A { BvhNode node; TriangleShading shading; Material material; };
-layout(set = 0, binding = kBindTestOutput, scalar) writeonly buffer B { SceneConstants sc; PixelStats stats; PunctualLight light; };
+layout(set = 0, binding = kBindTestOutput, scalar) writeonly buffer B { SceneConstants sc; PixelStats stats; PunctualLight light; BvhWideNode wide; };
 
 void main() {
     node.lmin = vec3(1, 2, 3); node.left = 4u; node.lmax = vec3(5, 6, 7); node.leftCount = 8u;
@@ -33,4 +33,8 @@ void main() {
 
     light.position = vec3(1, 2, 3); light.type = 4u; light.intensity = vec3(5, 6, 7); light.cosInner = 8.0;
     light.direction = vec3(9, 10, 11); light.cosOuter = 12.0;
+
+    wide.minX = vec4(1, 2, 3, 4); wide.minY = vec4(5, 6, 7, 8); wide.minZ = vec4(9, 10, 11, 12);
+    wide.maxX = vec4(13, 14, 15, 16); wide.maxY = vec4(17, 18, 19, 20); wide.maxZ = vec4(21, 22, 23, 24);
+    wide.child = uvec4(25, 26, 27, 28); wide.count = uvec4(29, 30, 31, 32);
 }

@@ -20,6 +20,7 @@
 
 #include "bvh/builder.h"
 #include "bvh/traverse_cpu.h"
+#include "bvh/wide_bvh.h"
 #include "bvh_test_scenes.h"
 
 namespace gdpt {
@@ -205,6 +206,56 @@ void checkStructure(const Mesh& m, const Bvh& bvh, uint32_t leafLimit) {
     EXPECT_EQ(bvh.stats.maxDepth, maxDepth);
 }
 
+// The wide tree: every wide node reachable once, every triangle in exactly one leaf slot
+// (the binary tree's leaf ranges, so the leaf count matches), each slot's box containing its
+// triangles or its child's slots, and the stack bound within the kernels' stack.
+void checkWideStructure(const Mesh& m, const Bvh& bvh, const WideBvh& wide) {
+    std::vector<int> seen(m.triangles.size(), 0);
+    std::vector<int> nodeSeen(wide.nodes.size(), 0);
+    uint32_t leaves = 0;
+    const auto contains = [](const glm::vec3& mn, const glm::vec3& mx, const glm::vec3& p) {
+        return p.x >= mn.x && p.y >= mn.y && p.z >= mn.z && p.x <= mx.x && p.y <= mx.y && p.z <= mx.z;
+    };
+    std::vector<uint32_t> todo = {0};
+    while (!todo.empty()) {
+        const uint32_t ni = todo.back();
+        todo.pop_back();
+        ASSERT_LT(ni, wide.nodes.size());
+        ++nodeSeen[ni];
+        const gpu::BvhWideNode& n = wide.nodes[ni];
+        for (glm::length_t k = 0; k < 4; ++k) {
+            if (n.child[k] == gpu::kInvalidIndex) continue;
+            const glm::vec3 mn(n.minX[k], n.minY[k], n.minZ[k]);
+            const glm::vec3 mx(n.maxX[k], n.maxY[k], n.maxZ[k]);
+            if (n.count[k] > 0) {
+                ++leaves;
+                for (uint32_t i = n.child[k]; i < n.child[k] + n.count[k]; ++i) {
+                    ASSERT_LT(i, seen.size());
+                    const uint32_t orig = bvh.triangleOrder[i];
+                    ++seen[orig];
+                    for (int c = 0; c < 3; ++c) EXPECT_TRUE(contains(mn, mx, m.positions[m.triangles[orig][c]]));
+                }
+            } else {
+                const gpu::BvhWideNode& c = wide.nodes[n.child[k]];
+                for (glm::length_t j = 0; j < 4; ++j) {
+                    if (c.child[j] == gpu::kInvalidIndex) continue;
+                    EXPECT_TRUE(contains(mn, mx, {c.minX[j], c.minY[j], c.minZ[j]}));
+                    EXPECT_TRUE(contains(mn, mx, {c.maxX[j], c.maxY[j], c.maxZ[j]}));
+                }
+                todo.push_back(n.child[k]);
+            }
+        }
+    }
+    for (size_t i = 0; i < seen.size(); ++i) ASSERT_EQ(seen[i], 1) << "triangle " << i;
+    for (size_t i = 0; i < nodeSeen.size(); ++i) ASSERT_EQ(nodeSeen[i], 1) << "wide node " << i << " unreachable";
+    EXPECT_EQ(leaves, bvh.stats.leafCount);
+    EXPECT_LE(wide.maxStack, gpu::kBvhWideStackSize);
+    EXPECT_LE(wide.maxDepth, bvh.stats.maxDepth);
+    if (bvh.stats.leafCount > 4) {
+        EXPECT_LT(wide.nodes.size(), bvh.nodes.size()) << "collapsing should merge nodes";
+    }
+}
+
 // Closest and any hit of the BVH against brute force over the triangles in ORIGINAL order
 // (so triangleOrder and makeTriangleGeoms are checked as well).
 void compareWithBruteForce(const Mesh& m, const BvhBuildOptions& opt, uint32_t rayCount,
@@ -215,13 +266,19 @@ void compareWithBruteForce(const Mesh& m, const BvhBuildOptions& opt, uint32_t r
     const auto origGeoms =
         makeTriangleGeoms(m.positions, m.triangles, identityOrder(m.triangles.size()));
     const std::vector<Ray> rays = makeRays(m, rayCount, seed);
+    const WideBvh wide = collapseToWide(bvh.nodes);
+    checkWideStructure(m, bvh, wide);
     uint32_t hits = 0;
     uint32_t failures = 0;
     for (const Ray& r : rays) {
-        const Hit b = traceClosestCpu(bvh.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax);
-        const Hit f = traceClosestBruteForce(origGeoms, r.orig, r.dir, 0.0f, r.tMax);
-        const bool anyB = traceAnyCpu(bvh.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax);
-        const bool anyF = traceAnyBruteForce(origGeoms, r.orig, r.dir, 0.0f, r.tMax);
+      const Hit f = traceClosestBruteForce(origGeoms, r.orig, r.dir, 0.0f, r.tMax);
+      const bool anyF = traceAnyBruteForce(origGeoms, r.orig, r.dir, 0.0f, r.tMax);
+      // The binary tree, then the four-wide tree the kernels traverse: the same checks.
+      for (int tree = 0; tree < 2; ++tree) {
+        const Hit b = tree == 0 ? traceClosestCpu(bvh.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax)
+                                : traceClosestWideCpu(wide.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax);
+        const bool anyB = tree == 0 ? traceAnyCpu(bvh.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax)
+                                    : traceAnyWideCpu(wide.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax);
         bool ok = (b.triangle == gpu::kInvalidIndex) == (f.triangle == gpu::kInvalidIndex) &&
                   anyB == anyF && anyF == (f.triangle != gpu::kInvalidIndex);
         if (ok && f.triangle != gpu::kInvalidIndex) {
@@ -239,16 +296,17 @@ void compareWithBruteForce(const Mesh& m, const BvhBuildOptions& opt, uint32_t r
             }
         }
         if (!ok && ++failures <= 5) {
-            ADD_FAILURE() << "ray o=(" << r.orig.x << "," << r.orig.y << "," << r.orig.z
-                          << ") d=(" << r.dir.x << "," << r.dir.y << "," << r.dir.z
+            ADD_FAILURE() << (tree == 0 ? "binary" : "wide") << " ray o=(" << r.orig.x << "," << r.orig.y << ","
+                          << r.orig.z << ") d=(" << r.dir.x << "," << r.dir.y << "," << r.dir.z
                           << ") bvh tri " << b.triangle << " t " << b.t << " brute tri "
                           << f.triangle << " t " << f.t << " any " << anyB << "/" << anyF;
         }
+      }
     }
     EXPECT_EQ(failures, 0u);
     // The test is only meaningful if a good share of rays hit something.
     if (!m.triangles.empty()) {
-        EXPECT_GT(hits, rayCount / 10) << "too few hits to exercise the traversal";
+        EXPECT_GT(hits, 2 * (rayCount / 10)) << "too few hits to exercise the traversal (counted per tree)";
     }
 }
 

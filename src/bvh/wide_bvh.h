@@ -1,0 +1,27 @@
+// wide_bvh.h — the four-wide BVH the kernels traverse: the binary binned-SAH tree of
+// builder.h collapsed into gpu::BvhWideNode (each wide node adopts grandchildren until it has
+// four children or only leaves), over the same leaf-ordered TriangleGeom array.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "gdpt_shared.h"
+
+namespace gdpt {
+
+struct WideBvh {
+    std::vector<gpu::BvhWideNode> nodes;  // node 0 is the root
+    uint32_t maxStack = 0;  // most stack entries a traversal of this tree can hold
+    uint32_t maxDepth = 0;  // deepest leaf; children of the root have depth 1
+};
+
+// Collapse of `binary` (a builder.h tree, root = node 0): a wide node starts from its binary
+// node's children and repeatedly replaces the inner child of largest surface area by that
+// child's two children while it has fewer than four. Leaves keep their triangle ranges.
+// Throws std::invalid_argument if a traversal could need more than gpu::kBvhWideStackSize
+// entries (bounded here by the sum over a root-to-leaf path of each node's inner children
+// minus one; the binary depth cap keeps real trees far below it).
+WideBvh collapseToWide(const std::vector<gpu::BvhNode>& binary);
+
+}  // namespace gdpt
