@@ -158,14 +158,19 @@ GDPT_INLINE void wideNodeBoxes(BvhWideNode n, vec3 orig, vec3 invDir, float tMin
                 tNear.z <= tFar.z && n.child.z != kInvalidIndex, tNear.w <= tFar.w && n.child.w != kInvalidIndex);
 }
 
-// Triangle k of the hit leaf children taken in slot order, whose counts are c0..c3 (0 for a
-// slot that is not a hit leaf): one loop tests them all, so a kernel holds one inlined
+// Triangle counts of the hit leaf children (0 for a slot that is not a hit leaf).
+GDPT_INLINE uvec4 wideLeafCounts(BvhWideNode n, bvec4 hit) {
+    return uvec4(hit.x ? n.count.x : 0u, hit.y ? n.count.y : 0u, hit.z ? n.count.z : 0u, hit.w ? n.count.w : 0u);
+}
+
+// Triangle k of the hit leaf children taken in slot order, with counts c (wideLeafCounts):
+// one loop over c.x + c.y + c.z + c.w tests them all, so a kernel holds one inlined
 // triangle test per traversal (on llvmpipe every copy costs its code).
-GDPT_INLINE uint wideLeafTriangle(uvec4 first, uint k, uint c0, uint c1, uint c2) {
-    uint a = c0;
-    uint b = c0 + c1;
-    uint c = b + c2;
-    return k < a ? first.x + k : (k < b ? first.y + (k - a) : (k < c ? first.z + (k - b) : first.w + (k - c)));
+GDPT_INLINE uint wideLeafTriangle(uvec4 first, uint k, uvec4 c) {
+    uint a = c.x;
+    uint b = a + c.y;
+    uint d = b + c.z;
+    return k < a ? first.x + k : (k < b ? first.y + (k - a) : (k < d ? first.z + (k - b) : first.w + (k - d)));
 }
 
 // Entry distance of an absent child in wideSortInner (sorts after every real one).
@@ -247,12 +252,9 @@ Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
         vec4 tNear;
         bvec4 h;
         wideNodeBoxes(n, orig, invDir, tMin, hit.t, tNear, h);
-        uint c0 = h.x ? n.count.x : 0u;
-        uint c1 = h.y ? n.count.y : 0u;
-        uint c2 = h.z ? n.count.z : 0u;
-        uint c3 = h.w ? n.count.w : 0u;
-        for (uint k = 0u; k < c0 + c1 + c2 + c3; ++k) {
-            uint i = wideLeafTriangle(n.child, k, c0, c1, c2);
+        uvec4 c = wideLeafCounts(n, h);
+        for (uint k = 0u; k < c.x + c.y + c.z + c.w; ++k) {
+            uint i = wideLeafTriangle(n.child, k, c);
             float tCand = hit.t;
             float u;
             float v;
@@ -304,12 +306,9 @@ bool traceAny(vec3 orig, vec3 dir, float tMin, float tMax) {
         vec4 tNear;
         bvec4 h;
         wideNodeBoxes(n, orig, invDir, tMin, tMax, tNear, h);
-        uint c0 = h.x ? n.count.x : 0u;
-        uint c1 = h.y ? n.count.y : 0u;
-        uint c2 = h.z ? n.count.z : 0u;
-        uint c3 = h.w ? n.count.w : 0u;
-        for (uint k = 0u; k < c0 + c1 + c2 + c3; ++k) {
-            uint i = wideLeafTriangle(n.child, k, c0, c1, c2);
+        uvec4 c = wideLeafCounts(n, h);
+        for (uint k = 0u; k < c.x + c.y + c.z + c.w; ++k) {
+            uint i = wideLeafTriangle(n.child, k, c);
             float tCand = tMax;
             float u;
             float v;

@@ -180,12 +180,9 @@ Hit traceClosestWideCpu(const std::vector<gpu::BvhWideNode>& nodes, const std::v
         glm::vec4 tNear;
         glm::bvec4 h;
         gpu::wideNodeBoxes(n, orig, invDir, tMin, hit.t, tNear, h);
-        const uint32_t c0 = h.x ? n.count.x : 0u;
-        const uint32_t c1 = h.y ? n.count.y : 0u;
-        const uint32_t c2 = h.z ? n.count.z : 0u;
-        const uint32_t c3 = h.w ? n.count.w : 0u;
-        for (uint32_t k = 0u; k < c0 + c1 + c2 + c3; ++k) {
-            const uint32_t i = gpu::wideLeafTriangle(n.child, k, c0, c1, c2);
+        const glm::uvec4 c = gpu::wideLeafCounts(n, h);
+        for (uint32_t k = 0u; k < c.x + c.y + c.z + c.w; ++k) {
+            const uint32_t i = gpu::wideLeafTriangle(n.child, k, c);
             float tCand = hit.t;
             float u;
             float v;
@@ -237,12 +234,9 @@ bool traceAnyWideCpu(const std::vector<gpu::BvhWideNode>& nodes, const std::vect
         glm::vec4 tNear;
         glm::bvec4 h;
         gpu::wideNodeBoxes(n, orig, invDir, tMin, tMax, tNear, h);
-        const uint32_t c0 = h.x ? n.count.x : 0u;
-        const uint32_t c1 = h.y ? n.count.y : 0u;
-        const uint32_t c2 = h.z ? n.count.z : 0u;
-        const uint32_t c3 = h.w ? n.count.w : 0u;
-        for (uint32_t k = 0u; k < c0 + c1 + c2 + c3; ++k) {
-            const uint32_t i = gpu::wideLeafTriangle(n.child, k, c0, c1, c2);
+        const glm::uvec4 c = gpu::wideLeafCounts(n, h);
+        for (uint32_t k = 0u; k < c.x + c.y + c.z + c.w; ++k) {
+            const uint32_t i = gpu::wideLeafTriangle(n.child, k, c);
             float tCand = tMax;
             float u;
             float v;
