@@ -74,7 +74,7 @@ vec3 cameraRay(vec2 pixelPos) {
 // with vertices of their own. Lavapipe with Mesa 22.3 runs every branch under lane masks,
 // also one that no lane takes, so that code costs its time at every bounce there: the split
 // loop is 15-25 % faster on it, neutral on Mesa 25 (which skips such branches), and its
-// pipeline takes about 0.45 s longer to create. A second build rather than a specialisation
+// pipeline takes about 0.37 s longer to create. A second build rather than a specialisation
 // constant, because lavapipe spends that time on the dead loop too. The image is the same
 // bit for bit either way (bench/RESULTS.md, fourth session).
 
@@ -129,7 +129,7 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
     for (; depth < kMaxDepth && depth < scene.maxDepth; ++depth) {
 #ifdef GDPT_GPT_SPLIT_BOUNCE
         bool own = false;
-        for (uint i = 0u; i < 4u; ++i) own = own || (offs[i].alive && offs[i].state == kShiftNotConnected);
+        for (uint i = 0u; i < 4u; ++i) own = own || (offs[i].alive && ownVertex(offs[i], true));
         if (!own) break;
 #endif
 #define GDPT_GPT_GENERAL true

@@ -142,6 +142,16 @@ GDPT_INLINE bool intersectTriangleGeom(vec3 orig, vec3 dir, vec3 v0, vec3 e1, ve
     return true;
 }
 
+// The result of a closest-hit query before any triangle is accepted: a miss at tMax.
+GDPT_INLINE Hit missHit(float tMax) {
+    Hit h;
+    h.t = tMax;
+    h.u = 0.0f;
+    h.v = 0.0f;
+    h.triangle = kInvalidIndex;
+    return h;
+}
+
 // Slab tests of a wide node's four children for (tMin, tFarLimit): intersectBox, four at
 // once; hit[k] is false for empty slots.
 GDPT_INLINE void wideNodeBoxes(BvhWideNode n, vec3 orig, vec3 invDir, float tMin, float tFarLimit,
@@ -237,11 +247,7 @@ bool intersectTriangle(vec3 orig, vec3 dir, uint tri, float tMin, inout float tM
 // their entry distance; popped entries beyond the closest hit so far are skipped. The stack
 // never holds more than collapseToWide's maxStack <= kBvhWideStackSize.
 Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
-    Hit hit;
-    hit.t = tMax;
-    hit.u = 0.0f;
-    hit.v = 0.0f;
-    hit.triangle = kInvalidIndex;
+    Hit hit = missHit(tMax);
     vec3 invDir = bvhSafeInverse(dir);
     uint stackNode[kBvhWideStackSize];
     float stackNear[kBvhWideStackSize];

@@ -2,9 +2,10 @@
 // traceSample's bounce loop: NEE with the same light point for all, BSDF sampling and Russian
 // roulette of the base, the shift of every live offset over the new segment, and the emission
 // it reaches. Not a function on purpose: gpt.comp includes this text twice, into two loops,
-// once with GDPT_GPT_GENERAL true and once false (the split bounce loop, see gpt.comp), and
-// lavapipe 22.3 creates the pipeline about 1.5x faster from loops that end paths with
-// `break` than from an inlined function that returns from inside them.
+// once with GDPT_GPT_GENERAL true and once false (the split bounce loop, see gpt.comp). The
+// function form (an inlined function returning from inside the loop, the fast loop behind a
+// specialisation constant) took lavapipe 22.3 630 ms to create the single-loop pipeline,
+// this form 330 ms, as before the split (bench/RESULTS.md, fourth session).
 //
 // Uses traceSample's locals: depth (the loop counter), px, py, rng, beta, sh, d, offs, rays,
 // and pathEnded (set, with a break, when the base path ends). With GDPT_GPT_GENERAL false

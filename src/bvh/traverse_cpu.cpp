@@ -24,30 +24,40 @@ bool intersectTriangleCpu(const gpu::TriangleGeom& g, glm::vec3 orig, glm::vec3 
 
 namespace {
 
-// Mirrors intersectLeafClosest / intersectLeafAny of the GLSL.
+// Triangle i against the ray: shrinks `hit` to it if it is accepted and closer (the body of
+// the GLSL traceClosest's triangle loop).
+void closerHit(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir, uint32_t i, float tMin,
+               Hit& hit) {
+    float tCand = hit.t;
+    float u;
+    float v;
+    if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) && anyHitFilter(i, u, v)) {
+        hit.t = tCand;
+        hit.u = u;
+        hit.v = v;
+        hit.triangle = i;
+    }
+}
+
+// Triangle i is hit and accepted in (tMin, tMax) (the body of traceAny's triangle loop).
+bool anyHitAt(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir, uint32_t i, float tMin,
+              float tMax) {
+    float tCand = tMax;
+    float u;
+    float v;
+    return intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) && anyHitFilter(i, u, v);
+}
+
+// Binary-tree leaves [first, first + count).
 void intersectLeafClosest(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
                           uint32_t first, uint32_t count, float tMin, Hit& hit) {
-    for (uint32_t i = first; i < first + count; ++i) {
-        float tCand = hit.t;
-        float u;
-        float v;
-        if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) && anyHitFilter(i, u, v)) {
-            hit.t = tCand;
-            hit.u = u;
-            hit.v = v;
-            hit.triangle = i;
-        }
-    }
+    for (uint32_t i = first; i < first + count; ++i) closerHit(geoms, orig, dir, i, tMin, hit);
 }
 
 bool intersectLeafAny(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
                       uint32_t first, uint32_t count, float tMin, float tMax) {
-    for (uint32_t i = first; i < first + count; ++i) {
-        float tCand = tMax;
-        float u;
-        float v;
-        if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) && anyHitFilter(i, u, v)) return true;
-    }
+    for (uint32_t i = first; i < first + count; ++i)
+        if (anyHitAt(geoms, orig, dir, i, tMin, tMax)) return true;
     return false;
 }
 
@@ -56,11 +66,7 @@ bool intersectLeafAny(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 ori
 Hit traceClosestCpu(const std::vector<gpu::BvhNode>& nodes,
                     const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
                     float tMin, float tMax) {
-    Hit hit;
-    hit.t = tMax;
-    hit.u = 0.0f;
-    hit.v = 0.0f;
-    hit.triangle = gpu::kInvalidIndex;
+    Hit hit = gpu::missHit(tMax);
     const glm::vec3 invDir = gpu::bvhSafeInverse(dir);
     uint32_t stack[gpu::kBvhStackSize];
     uint32_t stackSize = 0;
@@ -163,11 +169,7 @@ bool traceAnyCpu(const std::vector<gpu::BvhNode>& nodes,
 
 Hit traceClosestWideCpu(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<gpu::TriangleGeom>& geoms,
                         glm::vec3 orig, glm::vec3 dir, float tMin, float tMax) {
-    Hit hit;
-    hit.t = tMax;
-    hit.u = 0.0f;
-    hit.v = 0.0f;
-    hit.triangle = gpu::kInvalidIndex;
+    Hit hit = gpu::missHit(tMax);
     const glm::vec3 invDir = gpu::bvhSafeInverse(dir);
     uint32_t stackNode[gpu::kBvhWideStackSize];
     float stackNear[gpu::kBvhWideStackSize];
@@ -181,18 +183,8 @@ Hit traceClosestWideCpu(const std::vector<gpu::BvhWideNode>& nodes, const std::v
         glm::bvec4 h;
         gpu::wideNodeBoxes(n, orig, invDir, tMin, hit.t, tNear, h);
         const glm::uvec4 c = gpu::wideLeafCounts(n, h);
-        for (uint32_t k = 0u; k < c.x + c.y + c.z + c.w; ++k) {
-            const uint32_t i = gpu::wideLeafTriangle(n.child, k, c);
-            float tCand = hit.t;
-            float u;
-            float v;
-            if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) && anyHitFilter(i, u, v)) {
-                hit.t = tCand;
-                hit.u = u;
-                hit.v = v;
-                hit.triangle = i;
-            }
-        }
+        for (uint32_t k = 0u; k < c.x + c.y + c.z + c.w; ++k)
+            closerHit(geoms, orig, dir, gpu::wideLeafTriangle(n.child, k, c), tMin, hit);
         const gpu::WideOrder o = gpu::wideSortInner(n, h, tNear, hit.t);
         uint32_t next = o.child.x;
         if (o.child.w != gpu::kInvalidIndex) {
@@ -235,13 +227,8 @@ bool traceAnyWideCpu(const std::vector<gpu::BvhWideNode>& nodes, const std::vect
         glm::bvec4 h;
         gpu::wideNodeBoxes(n, orig, invDir, tMin, tMax, tNear, h);
         const glm::uvec4 c = gpu::wideLeafCounts(n, h);
-        for (uint32_t k = 0u; k < c.x + c.y + c.z + c.w; ++k) {
-            const uint32_t i = gpu::wideLeafTriangle(n.child, k, c);
-            float tCand = tMax;
-            float u;
-            float v;
-            if (intersectTriangleCpu(geoms[i], orig, dir, tMin, tCand, u, v) && anyHitFilter(i, u, v)) return true;
-        }
+        for (uint32_t k = 0u; k < c.x + c.y + c.z + c.w; ++k)
+            if (anyHitAt(geoms, orig, dir, gpu::wideLeafTriangle(n.child, k, c), tMin, tMax)) return true;
         uint32_t next = gpu::kInvalidIndex;
         for (glm::length_t j = 0; j < 4; ++j) {
             if (!(h[j] && n.count[j] == 0u)) continue;
@@ -264,29 +251,15 @@ bool traceAnyWideCpu(const std::vector<gpu::BvhWideNode>& nodes, const std::vect
 
 Hit traceClosestBruteForce(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig,
                            glm::vec3 dir, float tMin, float tMax) {
-    Hit hit{tMax, 0.0f, 0.0f, gpu::kInvalidIndex};
-    for (size_t i = 0; i < geoms.size(); ++i) {
-        float u;
-        float v;
-        if (intersectTriangleCpu(geoms[i], orig, dir, tMin, hit.t, u, v)) {
-            hit.u = u;
-            hit.v = v;
-            hit.triangle = static_cast<uint32_t>(i);
-        }
-    }
+    Hit hit = gpu::missHit(tMax);
+    for (size_t i = 0; i < geoms.size(); ++i) closerHit(geoms, orig, dir, static_cast<uint32_t>(i), tMin, hit);
     return hit;
 }
 
 bool traceAnyBruteForce(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig,
                         glm::vec3 dir, float tMin, float tMax) {
-    for (const gpu::TriangleGeom& g : geoms) {
-        float tCand = tMax;
-        float u;
-        float v;
-        if (intersectTriangleCpu(g, orig, dir, tMin, tCand, u, v)) {
-            return true;
-        }
-    }
+    for (size_t i = 0; i < geoms.size(); ++i)
+        if (anyHitAt(geoms, orig, dir, static_cast<uint32_t>(i), tMin, tMax)) return true;
     return false;
 }
 

@@ -38,7 +38,8 @@ public:
         }
         const auto me = static_cast<uint32_t>(out_.nodes.size());
         out_.nodes.emplace_back();
-        const auto inner = static_cast<uint32_t>(std::count_if(slots.begin(), slots.end(), [](const Slot& s) { return s.count == 0; }));
+        const auto inner = static_cast<uint32_t>(
+            std::count_if(slots.begin(), slots.end(), [](const Slot& s) { return s.count == 0; }));
         // Visiting this node pushes every inner child but the one it descends into.
         const uint32_t below = stack + (inner > 0 ? inner - 1 : 0);
         out_.maxStack = std::max(out_.maxStack, below);
