@@ -20,6 +20,7 @@ layout(set = 0, binding = kBindCounters, scalar) buffer CounterBuf { Counters co
 layout(push_constant, scalar) uniform Push { FrameParams frame; };
 
 #include "lib/bvh_traverse.glsl"
+#include "lib/camera.glsl"
 
 void main() {
     uint x = gl_GlobalInvocationID.x;
@@ -32,9 +33,7 @@ void main() {
     for (uint s = 0u; s < frame.samplesPerPixel; ++s) {
         Rng rng = rngInit(pixel, frame.sampleBase + s, frame.seed);
         vec2 pos = vec2(x, y) + rngNext2(rng);
-        vec2 ndc = vec2(2.0 * pos.x / float(scene.width) - 1.0, 1.0 - 2.0 * pos.y / float(scene.height));
-        vec3 d = normalize(scene.camForward + ndc.x * scene.tanHalfFovY * scene.aspect * scene.camRight +
-                           ndc.y * scene.tanHalfFovY * scene.camUp);
+        vec3 d = cameraRay(pos);
         vec3 o = scene.camPosition;
         uint segments = incoherent ? 4u : 1u;
         for (uint k = 0u; k < segments; ++k) {

@@ -20,7 +20,9 @@
 //   central(p)      Σ over the pairs of p of the base's MIS-weighted radiance
 //   neighbor_i(p)   offset i's MIS-weighted radiance (an estimate for pixel p + δ_i)
 //   gradient_i(p)   MIS-weighted (f_offset − f_base) of direction i
-//   direct(p)       emission seen directly from the camera (never shifted)
+//   direct(p)       emission seen directly from the camera (never shifted); zero in the
+//                   pixels of emitter-silhouette supersampling (visible.comp), whose
+//                   estimate gpt_resolve.comp takes instead
 // Each invocation writes only its own pixel: no races, no float atomics, deterministic.
 // gpt_resolve.comp gathers the neighbours' terms.
 #version 460
@@ -57,14 +59,8 @@ layout(push_constant, scalar) uniform Push { GptFrameParams frame; };
 const float kInf = 1.0 / 0.0;
 const ivec2 kOffsetDelta[4] = ivec2[4](ivec2(1, 0), ivec2(0, 1), ivec2(-1, 0), ivec2(0, -1));
 
-vec3 cameraRay(vec2 pixelPos) {
-    vec2 ndc = vec2(2.0 * pixelPos.x / float(scene.width) - 1.0,
-                    1.0 - 2.0 * pixelPos.y / float(scene.height));
-    vec3 d = scene.camForward + ndc.x * scene.tanHalfFovY * scene.aspect * scene.camRight +
-             ndc.y * scene.tanHalfFovY * scene.camUp;
-    return normalize(d);
-}
-
+#include "lib/camera.glsl"
+#include "lib/visible_emission.glsl"
 #include "lib/gpt_path.glsl"
 
 // Split bounce loop (GDPT_GPT_SPLIT_BOUNCE: a second build of this kernel, gpt_split; the
@@ -82,8 +78,10 @@ vec3 cameraRay(vec2 pixelPos) {
 bool ownVertex(OffsetPath o, bool general) { return general && o.state == kShiftNotConnected; }
 
 // Base + 4 offsets for one camera sample at pixelPos (continuous pixel coordinates).
-void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays, out vec3 direct,
-                 inout OffsetPath offs[4]) {
+// countDirect false: the emission seen by the camera ray is left to emitter-silhouette
+// supersampling (visible_emission.glsl) and `direct` stays zero.
+void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, bool countDirect, inout uint rays,
+                 out vec3 direct, inout OffsetPath offs[4]) {
     direct = vec3(0.0);
     for (uint i = 0u; i < 4u; ++i) {
         offs[i].alive = gptPairExists(px, py, i);
@@ -102,11 +100,11 @@ void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, inout uint rays
     Hit hit = traceClosest(o, d, 0.0, kInf);
     rays++;
     if (hit.triangle == kInvalidIndex) {
-        if (kHasEnv) direct += scene.envRadiance;
+        if (kHasEnv && countDirect) direct += scene.envRadiance;
         return;  // nothing is shifted (GPT_REFERENCE §1.2)
     }
     SurfaceHit sh = makeSurfaceHit(hit.triangle, hit.u, hit.v, d);
-    if (kHasLightTris) direct += surfaceEmission(sh);
+    if (kHasLightTris && countDirect) direct += surfaceEmission(sh);
     for (uint i = 0u; i < 4u; ++i) {
         offs[i].shifted = offs[i].alive;
         if (!offs[i].alive) continue;
@@ -163,12 +161,13 @@ void main() {
     uint nan = 0u;
     uint shiftPairs = 0u, shiftFailures = 0u;
     OffsetPath offs[4];
+    bool countDirect = !emissionSupersampled(pixel);
     for (uint s = 0u; s < frame.samplesPerPixel; ++s) {
         // Same stream as pt.comp's sample s: the base path is PT's path.
         Rng rng = rngInit(pixel, frame.sampleBase + s, frame.seed);
         vec2 jitter = rngNext2(rng);
         vec3 direct;
-        traceSample(rng, vec2(x, y) + jitter, x, y, rays, direct, offs);
+        traceSample(rng, vec2(x, y) + jitter, x, y, countDirect, rays, direct, offs);
         for (uint i = 0u; i < 4u; ++i) {
             shiftPairs += offs[i].shifted ? 1u : 0u;
             shiftFailures += offs[i].shifted && !offs[i].alive ? 1u : 0u;

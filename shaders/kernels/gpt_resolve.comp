@@ -38,6 +38,7 @@ layout(set = 0, binding = kBindGptGradient1, scalar) readonly buffer Gradient1Bu
 layout(set = 0, binding = kBindGptGradient2, scalar) readonly buffer Gradient2Buf { PixelStats statGradient2[]; };
 layout(set = 0, binding = kBindGptGradient3, scalar) readonly buffer Gradient3Buf { PixelStats statGradient3[]; };
 layout(set = 0, binding = kBindGptDirect, scalar) readonly buffer DirectBuf { PixelStats statDirect[]; };
+#include "lib/visible_emission.glsl"
 layout(set = 0, binding = kBindGptResolved, scalar) writeonly buffer ResolvedBuf { GptResolved resolved[]; };
 layout(push_constant, scalar) uniform Push { GptFrameParams frame; };
 
@@ -96,7 +97,10 @@ void main() {
         r.dy = a.mean - b.mean;
         r.varDy = varianceOfMean(a) + varianceOfMean(b);
     }
+    // Emitter-silhouette supersampling estimated this pixel's very-direct emission instead
+    // (visible.comp; gpt.comp then left statDirect zero here).
     PixelStats dir = statDirect[p];
+    if (emissionSupersampled(p)) dir = visibleStats[p];
     r.direct = dir.mean;
     r.varDirect = varianceOfMean(dir);
     resolved[p] = r;

@@ -13,13 +13,8 @@
 #ifndef GDPT_LIB_PT_CORE
 #define GDPT_LIB_PT_CORE
 
-vec3 cameraRay(vec2 pixelPos) {
-    vec2 ndc = vec2(2.0 * pixelPos.x / float(scene.width) - 1.0,
-                    1.0 - 2.0 * pixelPos.y / float(scene.height));
-    vec3 d = scene.camForward + ndc.x * scene.tanHalfFovY * scene.aspect * scene.camRight +
-             ndc.y * scene.tanHalfFovY * scene.camUp;
-    return normalize(d);
-}
+#include "lib/camera.glsl"
+#include "lib/visible_emission.glsl"
 
 // Starts the path of sample `sampleIndex` of pixel (x, y): box filter, so the sample
 // position is uniform over the pixel square.
@@ -48,14 +43,17 @@ void ptProcessHit(inout PathState s, Hit hit) {
     rng.state = s.rng;
     s.rays++;
     s.flags &= ~kPathFlagAlive;  // set again below if the path continues
+    // Emission seen by the camera ray itself: left to emitter-silhouette supersampling in
+    // the pixels it covers (visible_emission.glsl).
+    bool countEmission = s.depth > 0u || !emissionSupersampled(s.pixel);
     if (hit.triangle == kInvalidIndex) {
-        if (kHasEnv) s.radiance += s.beta * scene.envRadiance;
+        if (kHasEnv && countEmission) s.radiance += s.beta * scene.envRadiance;
         return;
     }
     vec3 d = s.dir;
     SurfaceHit sh = makeSurfaceHit(hit.triangle, hit.u, hit.v, d);
     vec3 Le = surfaceEmission(sh);
-    if (kHasLightTris && maxComponent(Le) > 0.0) {
+    if (kHasLightTris && countEmission && maxComponent(Le) > 0.0) {
         float w = 1.0;
         if ((s.flags & kPathFlagPrevSpecular) == 0u) {
             vec3 nl = normalize(cross(triGeoms[sh.triangle].e1, triGeoms[sh.triangle].e2));

@@ -204,6 +204,29 @@ struct FrameParams {
     uint pad2;
 };
 
+// Push constants of visible.comp (emitter-silhouette supersampling).
+struct VisibleParams {
+    uint phase;           // kVisiblePhase*
+    uint sampleBase;      // refine: first camera sample of this batch (per pixel)
+    uint samplesPerPixel; // refine: camera samples of this batch; each gets samplesPerSpp rays
+    uint seed;            // user seed
+    uint samplesPerSpp;   // supersampling factor requested (rays per camera sample, >= 1)
+    uint rayBudget;       // cap on refine rays per camera sample over the whole image
+    uint pad0;
+    uint pad1;
+};
+GDPT_CONST uint kVisiblePhaseProbe = 0u;   // 4 stratified rays per pixel -> signature
+GDPT_CONST uint kVisiblePhaseCount = 1u;   // count the pixels to supersample
+GDPT_CONST uint kVisiblePhaseRefine = 2u;  // supersample them (one batch)
+
+// Written by visible.comp's count phase. 16 bytes.
+struct VisibleCounter {
+    uint refinedPixels;   // pixels whose neighbourhood sees an emission edge
+    uint pad0;
+    uint pad1;
+    uint pad2;
+};
+
 // Per-pixel running statistics of one estimator (Welford/Chan merge). 32 bytes.
 // mean and m2 stay bounded as samples grow, so float32 is accurate over 10^5 samples
 // (each merge adds a correction of relative size 1/n to a bounded value).
@@ -241,7 +264,14 @@ GDPT_ENUM_BEGIN(SceneBinding)
     kBindCounters = 10u,
     kBindCount = 11u,
     kBindPathState = 12u,   // wavefront schedule: PathState per path
-    kBindPathHits = 13u     // wavefront schedule: closest hit per path (t, u, v, triangle bits)
+    kBindPathHits = 13u,    // wavefront schedule: closest hit per path (t, u, v, triangle bits)
+    // Emitter-silhouette supersampling (visible.comp, render/visible_pass.h): the
+    // supersampled estimate of the emission seen at the camera's first hit (PixelStats; a
+    // count > 0 tells the path kernels to leave that term to it), the probe signature
+    // per pixel (uint) and the pass's counter (VisibleCounter).
+    kBindVisibleStats = 14u,
+    kBindVisibleProbe = 15u,
+    kBindVisibleCounter = 16u
 GDPT_ENUM_END();
 
 // Bindings used only by test kernels (tests/gpu/kernels), kept here so no number repeats.
@@ -262,7 +292,8 @@ GDPT_ENUM_BEGIN(SpecId)
     kSpecHasGlossy = 6u,
     kSpecHasAlphaMask = 7u,
     kSpecMaxDepth = 8u,
-    kSpecPoissonFlags = 9u  // poisson_*.comp: the kPoissonFlag* bits of this pipeline variant
+    kSpecPoissonFlags = 9u,  // poisson_*.comp: the kPoissonFlag* bits of this pipeline variant
+    kSpecVisibleEmission = 10u  // path kernels: emitter-silhouette supersampling is on (visible_emission.glsl)
 GDPT_ENUM_END();
 
 // A ray of the BVH tests (tests/gpu/test_bvh_gpu.cpp). 32 bytes.

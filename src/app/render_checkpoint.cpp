@@ -80,7 +80,8 @@ ExrAttributes renderIdentity(const RenderArgs& args, const Scene& scene, std::ui
                         {"env", exact(env.x) + "," + exact(env.y) + "," + exact(env.z)},
                         {"camera", std::to_string(args.camera)},
                         {"schedule", args.schedule},
-                        {"max_batch_spp", std::to_string(maxBatchSpp)}};
+                        {"max_batch_spp", std::to_string(maxBatchSpp)},
+                        {"emitter_supersampling", std::to_string(args.emitterSupersampling)}};
     if (args.method == "gpt") id["shift_threshold"] = exact(args.shiftThreshold);
     return id;
 }

@@ -39,17 +39,19 @@ bool splitBounceFor(const vk::DeviceInfo& device, GptPassOptions::SplitBounce s)
     return s == GptPassOptions::SplitBounce::On;
 }
 
-vk::KernelDesc gptDesc(const SceneGpu& scene, WorkgroupSize wg, bool halfVector, bool splitBounce) {
+vk::KernelDesc gptDesc(const SceneGpu& scene, WorkgroupSize wg, bool halfVector, bool splitBounce,
+                       const VisiblePass& visible) {
     std::vector<std::uint32_t> extra = {gpu::kBindCounters};
     for (std::uint32_t i = 0; i < kNumStats; ++i) extra.push_back(gpu::kBindGptCentral + i);
     vk::KernelDesc d = scene.kernelDesc(splitBounce ? vk::kernelDesc("gpt", kSpv_gpt_split) : vk::kernelDesc("gpt", kSpv_gpt),
                                         wg, extra, sizeof(gpu::GptFrameParams));
     for (auto& [id, value] : d.specConstants)
         if (id == gpu::kSpecHasGlossy) value = halfVector ? 1u : 0u;
+    visible.configure(d);
     return d;
 }
 
-vk::KernelDesc resolveDesc(WorkgroupSize wg) {
+vk::KernelDesc resolveDesc(WorkgroupSize wg, const VisiblePass& visible) {
     vk::KernelDesc d = vk::kernelDesc("gpt_resolve", kSpv_gpt_resolve);
     for (std::uint32_t i = 0; i < kNumStats; ++i) d.bindings.push_back(gpu::kBindGptCentral + i);
     d.bindings.push_back(gpu::kBindGptResolved);
@@ -57,6 +59,7 @@ vk::KernelDesc resolveDesc(WorkgroupSize wg) {
     d.specConstants = {{gpu::kSpecWorkgroupX, wg.x}, {gpu::kSpecWorkgroupY, wg.y}};
     d.localSizeX = wg.x;
     d.localSizeY = wg.y;
+    visible.configure(d);
     return d;
 }
 
@@ -78,11 +81,12 @@ GptPass::GptPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg
       options_(options),
       halfVector_(options.forceHalfVector || needsHalfVector(scene, options.shiftThreshold)),
       splitBounce_(splitBounceFor(ctx.info(), options.splitBounce)),
-      kernel_(ctx, gptDesc(scene, wg, halfVector_, splitBounce_)),
-      resolveKernel_(ctx, resolveDesc(wg)),
+      counters_(ctx, sizeof(gpu::Counters), "gpt counters"),
+      visible_(ctx, scene, wg, options.visibleSupersampling, counters_),
+      kernel_(ctx, gptDesc(scene, wg, halfVector_, splitBounce_, visible_)),
+      resolveKernel_(ctx, resolveDesc(wg, visible_)),
       stats_(makeStats(ctx, std::uint64_t{width_} * height_)),
-      resolved_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::GptResolved), "gpt resolved"),
-      counters_(ctx, sizeof(gpu::Counters), "gpt counters") {
+      resolved_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::GptResolved), "gpt resolved") {
     const std::string what = " of a " + std::to_string(width_) + "x" + std::to_string(height_) + " image";
     ctx.checkStorageBufferSize(stats_[0].size(), "each G-PT per-pixel statistics buffer" + what);
     ctx.checkStorageBufferSize(resolved_.size(), "the resolved G-PT images" + what);
@@ -93,16 +97,20 @@ GptPass::GptPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg
         resolveKernel_.bind(gpu::kBindGptCentral + i, stats_[i]);
     }
     resolveKernel_.bind(gpu::kBindGptResolved, resolved_);
+    visible_.bindTo(kernel_);
+    visible_.bindTo(resolveKernel_);
     reset();
 }
 
 void GptPass::reset() {
     for (auto& b : stats_) b.zero();
     counters_.zero();
+    visible_.reset();
 }
 
 void GptPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
                      vk::GpuTimer* timer) {
+    visible_.record(cmd, sampleBase, spp, seed, timer);
     const std::uint64_t perRow = std::uint64_t{width_} * spp;
     const auto rowsPerDispatch = static_cast<std::uint32_t>(
         std::max<std::uint64_t>(1, kMaxPixelSamplesPerDispatch / std::max<std::uint64_t>(perRow, 1)));
@@ -143,17 +151,19 @@ std::vector<std::vector<gpu::PixelStats>> GptPass::downloadStats() const {
     std::vector<std::vector<gpu::PixelStats>> out;
     for (const auto& b : stats_)
         out.push_back(b.downloadVector<gpu::PixelStats>(std::size_t{width_} * height_));
+    out.push_back(visible_.downloadStats());
     return out;
 }
 
 void GptPass::uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats) {
     const std::size_t pixels = std::size_t{width_} * height_;
-    bool sizesMatch = stats.size() == stats_.size();
+    bool sizesMatch = stats.size() == stats_.size() + 1;
     for (std::size_t i = 0; sizesMatch && i < stats.size(); ++i) sizesMatch = stats[i].size() == pixels;
     if (!sizesMatch)
-        throw Error("gpt pixel statistics: expected " + std::to_string(stats_.size()) + " buffers of " +
+        throw Error("gpt pixel statistics: expected " + std::to_string(stats_.size() + 1) + " buffers of " +
                     std::to_string(pixels) + " entries");
     for (std::size_t i = 0; i < stats_.size(); ++i) stats_[i].uploadVector(stats[i]);
+    visible_.uploadStats(stats.back());
 }
 
 GptImages GptPass::readback() const {

@@ -12,6 +12,7 @@
 #include "gpt_shared.h"
 #include "image/image.h"
 #include "render/pt_pass.h"
+#include "render/visible_pass.h"
 #include "vk/buffer.h"
 #include "vk/context.h"
 #include "vk/kernel.h"
@@ -33,6 +34,8 @@ struct GptPassOptions {
     // to pay (splitBounceDefault); the image is the same either way.
     enum class SplitBounce { Auto, On, Off };
     SplitBounce splitBounce = SplitBounce::Auto;
+    // Rays per camera sample of emitter-silhouette supersampling (visible_pass.h; 0 = off).
+    std::uint32_t visibleSupersampling = kDefaultVisibleSupersampling;
 };
 
 // Whether the split bounce loop pays on this device: lavapipe with Mesa before 23, which runs
@@ -61,13 +64,15 @@ public:
     gpu::Counters takeCounters();
     // Reads the resolved images (after the fence of a resolve()).
     [[nodiscard]] GptImages readback() const;
-    // The raw per-pixel statistics of the 10 buffers, in binding order (after the fence),
-    // and their replacement (before the next record()) to continue a checkpointed render.
+    // The raw per-pixel statistics of the 10 buffers, in binding order, then the supersampled
+    // visible emission's (after the fence), and their replacement (before the next record())
+    // to continue a checkpointed render.
     [[nodiscard]] std::vector<std::vector<gpu::PixelStats>> downloadStats() const;
     void uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats);
     // Whether the half-vector branch is compiled in (kHasGlossy as specialised).
     [[nodiscard]] bool halfVectorCompiled() const { return halfVector_; }
     [[nodiscard]] bool splitBounceCompiled() const { return splitBounce_; }
+    [[nodiscard]] const VisiblePass& visible() const { return visible_; }
 
 private:
     const vk::Context& ctx_;
@@ -75,12 +80,13 @@ private:
     GptPassOptions options_;
     bool halfVector_ = false;
     bool splitBounce_ = false;
+    vk::Buffer counters_;
+    VisiblePass visible_;
     vk::Kernel kernel_;
     vk::Kernel resolveKernel_;
     // central, neighbor 0..3, gradient 0..3, direct (binding kBindGptCentral + index).
     std::array<vk::Buffer, 10> stats_;
     vk::Buffer resolved_;
-    vk::Buffer counters_;
 };
 
 }  // namespace gdpt

@@ -24,6 +24,7 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     stats.bvhBuildMs = sceneGpu.bvhInfo().buildMs;
     stats.features = sceneGpu.features();
     gpt.shiftThreshold = options.scene.shiftThreshold;
+    gpt.visibleSupersampling = options.visibleSupersampling;
     GptPass pass(ctx, sceneGpu, options.workgroup, gpt);
     stats.gptSplitBounce = pass.splitBounceCompiled();
     vk::GpuTimer timer(ctx);
@@ -80,6 +81,8 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     result.varDy = std::move(images.varDy);
     result.varDirect = std::move(images.varDirect);
     stats.readbackMs = phase.ms();
+    stats.visibleSupersampling = pass.visible().samplesPerSpp();
+    stats.visibleRefinedPixels = pass.visible().refinedPixels();
     stats.kernels = timer.totals();
     return result;
 }

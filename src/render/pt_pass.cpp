@@ -16,28 +16,40 @@ constexpr std::uint64_t kMaxPixelSamplesPerDispatch = 1u << 20;
 
 }  // namespace
 
-PtPass::PtPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg)
+namespace {
+vk::KernelDesc ptDesc(const SceneGpu& scene, WorkgroupSize wg, const VisiblePass& visible) {
+    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("pt", kSpv_pt), wg, {gpu::kBindAccum, gpu::kBindCounters});
+    visible.configure(d);
+    return d;
+}
+}  // namespace
+
+PtPass::PtPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg, std::uint32_t visibleSupersampling)
     : ctx_(ctx),
       width_(scene.constants().width),
       height_(scene.constants().height),
-      kernel_(ctx, scene.kernelDesc(vk::kernelDesc("pt", kSpv_pt), wg, {gpu::kBindAccum, gpu::kBindCounters})),
-      accum_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats), "pt pixel statistics"),
-      counters_(ctx, sizeof(gpu::Counters), "pt counters") {
+      counters_(ctx, sizeof(gpu::Counters), "pt counters"),
+      visible_(ctx, scene, wg, visibleSupersampling, counters_),
+      kernel_(ctx, ptDesc(scene, wg, visible_)),
+      accum_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats), "pt pixel statistics") {
     ctx.checkStorageBufferSize(accum_.size(), "the per-pixel statistics of a " + std::to_string(width_) + "x" +
                                                   std::to_string(height_) + " image");
     scene.bindTo(kernel_);
     kernel_.bind(gpu::kBindAccum, accum_);
     kernel_.bind(gpu::kBindCounters, counters_);
+    visible_.bindTo(kernel_);
     reset();
 }
 
 void PtPass::reset() {
     accum_.zero();
     counters_.zero();
+    visible_.reset();
 }
 
 void PtPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
                     vk::GpuTimer* timer) {
+    visible_.record(cmd, sampleBase, spp, seed, timer);
     const std::uint64_t perRow = std::uint64_t{width_} * spp;
     const auto rowsPerDispatch =
         static_cast<std::uint32_t>(std::max<std::uint64_t>(1, kMaxPixelSamplesPerDispatch / std::max<std::uint64_t>(perRow, 1)));
@@ -60,19 +72,23 @@ gpu::Counters PtPass::takeCounters() {
     return c;
 }
 
-std::vector<gpu::PixelStats> PtPass::downloadStats() const {
-    return accum_.downloadVector<gpu::PixelStats>(std::size_t{width_} * height_);
+std::vector<std::vector<gpu::PixelStats>> PtPass::downloadStats() const {
+    return {accum_.downloadVector<gpu::PixelStats>(std::size_t{width_} * height_), visible_.downloadStats()};
 }
 
-void PtPass::uploadStats(const std::vector<gpu::PixelStats>& stats) {
-    if (stats.size() != std::size_t{width_} * height_)
-        throw Error("pt pixel statistics: " + std::to_string(stats.size()) + " entries for a " +
+void PtPass::uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats) {
+    if (stats.size() != 2)
+        throw Error("pt pixel statistics: " + std::to_string(stats.size()) +
+                    " buffers, expected 2 (path samples, visible emission)");
+    if (stats[0].size() != std::size_t{width_} * height_)
+        throw Error("pt pixel statistics: " + std::to_string(stats[0].size()) + " entries for a " +
                     std::to_string(width_) + "x" + std::to_string(height_) + " image");
-    accum_.uploadVector(stats);
+    accum_.uploadVector(stats[0]);
+    visible_.uploadStats(stats[1]);
 }
 
 void PtPass::readback(Image& mean, Image& varianceOfMean) const {
-    const auto stats = downloadStats();
+    const auto stats = accum_.downloadVector<gpu::PixelStats>(std::size_t{width_} * height_);
     mean = Image(static_cast<int>(width_), static_cast<int>(height_));
     varianceOfMean = Image(static_cast<int>(width_), static_cast<int>(height_));
     for (std::size_t i = 0; i < stats.size(); ++i) {
@@ -84,6 +100,8 @@ void PtPass::readback(Image& mean, Image& varianceOfMean) const {
             varianceOfMean.plane(c)[i] = s.count > 1 ? s.m2[c] / (n - 1.0f) / n : 0.0f;
         }
     }
+    // Independent estimates of two parts of the pixel: their means and variances add.
+    visible_.addTo(&mean, &varianceOfMean);
 }
 
 }  // namespace gdpt

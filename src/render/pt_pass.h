@@ -9,6 +9,7 @@
 #include "gdpt_shared.h"
 #include "image/image.h"
 #include "render/scene_gpu.h"
+#include "render/visible_pass.h"
 #include "vk/buffer.h"
 #include "vk/kernel.h"
 
@@ -21,7 +22,10 @@ class GpuTimer;
 
 class PtPass {
 public:
-    PtPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg = {});
+    // visibleSupersampling: rays per camera sample of emitter-silhouette supersampling
+    // (visible_pass.h; 0 = off).
+    PtPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg = {},
+           std::uint32_t visibleSupersampling = kDefaultVisibleSupersampling);
 
     // Clears the statistics and counters.
     void reset();
@@ -30,22 +34,27 @@ public:
                 vk::GpuTimer* timer);
     // Reads the counters written since the last call and clears them (after the fence).
     gpu::Counters takeCounters();
-    // Mean radiance and the variance of that mean, per pixel (after the fence).
+    // Mean radiance and the variance of that mean, per pixel (after the fence); includes
+    // the supersampled visible emission.
     void readback(Image& mean, Image& varianceOfMean) const;
-    // The raw per-pixel statistics (after the fence), and their replacement (before the next
-    // record()) to continue a checkpointed render. uploadStats needs width*height entries.
-    [[nodiscard]] std::vector<gpu::PixelStats> downloadStats() const;
-    void uploadStats(const std::vector<gpu::PixelStats>& stats);
+    // The raw per-pixel statistics (after the fence): the path samples', then the
+    // supersampled visible emission's; and their replacement (before the next record()) to
+    // continue a checkpointed render (two buffers of width*height entries).
+    [[nodiscard]] std::vector<std::vector<gpu::PixelStats>> downloadStats() const;
+    void uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats);
     // The statistics and counters, shared with the wavefront schedule.
     [[nodiscard]] const vk::Buffer& accum() const { return accum_; }
     [[nodiscard]] const vk::Buffer& counters() const { return counters_; }
+    [[nodiscard]] VisiblePass& visible() { return visible_; }
+    [[nodiscard]] const VisiblePass& visible() const { return visible_; }
 
 private:
     const vk::Context& ctx_;
     std::uint32_t width_, height_;
+    vk::Buffer counters_;
+    VisiblePass visible_;
     vk::Kernel kernel_;
     vk::Buffer accum_;
-    vk::Buffer counters_;
 };
 
 }  // namespace gdpt

@@ -19,16 +19,16 @@ RenderResult renderPt(const vk::Context& ctx, const Scene& scene, const RenderOp
     SceneGpu sceneGpu(ctx, scene, options.scene);
     stats.bvhBuildMs = sceneGpu.bvhInfo().buildMs;
     stats.features = sceneGpu.features();
-    PtPass pass(ctx, sceneGpu, options.workgroup);
+    PtPass pass(ctx, sceneGpu, options.workgroup, options.visibleSupersampling);
     std::unique_ptr<WavefrontPass> wavefront;
     if (options.schedule == Schedule::Wavefront)
         wavefront = std::make_unique<WavefrontPass>(ctx, sceneGpu, pass, options.workgroup);
     vk::GpuTimer timer(ctx);
     vk::CommandStream stream(ctx, "pt");
-    if (options.resume) pass.uploadStats(options.resume->buffers.at(0));
+    if (options.resume) pass.uploadStats(options.resume->buffers);
     stats.uploadMs = phase.ms() - stats.bvhBuildMs;
     const auto snapshot = [&](SamplerState& state) {
-        state.buffers = {pass.downloadStats()};
+        state.buffers = pass.downloadStats();
         Image variance;
         pass.readback(state.preview, variance);
     };
@@ -57,6 +57,8 @@ RenderResult renderPt(const vk::Context& ctx, const Scene& scene, const RenderOp
     phase.restart();
     pass.readback(result.image, result.varianceOfMean);
     stats.readbackMs = phase.ms();
+    stats.visibleSupersampling = pass.visible().samplesPerSpp();
+    stats.visibleRefinedPixels = pass.visible().refinedPixels();
     stats.kernels = timer.totals();
     return result;
 }

@@ -36,6 +36,9 @@ struct RenderOptions {
     bool quiet = false;
     WorkgroupSize workgroup;
     Schedule schedule = Schedule::Megakernel;
+    // Rays per camera sample in the pixels of emitter-silhouette supersampling
+    // (render/visible_pass.h); 0 = off.
+    std::uint32_t visibleSupersampling = kDefaultVisibleSupersampling;
     std::uint32_t maxBatchSpp = 16;  // largest batch (samples per pixel per submission)
     const std::atomic<bool>* cancel = nullptr;  // set asynchronously to stop between batches
     // Continue from this state (its statistics and batch-schedule position) instead of from
@@ -62,6 +65,8 @@ struct RenderStats {
     std::uint64_t shiftPairs = 0;     // G-PT: shifts attempted (offsets in the image, base hit)
     std::uint64_t shiftFailures = 0;  // G-PT: shifts that failed (pair fell back to the base)
     bool gptSplitBounce = false;      // G-PT: the kernel ran the split bounce loop
+    std::uint32_t visibleSupersampling = 0;  // emitter-silhouette supersampling factor (0 = off)
+    std::uint32_t visibleRefinedPixels = 0;  // pixels it covered
     bool cancelled = false;
     std::map<std::string, vk::KernelTime> kernels;
     SceneFeatures features;

@@ -16,17 +16,26 @@ constexpr std::uint32_t kBouncesPerSubmit = 6;
 
 }  // namespace
 
-WavefrontPass::WavefrontPass(const vk::Context& ctx, const SceneGpu& scene, const PtPass& pt, WorkgroupSize wg)
+namespace {
+vk::KernelDesc shadeDesc(const SceneGpu& scene, WorkgroupSize wg, const VisiblePass& visible) {
+    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("wf_shade", kSpv_wf_shade), wg,
+                                        {gpu::kBindAccum, gpu::kBindCounters, gpu::kBindPathState, gpu::kBindPathHits});
+    visible.configure(d);
+    return d;
+}
+}  // namespace
+
+WavefrontPass::WavefrontPass(const vk::Context& ctx, const SceneGpu& scene, PtPass& pt, WorkgroupSize wg)
     : ctx_(ctx),
       width_(scene.constants().width),
       height_(scene.constants().height),
       extend_(ctx, scene.kernelDesc(vk::kernelDesc("wf_extend", kSpv_wf_extend), wg,
                                     {gpu::kBindPathState, gpu::kBindPathHits})),
-      shade_(ctx, scene.kernelDesc(vk::kernelDesc("wf_shade", kSpv_wf_shade), wg,
-                                   {gpu::kBindAccum, gpu::kBindCounters, gpu::kBindPathState, gpu::kBindPathHits})),
+      shade_(ctx, shadeDesc(scene, wg, pt.visible())),
       paths_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::PathState), "wavefront path state"),
       hits_(ctx, std::uint64_t{width_} * height_ * sizeof(glm::vec4), "wavefront hits"),
-      counters_(pt.counters()) {
+      counters_(pt.counters()),
+      visible_(pt.visible()) {
     ctx.checkStorageBufferSize(paths_.size(), "the wavefront path state");
     scene.bindTo(extend_);
     scene.bindTo(shade_);
@@ -36,6 +45,7 @@ WavefrontPass::WavefrontPass(const vk::Context& ctx, const SceneGpu& scene, cons
     shade_.bind(gpu::kBindCounters, pt.counters());
     shade_.bind(gpu::kBindPathState, paths_);
     shade_.bind(gpu::kBindPathHits, hits_);
+    visible_.bindTo(shade_);
 }
 
 void WavefrontPass::traceSample(vk::CommandStream& stream, std::uint32_t sampleIndex, std::uint32_t seed,
@@ -50,6 +60,7 @@ void WavefrontPass::traceSample(vk::CommandStream& stream, std::uint32_t sampleI
         VkCommandBuffer cmd = stream.begin();
         if (timer) timer->reset(cmd);
         if (first) {
+            visible_.record(cmd, sampleIndex, 1, seed, timer);
             p.pad0 = 0;  // start the paths
             shade_.dispatchItems(cmd, width_, height_, &p, timer);
             vk::computeBarrier(cmd);

@@ -21,7 +21,7 @@ class CommandStream;
 
 class WavefrontPass {
 public:
-    WavefrontPass(const vk::Context& ctx, const SceneGpu& scene, const PtPass& pt, WorkgroupSize wg = {});
+    WavefrontPass(const vk::Context& ctx, const SceneGpu& scene, PtPass& pt, WorkgroupSize wg = {});
     // Traces sample `sampleIndex` of every pixel to completion (several submissions of
     // kBouncesPerSubmit bounces until no path is alive) and merges it into pt's statistics.
     void traceSample(vk::CommandStream& stream, std::uint32_t sampleIndex, std::uint32_t seed, vk::GpuTimer* timer,
@@ -35,6 +35,7 @@ private:
     vk::Buffer paths_;
     vk::Buffer hits_;
     const vk::Buffer& counters_;
+    VisiblePass& visible_;
 };
 
 }  // namespace gdpt

@@ -1,0 +1,140 @@
+// visible.comp — emitter-silhouette supersampling: a separate estimate of the emission that
+// the camera sees at its first hit (the environment for a ray that misses), in the pixels
+// where that emission changes within the pixel's neighbourhood (the edges of lights seen
+// directly, of the sky, of emissive texture detail). Elsewhere the path kernels estimate it
+// as part of their samples.
+//
+// Why: with a box filter, a pixel that a bright emitter covers by a fraction c gets, per
+// camera sample, the emitter's radiance L with probability c and 0 otherwise: variance
+// c(1−c)L² per sample, large against the pixel's own value. G-PT's reconstruction does not
+// touch this term (it is added to the reconstructed indirect image, Kettunen et al. 2015 §5),
+// so at low sample counts these few pixels hold most of a G-PT image's relMSE (the Cornell
+// box at 5 spp: the light's rim, 0.1 % of the pixels, gave 60 %; bench/RESULTS.md, fifth
+// session). Here each such pixel gets samplesPerSpp first-hit rays per camera sample, at
+// scrambled Sobol' positions (sobol.glsl), which stratify the pixel as they accumulate.
+//
+// Phases (push constant `phase`, one dispatch each over the whole image):
+//   probe   4 rays per pixel (the first four scrambled Sobol' points: one per quarter);
+//           probe[p] = a hash of the emission if the four agree, else 1 ("mixed").
+//   count   a pixel is refined if it is mixed or a neighbour's (3x3) signature differs
+//           from its own; counts them.
+//   refine  per camera sample of the batch, k rays per refined pixel, merged into
+//           visibleStats[p]; k = samplesPerSpp, reduced so that k × refined pixels stays
+//           within rayBudget when the edges are many.
+// Unbiased: which pixels are refined depends only on the probe's rays; the refined estimate
+// uses other, independent rays, and each scrambled point is uniform over the pixel, so the
+// pixel's estimate is unbiased given the choice, hence unbiased. Both PT and G-PT use it.
+#version 460
+#extension GL_EXT_scalar_block_layout : require
+#extension GL_GOOGLE_include_directive : require
+
+#include "gdpt_shared.h"
+#include "lib/common.glsl"
+#include "lib/rng.glsl"
+#include "lib/ray.glsl"
+#include "lib/sobol.glsl"
+
+layout(local_size_x_id = kSpecWorkgroupX, local_size_y_id = kSpecWorkgroupY) in;
+
+#include "lib/scene_buffers.glsl"
+layout(set = 0, binding = kBindCounters, scalar) buffer CounterBuf { Counters counters; };
+layout(set = 0, binding = kBindVisibleStats, scalar) buffer VisibleStatsBuf { PixelStats visibleStats[]; };
+layout(set = 0, binding = kBindVisibleProbe, scalar) buffer VisibleProbeBuf { uint probe[]; };
+layout(set = 0, binding = kBindVisibleCounter, scalar) buffer VisibleCounterBuf { VisibleCounter visibleCounter; };
+layout(push_constant, scalar) uniform Push { VisibleParams params; };
+
+#include "lib/scene_access.glsl"
+#define GDPT_ANYHIT_FILTER(tri, u, v) alphaPasses(tri, u, v)
+#include "lib/bvh_traverse.glsl"
+#include "lib/camera.glsl"
+
+const uint kProbeMixed = 1u;  // signatures of agreeing probes have bit 0 clear
+
+// Emission seen along the camera ray through pixelPos (what the path kernels count at the
+// first hit: the front-facing emission of the surface, or the environment on a miss).
+vec3 firstHitEmission(vec2 pixelPos) {
+    vec3 d = cameraRay(pixelPos);
+    Hit hit = traceClosest(scene.camPosition, d, 0.0, 1.0 / 0.0);
+    if (hit.triangle == kInvalidIndex) return kHasEnv ? scene.envRadiance : vec3(0.0);
+    if (!kHasLightTris) return vec3(0.0);
+    return surfaceEmission(makeSurfaceHit(hit.triangle, hit.u, hit.v, d));
+}
+
+uint emissionSignature(vec3 e) {
+    // Any zero (±0) hashes as +0; bit 0 is kept clear for kProbeMixed.
+    uvec3 b = floatBitsToUint(e);
+    b = mix(b, uvec3(0u), equal(e, vec3(0.0)));
+    return pcgHash(b.x + pcgHash(b.y + pcgHash(b.z))) & ~kProbeMixed;
+}
+
+bool refined(uint x, uint y) {
+    uint own = probe[y * scene.width + x];
+    if ((own & kProbeMixed) != 0u) return true;
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            int nx = int(x) + dx, ny = int(y) + dy;
+            if (nx < 0 || ny < 0 || nx >= int(scene.width) || ny >= int(scene.height)) continue;
+            if (probe[uint(ny) * scene.width + uint(nx)] != own) return true;
+        }
+    }
+    return false;
+}
+
+void main() {
+    uint x = gl_GlobalInvocationID.x;
+    uint y = gl_GlobalInvocationID.y;
+    if (x >= scene.width || y >= scene.height) return;
+    uint pixel = y * scene.width + x;
+
+    if (params.phase == kVisiblePhaseCount) {
+        if (refined(x, y)) atomicAdd(visibleCounter.refinedPixels, 1u);
+        return;
+    }
+    // Probe: one "sample" of four rays; refine: the batch's camera samples of k rays each.
+    uint samples = 1u, raysPerSample = 4u, sampleBase = 0u;
+    uint salt = 0x70726f62u;  // "prob"
+    if (params.phase == kVisiblePhaseRefine) {
+        if (!refined(x, y)) return;
+        raysPerSample = clamp(params.rayBudget / max(visibleCounter.refinedPixels, 1u), 1u, params.samplesPerSpp);
+        samples = params.samplesPerPixel;
+        sampleBase = params.sampleBase;
+        salt = 0x76697369u;  // "visi"
+    }
+    // One scramble per pixel and phase, the same in every batch, so that the refine rays of
+    // successive batches continue one sequence (camera sample s owns its indices s·k ..).
+    uint seedX = pcgHash(pixel + pcgHash(salt + pcgHash(params.seed)));
+    uint seedY = pcgHash(seedX ^ 0x9e3779b9u);
+
+    // Welford over the camera samples, each the mean of its k rays (so that the statistics
+    // count camera samples, like every other per-pixel estimate).
+    vec3 mean = vec3(0.0), m2 = vec3(0.0), firstValue = vec3(0.0);
+    bool agree = true;
+    for (uint s = 0u; s < samples; ++s) {
+        vec3 sum = vec3(0.0);
+        for (uint i = 0u; i < raysPerSample; ++i) {
+            uint index = (sampleBase + s) * raysPerSample + i;
+            vec3 e = firstHitEmission(vec2(x, y) + sobolScrambled2(index, seedX, seedY));
+            if (i == 0u) firstValue = e;
+            agree = agree && all(equal(e, firstValue));
+            sum += e;
+        }
+        vec3 v = sum / float(raysPerSample);
+        vec3 delta = v - mean;
+        mean += delta / float(s + 1u);
+        m2 += delta * (v - mean);
+    }
+    atomicAdd(counters.raysTraced, samples * raysPerSample);
+    if (params.phase == kVisiblePhaseProbe) {
+        probe[pixel] = agree ? emissionSignature(firstValue) : kProbeMixed;
+        return;
+    }
+    // Chan et al. 1979 merge of this batch into the running statistics.
+    PixelStats acc = visibleStats[pixel];
+    uint total = acc.count + samples;
+    vec3 delta = mean - acc.mean;
+    float fb = float(samples) / float(total);
+    acc.mean += delta * fb;
+    acc.m2 += m2 + delta * delta * float(acc.count) * fb;
+    acc.count = total;
+    visibleStats[pixel] = acc;
+}

@@ -1,0 +1,137 @@
+#include "render/visible_pass.h"
+
+#include <algorithm>
+#include <string>
+
+#include "util/error.h"
+#include "visible.spv.h"
+#include "vk/commands.h"
+#include "vk/context.h"
+
+namespace gdpt {
+namespace {
+// Refine rays per camera sample over the whole image: a quarter of a ray per pixel, so
+// that a scene whose emission edges are everywhere (an emissive texture filling the view)
+// costs at most about a quarter of a primary ray per pixel and sample more.
+std::uint32_t rayBudget(std::uint32_t width, std::uint32_t height) {
+    return std::max<std::uint32_t>(1, width * height / 4);
+}
+
+bool canSeeEmission(const SceneGpu& scene) {
+    return scene.features().hasLightTris || scene.features().hasEnv;
+}
+}  // namespace
+
+VisiblePass::VisiblePass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg,
+                         std::uint32_t samplesPerSpp, const vk::Buffer& counters)
+    : width_(scene.constants().width),
+      height_(scene.constants().height),
+      samplesPerSpp_(samplesPerSpp),
+      stats_(ctx, samplesPerSpp > 0 && canSeeEmission(scene) ? std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats) : 0,
+             "visible-emission statistics"),
+      probe_(ctx, samplesPerSpp > 0 && canSeeEmission(scene) ? std::uint64_t{width_} * height_ * sizeof(std::uint32_t) : 0,
+             "visible-emission probe"),
+      counter_(ctx, sizeof(gpu::VisibleCounter), "visible-emission counter") {
+    if (samplesPerSpp > kMaxVisibleSupersampling)
+        throw Error("emitter supersampling " + std::to_string(samplesPerSpp) + " is above the maximum " +
+                    std::to_string(kMaxVisibleSupersampling));
+    if (samplesPerSpp == 0 || !canSeeEmission(scene)) {
+        samplesPerSpp_ = 0;
+        return;
+    }
+    ctx.checkStorageBufferSize(stats_.size(), "the visible-emission statistics of a " + std::to_string(width_) +
+                                                  "x" + std::to_string(height_) + " image");
+    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("visible", kSpv_visible), wg,
+                                        {gpu::kBindCounters, gpu::kBindVisibleStats, gpu::kBindVisibleProbe,
+                                         gpu::kBindVisibleCounter},
+                                        sizeof(gpu::VisibleParams));
+    kernel_.emplace(ctx, d);
+    scene.bindTo(*kernel_);
+    kernel_->bind(gpu::kBindCounters, counters);
+    kernel_->bind(gpu::kBindVisibleStats, stats_);
+    kernel_->bind(gpu::kBindVisibleProbe, probe_);
+    kernel_->bind(gpu::kBindVisibleCounter, counter_);
+    reset();
+}
+
+void VisiblePass::configure(vk::KernelDesc& desc) const {
+    desc.bindings.push_back(gpu::kBindVisibleStats);
+    desc.specConstants.push_back({gpu::kSpecVisibleEmission, enabled() ? 1u : 0u});
+}
+
+void VisiblePass::bindTo(vk::Kernel& kernel) const { kernel.bind(gpu::kBindVisibleStats, stats_); }
+
+void VisiblePass::reset() {
+    stats_.zero();
+    counter_.zero();
+    probed_ = false;
+}
+
+void VisiblePass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
+                         vk::GpuTimer* timer) {
+    if (!enabled() || spp == 0) return;
+    gpu::VisibleParams p{};
+    p.sampleBase = sampleBase;
+    p.samplesPerPixel = spp;
+    p.seed = seed;
+    p.samplesPerSpp = samplesPerSpp_;
+    p.rayBudget = rayBudget(width_, height_);
+    if (!probed_ || probeSeed_ != seed) {
+        // The probe and the count: the same for every batch of a render with this seed, so a
+        // resumed render redoes them and refines the same pixels.
+        counter_.zero();
+        p.phase = gpu::kVisiblePhaseProbe;
+        kernel_->dispatchItems(cmd, width_, height_, &p, timer);
+        vk::computeBarrier(cmd);
+        p.phase = gpu::kVisiblePhaseCount;
+        kernel_->dispatchItems(cmd, width_, height_, &p, timer);
+        vk::computeBarrier(cmd);
+        probed_ = true;
+        probeSeed_ = seed;
+    }
+    p.phase = gpu::kVisiblePhaseRefine;
+    kernel_->dispatchItems(cmd, width_, height_, &p, timer);
+    vk::computeBarrier(cmd);
+}
+
+std::vector<gpu::PixelStats> VisiblePass::downloadStats() const {
+    if (!enabled()) return std::vector<gpu::PixelStats>(std::size_t{width_} * height_);
+    return stats_.downloadVector<gpu::PixelStats>(std::size_t{width_} * height_);
+}
+
+void VisiblePass::uploadStats(const std::vector<gpu::PixelStats>& stats) {
+    if (stats.size() != std::size_t{width_} * height_)
+        throw Error("visible-emission statistics: " + std::to_string(stats.size()) + " entries for a " +
+                    std::to_string(width_) + "x" + std::to_string(height_) + " image");
+    if (!enabled()) {
+        const bool empty = std::all_of(stats.begin(), stats.end(), [](const gpu::PixelStats& s) { return s.count == 0; });
+        if (!empty) throw Error("visible-emission statistics have samples, but emitter supersampling is off");
+        return;
+    }
+    stats_.uploadVector(stats);
+}
+
+void VisiblePass::addTo(Image* mean, Image* varianceOfMean) const {
+    if (!enabled()) return;
+    const auto stats = downloadStats();
+    for (std::size_t i = 0; i < stats.size(); ++i) {
+        const gpu::PixelStats& s = stats[i];
+        if (s.count == 0) continue;
+        const float n = static_cast<float>(s.count);
+        for (int c = 0; c < 3; ++c) {
+            if (mean) mean->plane(c)[i] += s.mean[c];
+            // Over camera samples (each the mean of its k rays): rays that stratify the pixel
+            // across samples make this an upper bound.
+            if (varianceOfMean && s.count > 1) varianceOfMean->plane(c)[i] += s.m2[c] / (n - 1.0f) / n;
+        }
+    }
+}
+
+std::uint32_t VisiblePass::refinedPixels() const {
+    if (!enabled() || !probed_) return 0;
+    gpu::VisibleCounter c{};
+    counter_.download(&c, sizeof c);
+    return c.refinedPixels;
+}
+
+}  // namespace gdpt
