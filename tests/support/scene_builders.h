@@ -1,0 +1,50 @@
+// scene_builders.h — small scenes built in code for the GPU tests: a Lambertian (optionally
+// emissive) material, an axis-aligned quad facing +z or -z, a camera looking down -z.
+#pragma once
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "gdpt_shared.h"
+#include "scene/scene.h"
+
+namespace gdpt::test {
+
+inline gpu::Material lambert(glm::vec3 albedo, glm::vec3 emission = glm::vec3(0.0f)) {
+    gpu::Material m{};
+    m.baseColor = glm::vec4(albedo, 1.0f);
+    m.emissive = emission;
+    m.roughness = 1.0f;
+    m.ior = 1.5f;
+    m.alphaCutoff = 0.5f;
+    m.specularColor = glm::vec3(1.0f);
+    if (emission.x > 0 || emission.y > 0 || emission.z > 0) m.flags |= gpu::kMatFlagEmissive;
+    m.baseColorTex = m.metallicRoughnessTex = m.emissiveTex = m.normalTex = -1;
+    return m;
+}
+
+// Quad in the plane z = zPlane, half-size h, front face towards +z (or -z).
+inline void addQuadZ(Scene& s, float zPlane, float h, std::uint32_t mat, bool facePlusZ = true) {
+    const auto base = static_cast<std::uint32_t>(s.positions.size());
+    s.positions.insert(s.positions.end(), {{-h, -h, zPlane}, {h, -h, zPlane}, {h, h, zPlane}, {-h, h, zPlane}});
+    if (facePlusZ) {
+        s.triangles.emplace_back(base, base + 1, base + 2);
+        s.triangles.emplace_back(base, base + 2, base + 3);
+    } else {
+        s.triangles.emplace_back(base, base + 2, base + 1);
+        s.triangles.emplace_back(base, base + 3, base + 2);
+    }
+    s.triangleMaterial.insert(s.triangleMaterial.end(), {mat, mat});
+}
+
+inline Camera lookDown(float height, float yfovDeg) {
+    Camera c;
+    c.position = glm::vec3(0.0f, 0.0f, height);
+    c.forward = glm::vec3(0.0f, 0.0f, -1.0f);
+    c.up = glm::vec3(0.0f, 1.0f, 0.0f);
+    c.yfov = glm::radians(yfovDeg);
+    return c;
+}
+
+}  // namespace gdpt::test
