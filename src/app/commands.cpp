@@ -321,8 +321,12 @@ int runInfo(const InfoArgs& args) {
     const SceneFeatures f = analyzeScene(scene, parseColor(args.env, "--env"));
     std::printf("%s\n", describeScene(scene).c_str());
     for (const auto& [k, v] : describeFeatures(f)) std::printf("  %-26s %s\n", k.c_str(), v.c_str());
-    std::printf("kernel variant: pt[textures=%d punctual=%d lightTris=%d env=%d glossy=%d alphaMask=%d]\n",
-                f.hasTextures, f.hasPunctual, f.hasLightTris, f.hasEnv, f.hasGlossy, f.hasAlphaMask);
+    // visibleEmission: emitter-silhouette supersampling (render/visible_pass.h) at the default
+    // factor, which needs something the camera can see emit.
+    std::printf("kernel variant: pt[textures=%d punctual=%d lightTris=%d env=%d glossy=%d alphaMask=%d "
+                "visibleEmission=%d]\n",
+                f.hasTextures, f.hasPunctual, f.hasLightTris, f.hasEnv, f.hasGlossy, f.hasAlphaMask,
+                f.hasLightTris || f.hasEnv);
     for (const auto& u : scene.unsupported) std::printf("  unsupported: %s\n", u.c_str());
     return 0;
 }
