@@ -32,6 +32,7 @@
 #include "gpt_shared.h"
 #include "lib/common.glsl"
 #include "lib/rng.glsl"
+#include "lib/sampler.glsl"
 #include "lib/ray.glsl"
 
 layout(local_size_x_id = kSpecWorkgroupX, local_size_y_id = kSpecWorkgroupY) in;
@@ -80,7 +81,7 @@ bool ownVertex(OffsetPath o, bool general) { return general && o.state == kShift
 // Base + 4 offsets for one camera sample at pixelPos (continuous pixel coordinates).
 // countDirect false: the emission seen by the camera ray is left to emitter-silhouette
 // supersampling (visible_emission.glsl) and `direct` stays zero.
-void traceSample(inout Rng rng, vec2 pixelPos, uint px, uint py, bool countDirect, inout uint rays,
+void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, bool countDirect, inout uint rays,
                  out vec3 direct, inout OffsetPath offs[4]) {
     direct = vec3(0.0);
     for (uint i = 0u; i < 4u; ++i) {
@@ -165,9 +166,10 @@ void main() {
     for (uint s = 0u; s < frame.samplesPerPixel; ++s) {
         // Same stream as pt.comp's sample s: the base path is PT's path.
         Rng rng = rngInit(pixel, frame.sampleBase + s, frame.seed);
-        vec2 jitter = rngNext2(rng);
+        LdSample lds = ldSampleInit(pixel, frame.sampleBase + s, frame.seed);
+        vec2 jitter = ldGet2(lds, kLdDimPixel);
         vec3 direct;
-        traceSample(rng, vec2(x, y) + jitter, x, y, countDirect, rays, direct, offs);
+        traceSample(lds, rng, vec2(x, y) + jitter, x, y, countDirect, rays, direct, offs);
         for (uint i = 0u; i < 4u; ++i) {
             shiftPairs += offs[i].shifted ? 1u : 0u;
             shiftFailures += offs[i].shifted && !offs[i].alive ? 1u : 0u;

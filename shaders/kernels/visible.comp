@@ -94,8 +94,10 @@ void main() {
     uint samples = 1u, raysPerSample = 4u, sampleBase = 0u;
     uint salt = 0x70726f62u;  // "prob"
     if (params.phase == kVisiblePhaseRefine) {
+        uint k = clamp(params.rayBudget / max(visibleCounter.refinedPixels, 1u), 1u, params.samplesPerSpp);
+        if (pixel == 0u) visibleCounter.raysPerSample = k;  // for the host's report
         if (!refined(x, y)) return;
-        raysPerSample = clamp(params.rayBudget / max(visibleCounter.refinedPixels, 1u), 1u, params.samplesPerSpp);
+        raysPerSample = k;
         samples = params.samplesPerPixel;
         sampleBase = params.sampleBase;
         salt = 0x76697369u;  // "visi"

@@ -7,7 +7,7 @@
 // specialisation constant) took lavapipe 22.3 630 ms to create the single-loop pipeline,
 // this form 330 ms, as before the split (bench/RESULTS.md, fourth session).
 //
-// Uses traceSample's locals: depth (the loop counter), px, py, rng, beta, sh, d, offs, rays,
+// Uses traceSample's locals: depth (the loop counter), px, py, lds, rng, beta, sh, d, offs, rays,
 // and pathEnded (set, with a break, when the base path ends). With GDPT_GPT_GENERAL false
 // the code for offsets with vertices of their own (NOT_CONNECTED: own BSDFs, NEE rays,
 // reconnection and half-vector shifts) is compiled out; that form may only run once no live
@@ -65,7 +65,7 @@
     // Densities are visibility-aware: a path whose last segment is occluded cannot be
     // produced by BSDF sampling (its BSDF density is 0) but can by light sampling. This
     // keeps the four weights of a path equal whichever technique sampled it.
-    vec3 ul = rngNext3(rng);
+    vec3 ul = ldLight(lds, depth);
     LightSample ls;
     if (!bsdfIsDeltaOnly(bsdf) && sampleLight(sh.p, ul, ls) && dot(ls.wi, sh.ng) > 0.0) {
         vec3 wiLocal = toLocal(ls.wi, t, b, sh.ns);
@@ -139,7 +139,7 @@
 
     // ---- BSDF sampling continues the base path ----
     BsdfSample bs;
-    if (!bsdfSample(bsdf, woLocal, rngNext3(rng), bs)) { pathEnded = true; break; }
+    if (!bsdfSample(bsdf, woLocal, ldBsdf(lds, depth), bs)) { pathEnded = true; break; }
     vec3 wi = toWorld(bs.wi, t, b, sh.ns);
     if (dot(wi, sh.ng) <= 0.0) { pathEnded = true; break; }
     beta *= bs.weight;

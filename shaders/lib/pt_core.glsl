@@ -14,6 +14,7 @@
 #define GDPT_LIB_PT_CORE
 
 #include "lib/camera.glsl"
+#include "lib/sampler.glsl"
 #include "lib/visible_emission.glsl"
 
 // Starts the path of sample `sampleIndex` of pixel (x, y): box filter, so the sample
@@ -22,7 +23,8 @@ PathState ptBegin(uint x, uint y, uint sampleIndex, uint seed) {
     PathState s;
     s.pixel = y * scene.width + x;
     Rng rng = rngInit(s.pixel, sampleIndex, seed);
-    vec2 jitter = rngNext2(rng);
+    LdSample lds = ldSampleInit(s.pixel, sampleIndex, seed);
+    vec2 jitter = ldGet2(lds, kLdDimPixel);
     s.origin = scene.camPosition;
     s.dir = cameraRay(vec2(x, y) + jitter);
     s.prevPdf = 0.0;
@@ -33,6 +35,8 @@ PathState ptBegin(uint x, uint y, uint sampleIndex, uint seed) {
     s.prevP = s.origin;
     s.depth = 0u;
     s.rays = 0u;
+    s.ldSeed = lds.seed;
+    s.sampleIndex = sampleIndex;
     return s;
 }
 
@@ -41,6 +45,9 @@ PathState ptBegin(uint x, uint y, uint sampleIndex, uint seed) {
 void ptProcessHit(inout PathState s, Hit hit) {
     Rng rng;
     rng.state = s.rng;
+    LdSample lds;
+    lds.seed = s.ldSeed;
+    lds.index = s.sampleIndex;
     s.rays++;
     s.flags &= ~kPathFlagAlive;  // set again below if the path continues
     // Emission seen by the camera ray itself: left to emitter-silhouette supersampling in
@@ -73,9 +80,9 @@ void ptProcessHit(inout PathState s, Hit hit) {
     vec3 woLocal = toLocal(-d, t, b, sh.ns);
     vec3 origin = offsetRayOriginScaled(sh.p, sh.ng, scene.sceneRadius);
 
-    // Next-event estimation (the three numbers are drawn even when unused, so that the
-    // random stream does not depend on the material).
-    vec3 ul = rngNext3(rng);
+    // Next-event estimation (its numbers are this bounce's decision of the sampler,
+    // sampler.glsl, used or not).
+    vec3 ul = ldLight(lds, s.depth);
     if (!bsdfIsDeltaOnly(bsdf)) {
         LightSample ls;
         if (sampleLight(sh.p, ul, ls) && dot(ls.wi, sh.ng) > 0.0) {
@@ -94,7 +101,7 @@ void ptProcessHit(inout PathState s, Hit hit) {
 
     // BSDF sampling continues the path.
     BsdfSample bs;
-    bool sampled = bsdfSample(bsdf, woLocal, rngNext3(rng), bs);
+    bool sampled = bsdfSample(bsdf, woLocal, ldBsdf(lds, s.depth), bs);
     vec3 wi = sampled ? toWorld(bs.wi, t, b, sh.ns) : vec3(0.0);
     // A sample below the geometric surface (shading-normal leak) ends the path.
     if (sampled && dot(wi, sh.ng) > 0.0) {

@@ -222,7 +222,7 @@ GDPT_CONST uint kVisiblePhaseRefine = 2u;  // supersample them (one batch)
 // Written by visible.comp's count phase. 16 bytes.
 struct VisibleCounter {
     uint refinedPixels;   // pixels whose neighbourhood sees an emission edge
-    uint pad0;
+    uint raysPerSample;   // refine rays per camera sample in them (after the ray budget)
     uint pad1;
     uint pad2;
 };
@@ -318,9 +318,9 @@ struct PathState {
     vec3 prevP;      // position of the vertex that spawned the segment (for MIS)
     uint depth;      // index of the vertex the next hit will be (0 = first hit)
     uint rays;       // rays traced by this path so far
+    uint ldSeed;     // the pixel's LdSample seed (sampler.glsl)
+    uint sampleIndex;  // this camera sample's index in its pixel
     uint pad0;
-    uint pad1;
-    uint pad2;
 };
 GDPT_CONST uint kPathFlagAlive = 1u;
 GDPT_CONST uint kPathFlagPrevSpecular = 2u;  // camera ray or Dirac bounce: no MIS on emission

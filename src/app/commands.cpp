@@ -283,7 +283,8 @@ int runRender(const RenderArgs& args) {
                   {"kernels", kernelJson(s.kernels, s.samplingMs)},
                   {"validation_errors", ctx.validationErrors()}};
         if (args.method == "gpt") j["gpt_split_bounce"] = s.gptSplitBounce;
-        j["emitter_supersampling"] = {{"rays_per_sample", s.visibleSupersampling},
+        j["emitter_supersampling"] = {{"factor", s.visibleSupersampling},
+                                      {"rays_per_sample", s.visibleRaysPerSample},
                                       {"pixels", s.visibleRefinedPixels}};
         writeTextOutput(args.json, j.dump(2) + "\n");
     }

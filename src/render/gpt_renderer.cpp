@@ -81,8 +81,10 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     result.varDy = std::move(images.varDy);
     result.varDirect = std::move(images.varDirect);
     stats.readbackMs = phase.ms();
+    const gpu::VisibleCounter visible = pass.visible().report();
     stats.visibleSupersampling = pass.visible().samplesPerSpp();
-    stats.visibleRefinedPixels = pass.visible().refinedPixels();
+    stats.visibleRaysPerSample = visible.raysPerSample;
+    stats.visibleRefinedPixels = visible.refinedPixels;
     stats.kernels = timer.totals();
     return result;
 }

@@ -24,6 +24,10 @@ vk::KernelDesc ptDesc(const SceneGpu& scene, WorkgroupSize wg, const VisiblePass
 }
 }  // namespace
 
+std::uint32_t samplesPerDispatch(const vk::DeviceInfo& device, std::uint32_t batchSpp) {
+    return device.isCpu ? std::min<std::uint32_t>(1, batchSpp) : batchSpp;
+}
+
 PtPass::PtPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg, std::uint32_t visibleSupersampling)
     : ctx_(ctx),
       width_(scene.constants().width),
@@ -50,19 +54,23 @@ void PtPass::reset() {
 void PtPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
                     vk::GpuTimer* timer) {
     visible_.record(cmd, sampleBase, spp, seed, timer);
-    const std::uint64_t perRow = std::uint64_t{width_} * spp;
+    const std::uint32_t step = samplesPerDispatch(ctx_.info(), spp);
+    const std::uint64_t perRow = std::uint64_t{width_} * step;
     const auto rowsPerDispatch =
         static_cast<std::uint32_t>(std::max<std::uint64_t>(1, kMaxPixelSamplesPerDispatch / std::max<std::uint64_t>(perRow, 1)));
-    for (std::uint32_t row = 0; row < height_; row += rowsPerDispatch) {
-        gpu::FrameParams p{};
-        p.sampleBase = sampleBase;
-        p.samplesPerPixel = spp;
-        p.seed = seed;
-        p.rowOffset = row;
-        p.rowCount = std::min(rowsPerDispatch, height_ - row);
-        kernel_.dispatchItems(cmd, width_, p.rowCount, &p, timer);
+    for (std::uint32_t first = 0; first < spp; first += step) {
+        for (std::uint32_t row = 0; row < height_; row += rowsPerDispatch) {
+            gpu::FrameParams p{};
+            p.sampleBase = sampleBase + first;
+            p.samplesPerPixel = std::min(step, spp - first);
+            p.seed = seed;
+            p.rowOffset = row;
+            p.rowCount = std::min(rowsPerDispatch, height_ - row);
+            kernel_.dispatchItems(cmd, width_, p.rowCount, &p, timer);
+        }
+        // Each pixel's statistics are read and written by every dispatch of the batch.
+        vk::computeBarrier(cmd);
     }
-    vk::computeBarrier(cmd);
 }
 
 gpu::Counters PtPass::takeCounters() {

@@ -18,7 +18,17 @@ namespace gdpt {
 namespace vk {
 class Context;
 class GpuTimer;
+struct DeviceInfo;
 }  // namespace vk
+
+// Camera samples per pixel that one dispatch of a path kernel may take. llvmpipe ends any
+// outermost loop of a shader after 65535 iterations, silently, counting the iterations of
+// the loops nested in it (LP_MAX_TGSI_LOOP_ITERATIONS; see poisson_scalars.comp): the loop
+// over a pixel's samples, around the bounce loop and the BVH traversals, crossed that with
+// long paths (a 100-bounce furnace lost 14 % of its energy at 16 samples per dispatch), so
+// CPU devices take one sample per dispatch and the bounce loop is outermost. Elsewhere the
+// whole batch.
+std::uint32_t samplesPerDispatch(const vk::DeviceInfo& device, std::uint32_t batchSpp);
 
 class PtPass {
 public:

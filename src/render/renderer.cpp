@@ -57,8 +57,10 @@ RenderResult renderPt(const vk::Context& ctx, const Scene& scene, const RenderOp
     phase.restart();
     pass.readback(result.image, result.varianceOfMean);
     stats.readbackMs = phase.ms();
+    const gpu::VisibleCounter visible = pass.visible().report();
     stats.visibleSupersampling = pass.visible().samplesPerSpp();
-    stats.visibleRefinedPixels = pass.visible().refinedPixels();
+    stats.visibleRaysPerSample = visible.raysPerSample;
+    stats.visibleRefinedPixels = visible.refinedPixels;
     stats.kernels = timer.totals();
     return result;
 }

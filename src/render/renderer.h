@@ -66,6 +66,7 @@ struct RenderStats {
     std::uint64_t shiftFailures = 0;  // G-PT: shifts that failed (pair fell back to the base)
     bool gptSplitBounce = false;      // G-PT: the kernel ran the split bounce loop
     std::uint32_t visibleSupersampling = 0;  // emitter-silhouette supersampling factor (0 = off)
+    std::uint32_t visibleRaysPerSample = 0;  // rays per camera sample it took (after its ray budget)
     std::uint32_t visibleRefinedPixels = 0;  // pixels it covered
     bool cancelled = false;
     std::map<std::string, vk::KernelTime> kernels;

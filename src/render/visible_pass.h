@@ -59,8 +59,9 @@ public:
     // Adds the supersampled estimate's mean to `mean` and its variance of the mean to
     // `varianceOfMean` (either may be null) in the refined pixels (after the fence).
     void addTo(Image* mean, Image* varianceOfMean) const;
-    // Refined pixels of the current probe (after the fence of a record(); 0 before).
-    [[nodiscard]] std::uint32_t refinedPixels() const;
+    // Refined pixels of the current probe and the rays per camera sample they get (the
+    // factor, less where the ray budget cut it), after the fence of a record(); 0 before.
+    [[nodiscard]] gpu::VisibleCounter report() const;
     [[nodiscard]] std::uint32_t samplesPerSpp() const { return samplesPerSpp_; }
 
 private:

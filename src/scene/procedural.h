@@ -17,7 +17,7 @@ namespace gdpt {
 [[nodiscard]] Scene makeCornellBox();
 
 // A closed unit sphere (icosphere, 20 * 4^subdivisions triangles, radius 1, centred at the
-// origin) whose front faces and normals point to the centre, with Lambertian albedo
+// origin) whose front faces point to the centre, flat-shaded, with Lambertian albedo
 // `albedo` and uniform emitted radiance `emission`; camera at the centre looking -Z.
 // In such a furnace every path sees radiance emission / (1 - albedo).
 [[nodiscard]] Scene makeFurnaceSphere(float albedo, glm::vec3 emission, int subdivisions);

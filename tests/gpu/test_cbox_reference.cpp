@@ -9,7 +9,10 @@
 // reference's stated noise floor. A bias adds to this; the test requires the measured
 // relMSE to stay below (R_a + R_b) * (1 + tol), where tol = 0.25 covers the spread of the
 // relMSE estimate itself (dominated by a few bright firefly pixels; measured spread over
-// seeds at 32 spp is about ±10%).
+// seeds at 32 spp is about ±10%). gdpt's samples are stratified (sampler.glsl), so its
+// Welford variance over-estimates Var[a]: R_a is an upper bound and only the upper limit is
+// tight. Below, the measured relMSE cannot fall under the reference's own floor R_b (less
+// the same tolerance) for any image that is not the reference's noise itself.
 //
 // Region means: the image is cut into 8x8 regions; for each region and channel the
 // difference of means is z-tested with sigma^2 = sigma_a^2 + sigma_b^2. sigma_a comes from
@@ -63,7 +66,7 @@ TEST_F(CboxReference, PathTracerMatchesIndependentRenderer) {
     RecordProperty("relmse", std::to_string(measured));
     RecordProperty("relmse_predicted", std::to_string(predicted));
     EXPECT_LT(measured, predicted * 1.25) << "measured " << measured << " predicted " << predicted;
-    EXPECT_GT(measured, predicted * 0.75) << "measured " << measured << " predicted " << predicted;
+    EXPECT_GT(measured, kReferenceFloor * 0.75) << "measured " << measured;
 
     // Region means.
     const double k = kReferenceFloor / ra;  // reference variance = k * gdpt variance

@@ -1,4 +1,5 @@
-// sobol.glsl: the scrambled 2-D Sobol' points that emitter-silhouette supersampling uses.
+// sobol.glsl: the scrambled 2-D Sobol' points that emitter-silhouette supersampling uses;
+// sampler.glsl: the padded, shuffled patterns of the path decisions built from them.
 // Checked against the definition of a (0,2)-sequence (every aligned block of 2^m points is
 // a (0,m,2)-net: one point in each elementary interval of every shape 2^a x 2^(m-a)), and
 // the scramble's uniformity: over scramble seeds, each single point is uniform on [0,1)^2
@@ -9,6 +10,7 @@
 
 #include "gdpt_shared.h"
 #include "lib/rng.glsl"
+#include "lib/sampler.glsl"
 #include "lib/sobol.glsl"
 #include "stats.h"
 
@@ -84,6 +86,48 @@ TEST(Sobol, EachScrambledPointIsUniform) {
         counts[static_cast<int>(p.y * kCells) * kCells + static_cast<int>(p.x * kCells)] += 1.0;
     }
     const std::vector<double> expected(counts.size(), double(kSeeds) / counts.size());
+    const auto r = gdpt::stats::chi2Test(counts, expected);
+    EXPECT_GT(r.pValue, 1e-4) << "chi2 " << r.statistic << " dof " << r.dof;
+}
+
+// Every power-of-two prefix of a pixel's samples is a (0,m,2)-net in every 2-D decision, and
+// stratified (one point per 1/2^m interval) in every 1-D one; the decisions are padded
+// (decorrelated), not copies of one pattern.
+TEST(Sampler, EveryPrefixIsANetInEveryDecision) {
+    for (uint pixel = 0; pixel < 8; ++pixel) {
+        for (uint dim = 0; dim < 9; ++dim) {
+            for (uint m = 0; m <= 8; ++m) {
+                std::vector<vec2> pairs;
+                std::vector<int> strata(1u << m, 0);
+                for (uint i = 0; i < (1u << m); ++i) {
+                    const LdSample s = ldSampleInit(pixel, i, 77u);
+                    pairs.push_back(ldGet2(s, dim));
+                    ++strata[static_cast<uint>(ldGet1(s, dim) * static_cast<float>(1u << m))];
+                }
+                ASSERT_TRUE(isNet(pairs, m)) << "pixel " << pixel << " dim " << dim << " m " << m;
+                for (int c : strata) ASSERT_EQ(c, 1) << "pixel " << pixel << " dim " << dim << " m " << m;
+            }
+        }
+    }
+    // Padding: the light point and the BSDF direction of one bounce differ sample by sample.
+    int same = 0;
+    for (uint i = 0; i < 64; ++i) {
+        const LdSample s = ldSampleInit(3u, i, 77u);
+        const vec3 a = ldLight(s, 0u), b = ldBsdf(s, 0u);
+        same += (a.y == b.y && a.z == b.z) ? 1 : 0;
+    }
+    EXPECT_EQ(same, 0);
+}
+
+TEST(Sampler, EachSampleIsUniformOverPixels) {
+    // Sample 3's BSDF direction at bounce 1 over 2^16 pixels, 16 x 16 cells (256 expected).
+    constexpr int kCells = 16;
+    std::vector<double> counts(kCells * kCells, 0.0);
+    for (uint pixel = 0; pixel < (1u << 16); ++pixel) {
+        const vec3 u = ldBsdf(ldSampleInit(pixel, 3u, 5u), 1u);
+        counts[static_cast<int>(u.z * kCells) * kCells + static_cast<int>(u.y * kCells)] += 1.0;
+    }
+    const std::vector<double> expected(counts.size(), double(1u << 16) / counts.size());
     const auto r = gdpt::stats::chi2Test(counts, expected);
     EXPECT_GT(r.pValue, 1e-4) << "chi2 " << r.statistic << " dof " << r.dof;
 }
