@@ -8,7 +8,7 @@
 //
 // Dimension 0 is the van der Corput radical inverse (bit reversal of the index); dimension 1
 // is Sobol's second generator matrix, whose columns are v_0 = 2^31, v_{k+1} = v_k ^ (v_k >> 1)
-// (Bratley & Fox 1988). Scrambling: the hash permutation of Laine & Karras 2011 with the
+// (Bratley & Fox 1988), i.e. the Pascal matrix mod 2. Scrambling: the hash permutation of Laine & Karras 2011 with the
 // constants of Burley 2020 ("Practical Hash-based Owen Scrambling", JCGT 9(4)), applied to
 // the bit-reversed value. Each output bit then depends only on itself and the bits above it
 // (as in the fraction's leading digits), which makes it a nested uniform scramble: it keeps
@@ -19,25 +19,29 @@
 
 #include "common.glsl"
 
+#ifdef __cplusplus
+#include <glm/integer.hpp>
+#endif
+
 GDPT_NAMESPACE_BEGIN
 
 GDPT_INLINE uint sobolReverseBits(uint v) {
-    v = ((v >> 1u) & 0x55555555u) | ((v & 0x55555555u) << 1u);
-    v = ((v >> 2u) & 0x33333333u) | ((v & 0x33333333u) << 2u);
-    v = ((v >> 4u) & 0x0F0F0F0Fu) | ((v & 0x0F0F0F0Fu) << 4u);
-    v = ((v >> 8u) & 0x00FF00FFu) | ((v & 0x00FF00FFu) << 8u);
-    return (v >> 16u) | (v << 16u);
+    return bitfieldReverse(v);  // GLSL built-in; glm's in the C++ view
 }
 
-// Sobol' dimension 1 of `index` as a 0.32 fixed-point fraction.
+// Sobol' dimension 1 of `index` as a 0.32 fixed-point fraction. By Lucas' theorem the
+// generator matrix has a one at (fraction bit j, index bit k) iff j's bits are a subset of
+// k's (C(k, j) odd), so fraction bit j is the XOR of the index bits k ⊇ j: a superset XOR
+// transform over the five bits of k, five masked shift-XOR steps instead of a loop over the
+// 32 columns.
 GDPT_INLINE uint sobolDim1(uint index) {
-    uint result = 0u;
-    uint v = 0x80000000u;
-    for (uint i = index; i != 0u; i >>= 1u) {
-        if ((i & 1u) != 0u) result ^= v;
-        v ^= v >> 1u;
-    }
-    return result;
+    uint a = index;
+    a ^= (a >> 1u) & 0x55555555u;
+    a ^= (a >> 2u) & 0x33333333u;
+    a ^= (a >> 4u) & 0x0F0F0F0Fu;
+    a ^= (a >> 8u) & 0x00FF00FFu;
+    a ^= (a >> 16u) & 0x0000FFFFu;
+    return sobolReverseBits(a);
 }
 
 // Nested uniform scramble of a 0.32 fraction (Burley 2020, listing 3's constants).
