@@ -111,26 +111,19 @@ void GptPass::reset() {
 void GptPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
                      vk::GpuTimer* timer) {
     visible_.record(cmd, sampleBase, spp, seed, timer);
-    // One sample per dispatch on CPU devices: llvmpipe's loop cap (samplesPerDispatch).
-    const std::uint32_t step = samplesPerDispatch(ctx_.info(), spp);
-    const std::uint64_t perRow = std::uint64_t{width_} * step;
-    const auto rowsPerDispatch = static_cast<std::uint32_t>(
-        std::max<std::uint64_t>(1, kMaxPixelSamplesPerDispatch / std::max<std::uint64_t>(perRow, 1)));
-    for (std::uint32_t first = 0; first < spp; first += step) {
-        for (std::uint32_t row = 0; row < height_; row += rowsPerDispatch) {
-            gpu::GptFrameParams p{};
-            p.sampleBase = sampleBase + first;
-            p.samplesPerPixel = std::min(step, spp - first);
-            p.seed = seed;
-            p.rowOffset = row;
-            p.rowCount = std::min(rowsPerDispatch, height_ - row);
-            p.shiftThreshold = options_.shiftThreshold;
-            p.width = width_;
-            p.height = height_;
-            kernel_.dispatchItems(cmd, width_, p.rowCount, &p, timer);
-        }
-        vk::computeBarrier(cmd);
-    }
+    recordTiled(cmd, ctx_.info(), width_, height_, sampleBase, spp, kMaxPixelSamplesPerDispatch,
+                [&](const DispatchTile& t) {
+                    gpu::GptFrameParams p{};
+                    p.sampleBase = t.sampleBase;
+                    p.samplesPerPixel = t.samples;
+                    p.seed = seed;
+                    p.rowOffset = t.rowOffset;
+                    p.rowCount = t.rowCount;
+                    p.shiftThreshold = options_.shiftThreshold;
+                    p.width = width_;
+                    p.height = height_;
+                    kernel_.dispatchItems(cmd, width_, p.rowCount, &p, timer);
+                });
 }
 
 void GptPass::resolve(VkCommandBuffer cmd, vk::GpuTimer* timer) {

@@ -28,6 +28,20 @@ std::uint32_t samplesPerDispatch(const vk::DeviceInfo& device, std::uint32_t bat
     return device.isCpu ? std::min<std::uint32_t>(1, batchSpp) : batchSpp;
 }
 
+void recordTiled(VkCommandBuffer cmd, const vk::DeviceInfo& device, std::uint32_t width, std::uint32_t height,
+                 std::uint32_t sampleBase, std::uint32_t spp, std::uint64_t maxPixelSamples,
+                 const std::function<void(const DispatchTile&)>& dispatch) {
+    const std::uint32_t step = samplesPerDispatch(device, spp);
+    const std::uint64_t perRow = std::uint64_t{width} * step;
+    const auto rowsPerDispatch =
+        static_cast<std::uint32_t>(std::max<std::uint64_t>(1, maxPixelSamples / std::max<std::uint64_t>(perRow, 1)));
+    for (std::uint32_t first = 0; first < spp; first += step) {
+        for (std::uint32_t row = 0; row < height; row += rowsPerDispatch)
+            dispatch({sampleBase + first, std::min(step, spp - first), row, std::min(rowsPerDispatch, height - row)});
+        vk::computeBarrier(cmd);
+    }
+}
+
 PtPass::PtPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg, std::uint32_t visibleSupersampling)
     : ctx_(ctx),
       width_(scene.constants().width),
@@ -54,23 +68,16 @@ void PtPass::reset() {
 void PtPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
                     vk::GpuTimer* timer) {
     visible_.record(cmd, sampleBase, spp, seed, timer);
-    const std::uint32_t step = samplesPerDispatch(ctx_.info(), spp);
-    const std::uint64_t perRow = std::uint64_t{width_} * step;
-    const auto rowsPerDispatch =
-        static_cast<std::uint32_t>(std::max<std::uint64_t>(1, kMaxPixelSamplesPerDispatch / std::max<std::uint64_t>(perRow, 1)));
-    for (std::uint32_t first = 0; first < spp; first += step) {
-        for (std::uint32_t row = 0; row < height_; row += rowsPerDispatch) {
-            gpu::FrameParams p{};
-            p.sampleBase = sampleBase + first;
-            p.samplesPerPixel = std::min(step, spp - first);
-            p.seed = seed;
-            p.rowOffset = row;
-            p.rowCount = std::min(rowsPerDispatch, height_ - row);
-            kernel_.dispatchItems(cmd, width_, p.rowCount, &p, timer);
-        }
-        // Each pixel's statistics are read and written by every dispatch of the batch.
-        vk::computeBarrier(cmd);
-    }
+    recordTiled(cmd, ctx_.info(), width_, height_, sampleBase, spp, kMaxPixelSamplesPerDispatch,
+                [&](const DispatchTile& t) {
+                    gpu::FrameParams p{};
+                    p.sampleBase = t.sampleBase;
+                    p.samplesPerPixel = t.samples;
+                    p.seed = seed;
+                    p.rowOffset = t.rowOffset;
+                    p.rowCount = t.rowCount;
+                    kernel_.dispatchItems(cmd, width_, p.rowCount, &p, timer);
+                });
 }
 
 gpu::Counters PtPass::takeCounters() {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "gdpt_shared.h"
@@ -29,6 +30,21 @@ struct DeviceInfo;
 // CPU devices take one sample per dispatch and the bounce loop is outermost. Elsewhere the
 // whole batch.
 std::uint32_t samplesPerDispatch(const vk::DeviceInfo& device, std::uint32_t batchSpp);
+
+// One dispatch of a batch: camera samples [sampleBase, sampleBase + samples) of the image
+// rows [rowOffset, rowOffset + rowCount).
+struct DispatchTile {
+    std::uint32_t sampleBase, samples, rowOffset, rowCount;
+};
+
+// Records a batch of `spp` camera samples from `sampleBase` of a width x height image as
+// dispatches of samplesPerDispatch samples and at most maxPixelSamples pixel-samples each
+// (row tiles, so that no dispatch runs long enough to trip a GPU watchdog), calling
+// `dispatch` per tile and recording a compute barrier after each step of samples (every
+// dispatch of a step writes disjoint pixels; the next step merges into the same ones).
+void recordTiled(VkCommandBuffer cmd, const vk::DeviceInfo& device, std::uint32_t width, std::uint32_t height,
+                 std::uint32_t sampleBase, std::uint32_t spp, std::uint64_t maxPixelSamples,
+                 const std::function<void(const DispatchTile&)>& dispatch);
 
 class PtPass {
 public:

@@ -98,7 +98,7 @@ TEST(Sobol, EachScrambledPointIsUniform) {
         ASSERT_LT(p.y, 1.0f);
         counts[static_cast<int>(p.y * kCells) * kCells + static_cast<int>(p.x * kCells)] += 1.0;
     }
-    const std::vector<double> expected(counts.size(), double(kSeeds) / counts.size());
+    const std::vector<double> expected(counts.size(), double(kSeeds) / static_cast<double>(counts.size()));
     const auto r = gdpt::stats::chi2Test(counts, expected);
     EXPECT_GT(r.pValue, 1e-4) << "chi2 " << r.statistic << " dof " << r.dof;
 }
@@ -140,7 +140,7 @@ TEST(Sampler, EachSampleIsUniformOverPixels) {
         const vec3 u = ldBsdf(ldSampleInit(pixel, 3u, 5u), 1u);
         counts[static_cast<int>(u.z * kCells) * kCells + static_cast<int>(u.y * kCells)] += 1.0;
     }
-    const std::vector<double> expected(counts.size(), double(1u << 16) / counts.size());
+    const std::vector<double> expected(counts.size(), double(1u << 16) / static_cast<double>(counts.size()));
     const auto r = gdpt::stats::chi2Test(counts, expected);
     EXPECT_GT(r.pValue, 1e-4) << "chi2 " << r.statistic << " dof " << r.dof;
 }
