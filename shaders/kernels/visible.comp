@@ -47,6 +47,7 @@ layout(push_constant, scalar) uniform Push { VisibleParams params; };
 #define GDPT_ANYHIT_FILTER(tri, u, v) alphaPasses(tri, u, v)
 #include "lib/bvh_traverse.glsl"
 #include "lib/camera.glsl"
+#include "lib/pixel_stats.glsl"
 
 const uint kProbeMixed = 1u;  // signatures of agreeing probes have bit 0 clear
 
@@ -109,7 +110,10 @@ void main() {
 
     // Welford over the camera samples, each the mean of its k rays (so that the statistics
     // count camera samples, like every other per-pixel estimate).
-    vec3 mean = vec3(0.0), m2 = vec3(0.0), firstValue = vec3(0.0);
+    Welford acc;
+    acc.mean = vec3(0.0);
+    acc.m2 = vec3(0.0);
+    vec3 firstValue = vec3(0.0);
     bool agree = true;
     for (uint s = 0u; s < samples; ++s) {
         vec3 sum = vec3(0.0);
@@ -120,23 +124,12 @@ void main() {
             agree = agree && all(equal(e, firstValue));
             sum += e;
         }
-        vec3 v = sum / float(raysPerSample);
-        vec3 delta = v - mean;
-        mean += delta / float(s + 1u);
-        m2 += delta * (v - mean);
+        welfordAdd(acc, sum / float(raysPerSample), s + 1u);
     }
     atomicAdd(counters.raysTraced, samples * raysPerSample);
     if (params.phase == kVisiblePhaseProbe) {
         probe[pixel] = agree ? emissionSignature(firstValue) : kProbeMixed;
         return;
     }
-    // Chan et al. 1979 merge of this batch into the running statistics.
-    PixelStats acc = visibleStats[pixel];
-    uint total = acc.count + samples;
-    vec3 delta = mean - acc.mean;
-    float fb = float(samples) / float(total);
-    acc.mean += delta * fb;
-    acc.m2 += m2 + delta * delta * float(acc.count) * fb;
-    acc.count = total;
-    visibleStats[pixel] = acc;
+    visibleStats[pixel] = chanMerge(visibleStats[pixel], acc, samples);
 }

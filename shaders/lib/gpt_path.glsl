@@ -1,9 +1,11 @@
 // gpt_path.glsl — per-path state and small helpers of gpt.comp: the offset path record,
 // pair existence at image borders, the vertex classification used by the shift, the pair
-// accumulation, and the Welford/Chan statistics (as pt.comp). GLSL only: expects the
+// accumulation, and the Welford/Chan statistics (pixel_stats.glsl). GLSL only: expects the
 // kernel's scene buffers, `frame` (GptFrameParams) and kOffsetDelta to be declared.
 #ifndef GDPT_LIB_GPT_PATH
 #define GDPT_LIB_GPT_PATH
+
+#include "lib/pixel_stats.glsl"
 
 // One offset path. For kShiftNotConnected `hit` is the offset's own current vertex; after
 // reconnection the offset's vertex is the base's and only woWorld (its own incoming
@@ -52,29 +54,6 @@ bool oneSidedBack(SurfaceHit h) {
 void addPair(inout OffsetPath op, float w, vec3 fBase, vec3 fOffset) {
     op.baseSum += w * fBase;
     op.offSum += w * fOffset;
-}
-
-// Welford accumulator of one quantity over this batch.
-struct Welford {
-    vec3 mean;
-    vec3 m2;
-};
-
-void welfordAdd(inout Welford a, vec3 x, uint n) {
-    vec3 delta = x - a.mean;
-    a.mean += delta / float(n);
-    a.m2 += delta * (x - a.mean);
-}
-
-// Chan et al. 1979 pairwise merge of a batch (n samples) into stored statistics.
-PixelStats chanMerge(PixelStats acc, Welford a, uint n) {
-    uint total = acc.count + n;
-    vec3 delta = a.mean - acc.mean;
-    float fb = float(n) / float(total);
-    acc.mean += delta * fb;
-    acc.m2 += a.m2 + delta * delta * float(acc.count) * fb;
-    acc.count = total;
-    return acc;
 }
 
 #endif  // GDPT_LIB_GPT_PATH
