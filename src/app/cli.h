@@ -7,6 +7,8 @@
 
 #include <glm/glm.hpp>
 
+#include "render/visible_options.h"
+
 namespace gdpt {
 
 struct RenderArgs {
@@ -30,7 +32,7 @@ struct RenderArgs {
     std::string schedule = "megakernel";
     float shiftThreshold = 0.001f;
     std::string splitBounce = "auto";  // G-PT: auto, on, off (GptPassOptions::SplitBounce)
-    std::uint32_t emitterSupersampling = 16;  // render/visible_pass.h (kDefaultVisibleSupersampling)
+    std::uint32_t emitterSupersampling = kDefaultVisibleSupersampling;  // render/visible_pass.h
     std::string recon = "l1";
     double alpha = 0.2;
     double tolerance = 1e-4;

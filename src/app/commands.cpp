@@ -327,7 +327,7 @@ int runInfo(const InfoArgs& args) {
     std::printf("kernel variant: pt[textures=%d punctual=%d lightTris=%d env=%d glossy=%d alphaMask=%d "
                 "visibleEmission=%d]\n",
                 f.hasTextures, f.hasPunctual, f.hasLightTris, f.hasEnv, f.hasGlossy, f.hasAlphaMask,
-                f.hasLightTris || f.hasEnv);
+                visibleEmissionPossible(f));
     for (const auto& u : scene.unsupported) std::printf("  unsupported: %s\n", u.c_str());
     return 0;
 }

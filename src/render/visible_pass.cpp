@@ -18,8 +18,13 @@ std::uint32_t rayBudget(std::uint32_t width, std::uint32_t height) {
     return std::max<std::uint32_t>(1, width * height / 4);
 }
 
-bool canSeeEmission(const SceneGpu& scene) {
-    return scene.features().hasLightTris || scene.features().hasEnv;
+// The factor the pass runs with: 0 (disabled) where the scene has nothing the camera could
+// see emit. Throws for a factor above the bound.
+std::uint32_t activeFactor(std::uint32_t samplesPerSpp, const SceneGpu& scene) {
+    if (samplesPerSpp > kMaxVisibleSupersampling)
+        throw Error("emitter supersampling " + std::to_string(samplesPerSpp) + " is above the maximum " +
+                    std::to_string(kMaxVisibleSupersampling));
+    return visibleEmissionPossible(scene.features()) ? samplesPerSpp : 0;
 }
 }  // namespace
 
@@ -27,19 +32,13 @@ VisiblePass::VisiblePass(const vk::Context& ctx, const SceneGpu& scene, Workgrou
                          std::uint32_t samplesPerSpp, const vk::Buffer& counters)
     : width_(scene.constants().width),
       height_(scene.constants().height),
-      samplesPerSpp_(samplesPerSpp),
-      stats_(ctx, samplesPerSpp > 0 && canSeeEmission(scene) ? std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats) : 0,
+      samplesPerSpp_(activeFactor(samplesPerSpp, scene)),
+      // Disabled: 16-byte placeholders (the path kernels compile the read out).
+      stats_(ctx, enabled() ? std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats) : 0,
              "visible-emission statistics"),
-      probe_(ctx, samplesPerSpp > 0 && canSeeEmission(scene) ? std::uint64_t{width_} * height_ * sizeof(std::uint32_t) : 0,
-             "visible-emission probe"),
+      probe_(ctx, enabled() ? std::uint64_t{width_} * height_ * sizeof(std::uint32_t) : 0, "visible-emission probe"),
       counter_(ctx, sizeof(gpu::VisibleCounter), "visible-emission counter") {
-    if (samplesPerSpp > kMaxVisibleSupersampling)
-        throw Error("emitter supersampling " + std::to_string(samplesPerSpp) + " is above the maximum " +
-                    std::to_string(kMaxVisibleSupersampling));
-    if (samplesPerSpp == 0 || !canSeeEmission(scene)) {
-        samplesPerSpp_ = 0;
-        return;
-    }
+    if (!enabled()) return;
     ctx.checkStorageBufferSize(stats_.size(), "the visible-emission statistics of a " + std::to_string(width_) +
                                                   "x" + std::to_string(height_) + " image");
     vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("visible", kSpv_visible), wg,

@@ -16,6 +16,7 @@
 #include "gdpt_shared.h"
 #include "image/image.h"
 #include "render/scene_gpu.h"
+#include "render/visible_options.h"
 #include "vk/buffer.h"
 #include "vk/kernel.h"
 
@@ -26,21 +27,13 @@ class Context;
 class GpuTimer;
 }  // namespace vk
 
-// Default rays per camera sample in a refined pixel (`gdpt render --emitter-supersampling`).
-// On the Cornell box G-PT at 4-16 spp, 16 took the light rim's share of relMSE from 40-60 %
-// to a few percent at about 1 % more rays (bench/RESULTS.md, fifth session).
-constexpr std::uint32_t kDefaultVisibleSupersampling = 16;
-// Upper bound of the factor: keeps the Sobol' index (factor × samples per pixel) within 32
-// bits up to the 2^24 samples that PixelStats counts exactly.
-constexpr std::uint32_t kMaxVisibleSupersampling = 64;
-
 class VisiblePass {
 public:
     // samplesPerSpp in [0, kMaxVisibleSupersampling]; 0 disables the pass.
     VisiblePass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg, std::uint32_t samplesPerSpp,
                 const vk::Buffer& counters);
 
-    [[nodiscard]] bool enabled() const { return kernel_.has_value(); }
+    [[nodiscard]] bool enabled() const { return samplesPerSpp_ > 0; }
     // Adds what a kernel that reads the statistics needs to its descriptor: the binding
     // kBindVisibleStats and the constant kSpecVisibleEmission (off when disabled).
     void configure(vk::KernelDesc& desc) const;
