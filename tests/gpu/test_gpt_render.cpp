@@ -36,18 +36,7 @@
 namespace gdpt {
 namespace {
 
-class GptRender : public test::GpuTest {
-protected:
-    static RenderOptions options(int w, int h, std::uint32_t spp, std::uint32_t seed) {
-        RenderOptions o;
-        o.scene.width = w;
-        o.scene.height = h;
-        o.spp = spp;
-        o.seed = seed;
-        o.quiet = true;
-        return o;
-    }
-};
+class GptRender : public test::GpuTest {};
 
 // One z-test of a region sum: |sum of (estimate − expected)| <= z sqrt(sum of variances).
 // Float32 rounding of the running means (~1e-6 relative, not noise) is allowed on top.
@@ -189,8 +178,8 @@ void checkAgainstPt(const RenderResultGpt& g, const RenderResult& pt, int region
 // Diffuse Cornell box: reconnection shifts only, occlusion edges at the boxes and walls.
 TEST_F(GptRender, DiffuseCornellGradientsAndPrimalMatchPathTracer) {
     const Scene scene = makeCornellBox();
-    const RenderResultGpt g = renderGpt(ctx(), scene, options(24, 24, 256, 101));
-    const RenderResult pt = renderPt(ctx(), scene, options(24, 24, 512, 202));
+    const RenderResultGpt g = renderGpt(ctx(), scene, renderOptions(24, 24, 256, 101));
+    const RenderResult pt = renderPt(ctx(), scene, renderOptions(24, 24, 512, 202));
     checkAgainstPt(g, pt, 6, "cornell");
 }
 
@@ -198,8 +187,8 @@ TEST_F(GptRender, DiffuseCornellGradientsAndPrimalMatchPathTracer) {
 // mirror sphere (Dirac: half-vector copies, specular chains, invertibility checks).
 TEST_F(GptRender, GlossyCornellWithMirrorGradientsAndPrimalMatchPathTracer) {
     const Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/glossy_cornell.gltf");
-    const RenderResultGpt g = renderGpt(ctx(), scene, options(24, 24, 256, 103));
-    const RenderResult pt = renderPt(ctx(), scene, options(24, 24, 512, 204));
+    const RenderResultGpt g = renderGpt(ctx(), scene, renderOptions(24, 24, 256, 103));
+    const RenderResult pt = renderPt(ctx(), scene, renderOptions(24, 24, 512, 204));
     checkAgainstPt(g, pt, 6, "glossy cornell");
 }
 
@@ -207,10 +196,10 @@ TEST_F(GptRender, GlossyCornellWithMirrorGradientsAndPrimalMatchPathTracer) {
 // and are shifted by half-vector copies of a smooth lobe (Jacobian |wo'·h| / |wo·h|).
 TEST_F(GptRender, GlossyLobeHalfVectorShiftMatchesPathTracer) {
     const Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/glossy_cornell.gltf");
-    RenderOptions o = options(24, 24, 256, 105);
+    RenderOptions o = renderOptions(24, 24, 256, 105);
     o.scene.shiftThreshold = 0.5f;
     const RenderResultGpt g = renderGpt(ctx(), scene, o);
-    const RenderResult pt = renderPt(ctx(), scene, options(24, 24, 512, 206));
+    const RenderResult pt = renderPt(ctx(), scene, renderOptions(24, 24, 512, 206));
     // Region sums only: half-vector copies through a GGX-0.3 lobe give heavy-tailed offset
     // contributions (rare large J·p'/p ratios), so single-pixel variance estimates at 256 spp
     // are unreliable there (measured: a pixel's standard error barely shrinks from 256 to
@@ -228,8 +217,8 @@ TEST_F(GptRender, MirrorCoatedDiffuseMatchesPathTracer) {
     white.roughness = 0.0f;
     white.ior = 1.5f;
     white.specularColor = glm::vec3(1.0f);
-    const RenderResultGpt g = renderGpt(ctx(), scene, options(24, 24, 256, 109));
-    const RenderResult pt = renderPt(ctx(), scene, options(24, 24, 512, 210));
+    const RenderResultGpt g = renderGpt(ctx(), scene, renderOptions(24, 24, 256, 109));
+    const RenderResult pt = renderPt(ctx(), scene, renderOptions(24, 24, 512, 210));
     // Region sums only (heavy-tailed specular chains; see the threshold-0.5 test). They do
     // catch the double-counted NEE of the smooth-components light rule: region z of 6..9.
     checkAgainstPt(g, pt, 6, "mirror-coated cornell", false);
@@ -246,7 +235,7 @@ TEST_F(GptRender, EnvironmentAndPointLightMatchPathTracer) {
     light.type = gpu::kPunctualPoint;
     light.intensity = glm::vec3(2.0f, 1.5f, 1.0f);
     scene.punctualLights.push_back(light);
-    RenderOptions o = options(24, 24, 256, 107);
+    RenderOptions o = renderOptions(24, 24, 256, 107);
     o.scene.envRadiance = glm::vec3(0.4f, 0.5f, 0.6f);
     const RenderResultGpt g = renderGpt(ctx(), scene, o);
     o.seed = 208;
@@ -259,7 +248,7 @@ TEST_F(GptRender, EnvironmentAndPointLightMatchPathTracer) {
 // exactly zero and direct is exactly the radiance.
 TEST_F(GptRender, DirectlySeenEmitterHasExactlyZeroGradients) {
     const glm::vec3 le(3.0f, 2.0f, 0.5f);
-    const RenderResultGpt g = renderGpt(ctx(), makeEmissiveQuad(le), options(16, 12, 8, 1));
+    const RenderResultGpt g = renderGpt(ctx(), makeEmissiveQuad(le), renderOptions(16, 12, 8, 1));
     EXPECT_EQ(g.stats.nanSamples, 0u);
     for (int c = 0; c < 3; ++c)
         for (std::size_t i = 0; i < g.primal.pixelCount(); ++i) {
@@ -299,7 +288,7 @@ TEST_F(GptRender, SplitBounceLoopGivesTheSameBitsAsTheSingleLoop) {
                           {"mirror-coated cornell", &coated, 0.001f, glm::vec3(0.0f)}};
     for (const Case& c : cases) {
         SCOPED_TRACE(c.name);
-        RenderOptions o = options(20, 16, 6, 11);
+        RenderOptions o = renderOptions(20, 16, 6, 11);
         o.scene.shiftThreshold = c.threshold;
         o.scene.envRadiance = c.env;
         GptPassOptions split;
@@ -324,8 +313,8 @@ TEST_F(GptRender, SplitBounceLoopGivesTheSameBitsAsTheSingleLoop) {
 // Same seed and spp give bit-identical images (no atomics in the accumulation).
 TEST_F(GptRender, DeterministicPerSeed) {
     const Scene scene = makeCornellBox();
-    const RenderResultGpt a = renderGpt(ctx(), scene, options(12, 12, 6, 3));
-    const RenderResultGpt b = renderGpt(ctx(), scene, options(12, 12, 6, 3));
+    const RenderResultGpt a = renderGpt(ctx(), scene, renderOptions(12, 12, 6, 3));
+    const RenderResultGpt b = renderGpt(ctx(), scene, renderOptions(12, 12, 6, 3));
     for (int c = 0; c < 3; ++c) {
         ASSERT_EQ(a.primal.plane(c), b.primal.plane(c));
         ASSERT_EQ(a.dx.plane(c), b.dx.plane(c));

@@ -22,14 +22,9 @@ class RenderLights : public test::GpuTest {
 protected:
     RenderResult render(const Scene& s, int size, std::uint32_t spp, glm::vec3 env = glm::vec3(0.0f),
                         std::uint32_t maxDepth = 64) {
-        RenderOptions o;
-        o.scene.width = size;
-        o.scene.height = size;
+        RenderOptions o = renderOptions(size, size, spp, 5);
         o.scene.envRadiance = env;
         o.scene.maxDepth = maxDepth;
-        o.spp = spp;
-        o.seed = 5;
-        o.quiet = true;
         return renderPt(ctx(), s, o);
     }
 };

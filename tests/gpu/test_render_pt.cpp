@@ -17,13 +17,7 @@ namespace {
 class RenderPt : public test::GpuTest {
 protected:
     RenderResult render(const Scene& scene, int w, int h, std::uint32_t spp, std::uint32_t seed = 1) {
-        RenderOptions o;
-        o.scene.width = w;
-        o.scene.height = h;
-        o.spp = spp;
-        o.seed = seed;
-        o.quiet = true;
-        return renderPt(ctx(), scene, o);
+        return renderPt(ctx(), scene, renderOptions(w, h, spp, seed));
     }
 };
 

@@ -82,12 +82,7 @@ RimErrors rimErrors(const Image& image, std::uint32_t spp, const std::string& wh
 class VisibleEmission : public test::GpuTest {
 protected:
     static RenderOptions options(std::uint32_t spp, std::uint32_t supersampling, std::uint32_t seed) {
-        RenderOptions o;
-        o.scene.width = kSize;
-        o.scene.height = kSize;
-        o.spp = spp;
-        o.seed = seed;
-        o.quiet = true;
+        RenderOptions o = renderOptions(kSize, kSize, spp, seed);
         o.visibleSupersampling = supersampling;
         return o;
     }

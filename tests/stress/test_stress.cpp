@@ -25,13 +25,7 @@ bool longMode() { return std::getenv("GDPT_STRESS_LONG") != nullptr; }
 class Stress : public test::GpuTest {
 protected:
     RenderResult render(const Scene& s, int w, int h, std::uint32_t spp, std::uint32_t seed = 3) {
-        RenderOptions o;
-        o.scene.width = w;
-        o.scene.height = h;
-        o.spp = spp;
-        o.seed = seed;
-        o.quiet = true;
-        return renderPt(ctx(), s, o);
+        return renderPt(ctx(), s, renderOptions(w, h, spp, seed));
     }
 };
 

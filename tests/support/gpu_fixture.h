@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "render/renderer.h"
 #include "vk/context.h"
 
 namespace gdpt::test {
@@ -28,6 +29,16 @@ protected:
             << "Vulkan validation reported errors during this test";
     }
     static vk::Context& ctx() { return gpuContext(); }
+    // The render settings every GPU test starts from: size, samples, seed, no progress output.
+    static RenderOptions renderOptions(int w, int h, std::uint32_t spp, std::uint32_t seed) {
+        RenderOptions o;
+        o.scene.width = w;
+        o.scene.height = h;
+        o.spp = spp;
+        o.seed = seed;
+        o.quiet = true;
+        return o;
+    }
 
 private:
     std::uint32_t errorsBefore_ = 0;
