@@ -152,16 +152,41 @@ GDPT_INLINE Hit missHit(float tMax) {
     return h;
 }
 
-// Slab tests of a wide node's four children for (tMin, tFarLimit): intersectBox, four at
-// once; hit[k] is false for empty slots.
+// The four bytes of q as floats (exact small integers), byte k -> component k.
+GDPT_INLINE vec4 wideUnpackBytes(uint q) {
+    return vec4(float(q & 255u), float((q >> 8u) & 255u), float((q >> 16u) & 255u), float(q >> 24u));
+}
+
+// Scale of axis `axis` (0..2) of a wide node: 2^(e - 127), e = byte `axis` of exponents.
+GDPT_INLINE float wideAxisScale(uint exponents, uint axis) {
+    return uintBitsToFloat(((exponents >> (8u * axis)) & 255u) << 23u);
+}
+
+// Decoded bound of one axis for the four children: origin + q·scale (q·scale is exact, so
+// this is one rounding however it is evaluated; BvhWideNode).
+GDPT_INLINE vec4 wideDecodeAxis(float origin, uint q, float scale) {
+    return vec4(origin) + wideUnpackBytes(q) * scale;
+}
+
+// Children's triangle counts (0 = inner node or empty slot).
+GDPT_INLINE uvec4 wideCounts(BvhWideNode n) {
+    uint c = n.qMin.w;
+    return uvec4(c & 255u, (c >> 8u) & 255u, (c >> 16u) & 255u, c >> 24u);
+}
+
+// Slab tests of a wide node's four children (their decoded boxes) for (tMin, tFarLimit):
+// intersectBox, four at once; hit[k] is false for empty slots.
 GDPT_INLINE void wideNodeBoxes(BvhWideNode n, vec3 orig, vec3 invDir, float tMin, float tFarLimit,
                                GDPT_OUT(vec4) tNear, GDPT_OUT(bvec4) hit) {
-    vec4 t0x = (n.minX - orig.x) * invDir.x;
-    vec4 t1x = (n.maxX - orig.x) * invDir.x;
-    vec4 t0y = (n.minY - orig.y) * invDir.y;
-    vec4 t1y = (n.maxY - orig.y) * invDir.y;
-    vec4 t0z = (n.minZ - orig.z) * invDir.z;
-    vec4 t1z = (n.maxZ - orig.z) * invDir.z;
+    float sx = wideAxisScale(n.exponents, 0u);
+    float sy = wideAxisScale(n.exponents, 1u);
+    float sz = wideAxisScale(n.exponents, 2u);
+    vec4 t0x = (wideDecodeAxis(n.origin.x, n.qMin.x, sx) - orig.x) * invDir.x;
+    vec4 t1x = (wideDecodeAxis(n.origin.x, n.qMax.x, sx) - orig.x) * invDir.x;
+    vec4 t0y = (wideDecodeAxis(n.origin.y, n.qMin.y, sy) - orig.y) * invDir.y;
+    vec4 t1y = (wideDecodeAxis(n.origin.y, n.qMax.y, sy) - orig.y) * invDir.y;
+    vec4 t0z = (wideDecodeAxis(n.origin.z, n.qMin.z, sz) - orig.z) * invDir.z;
+    vec4 t1z = (wideDecodeAxis(n.origin.z, n.qMax.z, sz) - orig.z) * invDir.z;
     tNear = max(max(min(t0x, t1x), min(t0y, t1y)), max(min(t0z, t1z), vec4(tMin)));
     vec4 tFar = min(min(max(t0x, t1x), max(t0y, t1y)), min(max(t0z, t1z), vec4(tFarLimit))) * kBvhSlabFarScale;
     hit = bvec4(tNear.x <= tFar.x && n.child.x != kInvalidIndex, tNear.y <= tFar.y && n.child.y != kInvalidIndex,
@@ -169,8 +194,8 @@ GDPT_INLINE void wideNodeBoxes(BvhWideNode n, vec3 orig, vec3 invDir, float tMin
 }
 
 // Triangle counts of the hit leaf children (0 for a slot that is not a hit leaf).
-GDPT_INLINE uvec4 wideLeafCounts(BvhWideNode n, bvec4 hit) {
-    return uvec4(hit.x ? n.count.x : 0u, hit.y ? n.count.y : 0u, hit.z ? n.count.z : 0u, hit.w ? n.count.w : 0u);
+GDPT_INLINE uvec4 wideLeafCounts(uvec4 count, bvec4 hit) {
+    return uvec4(hit.x ? count.x : 0u, hit.y ? count.y : 0u, hit.z ? count.z : 0u, hit.w ? count.w : 0u);
 }
 
 // Triangle k of the hit leaf children taken in slot order, with counts c (wideLeafCounts):
@@ -206,10 +231,10 @@ GDPT_INLINE void wideCompareSwap(GDPT_INOUT(uint) ca, GDPT_INOUT(float) ta, GDPT
 
 // The inner children that the ray enters before tLimit, sorted by entry distance (a
 // five-comparator network over the four slots; absent ones last).
-GDPT_INLINE WideOrder wideSortInner(BvhWideNode n, bvec4 hit, vec4 tNear, float tLimit) {
+GDPT_INLINE WideOrder wideSortInner(BvhWideNode n, uvec4 count, bvec4 hit, vec4 tNear, float tLimit) {
     WideOrder o;
-    bvec4 inner = bvec4(hit.x && n.count.x == 0u && tNear.x <= tLimit, hit.y && n.count.y == 0u && tNear.y <= tLimit,
-                        hit.z && n.count.z == 0u && tNear.z <= tLimit, hit.w && n.count.w == 0u && tNear.w <= tLimit);
+    bvec4 inner = bvec4(hit.x && count.x == 0u && tNear.x <= tLimit, hit.y && count.y == 0u && tNear.y <= tLimit,
+                        hit.z && count.z == 0u && tNear.z <= tLimit, hit.w && count.w == 0u && tNear.w <= tLimit);
     o.child = uvec4(inner.x ? n.child.x : kInvalidIndex, inner.y ? n.child.y : kInvalidIndex,
                     inner.z ? n.child.z : kInvalidIndex, inner.w ? n.child.w : kInvalidIndex);
     o.t = vec4(inner.x ? tNear.x : kBvhNoEntry, inner.y ? tNear.y : kBvhNoEntry, inner.z ? tNear.z : kBvhNoEntry,
@@ -258,7 +283,8 @@ Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
         vec4 tNear;
         bvec4 h;
         wideNodeBoxes(n, orig, invDir, tMin, hit.t, tNear, h);
-        uvec4 c = wideLeafCounts(n, h);
+        uvec4 count = wideCounts(n);
+        uvec4 c = wideLeafCounts(count, h);
         for (uint k = 0u; k < c.x + c.y + c.z + c.w; ++k) {
             uint i = wideLeafTriangle(n.child, k, c);
             float tCand = hit.t;
@@ -273,7 +299,7 @@ Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
         }
         // Inner children still in reach, nearest first (wideSortInner); visit the nearest,
         // push the others farthest first so that they pop in near-to-far order.
-        WideOrder o = wideSortInner(n, h, tNear, hit.t);
+        WideOrder o = wideSortInner(n, count, h, tNear, hit.t);
         uint next = o.child.x;
         if (o.child.w != kInvalidIndex) {
             stackNode[stackSize] = o.child.w;
@@ -312,7 +338,8 @@ bool traceAny(vec3 orig, vec3 dir, float tMin, float tMax) {
         vec4 tNear;
         bvec4 h;
         wideNodeBoxes(n, orig, invDir, tMin, tMax, tNear, h);
-        uvec4 c = wideLeafCounts(n, h);
+        uvec4 count = wideCounts(n);
+        uvec4 c = wideLeafCounts(count, h);
         for (uint k = 0u; k < c.x + c.y + c.z + c.w; ++k) {
             uint i = wideLeafTriangle(n.child, k, c);
             float tCand = tMax;
@@ -322,7 +349,7 @@ bool traceAny(vec3 orig, vec3 dir, float tMin, float tMax) {
         }
         uint next = kInvalidIndex;
         for (uint j = 0u; j < 4u; ++j) {
-            if (!(h[j] && n.count[j] == 0u)) continue;
+            if (!(h[j] && count[j] == 0u)) continue;
             if (next == kInvalidIndex) {
                 next = n.child[j];
             } else {

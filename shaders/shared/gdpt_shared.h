@@ -90,20 +90,25 @@ struct BvhNode {
 };
 
 // Four-wide BVH node, what the kernels traverse (src/bvh/wide_bvh.h collapses the binary
-// BvhNode tree into it; root = node 0). Child k's box is (minX[k], minY[k], minZ[k]) ..
-// (maxX[k], maxY[k], maxZ[k]): one vec4 per coordinate, so the four slab tests are vec4
-// arithmetic. 128 bytes. Measured against the binary layout on lavapipe (bench/RESULTS.md,
-// fourth session): 9 % fewer G-PT ms per sample on Mesa 22.3 and on Mesa 25.
+// BvhNode tree into it; root = node 0), with its children's boxes quantised to 8 bits per
+// coordinate against the node's own box (after Ylitie et al. 2017, "Efficient incoherent ray
+// traversal on GPUs through compressed wide BVHs"). On axis a, child k's box is
+//   origin[a] + q * 2^(e_a - 127)  for q = byte k of qMin<a> .. byte k of qMax<a>,
+// e_a = byte a of `exponents`. The power-of-two scale makes q·2^e exact, so a decoded bound
+// is one rounding of origin + q·2^e whichever way a compiler evaluates it; the builder picks
+// each q so that the decoded box contains the child's exact box (wideQuantise in
+// wide_bvh.cpp). 64 bytes instead of 128: on lavapipe a node's loads are most of a node
+// visit (bench/RESULTS.md, sixth session).
 struct BvhWideNode {
-    vec4 minX;
-    vec4 minY;
-    vec4 minZ;
-    vec4 maxX;
-    vec4 maxY;
-    vec4 maxZ;
-    uvec4 child;  // node index (count 0) or first triangle (count > 0); kInvalidIndex = empty slot
-    uvec4 count;  // 0 = inner node, else triangle count (<= kMaxLeafTriangles)
+    vec3 origin;     // lower corner of the node's box (world space)
+    uint exponents;  // bytes 0..2: biased float exponents of the x, y, z scales; byte 3: 0
+    uvec4 qMin;      // xyz: byte k = child k's lower bound in scale steps above origin; w: counts
+    uvec4 qMax;      // xyz: byte k = child k's upper bound (rounded up); w: 0
+    uvec4 child;     // node index (count 0) or first triangle (count > 0); kInvalidIndex = empty slot
 };
+// Four 16-byte vectors, so that a node is four vector loads (llvmpipe loads per lane and per
+// load instruction); qMin.w holds the children's triangle counts, byte k for child k (0 =
+// inner node or empty slot, <= kMaxLeafTriangles).
 
 // ---------------------------------------------------------------------------------------------
 // Materials and textures

@@ -182,10 +182,11 @@ Hit traceClosestWideCpu(const std::vector<gpu::BvhWideNode>& nodes, const std::v
         glm::vec4 tNear;
         glm::bvec4 h;
         gpu::wideNodeBoxes(n, orig, invDir, tMin, hit.t, tNear, h);
-        const glm::uvec4 c = gpu::wideLeafCounts(n, h);
+        const glm::uvec4 count = gpu::wideCounts(n);
+        const glm::uvec4 c = gpu::wideLeafCounts(count, h);
         for (uint32_t k = 0u; k < c.x + c.y + c.z + c.w; ++k)
             closerHit(geoms, orig, dir, gpu::wideLeafTriangle(n.child, k, c), tMin, hit);
-        const gpu::WideOrder o = gpu::wideSortInner(n, h, tNear, hit.t);
+        const gpu::WideOrder o = gpu::wideSortInner(n, count, h, tNear, hit.t);
         uint32_t next = o.child.x;
         if (o.child.w != gpu::kInvalidIndex) {
             stackNode[stackSize] = o.child.w;
@@ -226,12 +227,13 @@ bool traceAnyWideCpu(const std::vector<gpu::BvhWideNode>& nodes, const std::vect
         glm::vec4 tNear;
         glm::bvec4 h;
         gpu::wideNodeBoxes(n, orig, invDir, tMin, tMax, tNear, h);
-        const glm::uvec4 c = gpu::wideLeafCounts(n, h);
+        const glm::uvec4 count = gpu::wideCounts(n);
+        const glm::uvec4 c = gpu::wideLeafCounts(count, h);
         for (uint32_t k = 0u; k < c.x + c.y + c.z + c.w; ++k)
             if (anyHitAt(geoms, orig, dir, gpu::wideLeafTriangle(n.child, k, c), tMin, tMax)) return true;
         uint32_t next = gpu::kInvalidIndex;
         for (glm::length_t j = 0; j < 4; ++j) {
-            if (!(h[j] && n.count[j] == 0u)) continue;
+            if (!(h[j] && count[j] == 0u)) continue;
             if (next == gpu::kInvalidIndex) {
                 next = n.child[j];
             } else {

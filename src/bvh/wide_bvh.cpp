@@ -1,8 +1,13 @@
 #include "bvh/wide_bvh.h"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
+
+#include "lib/bvh_traverse.glsl"
 
 namespace gdpt {
 namespace {
@@ -13,9 +18,78 @@ struct Slot {
     uint32_t count;  // 0 = inner
 };
 
+// Lower bound on the biased exponent of a quantisation scale: 2^-126, the smallest normal.
+constexpr int kMinBiasedExponent = 1;
+// Upper bound: 255 · 2^(246 - 127) is still finite, so no decoded bound becomes infinite.
+constexpr int kMaxBiasedExponent = 246;
+
+float scaleOf(int biased) {
+    return std::ldexp(1.0f, biased - 127);
+}
+
+// The shaders' decode (wideDecodeAxis): q·scale is exact, so this is their value bit for bit.
+float decode(float origin, uint32_t q, float scale) {
+    return origin + static_cast<float>(q) * scale;
+}
+
+// The smallest power-of-two scale whose 255 steps from origin reach `top` (biased exponent).
+int axisExponent(float origin, float top) {
+    const float extent = top - origin;
+    int biased = 127;
+    if (extent > 0.0f) {
+        int e = 0;
+        (void)std::frexp(extent / 255.0f, &e);  // extent / 255 < 2^e
+        biased = std::clamp(e + 127, kMinBiasedExponent, kMaxBiasedExponent);
+        while (biased > kMinBiasedExponent && decode(origin, 255u, scaleOf(biased - 1)) >= top) --biased;
+        while (biased < kMaxBiasedExponent && decode(origin, 255u, scaleOf(biased)) < top) ++biased;
+    }
+    if (!(decode(origin, 255u, scaleOf(biased)) >= top))
+        throw std::invalid_argument("collapseToWide: a node extends over more than a float's range");
+    return biased;
+}
+
+// Largest q whose decoded bound is <= v (a lower bound) or smallest whose bound is >= v.
+// floor/ceil in double are already right whenever v - origin is exact in double (rounding
+// to float is monotonic); the loops check the float decode itself for the other cases.
+uint32_t quantiseDown(float origin, float scale, float v) {
+    auto q = static_cast<uint32_t>(std::clamp(std::floor((double(v) - origin) / scale), 0.0, 255.0));
+    while (q > 0 && decode(origin, q, scale) > v) --q;
+    return q;
+}
+uint32_t quantiseUp(float origin, float scale, float v) {
+    auto q = static_cast<uint32_t>(std::clamp(std::ceil((double(v) - origin) / scale), 0.0, 255.0));
+    while (q < 255 && decode(origin, q, scale) < v) ++q;
+    return q;
+}
+
 float halfArea(const Slot& s) {
     const glm::vec3 e = s.max - s.min;
     return e.x * e.y + e.y * e.z + e.z * e.x;
+}
+
+// The wide node of `count` child boxes: origin = their union's lower corner, per axis the
+// scale of axisExponent and each bound rounded outwards (BvhWideNode). Children and counts
+// are left for the caller (empty slots keep kInvalidIndex).
+gpu::BvhWideNode quantiseWideNode(const std::array<Slot, 4>& slots, std::size_t count) {
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (std::size_t i = 0; i < count; ++i) {
+        lo = glm::min(lo, slots[i].min);
+        hi = glm::max(hi, slots[i].max);
+    }
+    gpu::BvhWideNode w{};
+    w.child = glm::uvec4(gpu::kInvalidIndex);
+    w.origin = count > 0 ? lo : glm::vec3(0.0f);
+    for (glm::length_t a = 0; a < 3; ++a) {
+        const int biased = count > 0 ? axisExponent(w.origin[a], hi[a]) : 127;
+        w.exponents |= static_cast<uint32_t>(biased) << (8 * a);
+        const float scale = scaleOf(biased);
+        for (std::size_t i = 0; i < count; ++i) {
+            const auto shift = static_cast<uint32_t>(8 * i);
+            w.qMin[a] |= quantiseDown(w.origin[a], scale, slots[i].min[a]) << shift;
+            w.qMax[a] |= quantiseUp(w.origin[a], scale, slots[i].max[a]) << shift;
+        }
+    }
+    return w;
 }
 
 class Collapser {
@@ -43,19 +117,13 @@ public:
         // Visiting this node pushes every inner child but the one it descends into.
         const uint32_t below = stack + (inner > 0 ? inner - 1 : 0);
         out_.maxStack = std::max(out_.maxStack, below);
-        gpu::BvhWideNode w{};
-        w.child = glm::uvec4(gpu::kInvalidIndex);
-        w.count = glm::uvec4(0u);
+        std::array<Slot, 4> boxes{};
+        for (std::size_t i = 0; i < slots.size(); ++i) boxes[i] = slots[i];
+        gpu::BvhWideNode w = quantiseWideNode(boxes, slots.size());
         for (std::size_t i = 0; i < slots.size(); ++i) {
             const auto k = static_cast<glm::length_t>(i);
             const Slot& s = slots[i];
-            w.minX[k] = s.min.x;
-            w.minY[k] = s.min.y;
-            w.minZ[k] = s.min.z;
-            w.maxX[k] = s.max.x;
-            w.maxY[k] = s.max.y;
-            w.maxZ[k] = s.max.z;
-            w.count[k] = s.count;
+            w.qMin.w |= s.count << (8u * static_cast<uint32_t>(i));
             if (s.count > 0) {
                 w.child[k] = s.index;
                 out_.maxDepth = std::max(out_.maxDepth, depth);
@@ -91,6 +159,20 @@ WideBvh collapseToWide(const std::vector<gpu::BvhNode>& binary) {
                                     " stack entries, more than the kernels' " +
                                     std::to_string(gpu::kBvhWideStackSize));
     return w;
+}
+
+WideChildBox wideChildBox(const gpu::BvhWideNode& node, int k) {
+    const auto slot = static_cast<glm::length_t>(k);
+    const glm::vec3 scale(gpu::wideAxisScale(node.exponents, 0u), gpu::wideAxisScale(node.exponents, 1u),
+                          gpu::wideAxisScale(node.exponents, 2u));
+    WideChildBox b;
+    b.min = {gpu::wideDecodeAxis(node.origin.x, node.qMin.x, scale.x)[slot],
+             gpu::wideDecodeAxis(node.origin.y, node.qMin.y, scale.y)[slot],
+             gpu::wideDecodeAxis(node.origin.z, node.qMin.z, scale.z)[slot]};
+    b.max = {gpu::wideDecodeAxis(node.origin.x, node.qMax.x, scale.x)[slot],
+             gpu::wideDecodeAxis(node.origin.y, node.qMax.y, scale.y)[slot],
+             gpu::wideDecodeAxis(node.origin.z, node.qMax.z, scale.z)[slot]};
+    return b;
 }
 
 }  // namespace gdpt

@@ -1,10 +1,13 @@
 // wide_bvh.h — the four-wide BVH the kernels traverse: the binary binned-SAH tree of
 // builder.h collapsed into gpu::BvhWideNode (each wide node adopts grandchildren until it has
-// four children or only leaves), over the same leaf-ordered TriangleGeom array.
+// four children or only leaves), over the same leaf-ordered TriangleGeom array, with each
+// node's child boxes quantised to 8 bits per bound and rounded outwards.
 #pragma once
 
 #include <cstdint>
 #include <vector>
+
+#include <glm/glm.hpp>
 
 #include "gdpt_shared.h"
 
@@ -22,6 +25,14 @@ struct WideBvh {
 // Throws std::invalid_argument if a traversal could need more than gpu::kBvhWideStackSize
 // entries (bounded here by the sum over a root-to-leaf path of each node's inner children
 // minus one; the binary depth cap keeps real trees far below it).
+// The slab bounds also throw std::invalid_argument if a node is too large for a finite
+// 8-bit quantisation (extents beyond about 2^127).
 WideBvh collapseToWide(const std::vector<gpu::BvhNode>& binary);
+
+// Child k's box as the kernels decode it (gpu::wideDecodeAxis); meaningless for an empty slot.
+struct WideChildBox {
+    glm::vec3 min, max;
+};
+WideChildBox wideChildBox(const gpu::BvhWideNode& node, int k);
 
 }  // namespace gdpt

@@ -55,14 +55,11 @@ TEST_F(LayoutGpu, EveryFieldMatchesBetweenCppAndGlsl) {
     EXPECT_EQ(pa.node.rmax, glm::vec3(13, 14, 15));
     EXPECT_EQ(pa.node.rightCount, 16u);
 
-    EXPECT_EQ(pb.wide.minX, glm::vec4(1, 2, 3, 4));
-    EXPECT_EQ(pb.wide.minY, glm::vec4(5, 6, 7, 8));
-    EXPECT_EQ(pb.wide.minZ, glm::vec4(9, 10, 11, 12));
-    EXPECT_EQ(pb.wide.maxX, glm::vec4(13, 14, 15, 16));
-    EXPECT_EQ(pb.wide.maxY, glm::vec4(17, 18, 19, 20));
-    EXPECT_EQ(pb.wide.maxZ, glm::vec4(21, 22, 23, 24));
-    EXPECT_EQ(pb.wide.child, glm::uvec4(25, 26, 27, 28));
-    EXPECT_EQ(pb.wide.count, glm::uvec4(29, 30, 31, 32));
+    EXPECT_EQ(pb.wide.origin, glm::vec3(1, 2, 3));
+    EXPECT_EQ(pb.wide.exponents, 4u);
+    EXPECT_EQ(pb.wide.qMin, glm::uvec4(5, 6, 7, 8));
+    EXPECT_EQ(pb.wide.qMax, glm::uvec4(9, 10, 11, 12));
+    EXPECT_EQ(pb.wide.child, glm::uvec4(13, 14, 15, 16));
 
     EXPECT_EQ(pa.shading.n0, glm::vec3(1, 2, 3));
     EXPECT_EQ(pa.shading.material, 4u);

@@ -34,7 +34,6 @@ void main() {
     light.position = vec3(1, 2, 3); light.type = 4u; light.intensity = vec3(5, 6, 7); light.cosInner = 8.0;
     light.direction = vec3(9, 10, 11); light.cosOuter = 12.0;
 
-    wide.minX = vec4(1, 2, 3, 4); wide.minY = vec4(5, 6, 7, 8); wide.minZ = vec4(9, 10, 11, 12);
-    wide.maxX = vec4(13, 14, 15, 16); wide.maxY = vec4(17, 18, 19, 20); wide.maxZ = vec4(21, 22, 23, 24);
-    wide.child = uvec4(25, 26, 27, 28); wide.count = uvec4(29, 30, 31, 32);
+    wide.origin = vec3(1, 2, 3); wide.exponents = 4u;
+    wide.qMin = uvec4(5, 6, 7, 8); wide.qMax = uvec4(9, 10, 11, 12); wide.child = uvec4(13, 14, 15, 16);
 }

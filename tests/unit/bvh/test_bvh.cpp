@@ -207,42 +207,47 @@ void checkStructure(const Mesh& m, const Bvh& bvh, uint32_t leafLimit) {
 }
 
 // The wide tree: every wide node reachable once, every triangle in exactly one leaf slot
-// (the binary tree's leaf ranges, so the leaf count matches), each slot's box containing its
-// triangles or its child's slots, and the stack bound within the kernels' stack.
+// (the binary tree's leaf ranges, so the leaf count matches), each triangle inside the
+// decoded (quantised) box of every slot on its path from the root, and the stack bound
+// within the kernels' stack.
 void checkWideStructure(const Mesh& m, const Bvh& bvh, const WideBvh& wide) {
     std::vector<int> seen(m.triangles.size(), 0);
     std::vector<int> nodeSeen(wide.nodes.size(), 0);
     uint32_t leaves = 0;
-    const auto contains = [](const glm::vec3& mn, const glm::vec3& mx, const glm::vec3& p) {
-        return p.x >= mn.x && p.y >= mn.y && p.z >= mn.z && p.x <= mx.x && p.y <= mx.y && p.z <= mx.z;
+    const auto contains = [](const WideChildBox& b, const glm::vec3& p) {
+        return p.x >= b.min.x && p.y >= b.min.y && p.z >= b.min.z && p.x <= b.max.x && p.y <= b.max.y &&
+               p.z <= b.max.z;
     };
-    std::vector<uint32_t> todo = {0};
+    struct Visit {
+        uint32_t node;
+        std::vector<WideChildBox> ancestors;  // decoded boxes of the slots leading here
+    };
+    std::vector<Visit> todo = {{0, {}}};
     while (!todo.empty()) {
-        const uint32_t ni = todo.back();
+        const Visit visit = todo.back();
         todo.pop_back();
+        const uint32_t ni = visit.node;
         ASSERT_LT(ni, wide.nodes.size());
         ++nodeSeen[ni];
         const gpu::BvhWideNode& n = wide.nodes[ni];
+        const glm::uvec4 count = gpu::wideCounts(n);
         for (glm::length_t k = 0; k < 4; ++k) {
             if (n.child[k] == gpu::kInvalidIndex) continue;
-            const glm::vec3 mn(n.minX[k], n.minY[k], n.minZ[k]);
-            const glm::vec3 mx(n.maxX[k], n.maxY[k], n.maxZ[k]);
-            if (n.count[k] > 0) {
+            std::vector<WideChildBox> path = visit.ancestors;
+            path.push_back(wideChildBox(n, k));
+            if (count[k] > 0) {
                 ++leaves;
-                for (uint32_t i = n.child[k]; i < n.child[k] + n.count[k]; ++i) {
+                for (uint32_t i = n.child[k]; i < n.child[k] + count[k]; ++i) {
                     ASSERT_LT(i, seen.size());
                     const uint32_t orig = bvh.triangleOrder[i];
                     ++seen[orig];
-                    for (int c = 0; c < 3; ++c) EXPECT_TRUE(contains(mn, mx, m.positions[m.triangles[orig][c]]));
+                    for (const WideChildBox& b : path)
+                        for (int c = 0; c < 3; ++c)
+                            EXPECT_TRUE(contains(b, m.positions[m.triangles[orig][c]]))
+                                << "triangle " << orig << " outside a decoded box on its path";
                 }
             } else {
-                const gpu::BvhWideNode& c = wide.nodes[n.child[k]];
-                for (glm::length_t j = 0; j < 4; ++j) {
-                    if (c.child[j] == gpu::kInvalidIndex) continue;
-                    EXPECT_TRUE(contains(mn, mx, {c.minX[j], c.minY[j], c.minZ[j]}));
-                    EXPECT_TRUE(contains(mn, mx, {c.maxX[j], c.maxY[j], c.maxZ[j]}));
-                }
-                todo.push_back(n.child[k]);
+                todo.push_back({n.child[k], path});
             }
         }
     }
@@ -334,6 +339,26 @@ TEST(BvhTraversal, ThinAxisAlignedMatchesBruteForce) {
     const Mesh m = thinAxisAlignedScene();
     compareWithBruteForce(m, BvhBuildOptions{}, 100000, 7);
     compareWithBruteForce(m, kDeepOptions, 5000, 8);
+}
+
+// The wide tree's 8-bit child boxes (BvhWideNode) where their rounding is most at risk: a
+// small detailed scene far from the origin (origin + q·scale rounds at a coarse float
+// spacing) and a huge one (large scale exponents; 1e10 keeps the triangle test's cubic
+// products within float range).
+Mesh transformed(Mesh m, float scale, glm::vec3 offset) {
+    for (glm::vec3& p : m.positions) p = p * scale + offset;
+    return m;
+}
+
+TEST(BvhTraversal, SmallSceneFarFromOriginMatchesBruteForce) {
+    const Mesh m = transformed(test::randomSoup(300, 0.25f, 21), 1e-2f, glm::vec3(3.0e4f, -7.5e4f, 1.25e5f));
+    compareWithBruteForce(m, BvhBuildOptions{}, 50000, 22);
+    compareWithBruteForce(m, kDeepOptions, 5000, 23);
+}
+
+TEST(BvhTraversal, HugeSceneMatchesBruteForce) {
+    const Mesh m = transformed(test::terrain(10, 13), 1e10f, glm::vec3(-2e10f, 0.0f, 5e9f));
+    compareWithBruteForce(m, BvhBuildOptions{}, 50000, 24);
 }
 
 TEST(BvhTraversal, SingleTriangle) {

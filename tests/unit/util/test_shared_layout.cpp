@@ -18,8 +18,9 @@ static_assert(offsetof(TriangleShading, material) == 12 && offsetof(TriangleShad
 static_assert(offsetof(TriangleShading, uv0) == 48 && offsetof(TriangleShading, lightIndex) == 72);
 static_assert(sizeof(BvhNode) == 64);
 static_assert(offsetof(BvhNode, leftCount) == 28 && offsetof(BvhNode, rightCount) == 60);
-static_assert(sizeof(BvhWideNode) == 128);
-static_assert(offsetof(BvhWideNode, maxX) == 48 && offsetof(BvhWideNode, child) == 96 && offsetof(BvhWideNode, count) == 112);
+static_assert(sizeof(BvhWideNode) == 64);
+static_assert(offsetof(BvhWideNode, exponents) == 12 && offsetof(BvhWideNode, qMin) == 16);
+static_assert(offsetof(BvhWideNode, qMax) == 32 && offsetof(BvhWideNode, child) == 48);
 static_assert(sizeof(Material) == 80);
 static_assert(offsetof(Material, emissive) == 16 && offsetof(Material, specularColor) == 32);
 static_assert(offsetof(Material, flags) == 60 && offsetof(Material, normalTex) == 76);
