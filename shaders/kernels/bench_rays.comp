@@ -23,6 +23,7 @@ layout(push_constant, scalar) uniform Push { FrameParams frame; };
 #include "lib/camera.glsl"
 
 void main() {
+    loadScene();
     uint x = gl_GlobalInvocationID.x;
     uint y = gl_GlobalInvocationID.y + frame.rowOffset;
     if (x >= scene.width || y >= scene.height || gl_GlobalInvocationID.y >= frame.rowCount) return;

@@ -146,6 +146,7 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
 }
 
 void main() {
+    loadScene();
     uint x = gl_GlobalInvocationID.x;
     uint y = gl_GlobalInvocationID.y + frame.rowOffset;
     if (x >= scene.width || y >= scene.height || gl_GlobalInvocationID.y >= frame.rowCount) return;

@@ -82,6 +82,7 @@ bool refined(uint x, uint y) {
 }
 
 void main() {
+    loadScene();
     uint x = gl_GlobalInvocationID.x;
     uint y = gl_GlobalInvocationID.y;
     if (x >= scene.width || y >= scene.height) return;

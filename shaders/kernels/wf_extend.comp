@@ -19,6 +19,7 @@ layout(push_constant, scalar) uniform Push { FrameParams frame; };
 #include "lib/bvh_traverse.glsl"
 
 void main() {
+    loadScene();
     uint i = gl_GlobalInvocationID.y * scene.width + gl_GlobalInvocationID.x;
     if (gl_GlobalInvocationID.x >= scene.width || gl_GlobalInvocationID.y >= scene.height) return;
     if ((paths[i].flags & kPathFlagAlive) == 0u) return;

@@ -27,6 +27,7 @@ layout(push_constant, scalar) uniform Push { FrameParams frame; };
 #include "lib/pt_core.glsl"
 
 void main() {
+    loadScene();
     uint x = gl_GlobalInvocationID.x;
     uint y = gl_GlobalInvocationID.y;
     if (x >= scene.width || y >= scene.height) return;

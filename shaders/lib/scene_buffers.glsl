@@ -20,6 +20,13 @@ layout(set = 0, binding = kBindTexInfo, scalar) readonly buffer TexInfoBuf { Tex
 layout(set = 0, binding = kBindTexels, scalar) readonly buffer TexelBuf { uvec2 texels[]; };
 layout(set = 0, binding = kBindLightTris, scalar) readonly buffer LightTriBuf { LightTriangle lightTris[]; };
 layout(set = 0, binding = kBindPunctual, scalar) readonly buffer PunctualBuf { PunctualLight punctual[]; };
-layout(set = 0, binding = kBindSceneConst, scalar) readonly buffer SceneConstBuf { SceneConstants scene; };
+layout(set = 0, binding = kBindSceneConst, scalar) readonly buffer SceneConstBuf { SceneConstants sceneStored; };
+
+// The scene constants as a private copy that every kernel's main() fills first (loadScene),
+// so that later reads are registers: lavapipe before Mesa 23 loads a storage-buffer value
+// lane by lane, in a loop with a branch per lane and component, at every read, even at a
+// uniform address (bench/RESULTS.md, sixth session).
+SceneConstants scene;
+void loadScene() { scene = sceneStored; }
 
 #endif  // GDPT_LIB_SCENE_BUFFERS
