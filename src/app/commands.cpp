@@ -133,7 +133,7 @@ int runRender(const RenderArgs& args) {
     const bool gpt = args.method == "gpt";
     std::vector<std::string> recons = {args.recon};
     if (args.allRecon)
-        for (const char* other : {"l1", "l2", "wl2"})
+        for (const char* other : {"l1", "l2", "wl2", "wl1"})
             if (args.recon != other) recons.push_back(other);
     std::vector<SolveOptions> solves;
     for (const std::string& name : recons) {
@@ -406,9 +406,9 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->check(CLI::IsMember({"pt", "gpt"}));
     r->add_option("--recon", render.recon,
                   "G-PT reconstruction in the default channels: l1 (IRLS), l2 (unbiased), wl2 (inverse-variance "
-                  "weighted L2)")
+                  "weighted L2), wl1 (L1 with inverse-variance weights from a 7x7 box of the variance)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"l1", "l2", "wl2"}));
+        ->check(CLI::IsMember({"l1", "l2", "wl2", "wl1"}));
     r->add_flag("--all-recon", render.allRecon, "G-PT: also write the other reconstructions as layers recon_*");
     r->add_option("--alpha", render.alpha, "G-PT: weight of the primal term in the screened Poisson energy")
         ->capture_default_str()

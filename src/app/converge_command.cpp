@@ -144,7 +144,8 @@ private:
         if (method == "gpt-l1") so.method = Reconstruction::L1;
         else if (method == "gpt-l2") so.method = Reconstruction::L2;
         else if (method == "gpt-wl2") so.method = Reconstruction::WeightedL2;
-        else throw UsageError("--methods: unknown method '" + method + "' (pt, gpt-l1, gpt-l2, gpt-wl2)");
+        else if (method == "gpt-wl1") so.method = Reconstruction::WeightedL1;
+        else throw UsageError("--methods: unknown method '" + method + "' (pt, gpt-l1, gpt-l2, gpt-wl2, gpt-wl1)");
         return so;
     }
 
@@ -387,7 +388,7 @@ Subcommand addConvergeCommand(CLI::App& app) {
     c->add_option("scene", a->scene, "glTF 2.0 scene")->required()->check(CLI::ExistingFile);
     c->add_option("--reference", a->reference, "Converged reference EXR (same size and camera)")->check(CLI::ExistingFile);
     c->add_option("--make-reference", a->makeReference, "Render a PT reference with this many spp (cached by scene hash)");
-    c->add_option("--methods", a->methods, "Methods: pt, gpt-l1, gpt-l2, gpt-wl2")->capture_default_str();
+    c->add_option("--methods", a->methods, "Methods: pt, gpt-l1, gpt-l2, gpt-wl2, gpt-wl1")->capture_default_str();
     c->add_option("--times", a->times, "Time budgets in seconds (comma-separated)")->capture_default_str();
     c->add_option("--repeats", a->repeats, "Independent repeats per budget (median reported)")
         ->capture_default_str()

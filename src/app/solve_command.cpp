@@ -79,9 +79,9 @@ int runSolve(const SolveArgs& a) {
         for (const Image* im : {direct, varP, varX, varY})
             if (im && !im->sameSize(primal)) throw Error(a.input + ": layers differ in size");
     }
-    if (o.method == Reconstruction::WeightedL2 && !(varP && varX && varY))
-        throw Error((separate ? a.primal : a.input) +
-                    ": --recon wl2 needs the layers var_primal, var_dx and var_dy");
+    if (needsVariance(o.method) && !(varP && varX && varY))
+        throw Error((separate ? a.primal : a.input) + ": --recon " + toString(o.method) +
+                    " needs the layers var_primal, var_dx and var_dy");
 
     vk::ContextOptions co;
     co.device = a.device;
@@ -94,7 +94,7 @@ int runSolve(const SolveArgs& a) {
     o.progress = [&](int roundsDone, int rounds, int iterations) {
         if (started.seconds() < 2.0) return;
         shown = true;
-        progress.update(double(roundsDone) / rounds, (o.method == Reconstruction::L1
+        progress.update(double(roundsDone) / rounds, (isIrls(o.method)
                                                           ? "IRLS round " + std::to_string(roundsDone) + "/" +
                                                                 std::to_string(rounds) + ", "
                                                           : std::string()) +
@@ -137,8 +137,10 @@ Subcommand addSolveCommand(CLI::App& app) {
         ->check(CLI::ExistingFile);
     sub->add_option("-o,--output", a->output, "Output EXR (final image + 'recon' layer)")
         ->capture_default_str();
-    sub->add_option("--recon", a->recon, "Reconstruction: l1, l2 or wl2 (inverse-variance weighted)")
-        ->check(CLI::IsMember({"l1", "l2", "wl2"}))
+    sub->add_option("--recon", a->recon,
+                    "Reconstruction: l1, l2, wl2 (inverse-variance weighted L2) or wl1 (L1 with inverse-variance "
+                    "weights from a 7x7 box of the variance)")
+        ->check(CLI::IsMember({"l1", "l2", "wl2", "wl1"}))
         ->capture_default_str();
     sub->add_option("--solver", a->solver, "Linear solver: mg-pcg, cg, jacobi or mg")
         ->check(CLI::IsMember({"mg-pcg", "cg", "jacobi", "mg"}))
@@ -152,7 +154,7 @@ Subcommand addSolveCommand(CLI::App& app) {
     sub->add_option("--max-iterations", a->maxIterations, "Iteration cap per linear solve")
         ->check(CLI::Range(1, 10000000))
         ->capture_default_str();
-    sub->add_option("--irls-iterations", a->irlsIterations, "IRLS rounds for --recon l1")
+    sub->add_option("--irls-iterations", a->irlsIterations, "IRLS rounds for --recon l1 and wl1")
         ->check(CLI::Range(1, 1000))
         ->capture_default_str();
     sub->add_option("--primal", a->primal, "Primal EXR (instead of INPUT)")->check(CLI::ExistingFile);

@@ -67,7 +67,66 @@ Reconstruction parseReconstruction(const std::string& t) {
     if (t == "l2") return Reconstruction::L2;
     if (t == "wl2") return Reconstruction::WeightedL2;
     if (t == "l1") return Reconstruction::L1;
-    throw UsageError("unknown reconstruction '" + t + "' (expected l1, l2 or wl2)");
+    if (t == "wl1") return Reconstruction::WeightedL1;
+    throw UsageError("unknown reconstruction '" + t + "' (expected l1, l2, wl2 or wl1)");
+}
+
+bool isIrls(Reconstruction r) {
+    return r == Reconstruction::L1 || r == Reconstruction::WeightedL1;
+}
+
+bool needsVariance(Reconstruction r) {
+    return r == Reconstruction::WeightedL2 || r == Reconstruction::WeightedL1;
+}
+
+std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& bad) {
+    const int w = var.width(), h = var.height();
+    const std::size_t n = var.pixelCount();
+    // Per-pixel RGB mean and validity, then running sums along x and along y.
+    std::vector<double> value(n, 0.0), count(n, 0.0);
+    for (std::size_t i = 0; i < n; ++i) {
+        const double v = (double(var.plane(0)[i]) + var.plane(1)[i] + var.plane(2)[i]) / 3.0;
+        if (finite3(var, i) && v >= 0.0) {
+            value[i] = v;
+            count[i] = 1.0;
+        } else {
+            ++bad;
+        }
+    }
+    const auto pass = [&](std::vector<double>& a, std::vector<double>& c, bool alongX) {
+        std::vector<double> sa(n, 0.0), sc(n, 0.0);
+        const int len = alongX ? w : h, lines = alongX ? h : w;
+        for (int line = 0; line < lines; ++line) {
+            const auto at = [&](int k) {
+                return alongX ? static_cast<std::size_t>(line) * static_cast<std::size_t>(w) + static_cast<std::size_t>(k)
+                              : static_cast<std::size_t>(k) * static_cast<std::size_t>(w) + static_cast<std::size_t>(line);
+            };
+            double runA = 0.0, runC = 0.0;
+            for (int k = 0; k < std::min(radius, len); ++k) {
+                runA += a[at(k)];
+                runC += c[at(k)];
+            }
+            for (int k = 0; k < len; ++k) {
+                if (k + radius < len) {
+                    runA += a[at(k + radius)];
+                    runC += c[at(k + radius)];
+                }
+                if (k - radius - 1 >= 0) {
+                    runA -= a[at(k - radius - 1)];
+                    runC -= c[at(k - radius - 1)];
+                }
+                sa[at(k)] = runA;
+                sc[at(k)] = runC;
+            }
+        }
+        a.swap(sa);
+        c.swap(sc);
+    };
+    pass(value, count, true);
+    pass(value, count, false);
+    std::vector<float> out(n);
+    for (std::size_t i = 0; i < n; ++i) out[i] = count[i] > 0.5 ? static_cast<float>(value[i] / count[i]) : -1.0f;
+    return out;
 }
 
 GpuSolver parseGpuSolver(const std::string& t) {
@@ -86,6 +145,8 @@ const char* toString(Reconstruction r) {
             return "wl2";
         case Reconstruction::L1:
             return "l1";
+        case Reconstruction::WeightedL1:
+            return "wl1";
     }
     return "?";
 }
@@ -258,10 +319,12 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
     if (!(o.tolerance > 0.0) || !(o.tolerance < 1.0))
         throw Error("Poisson solve: tolerance must be in (0, 1)");
     if (o.maxIterations < 1) throw Error("Poisson solve: max iterations must be >= 1");
-    if (o.method == Reconstruction::L1 && !(o.alpha > 0.0))
+    if (isIrls(o.method) && !(o.alpha > 0.0))
         throw Error("Poisson solve: L1 (IRLS) needs alpha > 0 (the primal rows anchor each iterate)");
-    if (o.method == Reconstruction::WeightedL2 && !(in.varPrimal && in.varDx && in.varDy))
-        throw Error("Poisson solve: wl2 needs the variance layers var_primal, var_dx and var_dy");
+    if (needsVariance(o.method) && !(in.varPrimal && in.varDx && in.varDy))
+        throw Error(std::string("Poisson solve: ") + toString(o.method) +
+                    " needs the variance layers var_primal, var_dx and var_dy");
+    if (o.varianceFilterRadius < 0) throw Error("Poisson solve: the variance filter radius must be >= 0");
     const std::size_t n = engine_.pixels();
     for (const std::vector<float>* wv : {in.weightPrimal, in.weightDx, in.weightDy})
         if (wv && wv->size() != n) throw Error("Poisson solve: weight vector size does not match the image");
@@ -273,6 +336,16 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
     const std::vector<float> dy = sanitise(*in.dy, report.nonFinite.dy, okY);
     std::vector<float> weights(3 * n, 1.0f);
     const bool wl2 = o.method == Reconstruction::WeightedL2;
+    const bool wl1 = o.method == Reconstruction::WeightedL1;
+    std::vector<float> varP, varX, varY;  // WL1: box-filtered variances (-1 = none valid)
+    if (wl1) {
+        varP = boxFilteredVariance(*in.varPrimal, o.varianceFilterRadius, report.nonFinite.variance);
+        varX = boxFilteredVariance(*in.varDx, o.varianceFilterRadius, report.nonFinite.variance);
+        varY = boxFilteredVariance(*in.varDy, o.varianceFilterRadius, report.nonFinite.variance);
+    }
+    const auto inverseFiltered = [&](const std::vector<float>& v, std::size_t i) {
+        return v[i] < 0.0f ? 0.0f : static_cast<float>(1.0 / (double(v[i]) + o.varianceEpsilon));
+    };
     for (std::size_t i = 0; i < n; ++i) {
         float* wp = &weights[i];
         float* wx = &weights[n + i];
@@ -291,6 +364,11 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
             *wp *= inverseVariance(*in.varPrimal, i, o.varianceEpsilon, report.nonFinite.variance);
             *wx *= inverseVariance(*in.varDx, i, o.varianceEpsilon, report.nonFinite.variance);
             *wy *= inverseVariance(*in.varDy, i, o.varianceEpsilon, report.nonFinite.variance);
+        }
+        if (wl1) {
+            *wp *= inverseFiltered(varP, i);
+            *wx *= inverseFiltered(varX, i);
+            *wy *= inverseFiltered(varY, i);
         }
         if (!okP[i]) *wp = 0.0f;
         if (!okX[i]) *wx = 0.0f;
@@ -311,7 +389,7 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
                     ++rows;
                 }
         }
-    if (wl2 && sum > 0.0) {
+    if ((wl2 || wl1) && sum > 0.0) {
         const float scale = static_cast<float>(double(rows) / sum);
         for (float& v : weights) v *= scale;
     }
@@ -334,8 +412,8 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
     VkCommandBuffer cmd = stream_.begin();
     if (o.timer) o.timer->reset(cmd);
     roundsDone_ = 0;
-    rounds_ = o.method == Reconstruction::L1 ? std::max(1, o.irlsIterations) : 1;
-    if (o.method != Reconstruction::L1) {
+    rounds_ = isIrls(o.method) ? std::max(1, o.irlsIterations) : 1;
+    if (!isIrls(o.method)) {
         const InnerResult r = innerSolve(o, o.tolerance, false, singular, true, report);
         report.iterations = r.iterations;
         report.converged = r.converged;
@@ -370,7 +448,7 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
     // L1 rejects anyway.
     out = Image(w, h);
     std::vector<float> sol = engine_.sol.downloadVector<float>(3 * n);
-    const bool shiftMean = singular || o.method != Reconstruction::L1;
+    const bool shiftMean = singular || !isIrls(o.method);
     for (int c = 0; c < 3; ++c) {
         const std::size_t o0 = static_cast<std::size_t>(c) * n;
         if (shiftMean) {

@@ -40,10 +40,12 @@
 
 namespace gdpt {
 
-enum class Reconstruction { L2, WeightedL2, L1 };
+// L2, inverse-variance weighted L2, L1 (IRLS; Kettunen et al. 2015) and L1 with
+// inverse-variance row weights taken from a box-filtered variance (weightedL1Weights).
+enum class Reconstruction { L2, WeightedL2, L1, WeightedL1 };
 enum class GpuSolver { MgPcg, Cg, Jacobi, Mg };
 
-// Parses "l1|l2|wl2" and "mg-pcg|cg|jacobi|mg"; throws gdpt::UsageError otherwise.
+// Parses "l1|l2|wl2|wl1" and "mg-pcg|cg|jacobi|mg"; throws gdpt::UsageError otherwise.
 Reconstruction parseReconstruction(const std::string& text);
 GpuSolver parseGpuSolver(const std::string& text);
 const char* toString(Reconstruction r);
@@ -61,7 +63,11 @@ struct SolveOptions {
     double irlsRegInit = 0.05;
     double irlsRegIter = 0.5;
     double irlsInnerTolerance = 1e-2;  // inner tolerance before the last IRLS round
-    double varianceEpsilon = 1e-4;     // WL2: w = 1/(var + ε)
+    double varianceEpsilon = 1e-4;     // WL2, WL1: w = 1/(var + ε)
+    // WL1: the variances are averaged over a (2r+1)² box first, so that a row's weight is
+    // not an estimate from the same samples as its value (unfiltered, WL1 and WL2 trade
+    // variance for a bias of their own: bench/RESULTS.md, sixth session).
+    int varianceFilterRadius = 3;
     VcycleParams vcycle{};             // smoother and sweeps of mg / mg-pcg
     bool keepHistory = false;          // fill SolveReport::history (test mode)
     bool warmStart = true;             // start from the primal (else from 0)
@@ -91,7 +97,7 @@ struct SolveReport {
 };
 
 // Inputs of one reconstruction: all images of one size. Optional per-pixel weights (shared
-// by the channels, ≥ 0) multiply the rows; optional variances enable WL2 weights.
+// by the channels, ≥ 0) multiply the rows; optional variances enable WL2 and WL1 weights.
 struct PoissonInput {
     const Image* primal = nullptr;
     const Image* dx = nullptr;
@@ -103,6 +109,16 @@ struct PoissonInput {
     const std::vector<float>* weightDx = nullptr;
     const std::vector<float>* weightDy = nullptr;
 };
+
+// Whether `r` is solved by IRLS rounds (L1, WL1) / needs the variance layers (WL2, WL1).
+bool isIrls(Reconstruction r);
+bool needsVariance(Reconstruction r);
+
+// Mean over RGB of `var`, averaged over the (2·radius+1)² box around each pixel (clipped at
+// the borders; separable, linear in the pixels). A pixel whose variance is not finite or
+// whose RGB mean is negative counts as missing: they are left out of the averages and counted in `bad`; a box with no valid
+// value gives -1 (the caller's weight 0).
+std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& bad);
 
 class PoissonSolverGpu {
 public:
@@ -131,7 +147,7 @@ private:
 };
 
 // One-call reconstruction for the renderer: primal, gradients and optional variances (WL2
-// uses them when options.method == WeightedL2).
+// and WL1 use them).
 Image reconstruct(const vk::Context& ctx, const Image& primal, const Image& dx, const Image& dy,
                   const Image* varPrimal, const Image* varDx, const Image* varDy, const SolveOptions& options,
                   SolveReport* report = nullptr);

@@ -180,10 +180,10 @@ TEST_F(ConvergeCli, ResultsJsonFollowsTheSchemaAndMatchesTheCsv) {
 // loaded cores (relMSE, spp at 0.25 s -> 2 s): PT 0.087 (32) -> 0.010 (379), G-PT L1 49 (1)
 // -> 0.012 (94), L2 0.52 (1) -> 0.011 (83), wL2 0.47 (1) -> 0.0095 (86).
 TEST_F(ConvergeCli, ErrorFallsWithTimeForEveryMethod) {
-    const std::vector<std::string> methods = {"pt", "gpt-l1", "gpt-l2", "gpt-wl2"};
+    const std::vector<std::string> methods = {"pt", "gpt-l1", "gpt-l2", "gpt-wl2", "gpt-wl1"};
     const test::RunResult r = test::runGdpt("converge " + kScene +
                                             " --make-reference 1024 --width 32 --height 32 "
-                                            "--methods pt,gpt-l1,gpt-l2,gpt-wl2 --times 0.25,2 --repeats 1 "
+                                            "--methods pt,gpt-l1,gpt-l2,gpt-wl2,gpt-wl1 --times 0.25,2 --repeats 1 "
                                             "--validate -o " +
                                             path("out"));
     ASSERT_EQ(r.code, 0) << r.output;

@@ -50,7 +50,7 @@ Image writeGradientExr(const std::string& file, bool withVariance) {
 
 TEST_F(PoissonCli, SolveWritesFinalAndReconLayers) {
     const Image truth = writeGradientExr(path("in.exr"), true);
-    for (const char* recon : {"l2", "l1", "wl2"}) {
+    for (const char* recon : {"l2", "l1", "wl2", "wl1"}) {
         const std::string out = path(std::string("out_") + recon + ".exr");
         const RunResult r = runGdpt("solve " + path("in.exr") + " -o " + out + " --recon " + recon);
         ASSERT_EQ(r.code, 0) << r.output;

@@ -565,6 +565,79 @@ TEST_F(PoissonGpu, WeightedL2MatchesCpuWithInverseVarianceWeights) {
     }
 }
 
+// The WL1 variance filter against a direct sum over each clipped box: RGB means, invalid
+// values (non-finite, negative) left out of the averages and counted, -1 where a box has
+// no valid value.
+TEST(BoxFilteredVariance, AveragesTheClippedBoxOfValidValues) {
+    const int w = 7, h = 5;
+    Image var(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) var.at(x, y, c) = float(x + 10 * y + c);
+    var.at(2, 1, 1) = std::nanf("");
+    var.at(5, 3, 0) = -400.0f;  // RGB mean negative
+    const auto valid = [&](int x, int y) { return !((x == 2 && y == 1) || (x == 5 && y == 3)); };
+    for (int radius : {0, 1, 2, 9}) {
+        std::size_t bad = 0;
+        const std::vector<float> f = boxFilteredVariance(var, radius, bad);
+        EXPECT_EQ(bad, 2u);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                double sum = 0.0;
+                int count = 0;
+                for (int yy = std::max(0, y - radius); yy <= std::min(h - 1, y + radius); ++yy)
+                    for (int xx = std::max(0, x - radius); xx <= std::min(w - 1, x + radius); ++xx)
+                        if (valid(xx, yy)) {
+                            sum += xx + 10.0 * yy + 1.0;  // mean of the channels x+10y+c
+                            ++count;
+                        }
+                const float expected = count > 0 ? float(sum / count) : -1.0f;
+                EXPECT_NEAR(f[static_cast<std::size_t>(y * w + x)], expected, 1e-4f)
+                    << "radius " << radius << " at " << x << "," << y;
+            }
+    }
+}
+
+// WL1 is L1 (IRLS) whose rows are weighted by the inverse of the box-filtered variances:
+// the same solve as L1 given those weights explicitly, and not the unweighted L1.
+TEST_F(PoissonGpu, WeightedL1IsL1WithFilteredInverseVarianceWeights) {
+    const int w = 26, h = 19;
+    const Image primal = randomImage(w, h, 71, 0.0, 1.0);
+    const Image dx = randomImage(w, h, 72, -0.3, 0.3), dy = randomImage(w, h, 73, -0.3, 0.3);
+    const Image vp = randomImage(w, h, 74, 0.01, 1.0), vx = randomImage(w, h, 75, 0.001, 0.1),
+                vy = randomImage(w, h, 76, 0.01, 2.0);
+    SolveOptions o;
+    o.method = Reconstruction::WeightedL1;
+    o.tolerance = 1e-6;
+    PoissonInput vars;
+    vars.varPrimal = &vp;
+    vars.varDx = &vx;
+    vars.varDy = &vy;
+    Image wl1, explicitWeights, l1;
+    const SolveReport r = solve(primal, dx, dy, o, wl1, &vars);
+    EXPECT_EQ(r.irlsIterations, o.irlsIterations);
+    const auto inverse = [&](const Image& v) {
+        std::size_t bad = 0;
+        std::vector<float> f = boxFilteredVariance(v, o.varianceFilterRadius, bad);
+        for (float& x : f) x = static_cast<float>(1.0 / (double(x) + o.varianceEpsilon));
+        return f;
+    };
+    const std::vector<float> wp = inverse(vp), wx = inverse(vx), wy = inverse(vy);
+    PoissonInput weighted;
+    weighted.weightPrimal = &wp;
+    weighted.weightDx = &wx;
+    weighted.weightDy = &wy;
+    SolveOptions plain = o;
+    plain.method = Reconstruction::L1;
+    solve(primal, dx, dy, plain, explicitWeights, &weighted);
+    solve(primal, dx, dy, plain, l1);
+    for (int c = 0; c < 3; ++c) {
+        Field a = channel(wl1, c), b = channel(explicitWeights, c), u = channel(l1, c);
+        EXPECT_LT(relError(a, b), 1e-4) << c;
+        EXPECT_GT(relError(a, u), 1e-3) << c << ": the weights should change the solution";
+    }
+}
+
 // NaN/Inf inputs are counted, replaced with zero-weight rows, and do not spread.
 TEST_F(PoissonGpu, NonFiniteInputsAreCountedAndContained) {
     const Image truth = structuredImage(30, 20);
