@@ -11,6 +11,7 @@
 // for these small grids.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -533,20 +534,33 @@ TEST_F(PoissonGpu, AlphaZeroFixesTheMeanFromThePrimal) {
     }
 }
 
+// Random primal, gradients and variances (primal variance in [0.01, 1], the gradients'
+// in the given ranges) from images seeded seed .. seed + 5.
+struct VarianceProblem {
+    Image primal, dx, dy, vp, vx, vy;
+    [[nodiscard]] PoissonInput variances() const {
+        PoissonInput in;
+        in.varPrimal = &vp;
+        in.varDx = &vx;
+        in.varDy = &vy;
+        return in;
+    }
+};
+VarianceProblem varianceProblem(int w, int h, unsigned seed, std::array<double, 2> vxRange,
+                                std::array<double, 2> vyRange) {
+    return {randomImage(w, h, seed, 0.0, 1.0),           randomImage(w, h, seed + 1, -0.3, 0.3),
+            randomImage(w, h, seed + 2, -0.3, 0.3),      randomImage(w, h, seed + 3, 0.01, 1.0),
+            randomImage(w, h, seed + 4, vxRange[0], vxRange[1]), randomImage(w, h, seed + 5, vyRange[0], vyRange[1])};
+}
+
 // Inverse-variance weights equal the CPU solve with the same row weights.
 TEST_F(PoissonGpu, WeightedL2MatchesCpuWithInverseVarianceWeights) {
-    const int w = 26, h = 19;
-    const Image primal = randomImage(w, h, 51, 0.0, 1.0);
-    const Image dx = randomImage(w, h, 52, -0.3, 0.3), dy = randomImage(w, h, 53, -0.3, 0.3);
-    const Image vp = randomImage(w, h, 54, 0.01, 1.0), vx = randomImage(w, h, 55, 0.01, 1.0),
-                vy = randomImage(w, h, 56, 0.01, 1.0);
+    const VarianceProblem p0 = varianceProblem(26, 19, 51, {0.01, 1.0}, {0.01, 1.0});
+    const Image &primal = p0.primal, &dx = p0.dx, &dy = p0.dy, &vp = p0.vp, &vx = p0.vx, &vy = p0.vy;
     SolveOptions o;
     o.method = Reconstruction::WeightedL2;
     o.tolerance = 1e-6;
-    PoissonInput in;
-    in.varPrimal = &vp;
-    in.varDx = &vx;
-    in.varDy = &vy;
+    const PoissonInput in = p0.variances();
     Image out;
     const SolveReport r = solve(primal, dx, dy, o, out, &in);
     EXPECT_TRUE(r.converged);
@@ -601,18 +615,12 @@ TEST(BoxFilteredVariance, AveragesTheClippedBoxOfValidValues) {
 // WL1 is L1 (IRLS) whose rows are weighted by the inverse of the box-filtered variances:
 // the same solve as L1 given those weights explicitly, and not the unweighted L1.
 TEST_F(PoissonGpu, WeightedL1IsL1WithFilteredInverseVarianceWeights) {
-    const int w = 26, h = 19;
-    const Image primal = randomImage(w, h, 71, 0.0, 1.0);
-    const Image dx = randomImage(w, h, 72, -0.3, 0.3), dy = randomImage(w, h, 73, -0.3, 0.3);
-    const Image vp = randomImage(w, h, 74, 0.01, 1.0), vx = randomImage(w, h, 75, 0.001, 0.1),
-                vy = randomImage(w, h, 76, 0.01, 2.0);
+    const VarianceProblem p0 = varianceProblem(26, 19, 71, {0.001, 0.1}, {0.01, 2.0});
+    const Image &primal = p0.primal, &dx = p0.dx, &dy = p0.dy, &vp = p0.vp, &vx = p0.vx, &vy = p0.vy;
     SolveOptions o;
     o.method = Reconstruction::WeightedL1;
     o.tolerance = 1e-6;
-    PoissonInput vars;
-    vars.varPrimal = &vp;
-    vars.varDx = &vx;
-    vars.varDy = &vy;
+    const PoissonInput vars = p0.variances();
     Image wl1, explicitWeights, l1;
     const SolveReport r = solve(primal, dx, dy, o, wl1, &vars);
     EXPECT_EQ(r.irlsIterations, o.irlsIterations);
