@@ -66,7 +66,7 @@ SurfaceHit makeSurfaceHit(uint tri, float u, float v, vec3 rayDir) {
     if (!h.frontFace) ng = -ng;
     h.ng = ng;
     vec3 ns = ng;
-    if ((s.flags & kTriFlagHasNormals) != 0u) {
+    if (kHasShadingNormals && (s.flags & kTriFlagHasNormals) != 0u) {
         vec3 n = (1.0 - u - v) * s.n0 + u * s.n1 + v * s.n2;
         float len = length(n);
         if (len > 0.0 && isFinite(len)) {

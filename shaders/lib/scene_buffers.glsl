@@ -11,6 +11,7 @@ layout(constant_id = kSpecHasEnv) const bool kHasEnv = true;
 layout(constant_id = kSpecHasGlossy) const bool kHasGlossy = true;
 layout(constant_id = kSpecHasAlphaMask) const bool kHasAlphaMask = true;
 layout(constant_id = kSpecMaxDepth) const uint kMaxDepth = 1024u;
+layout(constant_id = kSpecHasShadingNormals) const bool kHasShadingNormals = true;
 
 layout(set = 0, binding = kBindTriGeom, scalar) readonly buffer TriGeomBuf { TriangleGeom triGeoms[]; };
 layout(set = 0, binding = kBindTriShading, scalar) readonly buffer TriShadingBuf { TriangleShading triShading[]; };

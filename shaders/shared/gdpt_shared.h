@@ -71,7 +71,7 @@ struct TriangleShading {
     uint lightIndex; // index into LightTriangle table, kInvalidIndex if not emissive
     uint pad3;
 };
-GDPT_CONST uint kTriFlagHasNormals = 1u;  // n0..n2 valid; otherwise use the geometric normal
+GDPT_CONST uint kTriFlagHasNormals = 1u;  // n0..n2 valid and not all the face normal; otherwise use the geometric normal
 
 // Two-wide BVH node, what the builder writes (builder.h): stores both children's boxes. The
 // kernels traverse its four-wide collapse, BvhWideNode. 64 bytes.
@@ -298,7 +298,8 @@ GDPT_ENUM_BEGIN(SpecId)
     kSpecHasAlphaMask = 7u,
     kSpecMaxDepth = 8u,
     kSpecPoissonFlags = 9u,  // poisson_*.comp: the kPoissonFlag* bits of this pipeline variant
-    kSpecVisibleEmission = 10u  // path kernels: emitter-silhouette supersampling is on (visible_emission.glsl)
+    kSpecVisibleEmission = 10u,  // path kernels: emitter-silhouette supersampling is on (visible_emission.glsl)
+    kSpecHasShadingNormals = 11u  // some triangle carries kTriFlagHasNormals (features.h)
 GDPT_ENUM_END();
 
 // A ray of the BVH tests (tests/gpu/test_bvh_gpu.cpp). 32 bytes.

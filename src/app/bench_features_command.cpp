@@ -52,6 +52,7 @@ const Feature kFeatures[] = {
     {"env", gpu::kSpecHasEnv, [](const SceneFeatures& f, bool) { return f.hasEnv; }},
     {"glossy", gpu::kSpecHasGlossy, [](const SceneFeatures& f, bool gpt) { return f.hasGlossy || !gpt; }},
     {"alpha_mask", gpu::kSpecHasAlphaMask, [](const SceneFeatures& f, bool) { return f.hasAlphaMask; }},
+    {"shading_normals", gpu::kSpecHasShadingNormals, [](const SceneFeatures& f, bool) { return f.hasShadingNormals; }},
     {"max_depth", gpu::kSpecMaxDepth, [](const SceneFeatures&, bool) { return false; }},
 };
 

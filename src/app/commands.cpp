@@ -325,9 +325,9 @@ int runInfo(const InfoArgs& args) {
     // visibleEmission: emitter-silhouette supersampling (render/visible_pass.h) at the default
     // factor, which needs something the camera can see emit.
     std::printf("kernel variant: pt[textures=%d punctual=%d lightTris=%d env=%d glossy=%d alphaMask=%d "
-                "visibleEmission=%d]\n",
+                "shadingNormals=%d visibleEmission=%d]\n",
                 f.hasTextures, f.hasPunctual, f.hasLightTris, f.hasEnv, f.hasGlossy, f.hasAlphaMask,
-                visibleEmissionPossible(f));
+                f.hasShadingNormals, visibleEmissionPossible(f));
     for (const auto& u : scene.unsupported) std::printf("  unsupported: %s\n", u.c_str());
     return 0;
 }

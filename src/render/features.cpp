@@ -1,8 +1,28 @@
 #include "render/features.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace gdpt {
+
+bool triangleHasShadingNormals(const Scene& scene, std::size_t tri) {
+    if (scene.normals.empty()) return false;
+    const glm::uvec3 t = scene.triangles[tri];
+    const glm::vec3 face = glm::cross(scene.positions[t.y] - scene.positions[t.x], scene.positions[t.z] - scene.positions[t.x]);
+    const float faceLength = glm::length(face);
+    if (!(faceLength > 0.0f) || !std::isfinite(faceLength)) return true;  // degenerate: leave it to the kernels
+    float lo = 1.0f, hi = -1.0f;
+    for (int k = 0; k < 3; ++k) {
+        const glm::vec3 n = scene.normals[t[k]];
+        const float len = glm::length(n);
+        if (!(len > 0.0f) || !std::isfinite(len)) return true;
+        const float c = glm::dot(n, face) / (len * faceLength);
+        lo = std::min(lo, c);
+        hi = std::max(hi, c);
+    }
+    constexpr float kFlat = 1.0f - 1e-6f;
+    return !(lo >= kFlat || hi <= -kFlat);
+}
 
 SceneFeatures analyzeScene(const Scene& scene, glm::vec3 envRadiance, float shiftThreshold) {
     SceneFeatures f;
@@ -19,6 +39,8 @@ SceneFeatures analyzeScene(const Scene& scene, glm::vec3 envRadiance, float shif
         if (m < scene.materials.size() && (scene.materials[m].flags & gpu::kMatFlagEmissive)) ++f.emissiveTriangles;
     }
     f.hasLightTris = f.emissiveTriangles > 0;
+    for (std::size_t t = 0; t < scene.triangles.size() && !f.hasShadingNormals; ++t)
+        f.hasShadingNormals = triangleHasShadingNormals(scene, t);
     for (std::size_t i = 0; i < scene.materials.size(); ++i) {
         if (!used[i]) continue;
         const gpu::Material& m = scene.materials[i];
@@ -50,6 +72,7 @@ std::vector<std::pair<std::string, std::string>> describeFeatures(const SceneFea
         {"textures", std::to_string(f.textures)},
         {"textures sampled", yn(f.hasTextures)},
         {"alpha mask", yn(f.hasAlphaMask)},
+        {"shading normals", yn(f.hasShadingNormals)},
         {"specular layer", yn(f.hasSpecularLayer)},
         {"roughness range", std::to_string(f.minRoughness) + " .. " + std::to_string(f.maxRoughness)},
         {"glossy/specular vertices", yn(f.hasGlossy)},

@@ -27,9 +27,15 @@ struct SceneFeatures {
     bool hasGlossy = false;      // some vertex can be classified glossy (roughness <= threshold)
     bool hasSpecularLayer = false;  // some material has a non-Lambertian (metal/dielectric) lobe
     bool hasAlphaMask = false;
+    bool hasShadingNormals = false;  // some triangle's vertex normals differ from its face normal
     float minRoughness = 1.0f;   // over materials with a specular lobe
     float maxRoughness = 0.0f;
 };
+
+// Whether triangle `tri` of `scene` needs its vertex normals: false without normals and when
+// all three are parallel to the face normal with the same sign (within 1e-6 in the cosine),
+// where the kernels' interpolated shading normal would be the geometric one anyway.
+bool triangleHasShadingNormals(const Scene& scene, std::size_t tri);
 
 // shiftThreshold: roughness at or below which a vertex is "glossy" for gradient-domain
 // shifts (Kettunen et al. 2015 reference default 0.001).

@@ -40,7 +40,7 @@ std::vector<gpu::TriangleShading> makeShading(const Scene& scene, const std::vec
         s.material = scene.triangleMaterial[order[i]];
         const glm::vec3 p0 = scene.positions[t.x], p1 = scene.positions[t.y], p2 = scene.positions[t.z];
         s.area = 0.5f * glm::length(glm::cross(p1 - p0, p2 - p0));
-        if (normals) {
+        if (normals && triangleHasShadingNormals(scene, order[i])) {
             s.n0 = scene.normals[t.x];
             s.n1 = scene.normals[t.y];
             s.n2 = scene.normals[t.z];
@@ -185,7 +185,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> SceneGpu::specConstants() c
         {gpu::kSpecHasTextures, b(features_.hasTextures)}, {gpu::kSpecHasPunctual, b(features_.hasPunctual)},
         {gpu::kSpecHasLightTris, b(features_.hasLightTris)}, {gpu::kSpecHasEnv, b(features_.hasEnv)},
         {gpu::kSpecHasGlossy, b(features_.hasGlossy)},     {gpu::kSpecHasAlphaMask, b(features_.hasAlphaMask)},
-        {gpu::kSpecMaxDepth, maxDepthSpec_}};
+        {gpu::kSpecHasShadingNormals, b(features_.hasShadingNormals)}, {gpu::kSpecMaxDepth, maxDepthSpec_}};
     for (auto& [id, value] : spec)
         if (genericFeatures_ & (1u << id)) value = id == gpu::kSpecMaxDepth ? 1024u : 1u;
     return spec;
