@@ -33,7 +33,7 @@ struct RenderArgs {
     float shiftThreshold = 0.001f;
     std::string splitBounce = "auto";  // G-PT: auto, on, off (GptPassOptions::SplitBounce)
     std::uint32_t emitterSupersampling = kDefaultVisibleSupersampling;  // render/visible_pass.h
-    std::string recon = "wl1";
+    std::string recon = "l1";
     double alpha = 0.2;
     double tolerance = 1e-4;
     bool allRecon = false;

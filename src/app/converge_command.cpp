@@ -39,7 +39,7 @@ using nlohmann::json;
 struct ConvergeArgs {
     std::string scene;
     std::string reference;
-    std::string methods = "pt,gpt-l1,gpt-wl1,gpt-l2";
+    std::string methods = "pt,gpt-l1,gpt-l2";
     std::string times = "1,2,4,8";
     int repeats = 3;
     int width = 256;
