@@ -1,7 +1,6 @@
 #include "bvh/wide_bvh.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -23,13 +22,14 @@ constexpr int kMinBiasedExponent = 1;
 // Upper bound: 255 · 2^(246 - 127) is still finite, so no decoded bound becomes infinite.
 constexpr int kMaxBiasedExponent = 246;
 
+// The kernels' scale of a biased exponent and their decode of one bound (byte 0 of q), so
+// that the builder checks its rounding against exactly what the traversal computes.
 float scaleOf(int biased) {
-    return std::ldexp(1.0f, biased - 127);
+    return gpu::wideAxisScale(static_cast<uint32_t>(biased), 0u);
 }
 
-// The shaders' decode (wideDecodeAxis): q·scale is exact, so this is their value bit for bit.
 float decode(float origin, uint32_t q, float scale) {
-    return origin + static_cast<float>(q) * scale;
+    return gpu::wideDecodeAxis(origin, q, scale).x;
 }
 
 // The smallest power-of-two scale whose 255 steps from origin reach `top` (biased exponent).
@@ -67,10 +67,11 @@ float halfArea(const Slot& s) {
     return e.x * e.y + e.y * e.z + e.z * e.x;
 }
 
-// The wide node of `count` child boxes: origin = their union's lower corner, per axis the
+// The wide node of up to four child boxes: origin = their union's lower corner, per axis the
 // scale of axisExponent and each bound rounded outwards (BvhWideNode). Children and counts
 // are left for the caller (empty slots keep kInvalidIndex).
-gpu::BvhWideNode quantiseWideNode(const std::array<Slot, 4>& slots, std::size_t count) {
+gpu::BvhWideNode quantiseWideNode(const std::vector<Slot>& slots) {
+    const std::size_t count = slots.size();
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     for (std::size_t i = 0; i < count; ++i) {
         lo = glm::min(lo, slots[i].min);
@@ -117,9 +118,7 @@ public:
         // Visiting this node pushes every inner child but the one it descends into.
         const uint32_t below = stack + (inner > 0 ? inner - 1 : 0);
         out_.maxStack = std::max(out_.maxStack, below);
-        std::array<Slot, 4> boxes{};
-        for (std::size_t i = 0; i < slots.size(); ++i) boxes[i] = slots[i];
-        gpu::BvhWideNode w = quantiseWideNode(boxes, slots.size());
+        gpu::BvhWideNode w = quantiseWideNode(slots);
         for (std::size_t i = 0; i < slots.size(); ++i) {
             const auto k = static_cast<glm::length_t>(i);
             const Slot& s = slots[i];

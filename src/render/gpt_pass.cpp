@@ -114,11 +114,7 @@ void GptPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_
     recordTiled(cmd, ctx_.info(), width_, height_, sampleBase, spp, kMaxPixelSamplesPerDispatch,
                 [&](const DispatchTile& t) {
                     gpu::GptFrameParams p{};
-                    p.sampleBase = t.sampleBase;
-                    p.samplesPerPixel = t.samples;
-                    p.seed = seed;
-                    p.rowOffset = t.rowOffset;
-                    p.rowCount = t.rowCount;
+                    setTileParams(p, t, seed);
                     p.shiftThreshold = options_.shiftThreshold;
                     p.width = width_;
                     p.height = height_;

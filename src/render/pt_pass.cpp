@@ -71,11 +71,7 @@ void PtPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t
     recordTiled(cmd, ctx_.info(), width_, height_, sampleBase, spp, kMaxPixelSamplesPerDispatch,
                 [&](const DispatchTile& t) {
                     gpu::FrameParams p{};
-                    p.sampleBase = t.sampleBase;
-                    p.samplesPerPixel = t.samples;
-                    p.seed = seed;
-                    p.rowOffset = t.rowOffset;
-                    p.rowCount = t.rowCount;
+                    setTileParams(p, t, seed);
                     kernel_.dispatchItems(cmd, width_, p.rowCount, &p, timer);
                 });
 }

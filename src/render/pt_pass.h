@@ -37,6 +37,17 @@ struct DispatchTile {
     std::uint32_t sampleBase, samples, rowOffset, rowCount;
 };
 
+// Fills the tile's fields of a path kernel's push constants (gpu::FrameParams and
+// gpu::GptFrameParams begin with the same five).
+template <class Params>
+void setTileParams(Params& p, const DispatchTile& t, std::uint32_t seed) {
+    p.sampleBase = t.sampleBase;
+    p.samplesPerPixel = t.samples;
+    p.seed = seed;
+    p.rowOffset = t.rowOffset;
+    p.rowCount = t.rowCount;
+}
+
 // Records a batch of `spp` camera samples from `sampleBase` of a width x height image as
 // dispatches of samplesPerDispatch samples and at most maxPixelSamples pixel-samples each
 // (row tiles, so that no dispatch runs long enough to trip a GPU watchdog), calling
