@@ -24,7 +24,10 @@ struct SolveArgs {
     double alpha = 0.2;
     double tolerance = 1e-4;
     int maxIterations = 2000;
-    int irlsIterations = 8;
+    int irlsIterations = SolveOptions{}.irlsIterations;
+    double irlsRegInit = SolveOptions{}.irlsRegInit;
+    double irlsRegIter = SolveOptions{}.irlsRegIter;
+    double irlsInnerTolerance = SolveOptions{}.irlsInnerTolerance;
     std::string primal, dx, dy;
     std::string device;
     bool quiet = false;
@@ -50,6 +53,9 @@ int runSolve(const SolveArgs& a) {
     o.tolerance = a.tolerance;
     o.maxIterations = a.maxIterations;
     o.irlsIterations = a.irlsIterations;
+    o.irlsRegInit = a.irlsRegInit;
+    o.irlsRegIter = a.irlsRegIter;
+    o.irlsInnerTolerance = a.irlsInnerTolerance;
 
     std::vector<NamedLayer> layers;
     Image primal, dx, dy;
@@ -156,6 +162,17 @@ Subcommand addSolveCommand(CLI::App& app) {
         ->capture_default_str();
     sub->add_option("--irls-iterations", a->irlsIterations, "IRLS rounds for --recon l1 and wl1")
         ->check(CLI::Range(1, 1000))
+        ->capture_default_str();
+    sub->add_option("--irls-reg-init", a->irlsRegInit,
+                    "IRLS: regulariser of the second round's weights 1/(|e| + reg), in radiance units")
+        ->check(CLI::Range(1e-12, 1e6))
+        ->capture_default_str();
+    sub->add_option("--irls-reg-iter", a->irlsRegIter, "IRLS: factor applied to the regulariser every later round")
+        ->check(CLI::Range(1e-6, 1.0))
+        ->capture_default_str();
+    sub->add_option("--irls-inner-tolerance", a->irlsInnerTolerance,
+                    "IRLS: relative residual of the inner solves before the last round (the last uses --tolerance)")
+        ->check(CLI::Range(1e-12, 0.5))
         ->capture_default_str();
     sub->add_option("--primal", a->primal, "Primal EXR (instead of INPUT)")->check(CLI::ExistingFile);
     sub->add_option("--dx", a->dx, "Horizontal-gradient EXR (instead of INPUT)")->check(CLI::ExistingFile);

@@ -68,6 +68,48 @@ TEST_F(PoissonCli, SolveWritesFinalAndReconLayers) {
     }
 }
 
+// Largest absolute difference between the 'recon' layers of two solve outputs.
+double maxReconDifference(const std::string& a, const std::string& b) {
+    const Image ia = readExrLayer(a, "recon"), ib = readExrLayer(b, "recon");
+    double d = 0.0;
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < ia.pixelCount(); ++i)
+            d = std::max(d, double(std::abs(ia.plane(c)[i] - ib.plane(c)[i])));
+    return d;
+}
+
+// The IRLS schedule flags reach the solver: the defaults spelt out give the same bits, and a
+// regulariser far above every residual makes the weights 1/(|e| + reg) uniform, which turns
+// L1 back into the L2 solve (up to the solver tolerance), while the default L1 stays away
+// from it. Out-of-range values are usage errors.
+TEST_F(PoissonCli, SolveIrlsScheduleFlags) {
+    // Outliers in a few gradients: what L1 rejects and L2 spreads out.
+    writeGradientExr(path("clean.exr"), false);
+    Image dx = readExrLayer(path("clean.exr"), "dx");
+    for (int k = 0; k < 5; ++k)
+        for (int c = 0; c < 3; ++c) dx.at(3 + 4 * k, 2 + 3 * k, c) += 2.0f;
+    writeExr(path("in.exr"), {{"primal", readExrLayer(path("clean.exr"), "primal")},
+                              {"dx", dx},
+                              {"dy", readExrLayer(path("clean.exr"), "dy")}});
+    const std::string in = path("in.exr") + " --tolerance 1e-6 ";
+    ASSERT_EQ(runGdpt("solve " + in + "--recon l2 -o " + path("l2.exr")).code, 0);
+    ASSERT_EQ(runGdpt("solve " + in + "--recon l1 -o " + path("l1.exr")).code, 0);
+    ASSERT_EQ(runGdpt("solve " + in + "--recon l1 --irls-iterations 8 --irls-reg-init 0.05 --irls-reg-iter 0.5 "
+                      "--irls-inner-tolerance 0.01 -o " + path("l1_explicit.exr")).code, 0);
+    ASSERT_EQ(runGdpt("solve " + in + "--recon l1 --irls-reg-init 1e6 --irls-reg-iter 1 -o " + path("l1_reg.exr"))
+                  .code,
+              0);
+    EXPECT_EQ(maxReconDifference(path("l1.exr"), path("l1_explicit.exr")), 0.0);
+    const double l1ToL2 = maxReconDifference(path("l1.exr"), path("l2.exr"));
+    const double regToL2 = maxReconDifference(path("l1_reg.exr"), path("l2.exr"));
+    EXPECT_GT(l1ToL2, 0.05);
+    EXPECT_LT(regToL2, 0.1 * l1ToL2) << "L1 default to L2: " << l1ToL2;
+    for (const char* bad : {"--irls-reg-iter 0", "--irls-reg-iter 1.5", "--irls-reg-init 0",
+                            "--irls-inner-tolerance 0.9"})
+        EXPECT_EQ(runGdpt("solve " + in + "--recon l1 " + bad + " -o " + path("bad.exr")).code, 2) << bad;
+    EXPECT_FALSE(fs::exists(path("bad.exr")));
+}
+
 TEST_F(PoissonCli, SolveFromSeparateFilesAndErrors) {
     writeGradientExr(path("in.exr"), false);
     writeExr(path("p.exr"), readExrLayer(path("in.exr"), "primal"));
