@@ -151,6 +151,8 @@ int runRender(const RenderArgs& args) {
         reserve = reserveReconstruction(ctx, *solver, solves, reconCache);
         options.timeBudget = std::max(0.05 * args.time, args.time - reserve.seconds);
     }
+    // The reconstruction's pipelines are created while the path kernels compile.
+    if (gpt) options.whileCompiling = [&] { solver->preparePipelines(solves); };
     options.elapsedBefore = total.seconds();
     options.scene.shiftThreshold = args.shiftThreshold;
     options.maxBatchSpp = batchLimit(args.width, args.height, gpt);
@@ -267,6 +269,7 @@ int runRender(const RenderArgs& args) {
                   {"time_s", {{"total", seconds},
                               {"bvh_build", s.bvhBuildMs * 1e-3},
                               {"upload", s.uploadMs * 1e-3},
+                              {"pipeline_wait", s.pipelineWaitMs * 1e-3},
                               {"sampling", s.samplingMs * 1e-3},
                               {"readback", s.readbackMs * 1e-3},
                               {"reconstruction", s.reconstructionMs * 1e-3},
@@ -319,7 +322,12 @@ int runDiff(const DiffArgs& args) {
 
 int runInfo(const InfoArgs& args) {
     const Scene scene = loadGltf(args.scene);
-    const SceneFeatures f = analyzeScene(scene, parseColor(args.env, "--env"));
+    // The features the kernels are specialised for (SceneSpec: the light count is the light
+    // table's, without emitters of zero area or power); a scene without triangles has none.
+    SceneGpuOptions so;
+    so.envRadiance = parseColor(args.env, "--env");
+    const SceneFeatures f =
+        scene.triangles.empty() ? analyzeScene(scene, so.envRadiance) : SceneSpec(scene, so).features();
     std::printf("%s\n", describeScene(scene).c_str());
     for (const auto& [k, v] : describeFeatures(f)) std::printf("  %-26s %s\n", k.c_str(), v.c_str());
     // visibleEmission: emitter-silhouette supersampling (render/visible_pass.h) at the default

@@ -306,6 +306,31 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
     return result;
 }
 
+void PoissonSolverGpu::preparePipelines(const std::vector<SolveOptions>& solves) {
+    constexpr int kSize = 16;  // two levels: every per-level variant of a V-cycle occurs
+    PoissonSolverGpu small(engine_.context(), kSize, kSize, &engine_.kernels(), engine_.addressing());
+    Image primal(kSize, kSize, 0.5f), dx(kSize, kSize, 0.0f), dy(kSize, kSize, 0.0f), variance(kSize, kSize, 1e-3f);
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < primal.pixelCount(); ++i) {
+            const auto h = static_cast<std::uint32_t>((i + 1) * 2654435761u + static_cast<std::uint32_t>(c) * 40503u);
+            dx.plane(c)[i] = 0.1f * (static_cast<float>(h % 1000u) / 1000.0f - 0.5f);
+            dy.plane(c)[i] = 0.1f * (static_cast<float>((h >> 10) % 1000u) / 1000.0f - 0.5f);
+        }
+    PoissonInput in;
+    in.primal = &primal;
+    in.dx = &dx;
+    in.dy = &dy;
+    in.varPrimal = in.varDx = in.varDy = &variance;
+    for (SolveOptions o : solves) {
+        o.timer = nullptr;
+        o.progress = nullptr;
+        o.keepHistory = false;
+        Image out;
+        (void)small.solve(in, o, out);
+    }
+    engine_.bind();  // the shared variants now point at the small engine's buffers
+}
+
 SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& o, Image& out) {
     Timer wall;
     if (!in.primal || !in.dx || !in.dy) throw Error("Poisson solve: primal, dx and dy are required");

@@ -129,6 +129,12 @@ public:
     // Reconstructs into `out` (resized). Throws gdpt::Error on size mismatch or bad options.
     SolveReport solve(const PoissonInput& in, const SolveOptions& options, Image& out);
 
+    // Creates the pipeline variants that solve() with each of `solves` dispatches, by solving
+    // a small noisy problem (16x16) on the same kernels: the variants do not depend on the
+    // size. Lets a renderer create them while its path kernels compile, instead of in the
+    // reconstruction after sampling (RenderOptions::whileCompiling).
+    void preparePipelines(const std::vector<SolveOptions>& solves);
+
     [[nodiscard]] PoissonGpuEngine& engine() { return engine_; }
 
 private:

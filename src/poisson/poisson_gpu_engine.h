@@ -127,6 +127,8 @@ public:
     // when several engines share one PoissonKernels).
     void bind();
     [[nodiscard]] PoissonAddressing addressing() const { return addressing_; }
+    // The pipelines this engine dispatches (its own, or the ones it was given).
+    [[nodiscard]] PoissonKernels& kernels() { return *kernels_; }
 
     // The fields (kPoissonField*: bound as descriptors, or read through the device addresses
     // listed in fieldTable) and the descriptor-bound scalars.

@@ -24,6 +24,26 @@ bool triangleHasShadingNormals(const Scene& scene, std::size_t tri) {
     return !(lo >= kFlat || hi <= -kFlat);
 }
 
+float triangleArea(const Scene& scene, std::size_t tri) {
+    const glm::uvec3 t = scene.triangles[tri];
+    const glm::vec3 p0 = scene.positions[t.x], p1 = scene.positions[t.y], p2 = scene.positions[t.z];
+    return 0.5f * glm::length(glm::cross(p1 - p0, p2 - p0));
+}
+
+double emitterPower(const Scene& scene, std::size_t tri, float area) {
+    constexpr float kPi = 3.14159265358979f;  // float products, as the light table was always built
+    const std::uint32_t mi = scene.triangleMaterial[tri];
+    if (mi >= scene.materials.size()) return 0.0;
+    const gpu::Material& m = scene.materials[mi];
+    if (!(m.flags & gpu::kMatFlagEmissive) || !(area > 0.0f)) return 0.0;
+    const glm::vec3 le = m.emissive;
+    const float luminance = 0.2126f * le.x + 0.7152f * le.y + 0.0722f * le.z;
+    double p = area * luminance * kPi;
+    if (m.flags & gpu::kMatFlagDoubleSided) p *= 2.0;
+    if (!(p > 0.0)) p = area * kPi * std::max({le.x, le.y, le.z});
+    return p > 0.0 ? p : 0.0;
+}
+
 SceneFeatures analyzeScene(const Scene& scene, glm::vec3 envRadiance, float shiftThreshold) {
     SceneFeatures f;
     f.triangles = static_cast<std::uint32_t>(scene.triangles.size());

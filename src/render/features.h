@@ -37,6 +37,13 @@ struct SceneFeatures {
 // where the kernels' interpolated shading normal would be the geometric one anyway.
 bool triangleHasShadingNormals(const Scene& scene, std::size_t tri);
 
+// Area of triangle `tri` (float, as the kernels' light pdfs use it).
+float triangleArea(const Scene& scene, std::size_t tri);
+// Power of triangle `tri` as a light, area · luminance(Le) · π (×2 when double-sided;
+// the largest Le component where the luminance is 0), or 0 when it is not a light: not
+// emissive, no area, or no power. The light table's CDF is proportional to it.
+double emitterPower(const Scene& scene, std::size_t tri, float area);
+
 // shiftThreshold: roughness at or below which a vertex is "glossy" for gradient-domain
 // shifts (Kettunen et al. 2015 reference default 0.001).
 SceneFeatures analyzeScene(const Scene& scene, glm::vec3 envRadiance, float shiftThreshold = 0.001f);

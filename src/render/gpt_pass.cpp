@@ -28,7 +28,7 @@ const char* const kStatNames[kNumStats] = {"gpt central",    "gpt neighbor right
 // or one below bsdf.glsl's Dirac cutoff (perceptual roughness 0.01), which
 // bsdfRoughnessForShift reports as 0 whatever the threshold. Same rule as features.cpp's
 // hasGlossy, evaluated here for the pass's own threshold (GptPassOptions::shiftThreshold).
-bool needsHalfVector(const SceneGpu& scene, float threshold) {
+bool needsHalfVector(const SceneSpec& scene, float threshold) {
     const SceneFeatures& f = scene.features();
     constexpr float kDiracRoughness = 0.01f;  // sqrt(kDeltaAlpha)
     return f.hasSpecularLayer && (f.minRoughness <= threshold || f.minRoughness < kDiracRoughness);
@@ -39,7 +39,7 @@ bool splitBounceFor(const vk::DeviceInfo& device, GptPassOptions::SplitBounce s)
     return s == GptPassOptions::SplitBounce::On;
 }
 
-vk::KernelDesc gptDesc(const SceneGpu& scene, WorkgroupSize wg, bool halfVector, bool splitBounce,
+vk::KernelDesc gptDesc(const SceneSpec& scene, WorkgroupSize wg, bool halfVector, bool splitBounce,
                        const VisiblePass& visible) {
     std::vector<std::uint32_t> extra = {gpu::kBindCounters};
     for (std::uint32_t i = 0; i < kNumStats; ++i) extra.push_back(gpu::kBindGptCentral + i);
@@ -75,22 +75,27 @@ bool splitBounceDefault(const vk::DeviceInfo& device) {
 }
 
 GptPass::GptPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg, GptPassOptions options)
+    : GptPass(ctx, scene.spec(), wg, options, vk::PipelineCreation::Now) {
+    attach(scene);
+}
+
+GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize wg, GptPassOptions options,
+                 vk::PipelineCreation creation)
     : ctx_(ctx),
-      width_(scene.constants().width),
-      height_(scene.constants().height),
+      width_(scene.width()),
+      height_(scene.height()),
       options_(options),
       halfVector_(options.forceHalfVector || needsHalfVector(scene, options.shiftThreshold)),
       splitBounce_(splitBounceFor(ctx.info(), options.splitBounce)),
       counters_(ctx, sizeof(gpu::Counters), "gpt counters"),
-      visible_(ctx, scene, wg, options.visibleSupersampling, counters_),
-      kernel_(ctx, gptDesc(scene, wg, halfVector_, splitBounce_, visible_)),
-      resolveKernel_(ctx, resolveDesc(wg, visible_)),
+      visible_(ctx, scene, wg, options.visibleSupersampling, counters_, creation),
+      kernel_(ctx, gptDesc(scene, wg, halfVector_, splitBounce_, visible_), creation),
+      resolveKernel_(ctx, resolveDesc(wg, visible_), creation),
       stats_(makeStats(ctx, std::uint64_t{width_} * height_)),
       resolved_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::GptResolved), "gpt resolved") {
     const std::string what = " of a " + std::to_string(width_) + "x" + std::to_string(height_) + " image";
     ctx.checkStorageBufferSize(stats_[0].size(), "each G-PT per-pixel statistics buffer" + what);
     ctx.checkStorageBufferSize(resolved_.size(), "the resolved G-PT images" + what);
-    scene.bindTo(kernel_);
     kernel_.bind(gpu::kBindCounters, counters_);
     for (std::uint32_t i = 0; i < kNumStats; ++i) {
         kernel_.bind(gpu::kBindGptCentral + i, stats_[i]);
@@ -100,6 +105,15 @@ GptPass::GptPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg
     visible_.bindTo(kernel_);
     visible_.bindTo(resolveKernel_);
     reset();
+}
+
+void GptPass::attach(const SceneGpu& scene) {
+    scene.bindTo(kernel_);
+    visible_.attach(scene);
+}
+
+double GptPass::waitForPipelines() const {
+    return visible_.waitForPipeline() + kernel_.wait() + resolveKernel_.wait();
 }
 
 void GptPass::reset() {

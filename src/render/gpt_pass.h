@@ -52,6 +52,14 @@ struct GptImages {
 class GptPass {
 public:
     GptPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg = {}, GptPassOptions options = {});
+    // The same before the scene is on the device: the pipelines are created as `creation`
+    // says (Background: while the caller builds the SceneGpu), and attach() binds the
+    // scene's buffers (before record()).
+    GptPass(const vk::Context& ctx, const SceneSpec& spec, WorkgroupSize wg, GptPassOptions options,
+            vk::PipelineCreation creation);
+    void attach(const SceneGpu& scene);
+    // Waits for pipelines created in the background; the seconds waited.
+    double waitForPipelines() const;
 
     // Clears the statistics and counters.
     void reset();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <string>
+#include <utility>
 
 #include "render/batch_loop.h"
 #include "util/timer.h"
@@ -20,13 +21,19 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     RenderStats& stats = result.stats;
     Timer total;
     Timer phase;
-    SceneGpu sceneGpu(ctx, scene, options.scene);
-    stats.bvhBuildMs = sceneGpu.bvhInfo().buildMs;
-    stats.features = sceneGpu.features();
+    // The pipelines compile on worker threads (lavapipe: most of the set-up, on one core)
+    // while this thread builds the BVH and uploads the scene.
     gpt.shiftThreshold = options.scene.shiftThreshold;
     gpt.visibleSupersampling = options.visibleSupersampling;
-    GptPass pass(ctx, sceneGpu, options.workgroup, gpt);
+    SceneSpec spec(scene, options.scene);
+    GptPass pass(ctx, spec, options.workgroup, gpt, vk::PipelineCreation::Background);
+    SceneGpu sceneGpu(ctx, scene, options.scene, std::move(spec));
+    pass.attach(sceneGpu);
+    stats.bvhBuildMs = sceneGpu.bvhInfo().buildMs;
+    stats.features = sceneGpu.features();
     stats.gptSplitBounce = pass.splitBounceCompiled();
+    if (options.whileCompiling) options.whileCompiling();
+    stats.pipelineWaitMs = 1e3 * pass.waitForPipelines();
     vk::GpuTimer timer(ctx);
     vk::CommandStream stream(ctx, "gpt");
     if (options.resume) pass.uploadStats(options.resume->buffers);

@@ -17,7 +17,7 @@ constexpr std::uint64_t kMaxPixelSamplesPerDispatch = 1u << 20;
 }  // namespace
 
 namespace {
-vk::KernelDesc ptDesc(const SceneGpu& scene, WorkgroupSize wg, const VisiblePass& visible) {
+vk::KernelDesc ptDesc(const SceneSpec& scene, WorkgroupSize wg, const VisiblePass& visible) {
     vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("pt", kSpv_pt), wg, {gpu::kBindAccum, gpu::kBindCounters});
     visible.configure(d);
     return d;
@@ -43,21 +43,33 @@ void recordTiled(VkCommandBuffer cmd, const vk::DeviceInfo& device, std::uint32_
 }
 
 PtPass::PtPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg, std::uint32_t visibleSupersampling)
+    : PtPass(ctx, scene.spec(), wg, visibleSupersampling, vk::PipelineCreation::Now) {
+    attach(scene);
+}
+
+PtPass::PtPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize wg, std::uint32_t visibleSupersampling,
+               vk::PipelineCreation creation)
     : ctx_(ctx),
-      width_(scene.constants().width),
-      height_(scene.constants().height),
+      width_(scene.width()),
+      height_(scene.height()),
       counters_(ctx, sizeof(gpu::Counters), "pt counters"),
-      visible_(ctx, scene, wg, visibleSupersampling, counters_),
-      kernel_(ctx, ptDesc(scene, wg, visible_)),
+      visible_(ctx, scene, wg, visibleSupersampling, counters_, creation),
+      kernel_(ctx, ptDesc(scene, wg, visible_), creation),
       accum_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats), "pt pixel statistics") {
     ctx.checkStorageBufferSize(accum_.size(), "the per-pixel statistics of a " + std::to_string(width_) + "x" +
                                                   std::to_string(height_) + " image");
-    scene.bindTo(kernel_);
     kernel_.bind(gpu::kBindAccum, accum_);
     kernel_.bind(gpu::kBindCounters, counters_);
     visible_.bindTo(kernel_);
     reset();
 }
+
+void PtPass::attach(const SceneGpu& scene) {
+    scene.bindTo(kernel_);
+    visible_.attach(scene);
+}
+
+double PtPass::waitForPipelines() const { return visible_.waitForPipeline() + kernel_.wait(); }
 
 void PtPass::reset() {
     accum_.zero();

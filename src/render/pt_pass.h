@@ -63,6 +63,14 @@ public:
     // (visible_pass.h; 0 = off).
     PtPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg = {},
            std::uint32_t visibleSupersampling = kDefaultVisibleSupersampling);
+    // The same before the scene is on the device: the pipelines are created as `creation`
+    // says (Background: while the caller builds the SceneGpu), and attach() binds the
+    // scene's buffers (before record()).
+    PtPass(const vk::Context& ctx, const SceneSpec& spec, WorkgroupSize wg, std::uint32_t visibleSupersampling,
+           vk::PipelineCreation creation);
+    void attach(const SceneGpu& scene);
+    // Waits for pipelines created in the background; the seconds waited.
+    double waitForPipelines() const;
 
     // Clears the statistics and counters.
     void reset();

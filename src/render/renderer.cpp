@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <utility>
 
 #include "render/batch_loop.h"
 #include "render/wavefront_pass.h"
@@ -16,16 +17,21 @@ RenderResult renderPt(const vk::Context& ctx, const Scene& scene, const RenderOp
     RenderStats& stats = result.stats;
     Timer total;
     Timer phase;
-    SceneGpu sceneGpu(ctx, scene, options.scene);
+    // The pipelines compile on worker threads while this thread builds and uploads the scene.
+    SceneSpec spec(scene, options.scene);
+    PtPass pass(ctx, spec, options.workgroup, options.visibleSupersampling, vk::PipelineCreation::Background);
+    SceneGpu sceneGpu(ctx, scene, options.scene, std::move(spec));
+    pass.attach(sceneGpu);
     stats.bvhBuildMs = sceneGpu.bvhInfo().buildMs;
     stats.features = sceneGpu.features();
-    PtPass pass(ctx, sceneGpu, options.workgroup, options.visibleSupersampling);
     std::unique_ptr<WavefrontPass> wavefront;
     if (options.schedule == Schedule::Wavefront)
         wavefront = std::make_unique<WavefrontPass>(ctx, sceneGpu, pass, options.workgroup);
     vk::GpuTimer timer(ctx);
     vk::CommandStream stream(ctx, "pt");
     if (options.resume) pass.uploadStats(options.resume->buffers);
+    if (options.whileCompiling) options.whileCompiling();
+    stats.pipelineWaitMs = 1e3 * pass.waitForPipelines();
     stats.uploadMs = phase.ms() - stats.bvhBuildMs;
     const auto snapshot = [&](SamplerState& state) {
         state.buffers = pass.downloadStats();

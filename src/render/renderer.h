@@ -49,13 +49,19 @@ struct RenderOptions {
     // seconds (0 = never) and once when sampling ends, finished or cancelled.
     std::function<void(const SamplerState&)> checkpoint;
     double checkpointEvery = 0.0;
+    // If set, run on the calling thread after the scene is on the device, while the kernels'
+    // pipelines may still be compiling on worker threads (vk::PipelineCreation::Background),
+    // before sampling; for set-up of the caller's own that should overlap that compile (the
+    // reconstruction's pipelines). Its time counts in the budget like everything else.
+    std::function<void()> whileCompiling;
 };
 
 struct RenderStats {
     std::uint32_t spp = 0;
     std::uint32_t batches = 0;
     double bvhBuildMs = 0.0;
-    double uploadMs = 0.0;       // scene upload + pipeline creation
+    double uploadMs = 0.0;       // scene upload + pipeline creation (the part not overlapped)
+    double pipelineWaitMs = 0.0; // of which: waiting for the pipelines after the scene upload
     double samplingMs = 0.0;     // wall time of the batch loop
     double readbackMs = 0.0;
     double reconstructionMs = 0.0;  // G-PT: screened Poisson solve(s)

@@ -38,8 +38,7 @@ std::vector<gpu::TriangleShading> makeShading(const Scene& scene, const std::vec
         const glm::uvec3 t = scene.triangles[order[i]];
         gpu::TriangleShading s{};
         s.material = scene.triangleMaterial[order[i]];
-        const glm::vec3 p0 = scene.positions[t.x], p1 = scene.positions[t.y], p2 = scene.positions[t.z];
-        s.area = 0.5f * glm::length(glm::cross(p1 - p0, p2 - p0));
+        s.area = triangleArea(scene, order[i]);
         if (normals && triangleHasShadingNormals(scene, order[i])) {
             s.n0 = scene.normals[t.x];
             s.n1 = scene.normals[t.y];
@@ -70,15 +69,13 @@ void setCamera(gpu::SceneConstants& c, const Camera& camera, int width, int heig
     c.height = static_cast<std::uint32_t>(height);
 }
 
-std::vector<std::uint32_t> SceneGpu::sceneBindings() {
-    return {gpu::kBindTriGeom, gpu::kBindTriShading, gpu::kBindBvh,      gpu::kBindMaterials, gpu::kBindTexInfo,
-            gpu::kBindTexels,  gpu::kBindLightTris,  gpu::kBindPunctual, gpu::kBindSceneConst};
-}
+SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOptions& options)
+    : SceneGpu(ctx, scene, options, SceneSpec(scene, options)) {}
 
-SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOptions& options) {
+SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOptions& options, SceneSpec spec)
+    : spec_(std::move(spec)) {
     if (scene.triangles.empty()) throw Error("scene has no triangles to render");
     if (options.width < 1 || options.height < 1) throw Error("image size must be at least 1x1");
-    features_ = analyzeScene(scene, options.envRadiance, options.shiftThreshold);
 
     // BVH over the world-space triangles; everything per-triangle is laid out in leaf order.
     Timer timer;
@@ -95,11 +92,7 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     double total = 0.0;
     std::vector<double> power;
     for (std::uint32_t i = 0; i < shading.size(); ++i) {
-        const gpu::Material& m = scene.materials.at(shading[i].material);
-        if (!(m.flags & gpu::kMatFlagEmissive) || !(shading[i].area > 0.0f)) continue;
-        double p = shading[i].area * luminance(m.emissive) * kPi;
-        if (m.flags & gpu::kMatFlagDoubleSided) p *= 2.0;
-        if (!(p > 0.0)) p = shading[i].area * kPi * std::max({m.emissive.x, m.emissive.y, m.emissive.z});
+        const double p = emitterPower(scene, bvh.triangleOrder[i], shading[i].area);
         if (!(p > 0.0)) continue;
         shading[i].lightIndex = static_cast<std::uint32_t>(lights.size());
         lights.push_back({i, 0.0f, 0.0f, 0.0f});
@@ -112,8 +105,8 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
         lights[i].pmf = static_cast<float>(power[i] / total);
         lights[i].cdf = i + 1 == lights.size() ? 1.0f : static_cast<float>(running / total);
     }
-    features_.hasLightTris = !lights.empty();
-    features_.emissiveTriangles = static_cast<std::uint32_t>(lights.size());
+    // The spec counted the same lights (emitterPower) to specialise the kernels.
+    GDPT_CHECK(lights.size() == spec_.features().emissiveTriangles);
 
     double punctualPower = 0.0;
     for (const auto& l : scene.punctualLights) punctualPower += 4.0 * kPi * std::max(1e-12, double(luminance(l.intensity)));
@@ -151,10 +144,6 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     constants_.numTriangles = static_cast<std::uint32_t>(geoms.size());
     const Bounds b = scene.bounds();
     constants_.sceneRadius = 0.5f * glm::length(b.max - b.min);
-    // Kernels loop to min(spec max depth, scene.maxDepth); a small user depth is also
-    // compiled in so that the loop bound is a constant the compiler can see.
-    maxDepthSpec_ = std::min<std::uint32_t>(options.maxDepth + 1, 1024);
-    genericFeatures_ = options.genericFeatures;
 
     triGeom_ = makeBuffer(ctx, geoms, "triangle geometry");
     triShading_ = makeBuffer(ctx, shading, "triangle shading");
@@ -177,31 +166,6 @@ void SceneGpu::bindTo(vk::Kernel& kernel) const {
     kernel.bind(gpu::kBindLightTris, lightTris_);
     kernel.bind(gpu::kBindPunctual, punctual_);
     kernel.bind(gpu::kBindSceneConst, sceneConst_);
-}
-
-std::vector<std::pair<std::uint32_t, std::uint32_t>> SceneGpu::specConstants() const {
-    auto b = [](bool v) { return v ? 1u : 0u; };
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> spec = {
-        {gpu::kSpecHasTextures, b(features_.hasTextures)}, {gpu::kSpecHasPunctual, b(features_.hasPunctual)},
-        {gpu::kSpecHasLightTris, b(features_.hasLightTris)}, {gpu::kSpecHasEnv, b(features_.hasEnv)},
-        {gpu::kSpecHasGlossy, b(features_.hasGlossy)},     {gpu::kSpecHasAlphaMask, b(features_.hasAlphaMask)},
-        {gpu::kSpecHasShadingNormals, b(features_.hasShadingNormals)}, {gpu::kSpecMaxDepth, maxDepthSpec_}};
-    for (auto& [id, value] : spec)
-        if (genericFeatures_ & (1u << id)) value = id == gpu::kSpecMaxDepth ? 1024u : 1u;
-    return spec;
-}
-
-vk::KernelDesc SceneGpu::kernelDesc(vk::KernelDesc base, WorkgroupSize wg,
-                                    const std::vector<std::uint32_t>& extraBindings, std::uint32_t pushBytes) const {
-    base.bindings = sceneBindings();
-    base.bindings.insert(base.bindings.end(), extraBindings.begin(), extraBindings.end());
-    base.pushConstantBytes = pushBytes;
-    base.specConstants = specConstants();
-    base.specConstants.push_back({gpu::kSpecWorkgroupX, wg.x});
-    base.specConstants.push_back({gpu::kSpecWorkgroupY, wg.y});
-    base.localSizeX = wg.x;
-    base.localSizeY = wg.y;
-    return base;
 }
 
 std::uint64_t SceneGpu::deviceBytes() const {

@@ -20,7 +20,7 @@ std::uint32_t rayBudget(std::uint32_t width, std::uint32_t height) {
 
 // The factor the pass runs with: 0 (disabled) where the scene has nothing the camera could
 // see emit. Throws for a factor above the bound.
-std::uint32_t activeFactor(std::uint32_t samplesPerSpp, const SceneGpu& scene) {
+std::uint32_t activeFactor(std::uint32_t samplesPerSpp, const SceneSpec& scene) {
     if (samplesPerSpp > kMaxVisibleSupersampling)
         throw Error("emitter supersampling " + std::to_string(samplesPerSpp) + " is above the maximum " +
                     std::to_string(kMaxVisibleSupersampling));
@@ -30,8 +30,14 @@ std::uint32_t activeFactor(std::uint32_t samplesPerSpp, const SceneGpu& scene) {
 
 VisiblePass::VisiblePass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg,
                          std::uint32_t samplesPerSpp, const vk::Buffer& counters)
-    : width_(scene.constants().width),
-      height_(scene.constants().height),
+    : VisiblePass(ctx, scene.spec(), wg, samplesPerSpp, counters, vk::PipelineCreation::Now) {
+    attach(scene);
+}
+
+VisiblePass::VisiblePass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize wg,
+                         std::uint32_t samplesPerSpp, const vk::Buffer& counters, vk::PipelineCreation creation)
+    : width_(scene.width()),
+      height_(scene.height()),
       samplesPerSpp_(activeFactor(samplesPerSpp, scene)),
       // Disabled: 16-byte placeholders (the path kernels compile the read out).
       stats_(ctx, enabled() ? std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats) : 0,
@@ -45,13 +51,16 @@ VisiblePass::VisiblePass(const vk::Context& ctx, const SceneGpu& scene, Workgrou
                                         {gpu::kBindCounters, gpu::kBindVisibleStats, gpu::kBindVisibleProbe,
                                          gpu::kBindVisibleCounter},
                                         sizeof(gpu::VisibleParams));
-    kernel_.emplace(ctx, d);
-    scene.bindTo(*kernel_);
+    kernel_.emplace(ctx, d, creation);
     kernel_->bind(gpu::kBindCounters, counters);
     kernel_->bind(gpu::kBindVisibleStats, stats_);
     kernel_->bind(gpu::kBindVisibleProbe, probe_);
     kernel_->bind(gpu::kBindVisibleCounter, counter_);
     reset();
+}
+
+void VisiblePass::attach(const SceneGpu& scene) {
+    if (kernel_) scene.bindTo(*kernel_);
 }
 
 void VisiblePass::configure(vk::KernelDesc& desc) const {

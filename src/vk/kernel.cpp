@@ -1,6 +1,8 @@
 #include "vk/kernel.h"
 
 #include <algorithm>
+#include <chrono>
+#include <utility>
 
 #include "vk/buffer.h"
 #include "vk/context.h"
@@ -8,8 +10,44 @@
 #include "vk/vk_check.h"
 
 namespace gdpt::vk {
+namespace {
 
-Kernel::Kernel(const Context& ctx, const KernelDesc& desc) : ctx_(ctx), desc_(desc) {
+// What vkCreateComputePipelines needs, owned, so that a worker thread can run it.
+struct PipelineJob {
+    VkDevice device = VK_NULL_HANDLE;
+    VkShaderModule module = VK_NULL_HANDLE;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    std::vector<VkSpecializationMapEntry> entries;
+    std::vector<std::uint32_t> values;
+    std::string name;
+};
+
+VkPipeline createPipeline(const PipelineJob& job) {
+    VkSpecializationInfo spec{};
+    spec.mapEntryCount = static_cast<std::uint32_t>(job.entries.size());
+    spec.pMapEntries = job.entries.data();
+    spec.dataSize = job.values.size() * sizeof(std::uint32_t);
+    spec.pData = job.values.data();
+
+    VkComputePipelineCreateInfo pipeInfo{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    pipeInfo.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    pipeInfo.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    pipeInfo.stage.module = job.module;
+    pipeInfo.stage.pName = "main";
+    pipeInfo.stage.pSpecializationInfo = job.entries.empty() ? nullptr : &spec;
+    pipeInfo.layout = job.layout;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    try {
+        VK_CHECK(vkCreateComputePipelines(job.device, VK_NULL_HANDLE, 1, &pipeInfo, nullptr, &pipeline));
+    } catch (const Error& e) {
+        throw e.withContext("creating pipeline '" + job.name + "'");
+    }
+    return pipeline;
+}
+
+}  // namespace
+
+Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation creation) : ctx_(ctx), desc_(desc) {
     VkDevice device = ctx.device();
     GDPT_CHECK(desc.spirv != nullptr && desc.spirvBytes > 0);
     if (desc.pushConstantBytes > ctx.info().maxPushConstantsSize)
@@ -53,38 +91,19 @@ Kernel::Kernel(const Context& ctx, const KernelDesc& desc) : ctx_(ctx), desc_(de
     pipelineLayout_ = Handle<VkPipelineLayout>(
         pipelineLayout, [device](VkPipelineLayout l) { vkDestroyPipelineLayout(device, l, nullptr); });
 
-    std::vector<VkSpecializationMapEntry> entries;
-    std::vector<std::uint32_t> values;
+    PipelineJob job;
+    job.device = device;
+    job.module = module;
+    job.layout = pipelineLayout;
+    job.name = desc.name;
     for (const auto& [id, value] : desc.specConstants) {
         VkSpecializationMapEntry e{};
         e.constantID = id;
-        e.offset = static_cast<std::uint32_t>(values.size() * sizeof(std::uint32_t));
+        e.offset = static_cast<std::uint32_t>(job.values.size() * sizeof(std::uint32_t));
         e.size = sizeof(std::uint32_t);
-        entries.push_back(e);
-        values.push_back(value);
+        job.entries.push_back(e);
+        job.values.push_back(value);
     }
-    VkSpecializationInfo spec{};
-    spec.mapEntryCount = static_cast<std::uint32_t>(entries.size());
-    spec.pMapEntries = entries.data();
-    spec.dataSize = values.size() * sizeof(std::uint32_t);
-    spec.pData = values.data();
-
-    VkComputePipelineCreateInfo pipeInfo{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    pipeInfo.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-    pipeInfo.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    pipeInfo.stage.module = module;
-    pipeInfo.stage.pName = "main";
-    pipeInfo.stage.pSpecializationInfo = entries.empty() ? nullptr : &spec;
-    pipeInfo.layout = pipelineLayout;
-    VkPipeline pipeline = VK_NULL_HANDLE;
-    try {
-        VK_CHECK(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &pipeInfo, nullptr, &pipeline));
-    } catch (const Error& e) {
-        throw e.withContext("creating pipeline '" + desc.name + "'");
-    }
-    pipeline_ = Handle<VkPipeline>(pipeline, [device](VkPipeline p) { vkDestroyPipeline(device, p, nullptr); });
-    ctx.setName(VK_OBJECT_TYPE_PIPELINE, reinterpret_cast<std::uint64_t>(pipeline), desc.name);
-
     if (!bindings.empty()) {
         VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, static_cast<std::uint32_t>(bindings.size())};
         VkDescriptorPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
@@ -100,6 +119,36 @@ Kernel::Kernel(const Context& ctx, const KernelDesc& desc) : ctx_(ctx), desc_(de
         alloc.pSetLayouts = &setLayout;
         VK_CHECK(vkAllocateDescriptorSets(device, &alloc, &set_));
     }
+
+    // Last, so that nothing after it can throw while a worker is running.
+    if (creation == PipelineCreation::Background) {
+        pending_ = std::async(std::launch::async, [job = std::move(job)] { return createPipeline(job); });
+    } else {
+        const VkPipeline pipeline = createPipeline(job);
+        pipeline_ = Handle<VkPipeline>(pipeline, [device](VkPipeline p) { vkDestroyPipeline(device, p, nullptr); });
+        ctx.setName(VK_OBJECT_TYPE_PIPELINE, reinterpret_cast<std::uint64_t>(pipeline), desc.name);
+    }
+}
+
+Kernel::~Kernel() {
+    // The worker uses the module and the layout: it must finish before they are destroyed.
+    if (!pending_.valid()) return;
+    try {
+        const VkPipeline pipeline = pending_.get();
+        vkDestroyPipeline(ctx_.device(), pipeline, nullptr);
+    } catch (const std::exception&) {
+        // Its error was never asked for (the kernel was not used): nothing to destroy.
+    }
+}
+
+double Kernel::wait() const {
+    if (!pending_.valid()) return 0.0;
+    const auto start = std::chrono::steady_clock::now();
+    const VkPipeline pipeline = pending_.get();  // rethrows the worker's error
+    const VkDevice device = ctx_.device();
+    pipeline_ = Handle<VkPipeline>(pipeline, [device](VkPipeline p) { vkDestroyPipeline(device, p, nullptr); });
+    ctx_.setName(VK_OBJECT_TYPE_PIPELINE, reinterpret_cast<std::uint64_t>(pipeline), desc_.name);
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void Kernel::bind(std::uint32_t binding, const Buffer& buffer) {
@@ -115,6 +164,7 @@ void Kernel::bind(std::uint32_t binding, const Buffer& buffer) {
 }
 
 void Kernel::bindState(VkCommandBuffer cmd, const void* push) const {
+    (void)wait();
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.get());
     if (set_ != VK_NULL_HANDLE)
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelineLayout_.get(), 0, 1,

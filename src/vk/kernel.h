@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <future>
 #include <string>
 #include <utility>
 #include <vector>
@@ -40,9 +41,19 @@ KernelDesc kernelDesc(std::string name, const std::uint32_t (&spirv)[N]) {
     return d;
 }
 
+// When a Kernel's pipeline is created. Background: on a worker thread started by the
+// constructor; the first dispatch (or wait()) waits for it. Lavapipe spends most of a large
+// kernel's set-up in vkCreateComputePipelines (0.3-1 s for gpt.comp with Mesa 22.3), on one
+// core, so a pass can create its pipelines while the scene is built and uploaded.
+enum class PipelineCreation { Now, Background };
+
 class Kernel {
 public:
-    Kernel(const Context& ctx, const KernelDesc& desc);
+    Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation creation = PipelineCreation::Now);
+    // Waits for a pipeline still being created (and destroys it).
+    ~Kernel();
+    Kernel(const Kernel&) = delete;
+    Kernel& operator=(const Kernel&) = delete;
 
     // Points `binding` at `buffer` (whole range). Not while a submitted command buffer
     // that uses this kernel is pending.
@@ -59,6 +70,9 @@ public:
     void dispatchItems(VkCommandBuffer cmd, std::uint32_t itemsX, std::uint32_t itemsY,
                        const void* push = nullptr, GpuTimer* timer = nullptr) const;
     [[nodiscard]] const std::string& name() const { return desc_.name; }
+    // Waits until the pipeline exists; rethrows the error of a failed background creation
+    // (with the kernel's name). Returns the seconds waited.
+    double wait() const;
 
 private:
     void bindState(VkCommandBuffer cmd, const void* push) const;  // pipeline, set, push constants
@@ -68,7 +82,10 @@ private:
     Handle<VkShaderModule> module_;
     Handle<VkDescriptorSetLayout> setLayout_;
     Handle<VkPipelineLayout> pipelineLayout_;
-    Handle<VkPipeline> pipeline_;
+    // The pipeline, once created; pending_ holds a background creation until wait() takes
+    // it (both mutable: resolving it does not change what the kernel is).
+    mutable Handle<VkPipeline> pipeline_;
+    mutable std::future<VkPipeline> pending_;
     Handle<VkDescriptorPool> pool_;
     VkDescriptorSet set_ = VK_NULL_HANDLE;
 };

@@ -98,7 +98,8 @@ bool withinUlps(float a, float b, int ulps) {
 
 class BvhGpu : public test::GpuTest {
 protected:
-    void check(const Soup& soup, std::uint32_t seed) {
+    void check(const Soup& soup, std::uint32_t seed,
+               vk::PipelineCreation creation = vk::PipelineCreation::Now) {
         const Bvh bvh = buildBvh(soup.positions, soup.triangles);
         const auto geoms = makeTriangleGeoms(soup.positions, soup.triangles, bvh.triangleOrder);
         const std::uint32_t rayCount = 100000;
@@ -109,7 +110,7 @@ protected:
                          gpu::kBindTestOutput2};
         desc.pushConstantBytes = sizeof(std::uint32_t);
         desc.localSizeX = 64;
-        vk::Kernel kernel(ctx(), desc);
+        vk::Kernel kernel(ctx(), desc, creation);
         vk::Buffer geomBuf(ctx(), geoms.size() * sizeof(gpu::TriangleGeom), "geoms");
         const WideBvh wide = collapseToWide(bvh.nodes);
         vk::Buffer nodeBuf(ctx(), wide.nodes.size() * sizeof(gpu::BvhWideNode), "nodes");
@@ -158,6 +159,24 @@ protected:
 
 TEST_F(BvhGpu, RandomSoupMatchesBruteForce) { check(randomSoup(1000, 7), 11); }
 TEST_F(BvhGpu, CoplanarDuplicatedGridMatchesBruteForce) { check(coplanarGrid(), 12); }
+// The same kernel with its pipeline created on a worker thread while the buffers are made,
+// uploaded and bound (how the renderers create theirs): the first dispatch waits for it.
+TEST_F(BvhGpu, BackgroundPipelineMatchesBruteForce) {
+    check(randomSoup(300, 9), 13, vk::PipelineCreation::Background);
+}
+// A kernel whose background creation is never waited for is destroyed cleanly (the
+// destructor joins the worker and destroys the pipeline; validation reports any leak).
+TEST_F(BvhGpu, UnusedBackgroundPipelineIsDestroyed) {
+    vk::KernelDesc desc = vk::kernelDesc("trace_rays", kSpv_trace_rays);
+    desc.bindings = {gpu::kBindTriGeom, gpu::kBindBvh, gpu::kBindTestInput, gpu::kBindTestOutput,
+                     gpu::kBindTestOutput2};
+    desc.pushConstantBytes = sizeof(std::uint32_t);
+    desc.localSizeX = 64;
+    { vk::Kernel unused(ctx(), desc, vk::PipelineCreation::Background); }
+    vk::Kernel waited(ctx(), desc, vk::PipelineCreation::Background);
+    EXPECT_GE(waited.wait(), 0.0);
+    EXPECT_EQ(waited.wait(), 0.0);  // already there: no second wait
+}
 TEST_F(BvhGpu, DegenerateTrianglesMatchBruteForce) { check(degenerate(9), 13); }
 
 }  // namespace

@@ -692,6 +692,33 @@ TEST_F(PoissonGpu, SolvesAreBitReproducible) {
     }
 }
 
+// preparePipelines creates every variant a solve of another size then dispatches: a solve
+// after it creates none (each method with fresh kernels, so that nothing is left over from
+// other tests), and it did create some.
+TEST_F(PoissonGpu, PreparedPipelinesCoverALaterSolve) {
+    const Image primal = randomImage(57, 43, 71, 0.0, 1.0);
+    const Image dx = randomImage(57, 43, 72, -0.3, 0.3), dy = randomImage(57, 43, 73, -0.3, 0.3);
+    const Image var = randomImage(57, 43, 74, 0.001, 0.01);
+    for (Reconstruction m : {Reconstruction::L2, Reconstruction::L1, Reconstruction::WeightedL2,
+                             Reconstruction::WeightedL1}) {
+        PoissonKernels kernels(ctx());
+        PoissonSolverGpu solver(ctx(), primal.width(), primal.height(), &kernels);
+        SolveOptions o;
+        o.method = m;
+        solver.preparePipelines({o});
+        const std::size_t prepared = kernels.variantCount();
+        EXPECT_GT(prepared, 5u) << toString(m);
+        PoissonInput in;
+        in.primal = &primal;
+        in.dx = &dx;
+        in.dy = &dy;
+        in.varPrimal = in.varDx = in.varDy = &var;
+        Image out;
+        (void)solver.solve(in, o, out);
+        EXPECT_EQ(prepared, kernels.variantCount()) << toString(m);
+    }
+}
+
 // Seamless cloning (Pérez et al. 2003, eq. 7): the target is untouched outside Ω and the
 // discrete Laplacian of the result equals the source's at every pixel of Ω. The solve stops
 // at relative residual 1e-5 of ‖b‖ (b ~ O(1) per pixel here), so per-pixel Laplacians
