@@ -94,7 +94,7 @@ TEST_F(PoissonCli, SolveIrlsScheduleFlags) {
     const std::string in = path("in.exr") + " --tolerance 1e-6 ";
     ASSERT_EQ(runGdpt("solve " + in + "--recon l2 -o " + path("l2.exr")).code, 0);
     ASSERT_EQ(runGdpt("solve " + in + "--recon l1 -o " + path("l1.exr")).code, 0);
-    ASSERT_EQ(runGdpt("solve " + in + "--recon l1 --irls-iterations 8 --irls-reg-init 0.05 --irls-reg-iter 0.5 "
+    ASSERT_EQ(runGdpt("solve " + in + "--recon l1 --irls-iterations 6 --irls-reg-init 0.05 --irls-reg-iter 0.4 "
                       "--irls-inner-tolerance 0.02 -o " + path("l1_explicit.exr")).code, 0);
     ASSERT_EQ(runGdpt("solve " + in + "--recon l1 --irls-reg-init 1e6 --irls-reg-iter 1 -o " + path("l1_reg.exr"))
                   .code,
