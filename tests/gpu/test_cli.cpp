@@ -82,6 +82,11 @@ TEST_F(Cli, SmallValidatedRenderWritesExrPngAndJson) {
     EXPECT_GT(j["rays_traced"].get<double>(), 0.0);
     EXPECT_TRUE(j["kernels"].contains("pt"));
     EXPECT_NE(r.output.find("pt"), std::string::npos) << "--profile prints the kernel table";
+    // The wait for the background-created pipelines is part of the set-up it reports.
+    const auto& t = j["time_s"];
+    EXPECT_GE(t["pipeline_wait"].get<double>(), 0.0);
+    EXPECT_LE(t["pipeline_wait"].get<double>(), t["upload"].get<double>() + t["bvh_build"].get<double>() + 1e-6);
+    EXPECT_LE(t["upload"].get<double>() + t["sampling"].get<double>(), t["total"].get<double>());
 }
 
 // A timed G-PT render reserves its reconstruction time: the first run of a configuration
