@@ -264,6 +264,7 @@ int runRender(const RenderArgs& args) {
                   {"width", args.width},
                   {"height", args.height},
                   {"spp", s.spp},
+                  {"partial_pass_rows", s.partialPassRows},
                   {"seed", args.seed},
                   {"batches", s.batches},
                   {"time_s", {{"total", seconds},

@@ -72,6 +72,7 @@ struct Run {
     double seconds = 0.0;  // measured total
     double reconSeconds = 0.0;
     std::uint32_t spp = 0;
+    std::uint32_t partialPassRows = 0;  // rows with one sample more (the partial last pass)
     ImageErrorStats error;
 };
 
@@ -101,6 +102,7 @@ public:
             RenderResult res = renderPt(ctx_, scene_, o);
             result = std::move(res.image);
             r.spp = res.stats.spp;
+            r.partialPassRows = res.stats.partialPassRows;
         } else {
             // Sampling gets what is left after the (measured) reconstruction time.
             o.timeBudget = std::max(0.05 * budget, budget - reserve);
@@ -115,6 +117,7 @@ public:
             longest = std::max(longest, r.reconSeconds);
             result = addImages(solved, g.direct);
             r.spp = g.stats.spp;
+            r.partialPassRows = g.stats.partialPassRows;
         }
         r.seconds = total.seconds();
         r.error = compareImages(result, reference);
@@ -337,7 +340,7 @@ int runConverge(const ConvergeArgs& a) {
         const Run& r = runs[i];
         const int repeat = static_cast<int>(i % static_cast<std::size_t>(a.repeats));
         runsJson.push_back({{"method", r.method}, {"budget_s", r.budget}, {"repeat", repeat}, {"seconds", r.seconds},
-                            {"recon_seconds", r.reconSeconds}, {"spp", r.spp}, {"relmse", r.error.relMse},
+                            {"recon_seconds", r.reconSeconds}, {"spp", r.spp}, {"partial_pass_rows", r.partialPassRows}, {"relmse", r.error.relMse},
                             {"mse", r.error.mse}, {"mae", r.error.mae}, {"mean_bias", r.error.meanBias}});
         csv << r.method << "," << r.budget << "," << repeat << "," << r.seconds << "," << r.reconSeconds << ","
             << r.spp << "," << r.error.relMse << "," << r.error.mse << "," << r.error.mae << "," << r.error.meanBias

@@ -8,6 +8,12 @@
 
 namespace gdpt {
 
+std::uint32_t partialPassRows(double secondsLeft, double secondsPerSpp, std::uint32_t height) {
+    if (!(secondsLeft > 0.0) || !(secondsPerSpp > 0.0)) return 0;
+    const double rows = 0.9 * secondsLeft / secondsPerSpp * static_cast<double>(height);
+    return rows >= static_cast<double>(height) ? height : static_cast<std::uint32_t>(rows);
+}
+
 void runBatchLoop(const RenderOptions& options, const char* label, const Timer& total, RenderStats& stats,
                   const TraceBatchFn& traceBatch, const SnapshotFn& snapshot) {
     const bool timed = options.timeBudget > 0.0;
@@ -33,6 +39,11 @@ void runBatchLoop(const RenderOptions& options, const char* label, const Timer& 
     };
     Timer sinceCheckpoint;
     double secondsPerSpp = 0.0;  // measured on the last batch
+    const std::uint32_t height = static_cast<std::uint32_t>(options.scene.height);
+    // A partial pass leaves rows with different sample counts: not in a checkpoint (whose
+    // state is one sample count) and not with the wavefront schedule (whole samples only).
+    const bool partialPass = timed && !options.checkpoint && options.schedule == Schedule::Megakernel;
+    std::uint32_t rows = height;
     while (true) {
         if (options.cancel && options.cancel->load()) {
             stats.cancelled = true;
@@ -47,11 +58,16 @@ void runBatchLoop(const RenderOptions& options, const char* label, const Timer& 
             // sample per pixel fits (at least one batch always runs).
             const double left = budget - total.seconds();
             const auto fits = static_cast<std::uint32_t>(std::max(0.0, left / std::max(secondsPerSpp, 1e-9)));
-            if (fits == 0) break;
-            n = std::min(n, fits);
+            if (fits == 0) {
+                rows = partialPass ? partialPassRows(left, secondsPerSpp, height) : 0;
+                if (rows == 0 || rows >= height) break;
+                n = 1;
+            } else {
+                n = std::min(n, fits);
+            }
         }
         Timer batchTimer;
-        const gpu::Counters c = traceBatch(done, n, [&] {
+        const gpu::Counters c = traceBatch(done, n, rows, [&] {
             if (timed) progress.update(total.seconds());
         });
         stats.raysTraced += c.raysTraced;
@@ -59,8 +75,12 @@ void runBatchLoop(const RenderOptions& options, const char* label, const Timer& 
         stats.nanSamples += c.nanSamples;
         stats.shiftPairs += c.shiftPairs;
         stats.shiftFailures += c.shiftFailures;
-        done += n;
         ++stats.batches;
+        if (rows < height) {
+            stats.partialPassRows = rows;  // the last batch: one sample more in these rows
+            break;
+        }
+        done += n;
         secondsPerSpp = batchTimer.seconds() / n;
         const double mraysPerS = static_cast<double>(stats.raysTraced) / std::max(1e-9, phase.seconds()) * 1e-6;
         char rate[64];

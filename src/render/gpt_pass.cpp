@@ -123,9 +123,9 @@ void GptPass::reset() {
 }
 
 void GptPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
-                     vk::GpuTimer* timer) {
+                     vk::GpuTimer* timer, std::uint32_t rows) {
     visible_.record(cmd, sampleBase, spp, seed, timer);
-    recordTiled(cmd, ctx_.info(), width_, height_, sampleBase, spp, kMaxPixelSamplesPerDispatch,
+    recordTiled(cmd, ctx_.info(), width_, std::min(rows, height_), sampleBase, spp, kMaxPixelSamplesPerDispatch,
                 [&](const DispatchTile& t) {
                     gpu::GptFrameParams p{};
                     setTileParams(p, t, seed);

@@ -64,8 +64,9 @@ public:
     // Clears the statistics and counters.
     void reset();
     // Records a batch of `spp` camera samples per pixel starting at sample `sampleBase`.
+    // `rows`: only the first that many image rows (a timed render's partial last pass).
     void record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
-                vk::GpuTimer* timer);
+                vk::GpuTimer* timer, std::uint32_t rows = UINT32_MAX);
     // Records the gather into the resolved buffer (after the batches).
     void resolve(VkCommandBuffer cmd, vk::GpuTimer* timer);
     // Reads the counters written since the last call and clears them (after the fence).

@@ -61,10 +61,10 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     };
 
     runBatchLoop(options, "render gpt", total, stats,
-                 [&](std::uint32_t first, std::uint32_t n, const std::function<void()>& onWait) {
+                 [&](std::uint32_t first, std::uint32_t n, std::uint32_t rows, const std::function<void()>& onWait) {
                      VkCommandBuffer cmd = stream.begin();
                      if (options.profile) timer.reset(cmd);
-                     pass.record(cmd, first, n, options.seed, options.profile ? &timer : nullptr);
+                     pass.record(cmd, first, n, options.seed, options.profile ? &timer : nullptr, rows);
                      stream.setWhat("gpt batch " + std::to_string(stats.batches) + " (samples " +
                                     std::to_string(first) + ".." + std::to_string(first + n - 1) + ", seed " +
                                     std::to_string(options.seed) + ")");

@@ -78,9 +78,9 @@ void PtPass::reset() {
 }
 
 void PtPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
-                    vk::GpuTimer* timer) {
+                    vk::GpuTimer* timer, std::uint32_t rows) {
     visible_.record(cmd, sampleBase, spp, seed, timer);
-    recordTiled(cmd, ctx_.info(), width_, height_, sampleBase, spp, kMaxPixelSamplesPerDispatch,
+    recordTiled(cmd, ctx_.info(), width_, std::min(rows, height_), sampleBase, spp, kMaxPixelSamplesPerDispatch,
                 [&](const DispatchTile& t) {
                     gpu::FrameParams p{};
                     setTileParams(p, t, seed);

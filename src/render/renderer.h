@@ -57,7 +57,8 @@ struct RenderOptions {
 };
 
 struct RenderStats {
-    std::uint32_t spp = 0;
+    std::uint32_t spp = 0;              // samples in every pixel
+    std::uint32_t partialPassRows = 0;  // timed renders: rows (from the top) with one sample more
     std::uint32_t batches = 0;
     double bvhBuildMs = 0.0;
     double uploadMs = 0.0;       // scene upload + pipeline creation (the part not overlapped)

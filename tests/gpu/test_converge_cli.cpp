@@ -181,26 +181,38 @@ TEST_F(ConvergeCli, ResultsJsonFollowsTheSchemaAndMatchesTheCsv) {
 // -> 0.012 (94), L2 0.52 (1) -> 0.011 (83), wL2 0.47 (1) -> 0.0095 (86).
 TEST_F(ConvergeCli, ErrorFallsWithTimeForEveryMethod) {
     const std::vector<std::string> methods = {"pt", "gpt-l1", "gpt-l2", "gpt-wl2", "gpt-wl1"};
-    const test::RunResult r = test::runGdpt("converge " + kScene +
-                                            " --make-reference 1024 --width 32 --height 32 "
-                                            "--methods pt,gpt-l1,gpt-l2,gpt-wl2,gpt-wl1 --times 0.25,2 --repeats 1 "
-                                            "--validate -o " +
-                                            path("out"));
-    ASSERT_EQ(r.code, 0) << r.output;
-    checkResults(dir_ / "out", methods, {0.25, 2.0}, 1, 32, 32);
-    if (HasFatalFailure()) return;
-
-    std::ifstream in(dir_ / "out" / "results.json");
-    const json j = json::parse(in);
+    // The spp condition is a precondition of the comparison, not the property under test: one
+    // stall of the shared machine (seen twice in full parallel runs: a G-PT 2 s run at 1 spp,
+    // its budget taken by a reconstruction reserve raised by a stalled earlier run) voids it.
+    // Then the whole benchmark runs once more, and the second attempt is judged.
     std::map<std::pair<std::string, double>, json> byRun;
-    for (const json& run : j["runs"])
-        byRun[{run["method"].get<std::string>(), run["budget_s"].get<double>()}] = run;
+    for (int attempt = 0; attempt < 2; ++attempt) {
+        const std::string out = path("out" + std::to_string(attempt));
+        const test::RunResult r = test::runGdpt("converge " + kScene +
+                                                " --make-reference 1024 --width 32 --height 32 "
+                                                "--methods pt,gpt-l1,gpt-l2,gpt-wl2,gpt-wl1 --times 0.25,2 --repeats 1 "
+                                                "--validate -o " +
+                                                out);
+        ASSERT_EQ(r.code, 0) << r.output;
+        checkResults(fs::path(out), methods, {0.25, 2.0}, 1, 32, 32);
+        if (HasFatalFailure()) return;
+        std::ifstream in(fs::path(out) / "results.json");
+        const json j = json::parse(in);
+        byRun.clear();
+        for (const json& run : j["runs"])
+            byRun[{run["method"].get<std::string>(), run["budget_s"].get<double>()}] = run;
+        bool valid = true;
+        for (const auto& m : methods)
+            valid = valid && byRun.at({m, 2.0})["spp"].get<unsigned>() >= 2 * byRun.at({m, 0.25})["spp"].get<unsigned>();
+        if (valid) break;
+    }
     for (const auto& m : methods) {
         const json& shortRun = byRun.at({m, 0.25});
         const json& longRun = byRun.at({m, 2.0});
         const unsigned n1 = shortRun["spp"], n2 = longRun["spp"];
         ASSERT_GE(n2, 2 * n1) << m << ": the 2 s run reached " << n2 << " spp, the 0.25 s run " << n1
-                              << ": the machine slowed down ~4x between runs, the error comparison is void";
+                              << " (in both attempts): the machine slowed down ~4x between runs, the error "
+                                 "comparison is void";
         const double e1 = shortRun["relmse"], e2 = longRun["relmse"];
         EXPECT_LT(e2, 0.8 * e1) << m << ": relMSE " << e1 << " at " << n1 << " spp, " << e2 << " at " << n2
                                 << " spp";

@@ -3,11 +3,15 @@
 // Every tolerance is a number of standard errors estimated from the per-pixel sample
 // variance the renderer accumulates, with fixed seeds.
 #include <cmath>
+#include <cstring>
 
 #include <gtest/gtest.h>
 
 #include "gpu_fixture.h"
+#include "render/batch_loop.h"
+#include "render/pt_pass.h"
 #include "render/renderer.h"
+#include "vk/commands.h"
 #include "scene/procedural.h"
 #include "stats_normal.h"
 
@@ -89,6 +93,61 @@ TEST_F(RenderPt, DeterministicPerSeed) {
         differentSeedDiffers += a.image.plane(ch) != c.image.plane(ch);
     }
     EXPECT_GT(differentSeedDiffers, 0);
+}
+
+// The partial last pass of a timed render: rows that one more sample covers in the time
+// left, with the 10 % margin, never more than the image, none without time or a rate.
+TEST(PartialPass, RowsFitTheTimeLeft) {
+    EXPECT_EQ(partialPassRows(0.5, 1.0, 100), 45u);
+    EXPECT_EQ(partialPassRows(0.05, 1.0, 100), 4u);
+    EXPECT_EQ(partialPassRows(5.0, 1.0, 100), 100u);
+    EXPECT_EQ(partialPassRows(0.0, 1.0, 100), 0u);
+    EXPECT_EQ(partialPassRows(-1.0, 1.0, 100), 0u);
+    EXPECT_EQ(partialPassRows(0.5, 0.0, 100), 0u);
+}
+
+// A row-limited batch samples exactly those rows: after two whole samples and one more for
+// the first 3 rows, those rows hold the statistics of three whole samples bit for bit and the
+// others those of two.
+TEST_F(RenderPt, RowLimitedBatchSamplesOnlyThoseRows) {
+    const Scene scene = makeCornellBox();
+    SceneGpuOptions so;
+    so.width = 16;
+    so.height = 12;
+    SceneGpu sceneGpu(ctx(), scene, so);
+    auto statsAfter = [&](std::uint32_t lastRows) {
+        PtPass pass(ctx(), sceneGpu, WorkgroupSize{}, 0);
+        vk::CommandStream stream(ctx(), "row-limited");
+        pass.record(stream.begin(), 0, 2, 5, nullptr);
+        stream.submitAndWait();
+        pass.record(stream.begin(), 2, 1, 5, nullptr, lastRows);
+        stream.submitAndWait();
+        return pass.downloadStats()[0];
+    };
+    const auto partial = statsAfter(3), full = statsAfter(12);
+    const auto two = [&] {
+        PtPass pass(ctx(), sceneGpu, WorkgroupSize{}, 0);
+        vk::CommandStream stream(ctx(), "two");
+        pass.record(stream.begin(), 0, 2, 5, nullptr);
+        stream.submitAndWait();
+        return pass.downloadStats()[0];
+    }();
+    for (std::size_t i = 0; i < partial.size(); ++i) {
+        const auto& expected = i < 3u * 16u ? full[i] : two[i];
+        ASSERT_EQ(partial[i].count, i < 3u * 16u ? 3u : 2u) << "pixel " << i;
+        ASSERT_EQ(0, std::memcmp(&partial[i], &expected, sizeof expected)) << "pixel " << i;
+    }
+}
+
+// A timed render's counters agree with its sample counts: every pixel got `spp` samples and
+// the rows of the partial pass one more.
+TEST_F(RenderPt, TimedRenderCountsWholeAndPartialPasses) {
+    RenderOptions o = renderOptions(32, 24, 1, 2);
+    o.timeBudget = 0.6;
+    const RenderResult r = renderPt(ctx(), makeCornellBox(), o);
+    EXPECT_GE(r.stats.spp, 1u);
+    EXPECT_LT(r.stats.partialPassRows, 24u);
+    EXPECT_EQ(r.stats.pathsCompleted, std::uint64_t{r.stats.spp} * 32u * 24u + std::uint64_t{r.stats.partialPassRows} * 32u);
 }
 
 }  // namespace
