@@ -86,6 +86,9 @@ void checkResults(const fs::path& dir, const std::vector<std::string>& methods,
         ASSERT_TRUE(r.contains("method") && r["method"].is_string()) << r.dump();
         ASSERT_TRUE(r.contains("repeat") && r["repeat"].is_number_integer()) << r.dump();
         ASSERT_TRUE(r.contains("spp") && r["spp"].is_number_unsigned()) << r.dump();
+        // Rows of the partial last pass (one sample more): fewer than the image's rows.
+        ASSERT_TRUE(r.contains("partial_pass_rows") && r["partial_pass_rows"].is_number_unsigned()) << r.dump();
+        EXPECT_LT(r["partial_pass_rows"].get<unsigned>(), static_cast<unsigned>(height)) << r.dump();
         for (const char* key : {"budget_s", "seconds", "recon_seconds", "relmse", "mse", "mae", "mean_bias"})
             ASSERT_TRUE(r.contains(key) && r[key].is_number()) << key << " in " << r.dump();
         const auto m = r["method"].get<std::string>();
