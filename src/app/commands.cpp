@@ -251,8 +251,10 @@ int runRender(const RenderArgs& args) {
     if (args.profile) printProfile(s.kernels);
     if (!args.quiet)
         std::fprintf(stderr,
-                     "gdpt: wrote %s (%u spp, %.2f s total, BVH %.1f ms, sampling %.1f ms, %.2f Mrays/s, %.3f Msamples/s)\n",
-                     args.output.c_str(), s.spp, seconds, s.bvhBuildMs, s.samplingMs,
+                     "gdpt: wrote %s (%u spp%s, %.2f s total, BVH %.1f ms, sampling %.1f ms, %.2f Mrays/s, %.3f Msamples/s)\n",
+                     args.output.c_str(), s.spp,
+                     s.partialPassRows ? (" + 1 in the top " + std::to_string(s.partialPassRows) + " rows").c_str() : "",
+                     seconds, s.bvhBuildMs, s.samplingMs,
                      double(s.raysTraced) / (s.samplingMs * 1e-3) * 1e-6,
                      double(s.pathsCompleted) / (s.samplingMs * 1e-3) * 1e-6);
     if (!args.json.empty()) {
