@@ -1,8 +1,6 @@
 // recon_reserve.cpp — reconstruction-time estimates for timed G-PT renders (recon_reserve.h).
 #include "app/recon_reserve.h"
 
-#include <cmath>
-#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -13,22 +11,6 @@
 #include "vk/context.h"
 
 namespace gdpt {
-
-SyntheticReconProblem syntheticReconProblem(int width, int height) {
-    SyntheticReconProblem p{Image(width, height, 0.5f), Image(width, height, 0.0f),
-                            Image(width, height, 0.0f), Image(width, height, 1e-3f)};
-    for (int c = 0; c < 3; ++c)
-        for (std::size_t i = 0; i < p.primal.pixelCount(); ++i) {
-            p.primal.plane(c)[i] = 0.5f + 0.25f * std::sin(0.37f * static_cast<float>(i % 97));
-            // Low-spp-like noise in the gradients (a fixed hash, so the estimate is repeatable):
-            // smooth inputs converge in far fewer iterations than real renders.
-            const auto h =
-                static_cast<std::uint32_t>((i * 2654435761u) ^ (static_cast<std::uint32_t>(c) * 40503u));
-            p.dx.plane(c)[i] = 0.2f * (static_cast<float>(h % 1000u) / 1000.0f - 0.5f);
-            p.dy.plane(c)[i] = 0.2f * (static_cast<float>((h >> 10) % 1000u) / 1000.0f - 0.5f);
-        }
-    return p;
-}
 
 double calibrateReconSeconds(PoissonSolverGpu& solver, const SolveOptions& options, bool warmUp) {
     const SyntheticReconProblem p = syntheticReconProblem(solver.engine().width(), solver.engine().height());

@@ -21,13 +21,6 @@ class Context;
 
 namespace gdpt {
 
-// A repeatable stand-in for a low-spp G-PT output: smooth primal, hash-noise gradients and
-// a small constant variance, width x height.
-struct SyntheticReconProblem {
-    Image primal, dx, dy, variance;
-};
-SyntheticReconProblem syntheticReconProblem(int width, int height);
-
 // Seconds of one `options` solve of the synthetic problem with `solver` (the solver's size).
 // warmUp: after an untimed solve that compiles its pipeline variants (the steady-state time,
 // for benchmarks); without it the figure includes that one-off cost and the calibration

@@ -161,6 +161,14 @@ private:
     int roundsDone_ = 0, rounds_ = 1;  // for SolveOptions::progress
 };
 
+// A repeatable stand-in for a low-spp G-PT output: smooth primal, hash-noise gradients and
+// a small constant variance, width x height. For calibrating solve times and for
+// PoissonSolverGpu::preparePipelines.
+struct SyntheticReconProblem {
+    Image primal, dx, dy, variance;
+};
+SyntheticReconProblem syntheticReconProblem(int width, int height);
+
 // One-call reconstruction for the renderer: primal, gradients and optional variances (WL2
 // and WL1 use them).
 Image reconstruct(const vk::Context& ctx, const Image& primal, const Image& dx, const Image& dy,
