@@ -124,9 +124,7 @@ Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation crea
     if (creation == PipelineCreation::Background) {
         pending_ = std::async(std::launch::async, [job = std::move(job)] { return createPipeline(job); });
     } else {
-        const VkPipeline pipeline = createPipeline(job);
-        pipeline_ = Handle<VkPipeline>(pipeline, [device](VkPipeline p) { vkDestroyPipeline(device, p, nullptr); });
-        ctx.setName(VK_OBJECT_TYPE_PIPELINE, reinterpret_cast<std::uint64_t>(pipeline), desc.name);
+        adopt(createPipeline(job));
     }
 }
 
@@ -141,13 +139,16 @@ Kernel::~Kernel() {
     }
 }
 
-double Kernel::wait() const {
-    if (!pending_.valid()) return 0.0;
-    const auto start = std::chrono::steady_clock::now();
-    const VkPipeline pipeline = pending_.get();  // rethrows the worker's error
+void Kernel::adopt(VkPipeline pipeline) const {
     const VkDevice device = ctx_.device();
     pipeline_ = Handle<VkPipeline>(pipeline, [device](VkPipeline p) { vkDestroyPipeline(device, p, nullptr); });
     ctx_.setName(VK_OBJECT_TYPE_PIPELINE, reinterpret_cast<std::uint64_t>(pipeline), desc_.name);
+}
+
+double Kernel::wait() const {
+    if (!pending_.valid()) return 0.0;
+    const auto start = std::chrono::steady_clock::now();
+    adopt(pending_.get());  // rethrows the worker's error
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 

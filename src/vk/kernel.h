@@ -76,6 +76,7 @@ public:
 
 private:
     void bindState(VkCommandBuffer cmd, const void* push) const;  // pipeline, set, push constants
+    void adopt(VkPipeline pipeline) const;  // owns and names a created pipeline
 
     const Context& ctx_;
     KernelDesc desc_;
