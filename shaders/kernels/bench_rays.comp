@@ -42,7 +42,7 @@ void main() {
             rays++;
             if (h.triangle == kInvalidIndex) break;
             hits++;
-            TriangleGeom g = triGeoms[h.triangle];
+            TriangleGeom g = triangleGeom(h.triangle);
             vec3 n = normalize(cross(g.e1, g.e2));
             if (dot(n, d) > 0.0) n = -n;
             vec3 p = g.v0 + h.u * g.e1 + h.v * g.e2;

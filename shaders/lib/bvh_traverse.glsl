@@ -8,10 +8,9 @@
 //  * The traversal loops (traceClosest, traceAny) read the storage buffers and exist in GLSL
 //    only. src/bvh/traverse_cpu.cpp mirrors them statement for statement; change both.
 //
-// The including kernel must declare, before including this file,
-//   layout(scalar) readonly buffer ... { BvhWideNode bvhNodes[]; };
-//   layout(scalar) readonly buffer ... { TriangleGeom triGeoms[]; };
-// (scene_buffers.glsl does). Triangle indices are positions in TriangleGeom (leaf) order.
+// The including kernel must include scene_geometry.glsl (the accessors bvhNode(i) and
+// triangleGeom(i)) before this file; scene_buffers.glsl does. Triangle indices are
+// positions in TriangleGeom (leaf) order.
 //
 // Cutout (alpha-masked) triangles: define GDPT_ANYHIT_FILTER(tri, u, v) before including
 // this file; a hit for which it is false is ignored by both traceClosest and traceAny.
@@ -262,7 +261,7 @@ GDPT_NAMESPACE_END
 // Triangle `tri` (TriangleGeom order) against the ray; see intersectTriangleGeom.
 bool intersectTriangle(vec3 orig, vec3 dir, uint tri, float tMin, inout float tMax, out float u,
                        out float v) {
-    TriangleGeom g = triGeoms[tri];
+    TriangleGeom g = triangleGeom(tri);
     return intersectTriangleGeom(orig, dir, g.v0, g.e1, g.e2, tMin, tMax, u, v);
 }
 
@@ -279,7 +278,7 @@ Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
     uint stackSize = 0u;
     uint node = 0u;
     while (true) {
-        BvhWideNode n = bvhNodes[node];
+        BvhWideNode n = bvhNode(node);
         vec4 tNear;
         bvec4 h;
         wideNodeBoxes(n, orig, invDir, tMin, hit.t, tNear, h);
@@ -334,7 +333,7 @@ bool traceAny(vec3 orig, vec3 dir, float tMin, float tMax) {
     uint stackSize = 0u;
     uint node = 0u;
     while (true) {
-        BvhWideNode n = bvhNodes[node];
+        BvhWideNode n = bvhNode(node);
         vec4 tNear;
         bvec4 h;
         wideNodeBoxes(n, orig, invDir, tMin, tMax, tNear, h);

@@ -311,7 +311,7 @@
         vec3 le = surfaceEmission(nextSh);
         float pdfLight = 0.0;
         if (!prevSpecular && maxComponent(le) > 0.0) {
-            vec3 nl = normalize(cross(triGeoms[nextSh.triangle].e1, triGeoms[nextSh.triangle].e2));
+            vec3 nl = triangleUnitNormal(nextSh.triangle);
             pdfLight = lightTrianglePdf(nextSh.triangle, prevP, nextSh.p, nl);
         }
         for (uint i = 0u; i < 4u; ++i) {

@@ -63,7 +63,7 @@ void ptProcessHit(inout PathState s, Hit hit) {
     if (kHasLightTris && countEmission && maxComponent(Le) > 0.0) {
         float w = 1.0;
         if ((s.flags & kPathFlagPrevSpecular) == 0u) {
-            vec3 nl = normalize(cross(triGeoms[sh.triangle].e1, triGeoms[sh.triangle].e2));
+            vec3 nl = triangleUnitNormal(sh.triangle);
             float lightPdf = lightTrianglePdf(sh.triangle, s.prevP, sh.p, nl);
             w = powerHeuristic(1.0, s.prevPdf, 1.0, lightPdf);
         }

@@ -55,7 +55,7 @@ vec2 hitUv(uint tri, float u, float v) {
 }
 
 SurfaceHit makeSurfaceHit(uint tri, float u, float v, vec3 rayDir) {
-    TriangleGeom g = triGeoms[tri];
+    TriangleGeom g = triangleGeom(tri);
     TriangleShading s = triShading[tri];
     SurfaceHit h;
     h.triangle = tri;
@@ -168,7 +168,7 @@ bool sampleLight(vec3 p, vec3 u, out LightSample ls) {
     if (kHasLightTris && u.x < pTri) {
         uint li = pickLightTriangle(u.x / pTri);
         uint tri = lightTris[li].triangle;
-        TriangleGeom g = triGeoms[tri];
+        TriangleGeom g = triangleGeom(tri);
         vec3 bary = sampleUniformTriangle(u.yz);
         ls.pLight = g.v0 + bary.y * g.e1 + bary.z * g.e2;
         vec3 nl = normalize(cross(g.e1, g.e2));

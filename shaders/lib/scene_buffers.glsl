@@ -1,5 +1,6 @@
-// scene_buffers.glsl — declarations of the scene's storage buffers and the feature
-// specialisation constants, shared by every path-sampling kernel. Binding numbers and
+// scene_buffers.glsl — declarations of the scene's buffers (storage buffers, and the
+// geometry's texel buffers of scene_geometry.glsl) and the feature specialisation
+// constants, shared by every path-sampling kernel. Binding numbers and
 // constant ids come from gdpt_shared.h only.
 #ifndef GDPT_LIB_SCENE_BUFFERS
 #define GDPT_LIB_SCENE_BUFFERS
@@ -13,9 +14,9 @@ layout(constant_id = kSpecHasAlphaMask) const bool kHasAlphaMask = true;
 layout(constant_id = kSpecMaxDepth) const uint kMaxDepth = 1024u;
 layout(constant_id = kSpecHasShadingNormals) const bool kHasShadingNormals = true;
 
-layout(set = 0, binding = kBindTriGeom, scalar) readonly buffer TriGeomBuf { TriangleGeom triGeoms[]; };
+#include "scene_geometry.glsl"
+
 layout(set = 0, binding = kBindTriShading, scalar) readonly buffer TriShadingBuf { TriangleShading triShading[]; };
-layout(set = 0, binding = kBindBvh, scalar) readonly buffer BvhBuf { BvhWideNode bvhNodes[]; };
 layout(set = 0, binding = kBindMaterials, scalar) readonly buffer MaterialBuf { Material materials[]; };
 layout(set = 0, binding = kBindTexInfo, scalar) readonly buffer TexInfoBuf { TextureInfo texInfos[]; };
 layout(set = 0, binding = kBindTexels, scalar) readonly buffer TexelBuf { uvec2 texels[]; };

@@ -56,6 +56,7 @@ struct TriangleGeom {
     vec3 e2;   // v2 - v0 (world space)
     float pad2;
 };
+GDPT_CONST uint kTriangleGeomTexels = 3u;  // 16-byte texels per TriangleGeom (scene_geometry.glsl)
 
 // Shading data of one triangle, same index as TriangleGeom. 80 bytes.
 struct TriangleShading {
@@ -106,6 +107,7 @@ struct BvhWideNode {
     uvec4 qMax;      // xyz: byte k = child k's upper bound (rounded up); w: 0
     uvec4 child;     // node index (count 0) or first triangle (count > 0); kInvalidIndex = empty slot
 };
+GDPT_CONST uint kBvhWideNodeTexels = 4u;  // 16-byte texels per BvhWideNode (scene_geometry.glsl)
 // Four 16-byte vectors, so that a node is four vector loads (llvmpipe loads per lane and per
 // load instruction); qMin.w holds the children's triangle counts, byte k for child k (0 =
 // inner node or empty slot, <= kMaxLeafTriangles).

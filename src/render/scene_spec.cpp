@@ -29,6 +29,11 @@ std::vector<std::uint32_t> SceneSpec::sceneBindings() {
             gpu::kBindTexels,  gpu::kBindLightTris,  gpu::kBindPunctual, gpu::kBindSceneConst};
 }
 
+std::vector<std::pair<std::uint32_t, VkFormat>> SceneSpec::sceneTexelBindings() {
+    // shaders/lib/scene_geometry.glsl: the BVH as utextureBuffer, the triangles as textureBuffer.
+    return {{gpu::kBindBvh, VK_FORMAT_R32G32B32A32_UINT}, {gpu::kBindTriGeom, VK_FORMAT_R32G32B32A32_SFLOAT}};
+}
+
 std::vector<std::pair<std::uint32_t, std::uint32_t>> SceneSpec::specConstants() const {
     auto b = [](bool v) { return v ? 1u : 0u; };
     std::vector<std::pair<std::uint32_t, std::uint32_t>> spec = {
@@ -44,6 +49,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> SceneSpec::specConstants() 
 vk::KernelDesc SceneSpec::kernelDesc(vk::KernelDesc base, WorkgroupSize wg,
                                      const std::vector<std::uint32_t>& extraBindings, std::uint32_t pushBytes) const {
     base.bindings = sceneBindings();
+    base.texelBindings = sceneTexelBindings();
     base.bindings.insert(base.bindings.end(), extraBindings.begin(), extraBindings.end());
     base.pushConstantBytes = pushBytes;
     base.specConstants = specConstants();

@@ -50,6 +50,8 @@ public:
     [[nodiscard]] std::vector<std::pair<std::uint32_t, std::uint32_t>> specConstants() const;
     // The storage-buffer bindings of the scene (kBindTriGeom..kBindSceneConst).
     [[nodiscard]] static std::vector<std::uint32_t> sceneBindings();
+    // The scene bindings that the kernels read as texel buffers, with their view formats.
+    [[nodiscard]] static std::vector<std::pair<std::uint32_t, VkFormat>> sceneTexelBindings();
     // Completes `base` (name + SPIR-V) into the descriptor of a kernel that reads the scene:
     // the scene bindings plus `extraBindings`, `pushBytes` of push constants, the scene's
     // feature specialisation constants and the workgroup size.

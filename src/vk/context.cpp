@@ -87,6 +87,7 @@ DeviceInfo queryDevice(VkPhysicalDevice pd, std::uint32_t index) {
     d.driverVersion = p.driverVersion;
     d.apiVersion = p.apiVersion;
     d.maxStorageBufferRange = p.limits.maxStorageBufferRange;
+    d.maxTexelBufferElements = p.limits.maxTexelBufferElements;
     d.maxMemoryAllocationSize = maint3.maxMemoryAllocationSize;
     d.maxPushConstantsSize = p.limits.maxPushConstantsSize;
     d.maxComputeWorkGroupInvocations = p.limits.maxComputeWorkGroupInvocations;
@@ -321,6 +322,14 @@ void Context::checkAllocationSize(std::uint64_t bytes, const std::string& what) 
 void Context::checkStorageBufferSize(std::uint64_t bytes, const std::string& what) const {
     checkLimit(bytes, info_.maxStorageBufferRange, "a storage buffer", "maxStorageBufferRange", info_.name, what,
                "use a smaller scene or image");
+}
+
+void Context::checkTexelBufferSize(std::uint64_t texels, const std::string& what) const {
+    if (texels > info_.maxTexelBufferElements)
+        throw Error(what + " needs a texel buffer of " + std::to_string(texels) +
+                    " texels, more than the device limit maxTexelBufferElements = " +
+                    std::to_string(info_.maxTexelBufferElements) + " on '" + info_.name +
+                    "'; use a smaller scene");
 }
 
 }  // namespace gdpt::vk

@@ -32,6 +32,7 @@ struct DeviceInfo {
     std::uint32_t apiVersion = 0;
     bool isCpu = false;
     std::uint64_t maxStorageBufferRange = 0;    // largest descriptor range
+    std::uint64_t maxTexelBufferElements = 0;   // largest texel-buffer view, in texels
     std::uint64_t maxMemoryAllocationSize = 0;  // largest buffer (device-address access)
     std::uint32_t maxPushConstantsSize = 0;
     std::uint32_t maxComputeWorkGroupInvocations = 0;
@@ -79,6 +80,9 @@ public:
     // The same for a buffer read through its device address (no descriptor range limit):
     // throws if `bytes` exceeds maxMemoryAllocationSize.
     void checkAllocationSize(std::uint64_t bytes, const std::string& what) const;
+    // The same for a texel-buffer view of `texels` texels: throws if it exceeds
+    // maxTexelBufferElements.
+    void checkTexelBufferSize(std::uint64_t texels, const std::string& what) const;
 
 private:
     static VkBool32 VKAPI_PTR messengerCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,

@@ -64,10 +64,14 @@ Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation crea
     ctx.setName(VK_OBJECT_TYPE_SHADER_MODULE, reinterpret_cast<std::uint64_t>(module), desc.name);
 
     std::vector<VkDescriptorSetLayoutBinding> bindings;
+    std::uint32_t texelCount = 0;
+    for (const auto& [b, format] : desc.texelBindings)
+        GDPT_CHECK(std::find(desc.bindings.begin(), desc.bindings.end(), b) != desc.bindings.end());
     for (std::uint32_t b : desc.bindings) {
         VkDescriptorSetLayoutBinding lb{};
         lb.binding = b;
-        lb.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        lb.descriptorType = descriptorType(b);
+        texelCount += lb.descriptorType == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER ? 1u : 0u;
         lb.descriptorCount = 1;
         lb.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
         bindings.push_back(lb);
@@ -105,11 +109,14 @@ Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation crea
         job.values.push_back(value);
     }
     if (!bindings.empty()) {
-        VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, static_cast<std::uint32_t>(bindings.size())};
+        std::vector<VkDescriptorPoolSize> sizes;
+        const auto storageCount = static_cast<std::uint32_t>(bindings.size()) - texelCount;
+        if (storageCount) sizes.push_back({VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, storageCount});
+        if (texelCount) sizes.push_back({VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, texelCount});
         VkDescriptorPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
         poolInfo.maxSets = 1;
-        poolInfo.poolSizeCount = 1;
-        poolInfo.pPoolSizes = &size;
+        poolInfo.poolSizeCount = static_cast<std::uint32_t>(sizes.size());
+        poolInfo.pPoolSizes = sizes.data();
         VkDescriptorPool pool = VK_NULL_HANDLE;
         VK_CHECK(vkCreateDescriptorPool(device, &poolInfo, nullptr, &pool));
         pool_ = Handle<VkDescriptorPool>(pool, [device](VkDescriptorPool p) { vkDestroyDescriptorPool(device, p, nullptr); });
@@ -152,6 +159,12 @@ double Kernel::wait() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+VkDescriptorType Kernel::descriptorType(std::uint32_t binding) const {
+    for (const auto& [b, format] : desc_.texelBindings)
+        if (b == binding) return VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+    return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+}
+
 void Kernel::bind(std::uint32_t binding, const Buffer& buffer) {
     GDPT_CHECK(std::find(desc_.bindings.begin(), desc_.bindings.end(), binding) != desc_.bindings.end());
     VkDescriptorBufferInfo info{buffer.get(), 0, VK_WHOLE_SIZE};
@@ -159,9 +172,49 @@ void Kernel::bind(std::uint32_t binding, const Buffer& buffer) {
     write.dstSet = set_;
     write.dstBinding = binding;
     write.descriptorCount = 1;
-    write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    write.pBufferInfo = &info;
+    write.descriptorType = descriptorType(binding);
+    VkBufferView view = VK_NULL_HANDLE;
+    if (write.descriptorType == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER) {
+        view = texelView(binding, buffer);
+        write.pTexelBufferView = &view;
+    } else {
+        write.pBufferInfo = &info;
+    }
     vkUpdateDescriptorSets(ctx_.device(), 1, &write, 0, nullptr);
+}
+
+VkBufferView Kernel::createTexelView(const Buffer& buffer, VkFormat format) const {
+    // Every texel format used is 16 bytes (RGBA32); the view covers the whole texels.
+    GDPT_CHECK(format == VK_FORMAT_R32G32B32A32_UINT || format == VK_FORMAT_R32G32B32A32_SFLOAT);
+    constexpr std::uint64_t kTexelBytes = 16;
+    const std::uint64_t texels = buffer.size() / kTexelBytes;
+    ctx_.checkTexelBufferSize(texels, buffer.name());
+    VkBufferViewCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
+    info.buffer = buffer.get();
+    info.format = format;
+    info.offset = 0;
+    info.range = texels * kTexelBytes;
+    const VkDevice device = ctx_.device();
+    VkBufferView view = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateBufferView(device, &info, nullptr, &view));
+    ctx_.setName(VK_OBJECT_TYPE_BUFFER_VIEW, reinterpret_cast<std::uint64_t>(view), buffer.name());
+    return view;
+}
+
+VkBufferView Kernel::texelView(std::uint32_t binding, const Buffer& buffer) {
+    VkFormat format = VK_FORMAT_UNDEFINED;
+    for (const auto& [b, f] : desc_.texelBindings)
+        if (b == binding) format = f;
+    Handle<VkBufferView> view(createTexelView(buffer, format),
+                              [device = ctx_.device()](VkBufferView v) { vkDestroyBufferView(device, v, nullptr); });
+    const VkBufferView raw = view.get();
+    // A rebinding replaces the earlier view (bind() is never called while work is pending).
+    auto it = std::find_if(views_.begin(), views_.end(), [binding](const auto& e) { return e.first == binding; });
+    if (it != views_.end())
+        it->second = std::move(view);
+    else
+        views_.emplace_back(binding, std::move(view));
+    return raw;
 }
 
 void Kernel::bindState(VkCommandBuffer cmd, const void* push) const {

@@ -1,6 +1,7 @@
 // kernel.h — one compute pipeline: a .comp file's embedded SPIR-V, its descriptor-set
-// layout (storage buffers only), push-constant range and specialisation constants, plus
-// one descriptor set that buffers are bound to by binding number.
+// layout (storage buffers, and uniform texel buffers where the description says so),
+// push-constant range and specialisation constants, plus one descriptor set that buffers
+// are bound to by binding number.
 #pragma once
 
 #include <cstddef>
@@ -24,7 +25,12 @@ struct KernelDesc {
     std::string name;                    // shown in --profile and error messages
     const std::uint32_t* spirv = nullptr;
     std::size_t spirvBytes = 0;
-    std::vector<std::uint32_t> bindings;  // storage-buffer binding numbers of set 0
+    std::vector<std::uint32_t> bindings;  // binding numbers of set 0 (storage buffers unless below)
+    // Bindings of `bindings` that the shader reads as uniform texel buffers (GLSL
+    // textureBuffer / utextureBuffer + texelFetch), with the format of their view. Lavapipe
+    // before Mesa 23 loads a storage buffer lane by lane with a branch per lane and
+    // component, but fetches texels with vector gathers (bench/RESULTS.md, eighth session).
+    std::vector<std::pair<std::uint32_t, VkFormat>> texelBindings;
     std::uint32_t pushConstantBytes = 0;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> specConstants;  // (id, 32-bit value)
     std::uint32_t localSizeX = 1;  // workgroup size, for dispatch-by-items helpers
@@ -55,8 +61,9 @@ public:
     Kernel(const Kernel&) = delete;
     Kernel& operator=(const Kernel&) = delete;
 
-    // Points `binding` at `buffer` (whole range). Not while a submitted command buffer
-    // that uses this kernel is pending.
+    // Points `binding` at `buffer` (whole range; for a texel binding, a view of the whole
+    // texels it holds, which the kernel owns). Not while a submitted command buffer that
+    // uses this kernel is pending.
     void bind(std::uint32_t binding, const Buffer& buffer);
     // Records bind + push constants + dispatch of groups (x, y, z). With a timer, the
     // dispatch is wrapped in a named timestamp scope.
@@ -77,6 +84,10 @@ public:
 private:
     void bindState(VkCommandBuffer cmd, const void* push) const;  // pipeline, set, push constants
     void adopt(VkPipeline pipeline) const;  // owns and names a created pipeline
+    [[nodiscard]] VkDescriptorType descriptorType(std::uint32_t binding) const;
+    [[nodiscard]] VkBufferView createTexelView(const Buffer& buffer, VkFormat format) const;
+    // A view of `buffer` for texel binding `binding`, kept in views_ (replacing an older one).
+    VkBufferView texelView(std::uint32_t binding, const Buffer& buffer);
 
     const Context& ctx_;
     KernelDesc desc_;
@@ -89,6 +100,7 @@ private:
     mutable std::future<VkPipeline> pending_;
     Handle<VkDescriptorPool> pool_;
     VkDescriptorSet set_ = VK_NULL_HANDLE;
+    std::vector<std::pair<std::uint32_t, Handle<VkBufferView>>> views_;  // texel bindings' views
 };
 
 }  // namespace gdpt::vk

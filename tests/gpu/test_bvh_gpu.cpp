@@ -13,6 +13,7 @@
 #include "bvh/traverse_cpu.h"
 #include "bvh/wide_bvh.h"
 #include "gpu_fixture.h"
+#include "render/scene_spec.h"
 #include "trace_rays.spv.h"
 #include "vk/buffer.h"
 #include "vk/commands.h"
@@ -108,6 +109,7 @@ protected:
         vk::KernelDesc desc = vk::kernelDesc("trace_rays", kSpv_trace_rays);
         desc.bindings = {gpu::kBindTriGeom, gpu::kBindBvh, gpu::kBindTestInput, gpu::kBindTestOutput,
                          gpu::kBindTestOutput2};
+        desc.texelBindings = SceneSpec::sceneTexelBindings();
         desc.pushConstantBytes = sizeof(std::uint32_t);
         desc.localSizeX = 64;
         vk::Kernel kernel(ctx(), desc, creation);
@@ -170,6 +172,7 @@ TEST_F(BvhGpu, UnusedBackgroundPipelineIsDestroyed) {
     vk::KernelDesc desc = vk::kernelDesc("trace_rays", kSpv_trace_rays);
     desc.bindings = {gpu::kBindTriGeom, gpu::kBindBvh, gpu::kBindTestInput, gpu::kBindTestOutput,
                      gpu::kBindTestOutput2};
+    desc.texelBindings = SceneSpec::sceneTexelBindings();
     desc.pushConstantBytes = sizeof(std::uint32_t);
     desc.localSizeX = 64;
     { vk::Kernel unused(ctx(), desc, vk::PipelineCreation::Background); }

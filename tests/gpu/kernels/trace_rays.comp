@@ -7,8 +7,7 @@
 #include "lib/common.glsl"
 
 layout(local_size_x = 64) in;
-layout(set = 0, binding = kBindTriGeom, scalar) readonly buffer TriGeomBuf { TriangleGeom triGeoms[]; };
-layout(set = 0, binding = kBindBvh, scalar) readonly buffer BvhBuf { BvhWideNode bvhNodes[]; };
+#include "lib/scene_geometry.glsl"
 layout(set = 0, binding = kBindTestInput, scalar) readonly buffer RayBuf { TestRay rays[]; };
 layout(set = 0, binding = kBindTestOutput, scalar) writeonly buffer HitBuf { vec4 hits[]; };
 layout(set = 0, binding = kBindTestOutput2, scalar) writeonly buffer AnyBuf { uint anyHits[]; };
