@@ -26,14 +26,14 @@ bool gptOffsetLight(LightSample ls, vec3 ul, vec3 pBase, vec3 pOffset, vec3 wiOf
     jacobianLight = 0.0;
     if (ls.isDelta == 0u) {
         float cosL = dot(ls.nLight, -wiOffset);
-        bool twoSided = (materials[triShading[ls.triangle].material].flags & kMatFlagDoubleSided) != 0u;
+        bool twoSided = (material(triangleShading(ls.triangle).material).flags & kMatFlagDoubleSided) != 0u;
         if ((cosL <= 0.0 && !twoSided) || abs(cosL) <= 1e-7) return false;
         jacobianLight = reconnectionJacobian(pBase, pOffset, ls.pLight, ls.nLight);
         liOffset = ls.Li;
         return jacobianLight > 0.0;
     }
     if (!kHasPunctual) return false;
-    PunctualLight l = punctual[gptPunctualIndex(ul.x)];
+    PunctualLight l = punctualLight(gptPunctualIndex(ul.x));
     float falloff = 1.0;
     if (l.type == kPunctualSpot) {
         // glTF KHR_lights_punctual smooth cone falloff, as sampleLight.

@@ -47,7 +47,7 @@ bool roughAll(BsdfParams m) {
 }
 
 bool oneSidedBack(SurfaceHit h) {
-    return !h.frontFace && (materials[h.material].flags & kMatFlagDoubleSided) == 0u;
+    return !h.frontFace && (material(h.material).flags & kMatFlagDoubleSided) == 0u;
 }
 
 // Adds one estimator sample of a pair with MIS weight w (GPT_REFERENCE §1.6).

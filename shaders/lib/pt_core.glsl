@@ -69,7 +69,7 @@ void ptProcessHit(inout PathState s, Hit hit) {
         }
         s.radiance += s.beta * Le * w;
     }
-    Material mat = materials[sh.material];
+    Material mat = material(sh.material);
     // One-sided materials: the back face is an opaque black absorber.
     if (!sh.frontFace && (mat.flags & kMatFlagDoubleSided) == 0u) return;
     if (s.depth >= scene.maxDepth || s.depth + 1u >= kMaxDepth) return;  // no further segment

@@ -17,14 +17,12 @@ vec4 fetchTexel(TextureInfo info, int x, int y) {
     int h = int(info.height);
     x = ((x % w) + w) % w;
     y = ((y % h) + h) % h;
-    uint i = info.offset + uint(y * w + x);
-    uvec2 packed = texels[i];
-    return vec4(unpackHalf2x16(packed.x), unpackHalf2x16(packed.y));
+    return imageTexel(info.offset + uint(y * w + x));
 }
 
 vec4 sampleTexture(int tex, vec2 uv) {
     if (!kHasTextures || tex < 0) return vec4(1.0);
-    TextureInfo info = texInfos[tex];
+    TextureInfo info = textureInfo(tex);
     // glTF uv (0,0) is the top-left of the image (row 0).
     vec2 st = uv * vec2(info.width, info.height) - 0.5;
     vec2 f = floor(st);
@@ -50,13 +48,13 @@ struct SurfaceHit {
 };
 
 vec2 hitUv(uint tri, float u, float v) {
-    TriangleShading s = triShading[tri];
+    TriangleShading s = triangleShading(tri);
     return (1.0 - u - v) * s.uv0 + u * s.uv1 + v * s.uv2;
 }
 
 SurfaceHit makeSurfaceHit(uint tri, float u, float v, vec3 rayDir) {
     TriangleGeom g = triangleGeom(tri);
-    TriangleShading s = triShading[tri];
+    TriangleShading s = triangleShading(tri);
     SurfaceHit h;
     h.triangle = tri;
     h.material = s.material;
@@ -84,14 +82,14 @@ SurfaceHit makeSurfaceHit(uint tri, float u, float v, vec3 rayDir) {
 // Cutout test used during traversal (GDPT_ANYHIT_FILTER): false = ignore this hit.
 bool alphaPasses(uint tri, float u, float v) {
     if (!kHasAlphaMask) return true;
-    Material m = materials[triShading[tri].material];
+    Material m = material(triangleShading(tri).material);
     if ((m.flags & kMatFlagAlphaMask) == 0u) return true;
     float alpha = m.baseColor.w * sampleTexture(m.baseColorTex, hitUv(tri, u, v)).w;
     return alpha >= m.alphaCutoff;
 }
 
 BsdfParams materialBsdf(uint matIndex, vec2 uv) {
-    Material m = materials[matIndex];
+    Material m = material(matIndex);
     vec3 base = m.baseColor.xyz;
     float metallic = m.metallic;
     float roughness = m.roughness;
@@ -109,7 +107,7 @@ BsdfParams materialBsdf(uint matIndex, vec2 uv) {
 // Emitted radiance leaving the surface towards the viewer (front faces only unless the
 // material is double-sided).
 vec3 surfaceEmission(SurfaceHit h) {
-    Material m = materials[h.material];
+    Material m = material(h.material);
     if ((m.flags & kMatFlagEmissive) == 0u) return vec3(0.0);
     if (!h.frontFace && (m.flags & kMatFlagDoubleSided) == 0u) return vec3(0.0);
     vec3 e = m.emissive;
@@ -127,13 +125,13 @@ float lightTriangleSelectProb() {
 // Solid-angle pdf with which NEE would have chosen point `p` on emissive triangle `tri`
 // (area pdf pmf/area converted by dist^2/cos) seen from `from`.
 float lightTrianglePdf(uint tri, vec3 from, vec3 p, vec3 nLight) {
-    uint li = triShading[tri].lightIndex;
+    uint li = triangleShading(tri).lightIndex;
     if (li == kInvalidIndex) return 0.0;
     vec3 d = p - from;
     float dist2 = dot(d, d);
     float cosL = abs(dot(nLight, normalize(d)));
     if (cosL <= 0.0) return 0.0;
-    float pdfArea = lightTriangleSelectProb() * lightTris[li].pmf / triShading[tri].area;
+    float pdfArea = lightTriangleSelectProb() * lightTriangle(li).pmf / triangleShading(tri).area;
     return pdfArea * dist2 / cosL;
 }
 
@@ -154,7 +152,7 @@ uint pickLightTriangle(float u) {
     uint hi = scene.numLightTriangles - 1u;
     while (lo < hi) {
         uint mid = (lo + hi) >> 1u;
-        if (lightTris[mid].cdf <= u) lo = mid + 1u; else hi = mid;
+        if (lightTriangle(mid).cdf <= u) lo = mid + 1u; else hi = mid;
     }
     return lo;
 }
@@ -167,7 +165,7 @@ bool sampleLight(vec3 p, vec3 u, out LightSample ls) {
     float pTri = lightTriangleSelectProb();
     if (kHasLightTris && u.x < pTri) {
         uint li = pickLightTriangle(u.x / pTri);
-        uint tri = lightTris[li].triangle;
+        uint tri = lightTriangle(li).triangle;
         TriangleGeom g = triangleGeom(tri);
         vec3 bary = sampleUniformTriangle(u.yz);
         ls.pLight = g.v0 + bary.y * g.e1 + bary.z * g.e2;
@@ -177,7 +175,7 @@ bool sampleLight(vec3 p, vec3 u, out LightSample ls) {
         ls.dist = sqrt(dist2);
         ls.wi = d / ls.dist;
         float cosL = dot(nl, -ls.wi);
-        Material m = materials[triShading[tri].material];
+        Material m = material(triangleShading(tri).material);
         bool twoSided = (m.flags & kMatFlagDoubleSided) != 0u;
         if (cosL <= 0.0 && !twoSided) return false;
         cosL = abs(cosL);
@@ -187,13 +185,13 @@ bool sampleLight(vec3 p, vec3 u, out LightSample ls) {
         vec3 e = m.emissive;
         if (kHasTextures) e *= sampleTexture(m.emissiveTex, hitUv(tri, bary.y, bary.z)).xyz;
         ls.Li = e;
-        ls.pdf = pTri * lightTris[li].pmf / triShading[tri].area * dist2 / cosL;
+        ls.pdf = pTri * lightTriangle(li).pmf / triangleShading(tri).area * dist2 / cosL;
         return ls.pdf > 0.0 && isFinite(ls.pdf);
     }
     if (!kHasPunctual || scene.numPunctualLights == 0u) return false;
     float uu = (u.x - pTri) / (1.0 - pTri);
     uint idx = min(uint(uu * float(scene.numPunctualLights)), scene.numPunctualLights - 1u);
-    PunctualLight l = punctual[idx];
+    PunctualLight l = punctualLight(idx);
     vec3 d = l.position - p;
     float dist2 = dot(d, d);
     if (!(dist2 > 0.0)) return false;

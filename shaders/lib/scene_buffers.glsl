@@ -16,12 +16,102 @@ layout(constant_id = kSpecHasShadingNormals) const bool kHasShadingNormals = tru
 
 #include "scene_geometry.glsl"
 
-layout(set = 0, binding = kBindTriShading, scalar) readonly buffer TriShadingBuf { TriangleShading triShading[]; };
-layout(set = 0, binding = kBindMaterials, scalar) readonly buffer MaterialBuf { Material materials[]; };
-layout(set = 0, binding = kBindTexInfo, scalar) readonly buffer TexInfoBuf { TextureInfo texInfos[]; };
-layout(set = 0, binding = kBindTexels, scalar) readonly buffer TexelBuf { uvec2 texels[]; };
-layout(set = 0, binding = kBindLightTris, scalar) readonly buffer LightTriBuf { LightTriangle lightTris[]; };
-layout(set = 0, binding = kBindPunctual, scalar) readonly buffer PunctualBuf { PunctualLight punctual[]; };
+// The read-only tables, as uniform texel buffers like the geometry (scene_geometry.glsl says
+// why); the accessors below return the gdpt_shared.h structs. Fetches whose fields a caller
+// does not use are removed by the compiler like unused loads.
+layout(set = 0, binding = kBindTriShading) uniform utextureBuffer triShadingTexels;
+layout(set = 0, binding = kBindMaterials) uniform utextureBuffer materialTexels;
+layout(set = 0, binding = kBindTexInfo) uniform utextureBuffer texInfoTexels;
+layout(set = 0, binding = kBindTexels) uniform utextureBuffer imageTexels;  // RG32UI: two packed halves
+layout(set = 0, binding = kBindLightTris) uniform utextureBuffer lightTriTexels;
+layout(set = 0, binding = kBindPunctual) uniform utextureBuffer punctualTexels;
+
+TriangleShading triangleShading(uint i) {
+    int at = int(i * kTriangleShadingTexels);
+    uvec4 a = texelFetch(triShadingTexels, at);
+    uvec4 b = texelFetch(triShadingTexels, at + 1);
+    uvec4 c = texelFetch(triShadingTexels, at + 2);
+    uvec4 d = texelFetch(triShadingTexels, at + 3);
+    uvec4 e = texelFetch(triShadingTexels, at + 4);
+    TriangleShading s;
+    s.n0 = uintBitsToFloat(a.xyz);
+    s.material = a.w;
+    s.n1 = uintBitsToFloat(b.xyz);
+    s.area = uintBitsToFloat(b.w);
+    s.n2 = uintBitsToFloat(c.xyz);
+    s.flags = c.w;
+    s.uv0 = uintBitsToFloat(d.xy);
+    s.uv1 = uintBitsToFloat(d.zw);
+    s.uv2 = uintBitsToFloat(e.xy);
+    s.lightIndex = e.z;
+    s.pad3 = e.w;
+    return s;
+}
+
+Material material(uint i) {
+    int at = int(i * kMaterialTexels);
+    uvec4 a = texelFetch(materialTexels, at);
+    uvec4 b = texelFetch(materialTexels, at + 1);
+    uvec4 c = texelFetch(materialTexels, at + 2);
+    uvec4 d = texelFetch(materialTexels, at + 3);
+    ivec4 e = ivec4(texelFetch(materialTexels, at + 4));
+    Material m;
+    m.baseColor = uintBitsToFloat(a);
+    m.emissive = uintBitsToFloat(b.xyz);
+    m.metallic = uintBitsToFloat(b.w);
+    m.specularColor = uintBitsToFloat(c.xyz);
+    m.roughness = uintBitsToFloat(c.w);
+    m.specular = uintBitsToFloat(d.x);
+    m.ior = uintBitsToFloat(d.y);
+    m.alphaCutoff = uintBitsToFloat(d.z);
+    m.flags = d.w;
+    m.baseColorTex = e.x;
+    m.metallicRoughnessTex = e.y;
+    m.emissiveTex = e.z;
+    m.normalTex = e.w;
+    return m;
+}
+
+TextureInfo textureInfo(uint i) {
+    uvec4 a = texelFetch(texInfoTexels, int(i));
+    TextureInfo t;
+    t.offset = a.x;
+    t.width = a.y;
+    t.height = a.z;
+    t.flags = a.w;
+    return t;
+}
+
+// Texel i of the shared image table: linear RGBA (two packHalf2x16 words).
+vec4 imageTexel(uint i) {
+    uvec2 packed = texelFetch(imageTexels, int(i)).xy;
+    return vec4(unpackHalf2x16(packed.x), unpackHalf2x16(packed.y));
+}
+
+LightTriangle lightTriangle(uint i) {
+    uvec4 a = texelFetch(lightTriTexels, int(i));
+    LightTriangle l;
+    l.triangle = a.x;
+    l.cdf = uintBitsToFloat(a.y);
+    l.pmf = uintBitsToFloat(a.z);
+    l.pad = uintBitsToFloat(a.w);
+    return l;
+}
+
+PunctualLight punctualLight(uint i) {
+    int at = int(i * kPunctualLightTexels);
+    uvec4 a = texelFetch(punctualTexels, at);
+    uvec4 b = texelFetch(punctualTexels, at + 1);
+    uvec4 c = texelFetch(punctualTexels, at + 2);
+    PunctualLight l;
+    l.position = uintBitsToFloat(a.xyz);
+    l.type = a.w;
+    l.intensity = uintBitsToFloat(b.xyz);
+    l.cosInner = uintBitsToFloat(b.w);
+    l.direction = uintBitsToFloat(c.xyz);
+    l.cosOuter = uintBitsToFloat(c.w);
+    return l;
+}
 layout(set = 0, binding = kBindSceneConst, scalar) readonly buffer SceneConstBuf { SceneConstants sceneStored; };
 
 // The scene constants as a private copy that every kernel's main() fills first (loadScene),

@@ -72,6 +72,7 @@ struct TriangleShading {
     uint lightIndex; // index into LightTriangle table, kInvalidIndex if not emissive
     uint pad3;
 };
+GDPT_CONST uint kTriangleShadingTexels = 5u;  // 16-byte texels per TriangleShading (scene_buffers.glsl)
 GDPT_CONST uint kTriFlagHasNormals = 1u;  // n0..n2 valid and not all the face normal; otherwise use the geometric normal
 
 // Two-wide BVH node, what the builder writes (builder.h): stores both children's boxes. The
@@ -132,6 +133,7 @@ struct Material {
     int emissiveTex;      // texture index or -1
     int normalTex;        // texture index or -1 (currently unused by kernels; warned)
 };
+GDPT_CONST uint kMaterialTexels = 5u;  // 16-byte texels per Material (scene_buffers.glsl)
 GDPT_CONST uint kMatFlagDoubleSided = 1u;
 GDPT_CONST uint kMatFlagAlphaMask = 2u;
 GDPT_CONST uint kMatFlagEmissive = 4u;
@@ -172,6 +174,7 @@ struct PunctualLight {
     vec3 direction;   // spot: world-space unit direction the light points to
     float cosOuter;   // spot: cos(outerConeAngle)
 };
+GDPT_CONST uint kPunctualLightTexels = 3u;  // 16-byte texels per PunctualLight (scene_buffers.glsl)
 
 // ---------------------------------------------------------------------------------------------
 // Per-scene constants (one storage buffer, read-only)

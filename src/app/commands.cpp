@@ -356,6 +356,7 @@ int runDevices(const DevicesArgs& args) {
                                     std::to_string(VK_API_VERSION_MINOR(d.apiVersion)) + "." +
                                     std::to_string(VK_API_VERSION_PATCH(d.apiVersion))},
                         {"max_storage_buffer_range", d.maxStorageBufferRange},
+                        {"max_texel_buffer_elements", d.maxTexelBufferElements},
                         {"max_memory_allocation", d.maxMemoryAllocationSize},
                         {"max_push_constants", d.maxPushConstantsSize},
                         {"max_workgroup_invocations", d.maxComputeWorkGroupInvocations},

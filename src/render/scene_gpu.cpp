@@ -20,10 +20,16 @@ constexpr float kPi = 3.14159265358979f;
 
 float luminance(glm::vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
+// A scene table; the kernels read it as a texel buffer of `texelBytes`-byte texels
+// (SceneSpec::sceneTexelBindings), or as a storage buffer where texelBytes is 0.
 template <typename T>
-vk::Buffer makeBuffer(const vk::Context& ctx, const std::vector<T>& data, const std::string& name) {
+vk::Buffer makeBuffer(const vk::Context& ctx, const std::vector<T>& data, const std::string& name,
+                      std::uint64_t texelBytes) {
     const std::uint64_t bytes = data.size() * sizeof(T);
-    ctx.checkStorageBufferSize(bytes, name);
+    if (texelBytes)
+        ctx.checkTexelBufferSize(bytes / texelBytes, name);
+    else
+        ctx.checkStorageBufferSize(bytes, name);
     vk::Buffer b(ctx, bytes, name);
     b.uploadVector(data);
     return b;
@@ -145,15 +151,15 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     const Bounds b = scene.bounds();
     constants_.sceneRadius = 0.5f * glm::length(b.max - b.min);
 
-    triGeom_ = makeBuffer(ctx, geoms, "triangle geometry");
-    triShading_ = makeBuffer(ctx, shading, "triangle shading");
-    bvh_ = makeBuffer(ctx, collapseToWide(bvh.nodes).nodes, "BVH nodes (4-wide)");
-    materials_ = makeBuffer(ctx, scene.materials, "materials");
-    texInfo_ = makeBuffer(ctx, texInfo, "texture table");
-    texels_ = makeBuffer(ctx, texels, "texels");
-    lightTris_ = makeBuffer(ctx, lights, "light triangles");
-    punctual_ = makeBuffer(ctx, scene.punctualLights, "punctual lights");
-    sceneConst_ = makeBuffer(ctx, std::vector<gpu::SceneConstants>{constants_}, "scene constants");
+    triGeom_ = makeBuffer(ctx, geoms, "triangle geometry", 16);
+    triShading_ = makeBuffer(ctx, shading, "triangle shading", 16);
+    bvh_ = makeBuffer(ctx, collapseToWide(bvh.nodes).nodes, "BVH nodes (4-wide)", 16);
+    materials_ = makeBuffer(ctx, scene.materials, "materials", 16);
+    texInfo_ = makeBuffer(ctx, texInfo, "texture table", 16);
+    texels_ = makeBuffer(ctx, texels, "texels", 8);
+    lightTris_ = makeBuffer(ctx, lights, "light triangles", 16);
+    punctual_ = makeBuffer(ctx, scene.punctualLights, "punctual lights", 16);
+    sceneConst_ = makeBuffer(ctx, std::vector<gpu::SceneConstants>{constants_}, "scene constants", 0);
 }
 
 void SceneGpu::bindTo(vk::Kernel& kernel) const {

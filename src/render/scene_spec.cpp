@@ -25,29 +25,48 @@ SceneSpec::SceneSpec(const Scene& scene, const SceneGpuOptions& options)
 }
 
 std::vector<std::uint32_t> SceneSpec::sceneBindings() {
-    return {gpu::kBindTriGeom, gpu::kBindTriShading, gpu::kBindBvh,      gpu::kBindMaterials, gpu::kBindTexInfo,
-            gpu::kBindTexels,  gpu::kBindLightTris,  gpu::kBindPunctual, gpu::kBindSceneConst};
+    return {gpu::kBindTriGeom,   gpu::kBindTriShading, gpu::kBindBvh,
+            gpu::kBindMaterials, gpu::kBindTexInfo,    gpu::kBindTexels,
+            gpu::kBindLightTris, gpu::kBindPunctual,   gpu::kBindSceneConst};
+}
+
+std::vector<std::pair<std::uint32_t, VkFormat>> SceneSpec::geometryTexelBindings() {
+    return {{gpu::kBindTriGeom, VK_FORMAT_R32G32B32A32_SFLOAT}, {gpu::kBindBvh, VK_FORMAT_R32G32B32A32_UINT}};
 }
 
 std::vector<std::pair<std::uint32_t, VkFormat>> SceneSpec::sceneTexelBindings() {
-    // shaders/lib/scene_geometry.glsl: the BVH as utextureBuffer, the triangles as textureBuffer.
-    return {{gpu::kBindBvh, VK_FORMAT_R32G32B32A32_UINT}, {gpu::kBindTriGeom, VK_FORMAT_R32G32B32A32_SFLOAT}};
+    // shaders/lib/scene_geometry.glsl and scene_buffers.glsl: the triangles as textureBuffer,
+    // the image texels (two packed halves) as RG32UI, the other tables as RGBA32UI.
+    constexpr VkFormat kU4 = VK_FORMAT_R32G32B32A32_UINT;
+    std::vector<std::pair<std::uint32_t, VkFormat>> texel = geometryTexelBindings();
+    texel.insert(texel.end(), {{gpu::kBindTriShading, kU4},
+                               {gpu::kBindMaterials, kU4},
+                               {gpu::kBindTexInfo, kU4},
+                               {gpu::kBindTexels, VK_FORMAT_R32G32_UINT},
+                               {gpu::kBindLightTris, kU4},
+                               {gpu::kBindPunctual, kU4}});
+    return texel;
 }
 
 std::vector<std::pair<std::uint32_t, std::uint32_t>> SceneSpec::specConstants() const {
     auto b = [](bool v) { return v ? 1u : 0u; };
     std::vector<std::pair<std::uint32_t, std::uint32_t>> spec = {
-        {gpu::kSpecHasTextures, b(features_.hasTextures)}, {gpu::kSpecHasPunctual, b(features_.hasPunctual)},
-        {gpu::kSpecHasLightTris, b(features_.hasLightTris)}, {gpu::kSpecHasEnv, b(features_.hasEnv)},
-        {gpu::kSpecHasGlossy, b(features_.hasGlossy)},     {gpu::kSpecHasAlphaMask, b(features_.hasAlphaMask)},
-        {gpu::kSpecHasShadingNormals, b(features_.hasShadingNormals)}, {gpu::kSpecMaxDepth, maxDepthSpec_}};
+        {gpu::kSpecHasTextures, b(features_.hasTextures)},
+        {gpu::kSpecHasPunctual, b(features_.hasPunctual)},
+        {gpu::kSpecHasLightTris, b(features_.hasLightTris)},
+        {gpu::kSpecHasEnv, b(features_.hasEnv)},
+        {gpu::kSpecHasGlossy, b(features_.hasGlossy)},
+        {gpu::kSpecHasAlphaMask, b(features_.hasAlphaMask)},
+        {gpu::kSpecHasShadingNormals, b(features_.hasShadingNormals)},
+        {gpu::kSpecMaxDepth, maxDepthSpec_}};
     for (auto& [id, value] : spec)
         if (genericFeatures_ & (1u << id)) value = id == gpu::kSpecMaxDepth ? 1024u : 1u;
     return spec;
 }
 
 vk::KernelDesc SceneSpec::kernelDesc(vk::KernelDesc base, WorkgroupSize wg,
-                                     const std::vector<std::uint32_t>& extraBindings, std::uint32_t pushBytes) const {
+                                     const std::vector<std::uint32_t>& extraBindings,
+                                     std::uint32_t pushBytes) const {
     base.bindings = sceneBindings();
     base.texelBindings = sceneTexelBindings();
     base.bindings.insert(base.bindings.end(), extraBindings.begin(), extraBindings.end());

@@ -50,7 +50,9 @@ public:
     [[nodiscard]] std::vector<std::pair<std::uint32_t, std::uint32_t>> specConstants() const;
     // The storage-buffer bindings of the scene (kBindTriGeom..kBindSceneConst).
     [[nodiscard]] static std::vector<std::uint32_t> sceneBindings();
-    // The scene bindings that the kernels read as texel buffers, with their view formats.
+    // The scene bindings that the kernels read as texel buffers, with their view formats;
+    // the geometry's (triangles and BVH, scene_geometry.glsl) alone for ray-query kernels.
+    [[nodiscard]] static std::vector<std::pair<std::uint32_t, VkFormat>> geometryTexelBindings();
     [[nodiscard]] static std::vector<std::pair<std::uint32_t, VkFormat>> sceneTexelBindings();
     // Completes `base` (name + SPIR-V) into the descriptor of a kernel that reads the scene:
     // the scene bindings plus `extraBindings`, `pushBytes` of push constants, the scene's

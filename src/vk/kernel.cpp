@@ -184,16 +184,24 @@ void Kernel::bind(std::uint32_t binding, const Buffer& buffer) {
 }
 
 VkBufferView Kernel::createTexelView(const Buffer& buffer, VkFormat format) const {
-    // Every texel format used is 16 bytes (RGBA32); the view covers the whole texels.
-    GDPT_CHECK(format == VK_FORMAT_R32G32B32A32_UINT || format == VK_FORMAT_R32G32B32A32_SFLOAT);
-    constexpr std::uint64_t kTexelBytes = 16;
-    const std::uint64_t texels = buffer.size() / kTexelBytes;
+    // The formats gdpt uses (their uniform-texel-buffer support is required by Vulkan); the
+    // view covers the whole texels of the buffer.
+    std::uint64_t texelBytes = 0;
+    switch (format) {
+        case VK_FORMAT_R32G32B32A32_UINT:
+        case VK_FORMAT_R32G32B32A32_SFLOAT: texelBytes = 16; break;
+        case VK_FORMAT_R32G32_UINT: texelBytes = 8; break;
+        case VK_FORMAT_R32_UINT:
+        case VK_FORMAT_R32_SFLOAT: texelBytes = 4; break;
+        default: GDPT_CHECK(!"unsupported texel-buffer format");
+    }
+    const std::uint64_t texels = buffer.size() / texelBytes;
     ctx_.checkTexelBufferSize(texels, buffer.name());
     VkBufferViewCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
     info.buffer = buffer.get();
     info.format = format;
     info.offset = 0;
-    info.range = texels * kTexelBytes;
+    info.range = texels * texelBytes;
     const VkDevice device = ctx_.device();
     VkBufferView view = VK_NULL_HANDLE;
     VK_CHECK(vkCreateBufferView(device, &info, nullptr, &view));

@@ -109,7 +109,7 @@ protected:
         vk::KernelDesc desc = vk::kernelDesc("trace_rays", kSpv_trace_rays);
         desc.bindings = {gpu::kBindTriGeom, gpu::kBindBvh, gpu::kBindTestInput, gpu::kBindTestOutput,
                          gpu::kBindTestOutput2};
-        desc.texelBindings = SceneSpec::sceneTexelBindings();
+        desc.texelBindings = SceneSpec::geometryTexelBindings();
         desc.pushConstantBytes = sizeof(std::uint32_t);
         desc.localSizeX = 64;
         vk::Kernel kernel(ctx(), desc, creation);
@@ -172,7 +172,7 @@ TEST_F(BvhGpu, UnusedBackgroundPipelineIsDestroyed) {
     vk::KernelDesc desc = vk::kernelDesc("trace_rays", kSpv_trace_rays);
     desc.bindings = {gpu::kBindTriGeom, gpu::kBindBvh, gpu::kBindTestInput, gpu::kBindTestOutput,
                      gpu::kBindTestOutput2};
-    desc.texelBindings = SceneSpec::sceneTexelBindings();
+    desc.texelBindings = SceneSpec::geometryTexelBindings();
     desc.pushConstantBytes = sizeof(std::uint32_t);
     desc.localSizeX = 64;
     { vk::Kernel unused(ctx(), desc, vk::PipelineCreation::Background); }

@@ -27,6 +27,14 @@ static_assert(offsetof(Material, flags) == 60 && offsetof(Material, normalTex) =
 static_assert(sizeof(TextureInfo) == 16);
 static_assert(sizeof(LightTriangle) == 16);
 static_assert(sizeof(PunctualLight) == 48);
+// The kernels read these tables as uniform texel buffers of 16-byte texels
+// (shaders/lib/scene_geometry.glsl, scene_buffers.glsl), TriangleGeom and BvhWideNode
+// included: each struct must be whole texels, and its texel count as the shaders assume.
+static_assert(sizeof(TriangleGeom) == 16 * kTriangleGeomTexels);
+static_assert(sizeof(BvhWideNode) == 16 * kBvhWideNodeTexels);
+static_assert(sizeof(TriangleShading) == 16 * kTriangleShadingTexels);
+static_assert(sizeof(Material) == 16 * kMaterialTexels);
+static_assert(sizeof(PunctualLight) == 16 * kPunctualLightTexels);
 static_assert(sizeof(SceneConstants) == 112);
 static_assert(offsetof(SceneConstants, envRadiance) == 64 && offsetof(SceneConstants, pad) == 108);
 static_assert(sizeof(FrameParams) == 32 && sizeof(FrameParams) <= 128);
