@@ -372,12 +372,13 @@ int runDevices(const DevicesArgs& args) {
         return 0;
     }
     for (const auto& d : list)
-        std::printf("[%u] %s (%s, %s %s)\n    Vulkan %s, maxStorageBufferRange %llu MiB, maxMemoryAllocationSize %llu MiB, push constants %u B, "
+        std::printf("[%u] %s (%s, %s %s)\n    Vulkan %s, maxStorageBufferRange %llu MiB, maxTexelBufferElements %llu Mi, maxMemoryAllocationSize %llu MiB, push constants %u B, "
                     "workgroup %u, shared %u KiB, subgroup %u, timestamps %s, heap %llu MiB%s\n",
                     d["index"].get<unsigned>(), d["name"].get<std::string>().c_str(), d["type"].get<std::string>().c_str(),
                     d["driver"].get<std::string>().c_str(), d["driver_info"].get<std::string>().c_str(),
                     d["api"].get<std::string>().c_str(),
                     static_cast<unsigned long long>(d["max_storage_buffer_range"].get<std::uint64_t>() >> 20),
+                    static_cast<unsigned long long>(d["max_texel_buffer_elements"].get<std::uint64_t>() >> 20),
                     static_cast<unsigned long long>(d["max_memory_allocation"].get<std::uint64_t>() >> 20),
                     d["max_push_constants"].get<unsigned>(), d["max_workgroup_invocations"].get<unsigned>(),
                     d["shared_memory"].get<unsigned>() / 1024, d["subgroup_size"].get<unsigned>(),

@@ -168,6 +168,10 @@ TEST_F(Cli, DevicesListsAtLeastOneUsableDevice) {
                                std::to_string(j[0]["max_storage_buffer_range"].get<std::uint64_t>() >> 20) + " MiB"),
               std::string::npos)
         << text.output;
+    EXPECT_NE(text.output.find("maxTexelBufferElements " +
+                               std::to_string(j[0]["max_texel_buffer_elements"].get<std::uint64_t>() >> 20) + " Mi"),
+              std::string::npos)
+        << text.output;
     EXPECT_NE(text.output.find("maxMemoryAllocationSize " +
                                std::to_string(j[0]["max_memory_allocation"].get<std::uint64_t>() >> 20) + " MiB"),
               std::string::npos)
