@@ -5,8 +5,8 @@
 //  * The pure part (ray/box slab test, safe inverse direction, Möller–Trumbore triangle
 //    test, struct Hit) is written in the GLSL/C++ common subset of common.glsl, so that
 //    src/bvh/traverse_cpu.cpp runs the very same arithmetic on the host (GUIDE §2).
-//  * The traversal loops (traceClosest, traceAny) read the storage buffers and exist in GLSL
-//    only. src/bvh/traverse_cpu.cpp mirrors them statement for statement; change both.
+//  * The traversal loops (traceClosest, traceAny) read the scene's texel buffers and exist in
+//    GLSL only. src/bvh/traverse_cpu.cpp mirrors them statement for statement; change both.
 //
 // The including kernel must include scene_geometry.glsl (the accessors bvhNode(i) and
 // triangleGeom(i)) before this file; scene_buffers.glsl does. Triangle indices are

@@ -1,6 +1,6 @@
-// scene_buffers.glsl — declarations of the scene's buffers (storage buffers, and the
-// geometry's texel buffers of scene_geometry.glsl) and the feature specialisation
-// constants, shared by every path-sampling kernel. Binding numbers and
+// scene_buffers.glsl — declarations of the scene's buffers (its tables as texel buffers with
+// accessors, here and in scene_geometry.glsl; the scene constants as a storage buffer) and
+// the feature specialisation constants, shared by every path-sampling kernel. Binding numbers and
 // constant ids come from gdpt_shared.h only.
 #ifndef GDPT_LIB_SCENE_BUFFERS
 #define GDPT_LIB_SCENE_BUFFERS
@@ -112,6 +112,7 @@ PunctualLight punctualLight(uint i) {
     l.cosOuter = uintBitsToFloat(c.w);
     return l;
 }
+
 layout(set = 0, binding = kBindSceneConst, scalar) readonly buffer SceneConstBuf { SceneConstants sceneStored; };
 
 // The scene constants as a private copy that every kernel's main() fills first (loadScene),

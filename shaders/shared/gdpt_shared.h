@@ -109,9 +109,9 @@ struct BvhWideNode {
     uvec4 child;     // node index (count 0) or first triangle (count > 0); kInvalidIndex = empty slot
 };
 GDPT_CONST uint kBvhWideNodeTexels = 4u;  // 16-byte texels per BvhWideNode (scene_geometry.glsl)
-// Four 16-byte vectors, so that a node is four vector loads (llvmpipe loads per lane and per
-// load instruction); qMin.w holds the children's triangle counts, byte k for child k (0 =
-// inner node or empty slot, <= kMaxLeafTriangles).
+// Four 16-byte vectors, so that a node is four texel fetches (scene_geometry.glsl); qMin.w
+// holds the children's triangle counts, byte k for child k (0 = inner node or empty slot,
+// <= kMaxLeafTriangles).
 
 // ---------------------------------------------------------------------------------------------
 // Materials and textures

@@ -20,14 +20,15 @@ constexpr float kPi = 3.14159265358979f;
 
 float luminance(glm::vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
-// A scene table; the kernels read it as a texel buffer of `texelBytes`-byte texels
-// (SceneSpec::sceneTexelBindings), or as a storage buffer where texelBytes is 0.
+// The buffer of scene binding `binding`, checked against the limit of how the kernels read
+// it: a texel buffer of its SceneSpec::sceneTexelBindings format, else a storage buffer.
 template <typename T>
 vk::Buffer makeBuffer(const vk::Context& ctx, const std::vector<T>& data, const std::string& name,
-                      std::uint64_t texelBytes) {
+                      std::uint32_t binding) {
     const std::uint64_t bytes = data.size() * sizeof(T);
-    if (texelBytes)
-        ctx.checkTexelBufferSize(bytes / texelBytes, name);
+    const VkFormat format = vk::texelFormat(SceneSpec::sceneTexelBindings(), binding);
+    if (format != VK_FORMAT_UNDEFINED)
+        ctx.checkTexelBufferSize(bytes / vk::texelBytes(format), name);
     else
         ctx.checkStorageBufferSize(bytes, name);
     vk::Buffer b(ctx, bytes, name);
@@ -151,15 +152,15 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     const Bounds b = scene.bounds();
     constants_.sceneRadius = 0.5f * glm::length(b.max - b.min);
 
-    triGeom_ = makeBuffer(ctx, geoms, "triangle geometry", 16);
-    triShading_ = makeBuffer(ctx, shading, "triangle shading", 16);
-    bvh_ = makeBuffer(ctx, collapseToWide(bvh.nodes).nodes, "BVH nodes (4-wide)", 16);
-    materials_ = makeBuffer(ctx, scene.materials, "materials", 16);
-    texInfo_ = makeBuffer(ctx, texInfo, "texture table", 16);
-    texels_ = makeBuffer(ctx, texels, "texels", 8);
-    lightTris_ = makeBuffer(ctx, lights, "light triangles", 16);
-    punctual_ = makeBuffer(ctx, scene.punctualLights, "punctual lights", 16);
-    sceneConst_ = makeBuffer(ctx, std::vector<gpu::SceneConstants>{constants_}, "scene constants", 0);
+    triGeom_ = makeBuffer(ctx, geoms, "triangle geometry", gpu::kBindTriGeom);
+    triShading_ = makeBuffer(ctx, shading, "triangle shading", gpu::kBindTriShading);
+    bvh_ = makeBuffer(ctx, collapseToWide(bvh.nodes).nodes, "BVH nodes (4-wide)", gpu::kBindBvh);
+    materials_ = makeBuffer(ctx, scene.materials, "materials", gpu::kBindMaterials);
+    texInfo_ = makeBuffer(ctx, texInfo, "texture table", gpu::kBindTexInfo);
+    texels_ = makeBuffer(ctx, texels, "texels", gpu::kBindTexels);
+    lightTris_ = makeBuffer(ctx, lights, "light triangles", gpu::kBindLightTris);
+    punctual_ = makeBuffer(ctx, scene.punctualLights, "punctual lights", gpu::kBindPunctual);
+    sceneConst_ = makeBuffer(ctx, std::vector<gpu::SceneConstants>{constants_}, "scene constants", gpu::kBindSceneConst);
 }
 
 void SceneGpu::bindTo(vk::Kernel& kernel) const {

@@ -48,7 +48,7 @@ public:
     [[nodiscard]] std::uint32_t height() const { return height_; }
     // Specialisation constants for the scene features (ids from gdpt_shared.h).
     [[nodiscard]] std::vector<std::pair<std::uint32_t, std::uint32_t>> specConstants() const;
-    // The storage-buffer bindings of the scene (kBindTriGeom..kBindSceneConst).
+    // The bindings of the scene (kBindTriGeom..kBindSceneConst).
     [[nodiscard]] static std::vector<std::uint32_t> sceneBindings();
     // The scene bindings that the kernels read as texel buffers, with their view formats;
     // the geometry's (triangles and BVH, scene_geometry.glsl) alone for ray-query kernels.

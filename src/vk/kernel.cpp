@@ -47,6 +47,21 @@ VkPipeline createPipeline(const PipelineJob& job) {
 
 }  // namespace
 
+std::uint64_t texelBytes(VkFormat format) {
+    switch (format) {
+        case VK_FORMAT_R32G32B32A32_UINT:
+        case VK_FORMAT_R32G32B32A32_SFLOAT: return 16;
+        case VK_FORMAT_R32G32_UINT: return 8;
+        default: throw Error("unsupported texel-buffer format " + std::to_string(static_cast<int>(format)));
+    }
+}
+
+VkFormat texelFormat(const std::vector<std::pair<std::uint32_t, VkFormat>>& texelBindings, std::uint32_t binding) {
+    for (const auto& [b, format] : texelBindings)
+        if (b == binding) return format;
+    return VK_FORMAT_UNDEFINED;
+}
+
 Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation creation) : ctx_(ctx), desc_(desc) {
     VkDevice device = ctx.device();
     GDPT_CHECK(desc.spirv != nullptr && desc.spirvBytes > 0);
@@ -70,8 +85,9 @@ Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation crea
     for (std::uint32_t b : desc.bindings) {
         VkDescriptorSetLayoutBinding lb{};
         lb.binding = b;
-        lb.descriptorType = descriptorType(b);
-        texelCount += lb.descriptorType == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER ? 1u : 0u;
+        const bool texel = texelFormat(desc.texelBindings, b) != VK_FORMAT_UNDEFINED;
+        lb.descriptorType = texel ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        texelCount += texel ? 1u : 0u;
         lb.descriptorCount = 1;
         lb.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
         bindings.push_back(lb);
@@ -159,12 +175,6 @@ double Kernel::wait() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-VkDescriptorType Kernel::descriptorType(std::uint32_t binding) const {
-    for (const auto& [b, format] : desc_.texelBindings)
-        if (b == binding) return VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
-    return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-}
-
 void Kernel::bind(std::uint32_t binding, const Buffer& buffer) {
     GDPT_CHECK(std::find(desc_.bindings.begin(), desc_.bindings.end(), binding) != desc_.bindings.end());
     VkDescriptorBufferInfo info{buffer.get(), 0, VK_WHOLE_SIZE};
@@ -172,36 +182,29 @@ void Kernel::bind(std::uint32_t binding, const Buffer& buffer) {
     write.dstSet = set_;
     write.dstBinding = binding;
     write.descriptorCount = 1;
-    write.descriptorType = descriptorType(binding);
+    const VkFormat format = texelFormat(desc_.texelBindings, binding);
     VkBufferView view = VK_NULL_HANDLE;
-    if (write.descriptorType == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER) {
-        view = texelView(binding, buffer);
+    if (format != VK_FORMAT_UNDEFINED) {
+        write.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+        view = texelView(binding, buffer, format);
         write.pTexelBufferView = &view;
     } else {
+        write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
         write.pBufferInfo = &info;
     }
     vkUpdateDescriptorSets(ctx_.device(), 1, &write, 0, nullptr);
 }
 
 VkBufferView Kernel::createTexelView(const Buffer& buffer, VkFormat format) const {
-    // The formats gdpt uses (their uniform-texel-buffer support is required by Vulkan); the
-    // view covers the whole texels of the buffer.
-    std::uint64_t texelBytes = 0;
-    switch (format) {
-        case VK_FORMAT_R32G32B32A32_UINT:
-        case VK_FORMAT_R32G32B32A32_SFLOAT: texelBytes = 16; break;
-        case VK_FORMAT_R32G32_UINT: texelBytes = 8; break;
-        case VK_FORMAT_R32_UINT:
-        case VK_FORMAT_R32_SFLOAT: texelBytes = 4; break;
-        default: GDPT_CHECK(!"unsupported texel-buffer format");
-    }
-    const std::uint64_t texels = buffer.size() / texelBytes;
+    // The view covers the whole texels of the buffer.
+    const std::uint64_t bytesPerTexel = texelBytes(format);
+    const std::uint64_t texels = buffer.size() / bytesPerTexel;
     ctx_.checkTexelBufferSize(texels, buffer.name());
     VkBufferViewCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
     info.buffer = buffer.get();
     info.format = format;
     info.offset = 0;
-    info.range = texels * texelBytes;
+    info.range = texels * bytesPerTexel;
     const VkDevice device = ctx_.device();
     VkBufferView view = VK_NULL_HANDLE;
     VK_CHECK(vkCreateBufferView(device, &info, nullptr, &view));
@@ -209,10 +212,7 @@ VkBufferView Kernel::createTexelView(const Buffer& buffer, VkFormat format) cons
     return view;
 }
 
-VkBufferView Kernel::texelView(std::uint32_t binding, const Buffer& buffer) {
-    VkFormat format = VK_FORMAT_UNDEFINED;
-    for (const auto& [b, f] : desc_.texelBindings)
-        if (b == binding) format = f;
+VkBufferView Kernel::texelView(std::uint32_t binding, const Buffer& buffer, VkFormat format) {
     Handle<VkBufferView> view(createTexelView(buffer, format),
                               [device = ctx_.device()](VkBufferView v) { vkDestroyBufferView(device, v, nullptr); });
     const VkBufferView raw = view.get();

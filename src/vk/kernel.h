@@ -37,6 +37,14 @@ struct KernelDesc {
     std::uint32_t localSizeY = 1;
 };
 
+// Bytes per texel of a texel-binding format (the formats gdpt's kernels use: RGBA32 and
+// RG32, whose uniform-texel-buffer support Vulkan requires); throws for any other.
+std::uint64_t texelBytes(VkFormat format);
+
+// The view format that `texelBindings` (KernelDesc::texelBindings) gives `binding`;
+// VK_FORMAT_UNDEFINED if it lists no such binding (a storage buffer).
+VkFormat texelFormat(const std::vector<std::pair<std::uint32_t, VkFormat>>& texelBindings, std::uint32_t binding);
+
 // KernelDesc with the SPIR-V of an embedded array (kSpv_<name> from the build).
 template <std::size_t N>
 KernelDesc kernelDesc(std::string name, const std::uint32_t (&spirv)[N]) {
@@ -84,10 +92,10 @@ public:
 private:
     void bindState(VkCommandBuffer cmd, const void* push) const;  // pipeline, set, push constants
     void adopt(VkPipeline pipeline) const;  // owns and names a created pipeline
-    [[nodiscard]] VkDescriptorType descriptorType(std::uint32_t binding) const;
     [[nodiscard]] VkBufferView createTexelView(const Buffer& buffer, VkFormat format) const;
-    // A view of `buffer` for texel binding `binding`, kept in views_ (replacing an older one).
-    VkBufferView texelView(std::uint32_t binding, const Buffer& buffer);
+    // A `format` view of `buffer` for texel binding `binding`, kept in views_ (replacing an
+    // older one).
+    VkBufferView texelView(std::uint32_t binding, const Buffer& buffer, VkFormat format);
 
     const Context& ctx_;
     KernelDesc desc_;
