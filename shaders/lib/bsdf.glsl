@@ -24,6 +24,14 @@
 #include "common.glsl"
 #include "sampling.glsl"
 
+// False where no material has a specular lobe (every metallic and specular factor is 0:
+// scene_buffers.glsl defines it as the specialisation constant kHasSpecularLobe). The GGX
+// code then compiles away; with m = s = 0 the results are the same bits. On lavapipe before
+// Mesa 23, which runs every branch under lane masks, an untaken lobe still costs its time.
+#ifndef GDPT_BSDF_SPECULAR
+#define GDPT_BSDF_SPECULAR true
+#endif
+
 GDPT_NAMESPACE_BEGIN
 
 GDPT_CONST uint kLobeDiffuse = 0u;   // Lambertian part
@@ -148,6 +156,9 @@ GDPT_INLINE vec3 glossyFresnel(BsdfParams m, float cosVh) {
 // F(cos_o) + (1 - F(cos_o)) = 1 for the mirror case (Ashikhmin & Shirley 2000 use the same
 // kind of coupling).
 GDPT_INLINE float diffuseWeight(BsdfParams m, float cosO, float cosI) {
+    if (!GDPT_BSDF_SPECULAR) {
+        return 1.0f - m.metallic;  // s = 0: T_o = T_i = 1
+    }
     vec3 f0 = dielectricF0(m);
     float to = 1.0f - m.specular * maxComponent(schlickFresnel(f0, cosO));
     float ti = 1.0f - m.specular * maxComponent(schlickFresnel(f0, cosI));
@@ -160,7 +171,7 @@ GDPT_INLINE bool bsdfHasDiffuse(BsdfParams m) {
 }
 
 GDPT_INLINE bool bsdfHasGlossyOrMirror(BsdfParams m) {
-    return m.metallic > 0.0f || m.specular > 0.0f;
+    return GDPT_BSDF_SPECULAR && (m.metallic > 0.0f || m.specular > 0.0f);
 }
 
 GDPT_INLINE bool bsdfHasDelta(BsdfParams m) {
@@ -255,7 +266,7 @@ GDPT_INLINE bool bsdfSample(BsdfParams m, vec3 wo, vec3 u, GDPT_OUT(BsdfSample) 
         return false;
     }
     float pGlossy = glossySelectProb(m, wo);
-    if (u.x < pGlossy) {
+    if (GDPT_BSDF_SPECULAR && u.x < pGlossy) {  // pGlossy = 0 without the lobe
         if (m.alpha < kDeltaAlpha) {
             // Perfect mirror: h = n, so v.h = cos_o; Dirac weight F_spec / P(select).
             s.wi = vec3(-wo.x, -wo.y, wo.z);

@@ -13,6 +13,10 @@ layout(constant_id = kSpecHasGlossy) const bool kHasGlossy = true;
 layout(constant_id = kSpecHasAlphaMask) const bool kHasAlphaMask = true;
 layout(constant_id = kSpecMaxDepth) const uint kMaxDepth = 1024u;
 layout(constant_id = kSpecHasShadingNormals) const bool kHasShadingNormals = true;
+layout(constant_id = kSpecHasSpecularLobe) const bool kHasSpecularLobe = true;
+// bsdf.glsl compiles its GGX lobe only where some material has one (every material of the
+// scene is Lambertian otherwise); a kernel must include this file before bsdf.glsl for that.
+#define GDPT_BSDF_SPECULAR kHasSpecularLobe
 
 #include "scene_geometry.glsl"
 

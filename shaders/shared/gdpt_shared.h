@@ -304,7 +304,8 @@ GDPT_ENUM_BEGIN(SpecId)
     kSpecMaxDepth = 8u,
     kSpecPoissonFlags = 9u,  // poisson_*.comp: the kPoissonFlag* bits of this pipeline variant
     kSpecVisibleEmission = 10u,  // path kernels: emitter-silhouette supersampling is on (visible_emission.glsl)
-    kSpecHasShadingNormals = 11u  // some triangle carries kTriFlagHasNormals (features.h)
+    kSpecHasShadingNormals = 11u,  // some triangle carries kTriFlagHasNormals (features.h)
+    kSpecHasSpecularLobe = 12u  // some material has a metal/dielectric lobe (features.h hasSpecularLayer)
 GDPT_ENUM_END();
 
 // A ray of the BVH tests (tests/gpu/test_bvh_gpu.cpp). 32 bytes.

@@ -53,6 +53,7 @@ const Feature kFeatures[] = {
     {"glossy", gpu::kSpecHasGlossy, [](const SceneFeatures& f, bool gpt) { return f.hasGlossy || !gpt; }},
     {"alpha_mask", gpu::kSpecHasAlphaMask, [](const SceneFeatures& f, bool) { return f.hasAlphaMask; }},
     {"shading_normals", gpu::kSpecHasShadingNormals, [](const SceneFeatures& f, bool) { return f.hasShadingNormals; }},
+    {"specular_lobe", gpu::kSpecHasSpecularLobe, [](const SceneFeatures& f, bool) { return f.hasSpecularLayer; }},
     {"max_depth", gpu::kSpecMaxDepth, [](const SceneFeatures&, bool) { return false; }},
 };
 

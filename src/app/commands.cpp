@@ -336,9 +336,9 @@ int runInfo(const InfoArgs& args) {
     // visibleEmission: emitter-silhouette supersampling (render/visible_pass.h) at the default
     // factor, which needs something the camera can see emit.
     std::printf("kernel variant: pt[textures=%d punctual=%d lightTris=%d env=%d glossy=%d alphaMask=%d "
-                "shadingNormals=%d visibleEmission=%d]\n",
+                "shadingNormals=%d specularLobe=%d visibleEmission=%d]\n",
                 f.hasTextures, f.hasPunctual, f.hasLightTris, f.hasEnv, f.hasGlossy, f.hasAlphaMask,
-                f.hasShadingNormals, visibleEmissionPossible(f));
+                f.hasShadingNormals, f.hasSpecularLayer, visibleEmissionPossible(f));
     for (const auto& u : scene.unsupported) std::printf("  unsupported: %s\n", u.c_str());
     return 0;
 }

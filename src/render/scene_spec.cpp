@@ -58,6 +58,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> SceneSpec::specConstants() 
         {gpu::kSpecHasGlossy, b(features_.hasGlossy)},
         {gpu::kSpecHasAlphaMask, b(features_.hasAlphaMask)},
         {gpu::kSpecHasShadingNormals, b(features_.hasShadingNormals)},
+        {gpu::kSpecHasSpecularLobe, b(features_.hasSpecularLayer)},
         {gpu::kSpecMaxDepth, maxDepthSpec_}};
     for (auto& [id, value] : spec)
         if (genericFeatures_ & (1u << id)) value = id == gpu::kSpecMaxDepth ? 1024u : 1u;

@@ -1,10 +1,12 @@
 // test_scene_features.cpp — which triangles need their vertex normals (features.h): the rule
 // that lets flat-shaded scenes compile the shading-normal interpolation out of the kernels
-// (kSpecHasShadingNormals), and that it changes no image.
+// (kSpecHasShadingNormals), and that it changes no image; the same for the specular lobe
+// (kSpecHasSpecularLobe: a scene of Lambertian materials compiles the GGX code out).
 #include <gtest/gtest.h>
 
 #include "gpu_fixture.h"
 #include "render/features.h"
+#include "render/gpt_renderer.h"
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
 #include "scene/procedural.h"
@@ -57,6 +59,40 @@ TEST_F(ShadingNormalSpecialisation, FlatSceneSameImageEitherWay) {
     for (int c = 0; c < 3; ++c)
         for (std::size_t i = 0; i < specialised.pixelCount(); ++i)
             ASSERT_EQ(specialised.plane(c)[i], generic.plane(c)[i]) << "pixel " << i;
+}
+
+// Which shipped scenes have a metal/dielectric lobe: the Cornell boxes are Lambertian, the
+// glossy one is not.
+TEST(SceneFeatures, ShippedScenesClassifyTheirSpecularLobes) {
+    EXPECT_FALSE(analyzeScene(loadGltf(GDPT_SOURCE_DIR "/scenes/cornell_box.gltf"), glm::vec3(0)).hasSpecularLayer);
+    EXPECT_TRUE(analyzeScene(loadGltf(GDPT_SOURCE_DIR "/scenes/glossy_cornell.gltf"), glm::vec3(0)).hasSpecularLayer);
+}
+
+void expectSameBits(const Image& a, const Image& b, const char* what) {
+    ASSERT_EQ(a.pixelCount(), b.pixelCount());
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < a.pixelCount(); ++i)
+            ASSERT_EQ(a.plane(c)[i], b.plane(c)[i]) << what << ", pixel " << i << ", channel " << c;
+}
+
+class SpecularLobeSpecialisation : public test::GpuTest {};
+
+// A Lambertian scene renders the same bits, PT and G-PT (every buffer the sampler writes),
+// with the GGX lobe compiled out (specialised) and compiled in (generic: it is then evaluated
+// with metallic = specular = 0).
+TEST_F(SpecularLobeSpecialisation, LambertianSceneSameImageEitherWay) {
+    const Scene scene = loadGltf(GDPT_SOURCE_DIR "/scenes/cornell_box.gltf");
+    ASSERT_FALSE(analyzeScene(scene, glm::vec3(0)).hasSpecularLayer);
+    RenderOptions o = renderOptions(32, 32, 4, 3);
+    const Image pt = renderPt(ctx(), scene, o).image;
+    const RenderResultGpt gpt = renderGpt(ctx(), scene, o);
+    o.scene.genericFeatures = 1u << gpu::kSpecHasSpecularLobe;
+    expectSameBits(pt, renderPt(ctx(), scene, o).image, "pt");
+    const RenderResultGpt gptGeneric = renderGpt(ctx(), scene, o);
+    expectSameBits(gpt.primal, gptGeneric.primal, "gpt primal");
+    expectSameBits(gpt.dx, gptGeneric.dx, "gpt dx");
+    expectSameBits(gpt.dy, gptGeneric.dy, "gpt dy");
+    expectSameBits(gpt.direct, gptGeneric.direct, "gpt direct");
 }
 
 }  // namespace
