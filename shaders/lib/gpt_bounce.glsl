@@ -75,65 +75,80 @@
         bool visible = !traceAny(origin, ls.wi, 0.0, ls.dist * (1.0 - 1e-4));
         vec3 fBase = visible ? beta * f * ls.Li / ls.pdf : vec3(0.0);
         float pdfBsdfV = visible ? pdfBsdf : 0.0;  // BSDF density including visibility
+        // Per pair one weight and one addPair, whichever case it is: on lavapipe before Mesa
+        // 23 (every branch runs under lane masks) each case's own copy cost its time.
         for (uint i = 0u; i < 4u; ++i) {
             if (!gptPairExists(px, py, i)) continue;
-            if (!offs[i].alive) {
-                // Failed shift: the base alone, with PT's weight.
-                addPair(offs[i], gptMisWeight(ls.pdf, pdfBsdfV, 0.0, 0.0), fBase, vec3(0.0));
-                continue;
-            }
-            if (!ownVertex(offs[i], GDPT_GPT_GENERAL)) {
-                // Shared vertex: same light point and visibility; the offset's own
-                // incoming direction only changes the BSDF (§1.5 RECENTLY_CONNECTED).
-                vec3 fo = f;
-                float pdfBsdfO = pdfBsdfV;
-                if (offs[i].state == kShiftRecentlyConnected) {
-                    fo = bsdfEval(bsdf, offWo[i], wiLocal);
-                    pdfBsdfO = (ls.isDelta != 0u || !visible) ? 0.0 : bsdfPdf(bsdf, offWo[i], wiLocal);
-                }
-                vec3 fOff = visible ? offs[i].beta * fo * ls.Li / ls.pdf : vec3(0.0);
-                float w = gptMisWeight(ls.pdf, pdfBsdfV, offs[i].r * ls.pdf, offs[i].r * pdfBsdfO);
-                addPair(offs[i], w, fBase, fOff);
-                continue;
-            }
-            // NOT_CONNECTED: reconnect the offset vertex to the same light point, only if
-            // both vertices are rough or the light is punctual; otherwise this NEE sample
-            // counts for neither (weight 0, the reference's choice).
-            if (ls.isDelta == 0u && !lightActive[i]) continue;
-            BsdfParams ob = offBsdf[i];
-            SurfaceHit oh = offs[i].hit;
-            vec3 toLight = ls.pLight - oh.p;
-            float distO = length(toLight);
-            vec3 wiO = toLight / distO;
-            // Densities of the offset path under the reverse technique: zero where the
-            // base sampler at p+δ would have rejected it (light behind the surface, light
-            // facing away, Dirac-only vertex), which makes the shift fail.
-            vec3 liO;
-            float jacobianLight;
-            bool valid = distO > 0.0 && dot(wiO, oh.ng) > 0.0 && !bsdfIsDeltaOnly(ob) &&
-                         gptOffsetLight(ls, ul, sh.p, oh.p, wiO, distO, liO, jacobianLight);
-            if (!valid) {
-                addPair(offs[i], gptMisWeight(ls.pdf, pdfBsdfV, 0.0, 0.0), fBase, vec3(0.0));
-                continue;
-            }
-            vec3 wiLocalO = toLocal(wiO, offT[i], offB[i], oh.ns);
-            vec3 fo = bsdfEval(ob, offWo[i], wiLocalO) * liO;
-            float pdfBsdfO = ls.isDelta != 0u ? 0.0 : bsdfPdf(ob, offWo[i], wiLocalO);
+            bool own = offs[i].alive && ownVertex(offs[i], GDPT_GPT_GENERAL);
+            bool sharedVertex = offs[i].alive && !own;
+            // The offset's light and BSDF densities in the base's measure and its
+            // contribution; zero densities = a failed shift: the base alone, PT's weight.
+            float qLight = 0.0;
+            float qBsdf = 0.0;
             vec3 fOff = vec3(0.0);
-            // The offset's visibility matters for its contribution and for its BSDF
-            // density (which enters the base's weight).
-            if (maxComponent(fo) > 0.0 || (pdfBsdfO > 0.0 && maxComponent(fBase) > 0.0)) {
-                rays++;
-                if (!traceAny(offsetRayOriginScaled(oh.p, oh.ng, scene.sceneRadius), wiO, 0.0, distO * (1.0 - 1e-4)))
-                    fOff = offs[i].beta * fo * (jacobianLight / ls.pdf);
-                else
-                    pdfBsdfO = 0.0;
+            bool counts = true;
+            // The one BSDF evaluation a pair needs: a shared vertex with the offset's own
+            // incoming direction (§1.5 RECENTLY_CONNECTED), or the offset's own vertex.
+            bool evaluate = sharedVertex && offs[i].state == kShiftRecentlyConnected;
+            BsdfParams evalBsdf = bsdf;
+            vec3 evalWi = wiLocal;
+            vec3 wiO = vec3(0.0);
+            float distO = 0.0;
+            vec3 liO = vec3(0.0);
+            float jacobianLight = 0.0;
+            bool valid = false;
+            if (own) {
+                // NOT_CONNECTED: reconnect the offset vertex to the same light point, only
+                // if both vertices are rough or the light is punctual; otherwise this NEE
+                // sample counts for neither (weight 0, the reference's choice).
+                counts = ls.isDelta != 0u || lightActive[i];
+                SurfaceHit oh = offs[i].hit;
+                vec3 toLight = ls.pLight - oh.p;
+                distO = length(toLight);
+                wiO = toLight / distO;
+                // Densities of the offset path under the reverse technique: zero where the
+                // base sampler at p+δ would have rejected it (light behind the surface,
+                // light facing away, Dirac-only vertex), which makes the shift fail.
+                valid = counts && distO > 0.0 && dot(wiO, oh.ng) > 0.0 && !bsdfIsDeltaOnly(offBsdf[i]) &&
+                        gptOffsetLight(ls, ul, sh.p, oh.p, wiO, distO, liO, jacobianLight);
+                evaluate = valid;
+                evalBsdf = offBsdf[i];
+                evalWi = toLocal(wiO, offT[i], offB[i], oh.ns);
             }
-            // Light strategy of the offset in the base's measure: p'_L J = p_L (same light
-            // point, area measure); BSDF strategy p'_B J.
-            float w = gptMisWeight(ls.pdf, pdfBsdfV, offs[i].r * ls.pdf,
-                                   offs[i].r * pdfBsdfO * jacobianLight);
-            addPair(offs[i], w, fBase, fOff);
+            vec3 fEval = f;
+            float pdfEval = pdfBsdfV;
+            if (evaluate) {
+                fEval = bsdfEval(evalBsdf, offWo[i], evalWi);
+                pdfEval = bsdfPdf(evalBsdf, offWo[i], evalWi);
+            }
+            if (sharedVertex) {
+                // Shared vertex: same light point and visibility; the offset's own incoming
+                // direction only changes the BSDF (f, pdfBsdfV without it: both are zero
+                // already where the light is punctual or occluded).
+                float pdfBsdfO = (ls.isDelta != 0u || !visible) ? 0.0 : pdfEval;
+                fOff = visible ? offs[i].beta * fEval * ls.Li / ls.pdf : vec3(0.0);
+                qLight = offs[i].r * ls.pdf;
+                qBsdf = offs[i].r * pdfBsdfO;
+            }
+            if (own && valid) {
+                vec3 fo = fEval * liO;
+                float pdfBsdfO = ls.isDelta != 0u ? 0.0 : pdfEval;
+                // The offset's visibility matters for its contribution and for its BSDF
+                // density (which enters the base's weight).
+                if (maxComponent(fo) > 0.0 || (pdfBsdfO > 0.0 && maxComponent(fBase) > 0.0)) {
+                    SurfaceHit oh = offs[i].hit;
+                    rays++;
+                    if (!traceAny(offsetRayOriginScaled(oh.p, oh.ng, scene.sceneRadius), wiO, 0.0, distO * (1.0 - 1e-4)))
+                        fOff = offs[i].beta * fo * (jacobianLight / ls.pdf);
+                    else
+                        pdfBsdfO = 0.0;
+                }
+                // Light strategy of the offset in the base's measure: p'_L J = p_L (same
+                // light point, area measure); BSDF strategy p'_B J.
+                qLight = offs[i].r * ls.pdf;
+                qBsdf = offs[i].r * pdfBsdfO * jacobianLight;
+            }
+            if (counts) addPair(offs[i], gptMisWeight(ls.pdf, pdfBsdfV, qLight, qBsdf), fBase, fOff);
         }
     }
 
@@ -294,7 +309,7 @@
     }
 
     // ---- Emission reached by the BSDF sample: environment or an emitter (§1.6) ----
-    if (baseMissed) {
+    if (kHasEnv && baseMissed) {  // (kHasEnv: else the path ended above; lets the compiler drop this)
         vec3 le = scene.envRadiance;
         for (uint i = 0u; i < 4u; ++i) {
             if (!gptPairExists(px, py, i)) continue;
@@ -318,21 +333,19 @@
             if (!gptPairExists(px, py, i)) continue;
             // The light strategy competes only where NEE counted for this pair.
             float pdfLightPair = lightActive[i] ? pdfLight : 0.0;
-            if (!offs[i].alive) {
-                // Failed shift (before or at this bounce): the base alone. After a failed
-                // half-vector step the pair had no NEE, so the base takes full weight.
-                if (maxComponent(le) > 0.0)
-                    addPair(offs[i], gptMisWeight(bs.pdf, pdfLightPair, 0.0, 0.0), beta * le, vec3(0.0));
-            } else if (ownVertex(offs[i], GDPT_GPT_GENERAL)) {
+            if (ownVertex(offs[i], GDPT_GPT_GENERAL) && offs[i].alive) {
                 // Half-vector branch: BSDF sampling only, w = p²/(p² + (J p')²).
                 vec3 leO = surfaceEmission(offs[i].hit);
                 if (maxComponent(le) > 0.0 || maxComponent(leO) > 0.0)
                     addPair(offs[i], gptMisWeightPair(offs[i].r), beta * le, offs[i].beta * leO);
             } else if (maxComponent(le) > 0.0) {
-                // Reconnected (this bounce or before): four strategies.
-                float w = gptMisWeight(bs.pdf, pdfLightPair, offs[i].r * bs.pdf,
-                                       offs[i].rLight * pdfLightPair);
-                addPair(offs[i], w, beta * le, offs[i].beta * le);
+                // Reconnected (this bounce or before): four strategies. A failed shift
+                // (before or at this bounce): the base alone (zero offset densities); after a
+                // failed half-vector step the pair had no NEE, so the base takes full weight.
+                bool alive = offs[i].alive;
+                float w = gptMisWeight(bs.pdf, pdfLightPair, alive ? offs[i].r * bs.pdf : 0.0,
+                                       alive ? offs[i].rLight * pdfLightPair : 0.0);
+                addPair(offs[i], w, beta * le, alive ? offs[i].beta * le : vec3(0.0));
             }
         }
     }
