@@ -6,9 +6,11 @@
 #    code. The SPIR-V glslang emits keeps every local in memory and every function call;
 #    lavapipe's vkCreateComputePipelines spends its time lowering that in NIR, on one core, and
 #    at a 4 s budget that time is the render's (bench/RESULTS.md, ninth session: gpt_split
-#    0.75 s -> 0.40 s, the kernel runs as fast). Specialisation constants stay constants.
-#    No -O: its extra passes made the G-PT kernel run 4 % slower on lavapipe.
-# 3. Embed the words as `const uint32_t NAME[]` in OUT.
+#    0.75 s -> 0.40 s, the kernel runs as fast; Mesa 25 runs it ~12 % slower, hence both
+#    variants). Specialisation constants stay constants. No -O: its extra passes made the
+#    G-PT kernel run 4 % slower on lavapipe 22.3.
+# 3. Embed the words as `const uint32_t NAME[]` (glslang's) and `NAME_opt[]` (spirv-opt's; the
+#    same words without SPIRV_OPT) in OUT; vk::useOptimizedSpirv picks one per device.
 string(REPLACE "|" ";" FLAGS "${FLAGS}")
 set(raw "${OUT}.spv")
 execute_process(
@@ -22,6 +24,7 @@ file(READ ${OUT}.d dep)
 string(REPLACE "${raw}:" "${OUT}:" dep "${dep}")
 file(WRITE ${OUT}.d "${dep}")
 
+set(opt "${raw}")
 if(SPIRV_OPT)
   set(opt "${OUT}.opt.spv")
   execute_process(
@@ -37,18 +40,25 @@ if(SPIRV_OPT)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "spirv-opt failed on ${SRC}:\n${log}")
   endif()
-  set(raw ${opt})
 endif()
 
-file(READ ${raw} hex HEX)
-string(LENGTH "${hex}" n)
-math(EXPR rem "${n} % 8")
-if(n EQUAL 0 OR NOT rem EQUAL 0)
-  message(FATAL_ERROR "${raw}: not a whole number of 32-bit words")
-endif()
-# Little-endian bytes b0 b1 b2 b3 -> the word 0xb3b2b1b0.
-string(REGEX REPLACE "(..)(..)(..)(..)" "0x\\4\\3\\2\\1," words "${hex}")
-string(REPEAT "0x........," 8 eight)  # (CMake's regular expressions have no {8})
-string(REGEX REPLACE "(${eight})" "\\1\n" words "${words}")
-file(WRITE ${OUT}.tmp "#pragma once\n#include <cstdint>\nconst uint32_t ${NAME}[] = {\n${words}\n};\n")
+# The words of a SPIR-V file as C array initialisers, eight per line.
+function(spirv_words file outvar)
+  file(READ ${file} hex HEX)
+  string(LENGTH "${hex}" n)
+  math(EXPR rem "${n} % 8")
+  if(n EQUAL 0 OR NOT rem EQUAL 0)
+    message(FATAL_ERROR "${file}: not a whole number of 32-bit words")
+  endif()
+  # Little-endian bytes b0 b1 b2 b3 -> the word 0xb3b2b1b0.
+  string(REGEX REPLACE "(..)(..)(..)(..)" "0x\\4\\3\\2\\1," words "${hex}")
+  string(REPEAT "0x........," 8 eight)  # (CMake's regular expressions have no {8})
+  string(REGEX REPLACE "(${eight})" "\\1\n" words "${words}")
+  set(${outvar} "${words}" PARENT_SCOPE)
+endfunction()
+
+spirv_words(${raw} raw_words)
+spirv_words(${opt} opt_words)
+file(WRITE ${OUT}.tmp "#pragma once\n#include <cstdint>\nconst uint32_t ${NAME}[] = {\n${raw_words}\n};\n"
+                      "const uint32_t ${NAME}_opt[] = {\n${opt_words}\n};\n")
 file(RENAME ${OUT}.tmp ${OUT})

@@ -81,7 +81,7 @@ PoissonKernels::PoissonKernels(const vk::Context& ctx, std::uint32_t gx, std::ui
         descs_[1][static_cast<std::size_t>(op)] = describe(std::move(addressed), gx, gy, grid, true);
     };
 #define GDPT_POISSON_KERNEL(op, name, grid) \
-    set(PoissonOp::op, vk::kernelDesc(#name, kSpv_##name), vk::kernelDesc(#name, kSpv_##name##_addr), grid)
+    set(PoissonOp::op, vk::kernelDesc(#name, GDPT_KERNEL_SPIRV(name)), vk::kernelDesc(#name, GDPT_KERNEL_SPIRV(name##_addr)), grid)
     GDPT_POISSON_KERNEL(Setup, poisson_setup, true);
     GDPT_POISSON_KERNEL(Coarsen, poisson_coarsen, true);
     GDPT_POISSON_KERNEL(Residual, poisson_residual, true);

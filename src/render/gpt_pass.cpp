@@ -43,7 +43,8 @@ vk::KernelDesc gptDesc(const SceneSpec& scene, WorkgroupSize wg, bool halfVector
                        const VisiblePass& visible) {
     std::vector<std::uint32_t> extra = {gpu::kBindCounters};
     for (std::uint32_t i = 0; i < kNumStats; ++i) extra.push_back(gpu::kBindGptCentral + i);
-    vk::KernelDesc d = scene.kernelDesc(splitBounce ? vk::kernelDesc("gpt", kSpv_gpt_split) : vk::kernelDesc("gpt", kSpv_gpt),
+    vk::KernelDesc d = scene.kernelDesc(splitBounce ? vk::kernelDesc("gpt", GDPT_KERNEL_SPIRV(gpt_split))
+                                                    : vk::kernelDesc("gpt", GDPT_KERNEL_SPIRV(gpt)),
                                         wg, extra, sizeof(gpu::GptFrameParams));
     for (auto& [id, value] : d.specConstants)
         if (id == gpu::kSpecHasGlossy) value = halfVector ? 1u : 0u;
@@ -52,7 +53,7 @@ vk::KernelDesc gptDesc(const SceneSpec& scene, WorkgroupSize wg, bool halfVector
 }
 
 vk::KernelDesc resolveDesc(WorkgroupSize wg, const VisiblePass& visible) {
-    vk::KernelDesc d = vk::kernelDesc("gpt_resolve", kSpv_gpt_resolve);
+    vk::KernelDesc d = vk::kernelDesc("gpt_resolve", GDPT_KERNEL_SPIRV(gpt_resolve));
     for (std::uint32_t i = 0; i < kNumStats; ++i) d.bindings.push_back(gpu::kBindGptCentral + i);
     d.bindings.push_back(gpu::kBindGptResolved);
     d.pushConstantBytes = sizeof(gpu::GptFrameParams);
@@ -70,8 +71,7 @@ std::array<vk::Buffer, kNumStats> makeStats(const vk::Context& ctx, std::uint64_
 }  // namespace
 
 bool splitBounceDefault(const vk::DeviceInfo& device) {
-    // Mesa encodes driverVersion as VK_MAKE_VERSION(major, minor, patch).
-    return device.driverName == "llvmpipe" && VK_API_VERSION_MAJOR(device.driverVersion) < 23;
+    return device.lavapipeBeforeMesa23;
 }
 
 GptPass::GptPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg, GptPassOptions options)

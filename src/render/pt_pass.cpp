@@ -18,7 +18,7 @@ constexpr std::uint64_t kMaxPixelSamplesPerDispatch = 1u << 20;
 
 namespace {
 vk::KernelDesc ptDesc(const SceneSpec& scene, WorkgroupSize wg, const VisiblePass& visible) {
-    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("pt", kSpv_pt), wg, {gpu::kBindAccum, gpu::kBindCounters});
+    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("pt", GDPT_KERNEL_SPIRV(pt)), wg, {gpu::kBindAccum, gpu::kBindCounters});
     visible.configure(d);
     return d;
 }

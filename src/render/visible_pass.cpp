@@ -47,7 +47,7 @@ VisiblePass::VisiblePass(const vk::Context& ctx, const SceneSpec& scene, Workgro
     if (!enabled()) return;
     ctx.checkStorageBufferSize(stats_.size(), "the visible-emission statistics of a " + std::to_string(width_) +
                                                   "x" + std::to_string(height_) + " image");
-    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("visible", kSpv_visible), wg,
+    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("visible", GDPT_KERNEL_SPIRV(visible)), wg,
                                         {gpu::kBindCounters, gpu::kBindVisibleStats, gpu::kBindVisibleProbe,
                                          gpu::kBindVisibleCounter},
                                         sizeof(gpu::VisibleParams));

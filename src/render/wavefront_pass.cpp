@@ -18,7 +18,7 @@ constexpr std::uint32_t kBouncesPerSubmit = 6;
 
 namespace {
 vk::KernelDesc shadeDesc(const SceneGpu& scene, WorkgroupSize wg, const VisiblePass& visible) {
-    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("wf_shade", kSpv_wf_shade), wg,
+    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("wf_shade", GDPT_KERNEL_SPIRV(wf_shade)), wg,
                                         {gpu::kBindAccum, gpu::kBindCounters, gpu::kBindPathState, gpu::kBindPathHits});
     visible.configure(d);
     return d;
@@ -29,7 +29,7 @@ WavefrontPass::WavefrontPass(const vk::Context& ctx, const SceneGpu& scene, PtPa
     : ctx_(ctx),
       width_(scene.constants().width),
       height_(scene.constants().height),
-      extend_(ctx, scene.kernelDesc(vk::kernelDesc("wf_extend", kSpv_wf_extend), wg,
+      extend_(ctx, scene.kernelDesc(vk::kernelDesc("wf_extend", GDPT_KERNEL_SPIRV(wf_extend)), wg,
                                     {gpu::kBindPathState, gpu::kBindPathHits})),
       shade_(ctx, shadeDesc(scene, wg, pt.visible())),
       paths_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::PathState), "wavefront path state"),

@@ -8,6 +8,18 @@
 #include "vk/vk_check.h"
 
 namespace gdpt::vk {
+
+std::uint32_t mesaMajorVersion(const std::string& driverInfo, std::uint32_t driverVersion) {
+    const std::string prefix = "Mesa ";
+    if (driverInfo.rfind(prefix, 0) == 0) {
+        std::uint32_t major = 0;
+        std::size_t i = prefix.size();
+        for (; i < driverInfo.size() && driverInfo[i] >= '0' && driverInfo[i] <= '9' && i < prefix.size() + 4; ++i)
+            major = major * 10 + static_cast<std::uint32_t>(driverInfo[i] - '0');
+        if (i > prefix.size()) return major;
+    }
+    return VK_API_VERSION_MAJOR(driverVersion);
+}
 namespace {
 
 const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
@@ -85,6 +97,7 @@ DeviceInfo queryDevice(VkPhysicalDevice pd, std::uint32_t index) {
     d.driverName = driver.driverName;
     d.driverInfo = driver.driverInfo;
     d.driverVersion = p.driverVersion;
+    d.lavapipeBeforeMesa23 = d.driverName == "llvmpipe" && mesaMajorVersion(d.driverInfo, p.driverVersion) < 23;
     d.apiVersion = p.apiVersion;
     d.maxStorageBufferRange = p.limits.maxStorageBufferRange;
     d.maxTexelBufferElements = p.limits.maxTexelBufferElements;

@@ -31,6 +31,9 @@ struct DeviceInfo {
     std::uint32_t driverVersion = 0;  // VkPhysicalDeviceProperties::driverVersion (vendor encoding)
     std::uint32_t apiVersion = 0;
     bool isCpu = false;
+    // Lavapipe with Mesa before 23 (mesaMajorVersion): it runs every branch under lane masks,
+    // and its pipeline creation is what spirv-opt'd SPIR-V shortens (KernelDesc::spirvOptimized).
+    bool lavapipeBeforeMesa23 = false;
     std::uint64_t maxStorageBufferRange = 0;    // largest descriptor range
     std::uint64_t maxTexelBufferElements = 0;   // largest texel-buffer view, in texels
     std::uint64_t maxMemoryAllocationSize = 0;  // largest buffer (device-address access)
@@ -46,6 +49,11 @@ struct DeviceInfo {
     bool timestamps = false;
     std::string unsuitable;  // why gdpt cannot use it ("" = usable)
 };
+
+// Mesa's major version from driverInfo ("Mesa 22.3.6 (LLVM 15.0.6)" -> 22), else from
+// driverVersion read as VK_MAKE_VERSION(major, minor, patch). Lavapipe 22.3 encodes its
+// version there, but 25.0 reports driverVersion 1, so the string is read first.
+std::uint32_t mesaMajorVersion(const std::string& driverInfo, std::uint32_t driverVersion);
 
 class Context {
 public:

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
+#include <string>
 #include <utility>
 
 #include "vk/buffer.h"
@@ -62,6 +64,15 @@ VkFormat texelFormat(const std::vector<std::pair<std::uint32_t, VkFormat>>& texe
     return VK_FORMAT_UNDEFINED;
 }
 
+bool useOptimizedSpirv(const DeviceInfo& device) {
+    const char* env = std::getenv("GDPT_SPIRV");
+    const std::string v = env != nullptr ? env : "";
+    if (v.empty() || v == "auto") return device.lavapipeBeforeMesa23;
+    if (v == "opt") return true;
+    if (v == "raw") return false;
+    throw Error("GDPT_SPIRV='" + v + "': expected auto, raw or opt");
+}
+
 Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation creation) : ctx_(ctx), desc_(desc) {
     VkDevice device = ctx.device();
     GDPT_CHECK(desc.spirv != nullptr && desc.spirvBytes > 0);
@@ -71,8 +82,9 @@ Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation crea
                     std::to_string(ctx.info().maxPushConstantsSize));
 
     VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    moduleInfo.codeSize = desc.spirvBytes;
-    moduleInfo.pCode = desc.spirv;
+    const bool optimized = desc.spirvOptimized != nullptr && useOptimizedSpirv(ctx.info());
+    moduleInfo.codeSize = optimized ? desc.spirvOptimizedBytes : desc.spirvBytes;
+    moduleInfo.pCode = optimized ? desc.spirvOptimized : desc.spirv;
     VkShaderModule module = VK_NULL_HANDLE;
     VK_CHECK(vkCreateShaderModule(device, &moduleInfo, nullptr, &module));
     module_ = Handle<VkShaderModule>(module, [device](VkShaderModule m) { vkDestroyShaderModule(device, m, nullptr); });

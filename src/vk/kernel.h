@@ -19,12 +19,19 @@ namespace gdpt::vk {
 
 class Buffer;
 class Context;
+struct DeviceInfo;
 class GpuTimer;
 
 struct KernelDesc {
     std::string name;                    // shown in --profile and error messages
     const std::uint32_t* spirv = nullptr;
     std::size_t spirvBytes = 0;
+    // The same kernel through spirv-opt (cmake/GdptSpirvEmbed.cmake), if not null: lavapipe
+    // before Mesa 23 creates its pipeline in about half the time and runs it as fast; Mesa 25
+    // runs it ~12 % slower, so every other device gets `spirv` (bench/RESULTS.md, ninth
+    // session). GDPT_SPIRV=raw|opt in the environment overrides the choice.
+    const std::uint32_t* spirvOptimized = nullptr;
+    std::size_t spirvOptimizedBytes = 0;
     std::vector<std::uint32_t> bindings;  // binding numbers of set 0 (storage buffers unless below)
     // Bindings of `bindings` that the shader reads as uniform texel buffers (GLSL
     // textureBuffer / utextureBuffer + texelFetch), with the format of their view. Lavapipe
@@ -45,15 +52,23 @@ std::uint64_t texelBytes(VkFormat format);
 // VK_FORMAT_UNDEFINED if it lists no such binding (a storage buffer).
 VkFormat texelFormat(const std::vector<std::pair<std::uint32_t, VkFormat>>& texelBindings, std::uint32_t binding);
 
-// KernelDesc with the SPIR-V of an embedded array (kSpv_<name> from the build).
-template <std::size_t N>
-KernelDesc kernelDesc(std::string name, const std::uint32_t (&spirv)[N]) {
+// KernelDesc with the SPIR-V of the embedded arrays kSpv_<name> and kSpv_<name>_opt from the
+// build (GDPT_KERNEL_SPIRV(name) names both).
+template <std::size_t N, std::size_t M>
+KernelDesc kernelDesc(std::string name, const std::uint32_t (&spirv)[N], const std::uint32_t (&optimized)[M]) {
     KernelDesc d;
     d.name = std::move(name);
     d.spirv = spirv;
     d.spirvBytes = N * sizeof(std::uint32_t);
+    d.spirvOptimized = optimized;
+    d.spirvOptimizedBytes = M * sizeof(std::uint32_t);
     return d;
 }
+#define GDPT_KERNEL_SPIRV(name) kSpv_##name, kSpv_##name##_opt
+
+// Whether a kernel on this device is created from KernelDesc::spirvOptimized: GDPT_SPIRV=opt
+// or raw in the environment, else lavapipe before Mesa 23 only. Throws for another value.
+bool useOptimizedSpirv(const DeviceInfo& device);
 
 // When a Kernel's pipeline is created. Background: on a worker thread started by the
 // constructor; the first dispatch (or wait()) waits for it. Lavapipe spends most of a large

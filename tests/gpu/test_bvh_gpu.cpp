@@ -106,7 +106,7 @@ protected:
         const std::uint32_t rayCount = 100000;
         const auto rays = randomRays(rayCount, seed);
 
-        vk::KernelDesc desc = vk::kernelDesc("trace_rays", kSpv_trace_rays);
+        vk::KernelDesc desc = vk::kernelDesc("trace_rays", GDPT_KERNEL_SPIRV(trace_rays));
         desc.bindings = {gpu::kBindTriGeom, gpu::kBindBvh, gpu::kBindTestInput, gpu::kBindTestOutput,
                          gpu::kBindTestOutput2};
         desc.texelBindings = SceneSpec::geometryTexelBindings();
@@ -169,7 +169,7 @@ TEST_F(BvhGpu, BackgroundPipelineMatchesBruteForce) {
 // A kernel whose background creation is never waited for is destroyed cleanly (the
 // destructor joins the worker and destroys the pipeline; validation reports any leak).
 TEST_F(BvhGpu, UnusedBackgroundPipelineIsDestroyed) {
-    vk::KernelDesc desc = vk::kernelDesc("trace_rays", kSpv_trace_rays);
+    vk::KernelDesc desc = vk::kernelDesc("trace_rays", GDPT_KERNEL_SPIRV(trace_rays));
     desc.bindings = {gpu::kBindTriGeom, gpu::kBindBvh, gpu::kBindTestInput, gpu::kBindTestOutput,
                      gpu::kBindTestOutput2};
     desc.texelBindings = SceneSpec::geometryTexelBindings();

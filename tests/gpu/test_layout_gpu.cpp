@@ -36,7 +36,7 @@ struct ProbeB {
 class LayoutGpu : public test::GpuTest {};
 
 TEST_F(LayoutGpu, EveryFieldMatchesBetweenCppAndGlsl) {
-    vk::KernelDesc desc = vk::kernelDesc("layout_probe", kSpv_layout_probe);
+    vk::KernelDesc desc = vk::kernelDesc("layout_probe", GDPT_KERNEL_SPIRV(layout_probe));
     desc.bindings = {gpu::kBindTestInput, gpu::kBindTestOutput};
     vk::Kernel kernel(ctx(), desc);
     vk::Buffer a(ctx(), sizeof(ProbeA), "probe A");
@@ -175,7 +175,7 @@ TEST_F(LayoutGpu, TexelAccessorsReturnTheUploadedStructs) {
         {glm::packHalf2x16({0.5f, 1.5f}), glm::packHalf2x16({2.5f, 3.5f})},
         {glm::packHalf2x16({-4.0f, 0.25f}), glm::packHalf2x16({8.0f, 1024.0f})}};
 
-    vk::KernelDesc desc = vk::kernelDesc("table_probe", kSpv_table_probe);
+    vk::KernelDesc desc = vk::kernelDesc("table_probe", GDPT_KERNEL_SPIRV(table_probe));
     desc.bindings = SceneSpec::sceneBindings();
     desc.bindings.push_back(gpu::kBindTestOutput);
     desc.texelBindings = SceneSpec::sceneTexelBindings();

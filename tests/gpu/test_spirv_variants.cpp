@@ -1,0 +1,83 @@
+// test_spirv_variants.cpp — the two embedded SPIR-V forms of every kernel (glslang's, and
+// spirv-opt's: cmake/GdptSpirvEmbed.cmake) render the same image, and which one a device
+// gets (vk::useOptimizedSpirv: lavapipe before Mesa 23, read from the driver string).
+#include <cstdlib>
+
+#include <gtest/gtest.h>
+
+#include "gpu_fixture.h"
+#include "render/gpt_renderer.h"
+#include "render/renderer.h"
+#include "scene/gltf_loader.h"
+#include "vk/kernel.h"
+#include "util/error.h"
+
+namespace gdpt {
+namespace {
+
+TEST(SpirvVariants, MesaMajorVersionComesFromTheDriverString) {
+    EXPECT_EQ(vk::mesaMajorVersion("Mesa 22.3.6 (LLVM 15.0.6)", VK_MAKE_VERSION(22, 3, 6)), 22u);
+    // Mesa 25's lavapipe reports driverVersion 1: the string decides.
+    EXPECT_EQ(vk::mesaMajorVersion("Mesa 25.0.7-2~bpo12+1 (LLVM 15.0.6)", 1u), 25u);
+    // Not Mesa's format: driverVersion as VK_MAKE_VERSION.
+    EXPECT_EQ(vk::mesaMajorVersion("NVIDIA 550.54", VK_MAKE_VERSION(550, 54, 0)), 550u & 0x7Fu);
+    EXPECT_EQ(vk::mesaMajorVersion("Mesa x", VK_MAKE_VERSION(23, 1, 0)), 23u);
+}
+
+TEST(SpirvVariants, EnvironmentChoosesTheVariant) {
+    vk::DeviceInfo old;
+    old.lavapipeBeforeMesa23 = true;
+    vk::DeviceInfo other;
+    ::unsetenv("GDPT_SPIRV");
+    EXPECT_TRUE(vk::useOptimizedSpirv(old));
+    EXPECT_FALSE(vk::useOptimizedSpirv(other));
+    ::setenv("GDPT_SPIRV", "opt", 1);
+    EXPECT_TRUE(vk::useOptimizedSpirv(other));
+    ::setenv("GDPT_SPIRV", "raw", 1);
+    EXPECT_FALSE(vk::useOptimizedSpirv(old));
+    ::setenv("GDPT_SPIRV", "fast", 1);
+    EXPECT_THROW(vk::useOptimizedSpirv(old), Error);
+    ::unsetenv("GDPT_SPIRV");
+}
+
+void expectSameBits(const Image& a, const Image& b, const char* what) {
+    ASSERT_EQ(a.pixelCount(), b.pixelCount());
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < a.pixelCount(); ++i)
+            ASSERT_EQ(a.plane(c)[i], b.plane(c)[i]) << what << ", pixel " << i << ", channel " << c;
+}
+
+class SpirvVariantsGpu : public test::GpuTest {};
+
+// spirv-opt only inlines, promotes locals to SSA and removes dead code: on lavapipe the
+// arithmetic is the same, so the images are the same bits (PT, and every buffer G-PT's
+// sampler writes, with the split bounce loop and without).
+TEST_F(SpirvVariantsGpu, OptimizedAndRawSpirvRenderTheSameImage) {
+    const Scene scene = loadGltf(GDPT_SOURCE_DIR "/scenes/glossy_cornell.gltf");
+    RenderOptions o = renderOptions(24, 24, 2, 5);
+    ::setenv("GDPT_SPIRV", "raw", 1);
+    const Image ptRaw = renderPt(ctx(), scene, o).image;
+    GptPassOptions split;
+    split.splitBounce = GptPassOptions::SplitBounce::On;
+    GptPassOptions single;
+    single.splitBounce = GptPassOptions::SplitBounce::Off;
+    const RenderResultGpt splitRaw = renderGpt(ctx(), scene, o, split);
+    const RenderResultGpt singleRaw = renderGpt(ctx(), scene, o, single);
+    ::setenv("GDPT_SPIRV", "opt", 1);
+    const Image ptOpt = renderPt(ctx(), scene, o).image;
+    const RenderResultGpt splitOpt = renderGpt(ctx(), scene, o, split);
+    const RenderResultGpt singleOpt = renderGpt(ctx(), scene, o, single);
+    ::unsetenv("GDPT_SPIRV");
+    expectSameBits(ptRaw, ptOpt, "pt");
+    for (const auto* pair : {&splitRaw, &singleRaw}) {
+        const RenderResultGpt& raw = *pair;
+        const RenderResultGpt& opt = pair == &splitRaw ? splitOpt : singleOpt;
+        expectSameBits(raw.primal, opt.primal, "gpt primal");
+        expectSameBits(raw.dx, opt.dx, "gpt dx");
+        expectSameBits(raw.dy, opt.dy, "gpt dy");
+        expectSameBits(raw.direct, opt.direct, "gpt direct");
+    }
+}
+
+}  // namespace
+}  // namespace gdpt
