@@ -335,7 +335,7 @@ int runConverge(const ConvergeArgs& a) {
 
     json runsJson = json::array();
     std::ostringstream csv;
-    csv << "method,budget_s,repeat,seconds,recon_seconds,spp,relmse,mse,mae,mean_bias\n";
+    csv << "method,budget_s,repeat,seconds,recon_seconds,spp,partial_pass_rows,relmse,mse,mae,mean_bias\n";
     for (std::size_t i = 0; i < runs.size(); ++i) {
         const Run& r = runs[i];
         const int repeat = static_cast<int>(i % static_cast<std::size_t>(a.repeats));
@@ -343,7 +343,7 @@ int runConverge(const ConvergeArgs& a) {
                             {"recon_seconds", r.reconSeconds}, {"spp", r.spp}, {"partial_pass_rows", r.partialPassRows}, {"relmse", r.error.relMse},
                             {"mse", r.error.mse}, {"mae", r.error.mae}, {"mean_bias", r.error.meanBias}});
         csv << r.method << "," << r.budget << "," << repeat << "," << r.seconds << "," << r.reconSeconds << ","
-            << r.spp << "," << r.error.relMse << "," << r.error.mse << "," << r.error.mae << "," << r.error.meanBias
+            << r.spp << "," << r.partialPassRows << "," << r.error.relMse << "," << r.error.mse << "," << r.error.mae << "," << r.error.meanBias
             << "\n";
     }
     const json results = {{"schema", "gdpt-converge-1"},

@@ -130,8 +130,9 @@ void checkResults(const fs::path& dir, const std::vector<std::string>& methods,
     // CSV: the header, then the JSON runs in the same order with the same values.
     const auto rows = readCsv((dir / "results.csv").string());
     ASSERT_EQ(rows.size(), runs.size() + 1);
-    const std::vector<std::string> header = {"method", "budget_s", "repeat", "seconds", "recon_seconds",
-                                             "spp",    "relmse",   "mse",    "mae",     "mean_bias"};
+    const std::vector<std::string> header = {"method", "budget_s", "repeat",            "seconds",
+                                             "recon_seconds", "spp", "partial_pass_rows", "relmse",
+                                             "mse",    "mae",      "mean_bias"};
     ASSERT_EQ(rows[0], header);
     for (std::size_t i = 0; i < runs.size(); ++i) {
         const auto& row = rows[i + 1];
@@ -140,7 +141,8 @@ void checkResults(const fs::path& dir, const std::vector<std::string>& methods,
         EXPECT_EQ(row[0], r["method"].get<std::string>()) << "csv row " << i + 1;
         EXPECT_EQ(std::stoi(row[2]), r["repeat"].get<int>()) << "csv row " << i + 1;
         EXPECT_EQ(std::stoul(row[5]), r["spp"].get<unsigned long>()) << "csv row " << i + 1;
-        for (std::size_t k : {1u, 3u, 4u, 6u, 7u, 8u, 9u})
+        EXPECT_EQ(std::stoul(row[6]), r["partial_pass_rows"].get<unsigned long>()) << "csv row " << i + 1;
+        for (std::size_t k : {1u, 3u, 4u, 7u, 8u, 9u, 10u})
             expectSameNumber(row[k], r[header[k]].get<double>(),
                              "csv row " + std::to_string(i + 1) + " " + header[k]);
     }
