@@ -147,10 +147,16 @@ int runRender(const RenderArgs& args) {
     if (gpt) solver = std::make_unique<PoissonSolverGpu>(ctx, args.width, args.height);
     const ReconTimeCache reconCache(ReconTimeCache::defaultPath());
     ReconReservation reserve;
-    if (gpt && args.time > 0.0) {
-        reserve = reserveReconstruction(ctx, *solver, solves, reconCache);
-        options.timeBudget = std::max(0.05 * args.time, args.time - reserve.seconds);
-    }
+    if (gpt && args.time > 0.0) reserve = reserveReconstruction(ctx, *solver, solves, reconCache);
+    // The rest after sampling (resolve and readback, output layers, EXR + PNG) is waited for
+    // too: reserve what it took the last time for this device, method, size and solves (the
+    // first run of a configuration reserves nothing for it).
+    const std::string finishKey = "finish|" + ctx.info().name + "|" + ctx.info().driverInfo + "|" + args.method +
+                                  "|" + std::to_string(args.width) + "x" + std::to_string(args.height) +
+                                  (gpt ? "|" + std::to_string(recons.size()) + " solves" : "");
+    const double finishReserved = args.time > 0.0 ? reconCache.get(finishKey).value_or(0.0) : 0.0;
+    if (args.time > 0.0)
+        options.timeBudget = std::max(0.05 * args.time, args.time - reserve.seconds - finishReserved);
     // The reconstruction's pipelines are created while the path kernels compile.
     if (gpt) options.whileCompiling = [&] { solver->preparePipelines(solves); };
     options.elapsedBefore = total.seconds();
@@ -190,6 +196,7 @@ int runRender(const RenderArgs& args) {
     // chosen), plus every buffer the sampler produced as a named layer.
     std::vector<NamedLayer> layers;
     RenderStats stats;
+    double afterSampling = 0.0;  // total.seconds() when the batch loop ended (about)
     if (args.method == "gpt") {
         GptPassOptions gptOptions;
         gptOptions.shiftThreshold = args.shiftThreshold;
@@ -197,6 +204,7 @@ int runRender(const RenderArgs& args) {
                                  : args.splitBounce == "off" ? GptPassOptions::SplitBounce::Off
                                                              : GptPassOptions::SplitBounce::Auto;
         RenderResultGpt g = renderGpt(ctx, scene, options, gptOptions);
+        afterSampling = total.seconds() - g.stats.readbackMs * 1e-3;
         stats = g.stats;
         // Screened Poisson reconstruction of the indirect image from primal + gradients;
         // the final image is reconstruction + very-direct light (Kettunen et al. 2015 §5).
@@ -228,6 +236,7 @@ int runRender(const RenderArgs& args) {
         layers.insert(layers.end(), buffers.begin(), buffers.end());
     } else {
         RenderResult r = renderPt(ctx, scene, options);
+        afterSampling = total.seconds() - r.stats.readbackMs * 1e-3;
         layers = {{"", r.image}, {"variance", r.varianceOfMean}};
         stats = r.stats;
     }
@@ -248,6 +257,7 @@ int runRender(const RenderArgs& args) {
     const double writeMs = writeTimer.ms();
     const RenderStats& s = stats;
     const double seconds = total.seconds();
+    if (args.time > 0.0) reconCache.put(finishKey, std::max(0.0, seconds - afterSampling - s.reconstructionMs * 1e-3));
     if (args.profile) printProfile(s.kernels);
     if (!args.quiet)
         std::fprintf(stderr,
@@ -277,6 +287,7 @@ int runRender(const RenderArgs& args) {
                               {"readback", s.readbackMs * 1e-3},
                               {"reconstruction", s.reconstructionMs * 1e-3},
                               {"reconstruction_reserved", reserve.seconds},
+                              {"finish_reserved", finishReserved},
                               {"write", writeMs * 1e-3}}},
                   {"rays_traced", s.raysTraced},
                   {"paths_completed", s.pathsCompleted},

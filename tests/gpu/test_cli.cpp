@@ -92,6 +92,7 @@ TEST_F(Cli, SmallValidatedRenderWritesExrPngAndJson) {
 // A timed G-PT render reserves its reconstruction time: the first run of a configuration
 // measures it (calibration solve) and remembers the real reconstruction's time in the cache
 // ($GDPT_CACHE_DIR/recon_times.json); the next run reserves exactly the remembered value.
+// The same for the time after sampling without the reconstruction (finish_reserved).
 TEST_F(Cli, TimedGptRenderReservesTheRememberedReconstructionTime) {
     const std::string env = "GDPT_CACHE_DIR=" + path("cache") + " ";
     const std::string cmd = "render " + kScene + " --method gpt -o " + path("g.exr") +
@@ -108,16 +109,25 @@ TEST_F(Cli, TimedGptRenderReservesTheRememberedReconstructionTime) {
     EXPECT_GT(readJson(path("g.json"))["time_s"]["reconstruction_reserved"].get<double>(), 0.0);
     ASSERT_TRUE(fs::exists(cached));
     nlohmann::json entries = readJson(cached);
-    ASSERT_EQ(entries.size(), 1u);
-    const std::string key = entries.begin().key();
+    // The reconstruction's entry and the finish's (readback, layers, writing: finish_reserved).
+    ASSERT_EQ(entries.size(), 2u) << entries.dump();
+    std::string key;
+    std::string finishKey;
+    for (const auto& [k, v] : entries.items()) (k.rfind("finish|", 0) == 0 ? finishKey : key) = k;
+    ASSERT_FALSE(key.empty()) << entries.dump();
+    ASSERT_FALSE(finishKey.empty()) << entries.dump();
+    EXPECT_NE(finishKey.find("gpt"), std::string::npos) << finishKey;
     EXPECT_NE(key.find("16x16"), std::string::npos) << key;
     EXPECT_NE(key.find("l1"), std::string::npos) << key;
-    entries[key] = 0.125;  // a value no measurement produces, to see it come back
+    entries[key] = 0.125;  // values no measurement produces, to see them come back
+    entries[finishKey] = 0.0625;
     std::ofstream(cached) << entries.dump();
     r = runWithEnv(env, cmd);
     ASSERT_EQ(r.code, 0) << r.output;
     EXPECT_DOUBLE_EQ(readJson(path("g.json"))["time_s"]["reconstruction_reserved"].get<double>(), 0.125);
+    EXPECT_DOUBLE_EQ(readJson(path("g.json"))["time_s"]["finish_reserved"].get<double>(), 0.0625);
     EXPECT_NE(readJson(cached)[key].get<double>(), 0.125) << "the real reconstruction time replaces it";
+    EXPECT_NE(readJson(cached)[finishKey].get<double>(), 0.0625) << "the real finishing time replaces it";
 }
 
 // A 4096x4096 render: on a device whose maxStorageBufferRange cannot hold its per-pixel
