@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "gpu_fixture.h"
+#include "same_bits.h"
 #include "render/gpt_renderer.h"
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
@@ -40,13 +41,6 @@ TEST(SpirvVariants, EnvironmentChoosesTheVariant) {
     ::unsetenv("GDPT_SPIRV");
 }
 
-void expectSameBits(const Image& a, const Image& b, const char* what) {
-    ASSERT_EQ(a.pixelCount(), b.pixelCount());
-    for (int c = 0; c < 3; ++c)
-        for (std::size_t i = 0; i < a.pixelCount(); ++i)
-            ASSERT_EQ(a.plane(c)[i], b.plane(c)[i]) << what << ", pixel " << i << ", channel " << c;
-}
-
 class SpirvVariantsGpu : public test::GpuTest {};
 
 // spirv-opt only inlines, promotes locals to SSA and removes dead code: on lavapipe the
@@ -68,15 +62,9 @@ TEST_F(SpirvVariantsGpu, OptimizedAndRawSpirvRenderTheSameImage) {
     const RenderResultGpt splitOpt = renderGpt(ctx(), scene, o, split);
     const RenderResultGpt singleOpt = renderGpt(ctx(), scene, o, single);
     ::unsetenv("GDPT_SPIRV");
-    expectSameBits(ptRaw, ptOpt, "pt");
-    for (const auto* pair : {&splitRaw, &singleRaw}) {
-        const RenderResultGpt& raw = *pair;
-        const RenderResultGpt& opt = pair == &splitRaw ? splitOpt : singleOpt;
-        expectSameBits(raw.primal, opt.primal, "gpt primal");
-        expectSameBits(raw.dx, opt.dx, "gpt dx");
-        expectSameBits(raw.dy, opt.dy, "gpt dy");
-        expectSameBits(raw.direct, opt.direct, "gpt direct");
-    }
+    test::expectSameBits(ptRaw, ptOpt, "pt");
+    test::expectSameGptBits(splitRaw, splitOpt, "gpt split");
+    test::expectSameGptBits(singleRaw, singleOpt, "gpt single loop");
 }
 
 }  // namespace
