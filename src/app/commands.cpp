@@ -151,8 +151,7 @@ int runRender(const RenderArgs& args) {
     // The rest after sampling (resolve and readback, output layers, EXR + PNG) is waited for
     // too: reserve what it took the last time for this device, method, size and solves (the
     // first run of a configuration reserves nothing for it).
-    const std::string finishKey = "finish|" + ctx.info().name + "|" + ctx.info().driverInfo + "|" + args.method +
-                                  "|" + std::to_string(args.width) + "x" + std::to_string(args.height) +
+    const std::string finishKey = "finish|" + reservationKey(ctx, args.width, args.height) + "|" + args.method +
                                   (gpt ? "|" + std::to_string(recons.size()) + " solves" : "");
     const double finishReserved = args.time > 0.0 ? reconCache.get(finishKey).value_or(0.0) : 0.0;
     if (args.time > 0.0)

@@ -67,11 +67,14 @@ void ReconTimeCache::put(const std::string& key, double seconds) const {
     }
 }
 
+std::string reservationKey(const vk::Context& ctx, std::uint32_t width, std::uint32_t height) {
+    return ctx.info().name + "|" + ctx.info().driverInfo + "|" + std::to_string(width) + "x" + std::to_string(height);
+}
+
 ReconReservation reserveReconstruction(const vk::Context& ctx, PoissonSolverGpu& solver,
                                        const std::vector<SolveOptions>& solves, const ReconTimeCache& cache) {
     ReconReservation r;
-    r.key = ctx.info().name + "|" + ctx.info().driverInfo + "|" + std::to_string(solver.engine().width()) +
-            "x" + std::to_string(solver.engine().height());
+    r.key = reservationKey(ctx, solver.engine().width(), solver.engine().height());
     for (const SolveOptions& so : solves)
         r.key += std::string("|") + toString(so.method) + " alpha " + std::to_string(so.alpha) + " tol " +
                  std::to_string(so.tolerance);

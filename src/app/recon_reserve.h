@@ -8,6 +8,7 @@
 // render of a configuration pays for one calibration solve; later ones pay nothing.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -42,6 +43,11 @@ public:
 private:
     std::string path_;
 };
+
+// The part of a reservation's cache key that names the configuration's device, driver and
+// image size ("<device>|<driver>|<w>x<h>"); the reconstruction and the finishing time of a
+// timed render extend it.
+std::string reservationKey(const vk::Context& ctx, std::uint32_t width, std::uint32_t height);
 
 // The reservation of a timed G-PT render: the cache key of its configuration (device,
 // driver, size, each solve's method, alpha and tolerance) and the seconds to reserve (the

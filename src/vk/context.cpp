@@ -10,16 +10,11 @@
 namespace gdpt::vk {
 
 std::uint32_t mesaMajorVersion(const std::string& driverInfo, std::uint32_t driverVersion) {
-    const std::string prefix = "Mesa ";
-    if (driverInfo.rfind(prefix, 0) == 0) {
-        std::uint32_t major = 0;
-        std::size_t i = prefix.size();
-        for (; i < driverInfo.size() && driverInfo[i] >= '0' && driverInfo[i] <= '9' && i < prefix.size() + 4; ++i)
-            major = major * 10 + static_cast<std::uint32_t>(driverInfo[i] - '0');
-        if (i > prefix.size()) return major;
-    }
+    unsigned major = 0;
+    if (std::sscanf(driverInfo.c_str(), "Mesa %u", &major) == 1) return major;
     return VK_API_VERSION_MAJOR(driverVersion);
 }
+
 namespace {
 
 const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";

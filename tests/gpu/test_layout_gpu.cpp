@@ -45,10 +45,7 @@ TEST_F(LayoutGpu, EveryFieldMatchesBetweenCppAndGlsl) {
     b.zero();
     kernel.bind(gpu::kBindTestInput, a);
     kernel.bind(gpu::kBindTestOutput, b);
-    vk::CommandStream cmd(ctx(), "layout probe");
-    kernel.dispatch(cmd.begin(), 1, 1, 1);
-    vk::computeBarrier(cmd.cmd());
-    cmd.submitAndWait();
+    dispatchOnce(kernel, "layout probe");
     ProbeA pa{};
     ProbeB pb{};
     a.download(&pa, sizeof pa);
@@ -194,10 +191,7 @@ TEST_F(LayoutGpu, TexelAccessorsReturnTheUploadedStructs) {
     vk::Buffer out(ctx(), sizeof(TableProbe), "probe");
     out.zero();
     kernel.bind(gpu::kBindTestOutput, out);
-    vk::CommandStream cmd(ctx(), "table probe");
-    kernel.dispatch(cmd.begin(), 1, 1, 1);
-    vk::computeBarrier(cmd.cmd());
-    cmd.submitAndWait();
+    dispatchOnce(kernel, "table probe");
     TableProbe p{};
     out.download(&p, sizeof p);
 

@@ -4,11 +4,14 @@
 #pragma once
 
 #include <memory>
+#include <string>
 
 #include <gtest/gtest.h>
 
 #include "render/renderer.h"
+#include "vk/commands.h"
 #include "vk/context.h"
+#include "vk/kernel.h"
 
 namespace gdpt::test {
 
@@ -29,6 +32,13 @@ protected:
             << "Vulkan validation reported errors during this test";
     }
     static vk::Context& ctx() { return gpuContext(); }
+    // Runs one workgroup of `kernel` (bound already) and waits for it (probe kernels).
+    static void dispatchOnce(vk::Kernel& kernel, const std::string& what) {
+        vk::CommandStream cmd(ctx(), what);
+        kernel.dispatch(cmd.begin(), 1, 1, 1);
+        vk::computeBarrier(cmd.cmd());
+        cmd.submitAndWait();
+    }
     // The render settings every GPU test starts from: size, samples, seed, no progress output.
     static RenderOptions renderOptions(int w, int h, std::uint32_t spp, std::uint32_t seed) {
         RenderOptions o;
