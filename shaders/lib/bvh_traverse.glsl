@@ -258,6 +258,61 @@ GDPT_NAMESPACE_END
 #define GDPT_ANYHIT_FILTER(tri, u, v) true
 #endif
 
+// The traversal stack. lavapipe keeps an array indexed by a per-lane size in scratch memory
+// and reads and writes it lane by lane. A tree whose traversals never hold more than 8 or 16
+// entries (WideBvh::maxStack, known before the pipelines are created for small scenes:
+// SceneSpec) is traversed with the stack in two or four uvec4 / vec4 pairs instead, the
+// newest entry in .x of the first, shifted on push and pop, which stay in registers
+// (bench/RESULTS.md). The same entries in the same order either way, so the same hits.
+// kBvhRegisterStack = 0 (the host's default): the array.
+layout(constant_id = kSpecBvhRegisterStack) const uint kBvhRegisterStack = 0u;
+
+#define GDPT_BVH_STACK_DECLARE()                                  \
+    uint stackNode[kBvhWideStackSize];                            \
+    float stackNear[kBvhWideStackSize];                           \
+    uvec4 regNode0 = uvec4(0u), regNode1 = uvec4(0u);             \
+    uvec4 regNode2 = uvec4(0u), regNode3 = uvec4(0u);             \
+    vec4 regNear0 = vec4(0.0f), regNear1 = vec4(0.0f);            \
+    vec4 regNear2 = vec4(0.0f), regNear3 = vec4(0.0f);            \
+    uint stackSize = 0u
+
+// With 8 entries the upper pairs are never written, so they stay zero (constants).
+#define GDPT_BVH_STACK_PUSH(c, t)                                 \
+    if (kBvhRegisterStack > 0u) {                                 \
+        if (kBvhRegisterStack > 8u) {                             \
+            regNode3 = uvec4(regNode2.w, regNode3.xyz);           \
+            regNear3 = vec4(regNear2.w, regNear3.xyz);            \
+            regNode2 = uvec4(regNode1.w, regNode2.xyz);           \
+            regNear2 = vec4(regNear1.w, regNear2.xyz);            \
+        }                                                         \
+        regNode1 = uvec4(regNode0.w, regNode1.xyz);               \
+        regNear1 = vec4(regNear0.w, regNear1.xyz);                \
+        regNode0 = uvec4((c), regNode0.xyz);                      \
+        regNear0 = vec4((t), regNear0.xyz);                       \
+    } else {                                                      \
+        stackNode[stackSize] = (c);                               \
+        stackNear[stackSize] = (t);                               \
+    }                                                             \
+    ++stackSize
+
+#define GDPT_BVH_STACK_POP(c, t)                                  \
+    --stackSize;                                                  \
+    if (kBvhRegisterStack > 0u) {                                 \
+        (c) = regNode0.x;                                         \
+        (t) = regNear0.x;                                         \
+        regNode0 = uvec4(regNode0.yzw, regNode1.x);               \
+        regNear0 = vec4(regNear0.yzw, regNear1.x);                \
+        regNode1 = uvec4(regNode1.yzw, regNode2.x);               \
+        regNear1 = vec4(regNear1.yzw, regNear2.x);                \
+        regNode2 = uvec4(regNode2.yzw, regNode3.x);               \
+        regNear2 = vec4(regNear2.yzw, regNear3.x);                \
+        regNode3 = uvec4(regNode3.yzw, 0u);                       \
+        regNear3 = vec4(regNear3.yzw, 0.0f);                      \
+    } else {                                                      \
+        (c) = stackNode[stackSize];                               \
+        (t) = stackNear[stackSize];                               \
+    }
+
 // Triangle `tri` (TriangleGeom order) against the ray; see intersectTriangleGeom.
 bool intersectTriangle(vec3 orig, vec3 dir, uint tri, float tMin, inout float tMax, out float u,
                        out float v) {
@@ -273,9 +328,7 @@ bool intersectTriangle(vec3 orig, vec3 dir, uint tri, float tMin, inout float tM
 Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
     Hit hit = missHit(tMax);
     vec3 invDir = bvhSafeInverse(dir);
-    uint stackNode[kBvhWideStackSize];
-    float stackNear[kBvhWideStackSize];
-    uint stackSize = 0u;
+    GDPT_BVH_STACK_DECLARE();
     uint node = 0u;
     while (true) {
         BvhWideNode n = bvhNode(node);
@@ -301,23 +354,19 @@ Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
         WideOrder o = wideSortInner(n, count, h, tNear, hit.t);
         uint next = o.child.x;
         if (o.child.w != kInvalidIndex) {
-            stackNode[stackSize] = o.child.w;
-            stackNear[stackSize] = o.t.w;
-            ++stackSize;
+            GDPT_BVH_STACK_PUSH(o.child.w, o.t.w);
         }
         if (o.child.z != kInvalidIndex) {
-            stackNode[stackSize] = o.child.z;
-            stackNear[stackSize] = o.t.z;
-            ++stackSize;
+            GDPT_BVH_STACK_PUSH(o.child.z, o.t.z);
         }
         if (o.child.y != kInvalidIndex) {
-            stackNode[stackSize] = o.child.y;
-            stackNear[stackSize] = o.t.y;
-            ++stackSize;
+            GDPT_BVH_STACK_PUSH(o.child.y, o.t.y);
         }
         while (next == kInvalidIndex && stackSize > 0u) {
-            --stackSize;
-            if (stackNear[stackSize] <= hit.t) next = stackNode[stackSize];
+            uint popped;
+            float poppedNear;
+            GDPT_BVH_STACK_POP(popped, poppedNear);
+            if (poppedNear <= hit.t) next = popped;
         }
         if (next == kInvalidIndex) break;
         node = next;
@@ -329,8 +378,7 @@ Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
 // without the shrinking tMax and the ordering (order does not change the answer).
 bool traceAny(vec3 orig, vec3 dir, float tMin, float tMax) {
     vec3 invDir = bvhSafeInverse(dir);
-    uint stackNode[kBvhWideStackSize];
-    uint stackSize = 0u;
+    GDPT_BVH_STACK_DECLARE();
     uint node = 0u;
     while (true) {
         BvhWideNode n = bvhNode(node);
@@ -352,14 +400,13 @@ bool traceAny(vec3 orig, vec3 dir, float tMin, float tMax) {
             if (next == kInvalidIndex) {
                 next = n.child[j];
             } else {
-                stackNode[stackSize] = n.child[j];
-                ++stackSize;
+                GDPT_BVH_STACK_PUSH(n.child[j], 0.0f);
             }
         }
         if (next == kInvalidIndex) {
             if (stackSize == 0u) break;
-            --stackSize;
-            next = stackNode[stackSize];
+            float unusedNear;
+            GDPT_BVH_STACK_POP(next, unusedNear);
         }
         node = next;
     }

@@ -41,6 +41,9 @@ GDPT_CONST uint kBvhMaxDepth = 60u;       // builder never exceeds this depth
 // Traversal stack of the wide tree: nodes waiting to be visited (collapseToWide checks that
 // its tree never needs more).
 GDPT_CONST uint kBvhWideStackSize = 128u;
+// The register traversal stack (kSpecBvhRegisterStack = its entries, 8 or 16): trees whose
+// maxStack is at most that traverse with the stack in vector variables instead of an array.
+GDPT_CONST uint kBvhRegisterStackMax = 16u;
 GDPT_CONST uint kMaxLeafTriangles = 255u; // leaf primitive count must fit in this
 
 // ---------------------------------------------------------------------------------------------
@@ -305,7 +308,8 @@ GDPT_ENUM_BEGIN(SpecId)
     kSpecPoissonFlags = 9u,  // poisson_*.comp: the kPoissonFlag* bits of this pipeline variant
     kSpecVisibleEmission = 10u,  // path kernels: emitter-silhouette supersampling is on (visible_emission.glsl)
     kSpecHasShadingNormals = 11u,  // some triangle carries kTriFlagHasNormals (features.h)
-    kSpecHasSpecularLobe = 12u  // some material has a metal/dielectric lobe (features.h hasSpecularLayer)
+    kSpecHasSpecularLobe = 12u,  // some material has a metal/dielectric lobe (features.h hasSpecularLayer)
+    kSpecBvhRegisterStack = 13u  // entries of the register traversal stack (8, 16), 0 = in memory (bvh_traverse.glsl)
 GDPT_ENUM_END();
 
 // A ray of the BVH tests (tests/gpu/test_bvh_gpu.cpp). 32 bytes.

@@ -278,6 +278,7 @@ int runRender(const RenderArgs& args) {
                   {"partial_pass_rows", s.partialPassRows},
                   {"seed", args.seed},
                   {"batches", s.batches},
+                  {"bvh_register_stack", s.bvhRegisterStack},
                   {"time_s", {{"total", seconds},
                               {"bvh_build", s.bvhBuildMs * 1e-3},
                               {"upload", s.uploadMs * 1e-3},
@@ -339,16 +340,27 @@ int runInfo(const InfoArgs& args) {
     // table's, without emitters of zero area or power); a scene without triangles has none.
     SceneGpuOptions so;
     so.envRadiance = parseColor(args.env, "--env");
-    const SceneFeatures f =
-        scene.triangles.empty() ? analyzeScene(scene, so.envRadiance) : SceneSpec(scene, so).features();
+    std::unique_ptr<const SceneSpec> spec;
+    if (!scene.triangles.empty()) spec = std::make_unique<const SceneSpec>(scene, so);
+    const SceneFeatures f = spec ? spec->features() : analyzeScene(scene, so.envRadiance);
     std::printf("%s\n", describeScene(scene).c_str());
     for (const auto& [k, v] : describeFeatures(f)) std::printf("  %-26s %s\n", k.c_str(), v.c_str());
+    // bvhRegisterStack: entries of the register traversal stack when the tree was built before
+    // the pipelines (small scenes) and its traversals hold at most kBvhRegisterStackMax
+    // (bvh_traverse.glsl); 0 = the stack in memory.
+    if (spec && spec->bvh())
+        std::printf("  %-26s %u (register stack up to %u)\n", "bvh traversal stack", spec->bvh()->wide.maxStack,
+                    gpu::kBvhRegisterStackMax);
+    else
+        std::printf("  %-26s built with the scene upload (more than %zu triangles)\n", "bvh traversal stack",
+                    kSpecBvhTriangles);
     // visibleEmission: emitter-silhouette supersampling (render/visible_pass.h) at the default
     // factor, which needs something the camera can see emit.
     std::printf("kernel variant: pt[textures=%d punctual=%d lightTris=%d env=%d glossy=%d alphaMask=%d "
-                "shadingNormals=%d specularLobe=%d visibleEmission=%d]\n",
+                "shadingNormals=%d specularLobe=%d visibleEmission=%d bvhRegisterStack=%u]\n",
                 f.hasTextures, f.hasPunctual, f.hasLightTris, f.hasEnv, f.hasGlossy, f.hasAlphaMask,
-                f.hasShadingNormals, f.hasSpecularLayer, visibleEmissionPossible(f));
+                f.hasShadingNormals, f.hasSpecularLayer, visibleEmissionPossible(f),
+                spec ? spec->bvhRegisterStack() : 0u);
     for (const auto& u : scene.unsupported) std::printf("  unsupported: %s\n", u.c_str());
     return 0;
 }

@@ -9,7 +9,6 @@
 #include "bvh/wide_bvh.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
-#include "util/timer.h"
 #include "vk/context.h"
 #include "vk/kernel.h"
 
@@ -84,12 +83,16 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     if (scene.triangles.empty()) throw Error("scene has no triangles to render");
     if (options.width < 1 || options.height < 1) throw Error("image size must be at least 1x1");
 
-    // BVH over the world-space triangles; everything per-triangle is laid out in leaf order.
-    Timer timer;
-    const Bvh bvh = buildBvh(scene.positions, scene.triangles);
-    bvhInfo_.buildMs = timer.ms();
+    // BVH over the world-space triangles (the spec's, for a small scene); everything
+    // per-triangle is laid out in leaf order.
+    std::shared_ptr<const SceneBvh> built = spec_.bvh();
+    if (!built) built = std::make_shared<const SceneBvh>(buildSceneBvh(scene));
+    const Bvh& bvh = built->binary;
+    bvhInfo_.buildMs = built->buildMs;
     bvhInfo_.nodes = static_cast<std::uint32_t>(bvh.nodes.size());
     bvhInfo_.maxDepth = bvh.stats.maxDepth;
+    bvhInfo_.maxStack = built->wide.maxStack;
+    bvhInfo_.registerStack = spec_.bvhRegisterStack();
     std::vector<gpu::TriangleGeom> geoms = makeTriangleGeoms(scene.positions, scene.triangles, bvh.triangleOrder);
     std::vector<gpu::TriangleShading> shading = makeShading(scene, bvh.triangleOrder);
 
@@ -154,7 +157,7 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
 
     triGeom_ = makeBuffer(ctx, geoms, "triangle geometry", gpu::kBindTriGeom);
     triShading_ = makeBuffer(ctx, shading, "triangle shading", gpu::kBindTriShading);
-    bvh_ = makeBuffer(ctx, collapseToWide(bvh.nodes).nodes, "BVH nodes (4-wide)", gpu::kBindBvh);
+    bvh_ = makeBuffer(ctx, built->wide.nodes, "BVH nodes (4-wide)", gpu::kBindBvh);
     materials_ = makeBuffer(ctx, scene.materials, "materials", gpu::kBindMaterials);
     texInfo_ = makeBuffer(ctx, texInfo, "texture table", gpu::kBindTexInfo);
     texels_ = makeBuffer(ctx, texels, "texels", gpu::kBindTexels);

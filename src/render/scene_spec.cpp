@@ -3,8 +3,18 @@
 #include <algorithm>
 
 #include "util/error.h"
+#include "util/timer.h"
 
 namespace gdpt {
+
+SceneBvh buildSceneBvh(const Scene& scene) {
+    Timer timer;
+    SceneBvh out;
+    out.binary = buildBvh(scene.positions, scene.triangles);
+    out.wide = collapseToWide(out.binary.nodes);
+    out.buildMs = timer.ms();
+    return out;
+}
 
 SceneSpec::SceneSpec(const Scene& scene, const SceneGpuOptions& options)
     : features_(analyzeScene(scene, options.envRadiance, options.shiftThreshold)),
@@ -22,6 +32,13 @@ SceneSpec::SceneSpec(const Scene& scene, const SceneGpuOptions& options)
         if (emitterPower(scene, t, triangleArea(scene, t)) > 0.0) ++lights;
     features_.emissiveTriangles = lights;
     features_.hasLightTris = lights > 0;
+    if (scene.triangles.size() <= kSpecBvhTriangles) bvh_ = std::make_shared<const SceneBvh>(buildSceneBvh(scene));
+}
+
+std::uint32_t SceneSpec::bvhRegisterStack() const {
+    if (!bvh_ || bvh_->wide.maxStack > gpu::kBvhRegisterStackMax) return 0;
+    if (genericFeatures_ & (1u << gpu::kSpecBvhRegisterStack)) return 0;
+    return bvh_->wide.maxStack <= 8 ? 8u : gpu::kBvhRegisterStackMax;
 }
 
 std::vector<std::uint32_t> SceneSpec::sceneBindings() {
@@ -59,9 +76,14 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> SceneSpec::specConstants() 
         {gpu::kSpecHasAlphaMask, b(features_.hasAlphaMask)},
         {gpu::kSpecHasShadingNormals, b(features_.hasShadingNormals)},
         {gpu::kSpecHasSpecularLobe, b(features_.hasSpecularLayer)},
-        {gpu::kSpecMaxDepth, maxDepthSpec_}};
+        {gpu::kSpecMaxDepth, maxDepthSpec_},
+        {gpu::kSpecBvhRegisterStack, bvhRegisterStack()}};
+    // The generic kernel: every feature compiled in, 1024 bounces, the stack in memory.
+    const auto generic = [](std::uint32_t id) {
+        return id == gpu::kSpecMaxDepth ? 1024u : id == gpu::kSpecBvhRegisterStack ? 0u : 1u;
+    };
     for (auto& [id, value] : spec)
-        if (genericFeatures_ & (1u << id)) value = id == gpu::kSpecMaxDepth ? 1024u : 1u;
+        if (genericFeatures_ & (1u << id)) value = generic(id);
     return spec;
 }
 

@@ -1,15 +1,21 @@
 // scene_spec.h — what the scene kernels are compiled for: the scene's features (features.h)
 // as specialisation constants, and the descriptor of a kernel that reads the scene buffers.
-// It needs no BVH and no device memory, so a pass can start creating its pipelines
-// (vk::PipelineCreation::Background) before SceneGpu builds and uploads the scene.
+// It needs no device memory, so a pass can start creating its pipelines
+// (vk::PipelineCreation::Background) before SceneGpu uploads the scene. A small scene's BVH
+// (at most kSpecBvhTriangles triangles: well under a millisecond to build) is built here, so
+// that the kernels can be specialised to its tree (the register traversal stack); a larger
+// one is built by SceneGpu while the pipelines are created.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
 
+#include "bvh/builder.h"
+#include "bvh/wide_bvh.h"
 #include "gdpt_shared.h"
 #include "render/features.h"
 #include "scene/scene.h"
@@ -32,10 +38,24 @@ struct SceneGpuOptions {
     int camera = -1;  // index into Scene::cameras; -1 = first, or a framing default
     float shiftThreshold = 0.001f;
     // Bits (1u << kSpec*) of scene features to compile in whatever the scene needs (the
-    // generic kernel; kSpecMaxDepth: the 1024-bounce cap). For `gdpt bench-features`, which
+    // generic kernel; kSpecMaxDepth: the 1024-bounce cap; kSpecBvhRegisterStack: the stack
+    // in memory, which every tree fits). For `gdpt bench-features`, which
     // measures what each specialisation saves; renders leave it 0.
     std::uint32_t genericFeatures = 0;
 };
+
+// The scene's BVH: the binary tree (its triangle order lays out every per-triangle table)
+// and the four-wide tree the kernels traverse.
+struct SceneBvh {
+    Bvh binary;
+    WideBvh wide;
+    double buildMs = 0.0;  // both trees
+};
+SceneBvh buildSceneBvh(const Scene& scene);
+
+// Scenes up to this many triangles have their BVH built by SceneSpec (cbox's 36 take 0.08 ms;
+// trees much larger than this need more than kBvhRegisterStackSize stack entries anyway).
+inline constexpr std::size_t kSpecBvhTriangles = 4096;
 
 class SceneSpec {
 public:
@@ -46,6 +66,12 @@ public:
     [[nodiscard]] const SceneFeatures& features() const { return features_; }
     [[nodiscard]] std::uint32_t width() const { return width_; }
     [[nodiscard]] std::uint32_t height() const { return height_; }
+    // The BVH built with the spec (small scenes), or null: SceneGpu builds it.
+    [[nodiscard]] const std::shared_ptr<const SceneBvh>& bvh() const { return bvh_; }
+    // Entries of the register traversal stack the kernels use (kSpecBvhRegisterStack: 8 or
+    // 16, the fewest that hold the tree's maxStack), or 0: the stack in memory (the tree is
+    // not known yet, or needs more than kBvhRegisterStackMax; or the generic kernel).
+    [[nodiscard]] std::uint32_t bvhRegisterStack() const;
     // Specialisation constants for the scene features (ids from gdpt_shared.h).
     [[nodiscard]] std::vector<std::pair<std::uint32_t, std::uint32_t>> specConstants() const;
     // The bindings of the scene (kBindTriGeom..kBindSceneConst).
@@ -66,6 +92,7 @@ private:
     std::uint32_t width_ = 0, height_ = 0;
     std::uint32_t maxDepthSpec_ = 1024;
     std::uint32_t genericFeatures_ = 0;
+    std::shared_ptr<const SceneBvh> bvh_;
 };
 
 }  // namespace gdpt

@@ -2,7 +2,8 @@
 // triangles on the CPU, for 10^5 seeded random rays per scene, on scenes that stress it:
 // a random soup, a grid of coplanar and duplicated triangles, and degenerate slivers.
 // Closest hit: the same triangle, or (for coplanar/duplicate ties) the same t; t within a
-// few ulps. Any hit: identical answers.
+// few ulps. Any hit: identical answers. The same with the stack in registers
+// (kSpecBvhRegisterStack, 8 and 16 entries) on trees that need exactly that many.
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -32,9 +33,10 @@ struct Soup {
     }
 };
 
-Soup randomSoup(std::uint32_t count, std::uint32_t seed) {
+// `count` triangles with vertices within `extent` of centres uniform in [-1, 1]^3.
+Soup randomSoup(std::uint32_t count, std::uint32_t seed, float extent = 0.1f) {
     std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> pos(-1.0f, 1.0f), size(-0.1f, 0.1f);
+    std::uniform_real_distribution<float> pos(-1.0f, 1.0f), size(-extent, extent);
     Soup s;
     for (std::uint32_t i = 0; i < count; ++i) {
         const glm::vec3 c(pos(rng), pos(rng), pos(rng));
@@ -99,11 +101,12 @@ bool withinUlps(float a, float b, int ulps) {
 
 class BvhGpu : public test::GpuTest {
 protected:
+    // registerStack: kSpecBvhRegisterStack (0 = the stack in memory); the tree must fit it.
     void check(const Soup& soup, std::uint32_t seed,
-               vk::PipelineCreation creation = vk::PipelineCreation::Now) {
+               vk::PipelineCreation creation = vk::PipelineCreation::Now, std::uint32_t registerStack = 0,
+               std::uint32_t rayCount = 100000) {
         const Bvh bvh = buildBvh(soup.positions, soup.triangles);
         const auto geoms = makeTriangleGeoms(soup.positions, soup.triangles, bvh.triangleOrder);
-        const std::uint32_t rayCount = 100000;
         const auto rays = randomRays(rayCount, seed);
 
         vk::KernelDesc desc = vk::kernelDesc("trace_rays", GDPT_KERNEL_SPIRV(trace_rays));
@@ -112,9 +115,13 @@ protected:
         desc.texelBindings = SceneSpec::geometryTexelBindings();
         desc.pushConstantBytes = sizeof(std::uint32_t);
         desc.localSizeX = 64;
+        const WideBvh wide = collapseToWide(bvh.nodes);
+        if (registerStack != 0) {
+            ASSERT_LE(wide.maxStack, registerStack) << "the tree does not fit the register stack";
+            desc.specConstants = {{gpu::kSpecBvhRegisterStack, registerStack}};
+        }
         vk::Kernel kernel(ctx(), desc, creation);
         vk::Buffer geomBuf(ctx(), geoms.size() * sizeof(gpu::TriangleGeom), "geoms");
-        const WideBvh wide = collapseToWide(bvh.nodes);
         vk::Buffer nodeBuf(ctx(), wide.nodes.size() * sizeof(gpu::BvhWideNode), "nodes");
         vk::Buffer rayBuf(ctx(), rays.size() * sizeof(gpu::TestRay), "rays");
         vk::Buffer hitBuf(ctx(), rays.size() * sizeof(glm::vec4), "hits");
@@ -181,6 +188,25 @@ TEST_F(BvhGpu, UnusedBackgroundPipelineIsDestroyed) {
     EXPECT_EQ(waited.wait(), 0.0);  // already there: no second wait
 }
 TEST_F(BvhGpu, DegenerateTrianglesMatchBruteForce) { check(degenerate(9), 13); }
+
+// The register stacks at their capacity: a soup whose tree needs exactly 8 (16) entries,
+// the most each holds, so the deepest entries are pushed and popped too (larger triangles
+// than randomSoup's default, so that a tenth of the rays hit so few). 20,000 rays each.
+Soup soupNeedingStack(std::uint32_t entries) {
+    for (std::uint32_t n = 16; n <= 4096; n += 8) {
+        Soup s = randomSoup(n, 7, 0.4f);
+        const Bvh bvh = buildBvh(s.positions, s.triangles);
+        if (collapseToWide(bvh.nodes).maxStack == entries) return s;
+    }
+    ADD_FAILURE() << "no random soup of up to 4096 triangles needs exactly " << entries << " stack entries";
+    return {};
+}
+TEST_F(BvhGpu, RegisterStackOfEightMatchesBruteForce) {
+    check(soupNeedingStack(8), 21, vk::PipelineCreation::Now, 8, 20000);
+}
+TEST_F(BvhGpu, RegisterStackOfSixteenMatchesBruteForce) {
+    check(soupNeedingStack(16), 22, vk::PipelineCreation::Now, 16, 20000);
+}
 
 }  // namespace
 }  // namespace gdpt

@@ -1,7 +1,9 @@
 // test_scene_features.cpp — which triangles need their vertex normals (features.h): the rule
 // that lets flat-shaded scenes compile the shading-normal interpolation out of the kernels
 // (kSpecHasShadingNormals), and that it changes no image; the same for the specular lobe
-// (kSpecHasSpecularLobe: a scene of Lambertian materials compiles the GGX code out).
+// (kSpecHasSpecularLobe: a scene of Lambertian materials compiles the GGX code out), and for
+// the register traversal stack (kSpecBvhRegisterStack, chosen from the tree SceneSpec builds
+// for a small scene).
 #include <gtest/gtest.h>
 
 #include "gpu_fixture.h"
@@ -9,6 +11,7 @@
 #include "render/features.h"
 #include "render/gpt_renderer.h"
 #include "render/renderer.h"
+#include "render/scene_spec.h"
 #include "scene/gltf_loader.h"
 #include "scene/procedural.h"
 
@@ -78,6 +81,50 @@ TEST_F(SpecularLobeSpecialisation, LambertianSceneSameImageEitherWay) {
     o.scene.genericFeatures = 1u << gpu::kSpecHasSpecularLobe;
     test::expectSameBits(pt, renderPt(ctx(), scene, o).image, "pt");
     test::expectSameGptBits(gpt, renderGpt(ctx(), scene, o), "gpt");
+}
+
+// The stack the spec picks: the fewest register entries (8, 16) that hold the tree's
+// maxStack, and the stack in memory for a tree that needs more or a scene too large to be
+// built before the pipelines.
+TEST(BvhRegisterStack, SpecPicksTheSmallestStackThatHoldsTheTree) {
+    const auto registerStack = [](const SceneSpec& spec) {
+        for (const auto& [id, value] : spec.specConstants())
+            if (id == gpu::kSpecBvhRegisterStack) return value;
+        ADD_FAILURE() << "no kSpecBvhRegisterStack constant";
+        return 99u;
+    };
+    SceneGpuOptions o;
+    for (const char* name : {"cornell_box", "indirect_gap", "glossy_cornell", "furnace"}) {
+        const SceneSpec spec(loadGltf(std::string(GDPT_SOURCE_DIR "/scenes/") + name + ".gltf"), o);
+        ASSERT_TRUE(spec.bvh()) << name;
+        const std::uint32_t need = spec.bvh()->wide.maxStack;
+        const std::uint32_t expected = need <= 8 ? 8u : need <= 16 ? 16u : 0u;
+        EXPECT_EQ(registerStack(spec), expected) << name << " needs " << need;
+    }
+    const SceneSpec large(makeTriangleScene(10000, 1), o);
+    EXPECT_FALSE(large.bvh()) << "built with the upload, after the pipelines";
+    EXPECT_EQ(registerStack(large), 0u);
+    o.genericFeatures = 1u << gpu::kSpecBvhRegisterStack;
+    EXPECT_EQ(registerStack(SceneSpec(makeCornellBox(), o)), 0u) << "the generic kernel keeps it in memory";
+}
+
+class BvhRegisterStackSpecialisation : public test::GpuTest {};
+
+// The same bits, PT and G-PT, with the stack in registers and in memory: cornell_box's tree
+// takes the 8-entry stack, glossy_cornell's the 16-entry one.
+TEST_F(BvhRegisterStackSpecialisation, SameImageEitherWay) {
+    for (const char* name : {"cornell_box", "glossy_cornell"}) {
+        const Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR "/scenes/") + name + ".gltf");
+        RenderOptions o = renderOptions(32, 32, 4, 3);
+        const RenderResult pt = renderPt(ctx(), scene, o);
+        const RenderResultGpt gpt = renderGpt(ctx(), scene, o);
+        EXPECT_NE(pt.stats.bvhRegisterStack, 0u) << name;
+        o.scene.genericFeatures = 1u << gpu::kSpecBvhRegisterStack;
+        const RenderResult ptMemory = renderPt(ctx(), scene, o);
+        EXPECT_EQ(ptMemory.stats.bvhRegisterStack, 0u);
+        test::expectSameBits(pt.image, ptMemory.image, std::string(name) + " pt");
+        test::expectSameGptBits(gpt, renderGpt(ctx(), scene, o), std::string(name) + " gpt");
+    }
 }
 
 }  // namespace
