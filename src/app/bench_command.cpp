@@ -77,8 +77,10 @@ int runBench(const BenchArgs& a) {
         so.width = a.width;
         so.height = a.height;
         std::vector<double> primary, incoherent, primaryCpu, incoherentCpu;
+        std::uint32_t registerStack = 0;
         {
             SceneGpu sceneGpu(ctx, scene, so);
+            registerStack = sceneGpu.bvhInfo().registerStack;
             BenchRaysPass pass(ctx, sceneGpu, wg);
             pass.run(1, false, 99);  // warm-up: pipeline compilation happens lazily on some drivers
             for (int r = 0; r < a.repeats; ++r) {
@@ -114,6 +116,7 @@ int runBench(const BenchArgs& a) {
         out["scenes"].push_back({{"scene", name},
                                  {"triangles", scene.triangles.size()},
                                  {"bvh_build_ms", median(buildMs)},
+                                 {"bvh_register_stack", registerStack},
                                  {"primary_rays_per_s", median(primary)},
                                  {"incoherent_rays_per_s", median(incoherent)},
                                  {"primary_rays_per_cpu_s", median(primaryCpu)},

@@ -45,6 +45,8 @@ struct Feature {
 // kHasGlossy only exists in the G-PT kernel (the half-vector shift); PT compiles the same
 // code either way, so it is never "lacking" there. kMaxDepth is always specialised (the
 // scene's own depth cap), so its generic variant is the 1024-bounce loop bound.
+// memory_stack: the traversal stack in memory instead of registers (kSpecBvhRegisterStack;
+// where the scene's tree is too large for the register stack, the same kernel).
 const Feature kFeatures[] = {
     {"textures", gpu::kSpecHasTextures, [](const SceneFeatures& f, bool) { return f.hasTextures; }},
     {"punctual", gpu::kSpecHasPunctual, [](const SceneFeatures& f, bool) { return f.hasPunctual; }},
@@ -55,6 +57,7 @@ const Feature kFeatures[] = {
     {"shading_normals", gpu::kSpecHasShadingNormals, [](const SceneFeatures& f, bool) { return f.hasShadingNormals; }},
     {"specular_lobe", gpu::kSpecHasSpecularLobe, [](const SceneFeatures& f, bool) { return f.hasSpecularLayer; }},
     {"max_depth", gpu::kSpecMaxDepth, [](const SceneFeatures&, bool) { return false; }},
+    {"memory_stack", gpu::kSpecBvhRegisterStack, [](const SceneFeatures&, bool) { return false; }},
 };
 
 struct Variant {
