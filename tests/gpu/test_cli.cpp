@@ -81,6 +81,7 @@ TEST_F(Cli, SmallValidatedRenderWritesExrPngAndJson) {
     EXPECT_EQ(j["validation_errors"].get<int>(), 0);
     EXPECT_GT(j["rays_traced"].get<double>(), 0.0);
     EXPECT_TRUE(j["kernels"].contains("pt"));
+    EXPECT_EQ(j["bvh_register_stack"].get<int>(), 8) << "cornell_box's tree needs 4 stack entries";
     EXPECT_NE(r.output.find("pt"), std::string::npos) << "--profile prints the kernel table";
     // The wait for the background-created pipelines is part of the set-up it reports.
     const auto& t = j["time_s"];
@@ -133,6 +134,20 @@ TEST_F(Cli, TimedGptRenderReservesTheRememberedReconstructionTime) {
 // A 4096x4096 render: on a device whose maxStorageBufferRange cannot hold its per-pixel
 // statistics (lavapipe: 128 MiB < 512 MiB) it is refused with one line naming the limit and
 // leaves no file behind; on a device that can, it renders a finite image.
+// `gdpt info` names the scene's features and the kernel variant it selects, including the
+// traversal stack: cornell_box's 36-triangle tree needs 4 entries (register stack of 8);
+// the procedural furnace sphere's 1280 triangles need 13 (register stack of 16).
+TEST_F(Cli, InfoPrintsTheFeaturesAndTheKernelVariant) {
+    const RunResult box = run("info " + kScene);
+    ASSERT_EQ(box.code, 0) << box.output;
+    EXPECT_NE(box.output.find("36 triangles"), std::string::npos) << box.output;
+    EXPECT_NE(box.output.find("textures=0"), std::string::npos) << box.output;
+    EXPECT_NE(box.output.find("bvhRegisterStack=8]"), std::string::npos) << box.output;
+    const RunResult furnace = run("info " + std::string(GDPT_SOURCE_DIR) + "/scenes/furnace.gltf");
+    ASSERT_EQ(furnace.code, 0) << furnace.output;
+    EXPECT_NE(furnace.output.find("bvhRegisterStack=16]"), std::string::npos) << furnace.output;
+}
+
 TEST_F(Cli, HugeImageRendersOrIsRefusedNamingTheDeviceLimit) {
     const std::string out = path("huge.exr");
     const RunResult r = run("render " + kScene + " --width 4096 --height 4096 --spp 1 --max-depth 1 --quiet -o " + out);
