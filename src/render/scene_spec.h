@@ -2,7 +2,7 @@
 // as specialisation constants, and the descriptor of a kernel that reads the scene buffers.
 // It needs no device memory, so a pass can start creating its pipelines
 // (vk::PipelineCreation::Background) before SceneGpu uploads the scene. A small scene's BVH
-// (at most kSpecBvhTriangles triangles: well under a millisecond to build) is built here, so
+// (at most kSpecBvhTriangles triangles: a few milliseconds at most) is built here, so
 // that the kernels can be specialised to its tree (the register traversal stack); a larger
 // one is built by SceneGpu while the pipelines are created.
 #pragma once
@@ -53,8 +53,9 @@ struct SceneBvh {
 };
 SceneBvh buildSceneBvh(const Scene& scene);
 
-// Scenes up to this many triangles have their BVH built by SceneSpec (cbox's 36 take 0.08 ms;
-// trees much larger than this need more than kBvhRegisterStackSize stack entries anyway).
+// Scenes up to this many triangles have their BVH built by SceneSpec, before the pipelines
+// (cbox's 36 take 0.08 ms, 5k triangles about 5 ms); larger trees need more than
+// kBvhRegisterStackMax stack entries anyway (a 5k-triangle soup of spheres needs 20).
 inline constexpr std::size_t kSpecBvhTriangles = 4096;
 
 class SceneSpec {
