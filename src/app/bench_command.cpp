@@ -80,7 +80,7 @@ int runBench(const BenchArgs& a) {
         std::uint32_t registerStack = 0;
         {
             SceneGpu sceneGpu(ctx, scene, so);
-            registerStack = sceneGpu.bvhInfo().registerStack;
+            registerStack = sceneGpu.spec().bvhRegisterStack();
             BenchRaysPass pass(ctx, sceneGpu, wg);
             pass.run(1, false, 99);  // warm-up: pipeline compilation happens lazily on some drivers
             for (int r = 0; r < a.repeats; ++r) {

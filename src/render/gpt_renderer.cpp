@@ -30,7 +30,7 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     SceneGpu sceneGpu(ctx, scene, options.scene, std::move(spec));
     pass.attach(sceneGpu);
     stats.bvhBuildMs = sceneGpu.bvhInfo().buildMs;
-    stats.bvhRegisterStack = sceneGpu.bvhInfo().registerStack;
+    stats.bvhRegisterStack = sceneGpu.spec().bvhRegisterStack();
     stats.features = sceneGpu.features();
     stats.gptSplitBounce = pass.splitBounceCompiled();
     if (options.whileCompiling) options.whileCompiling();

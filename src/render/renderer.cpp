@@ -23,7 +23,7 @@ RenderResult renderPt(const vk::Context& ctx, const Scene& scene, const RenderOp
     SceneGpu sceneGpu(ctx, scene, options.scene, std::move(spec));
     pass.attach(sceneGpu);
     stats.bvhBuildMs = sceneGpu.bvhInfo().buildMs;
-    stats.bvhRegisterStack = sceneGpu.bvhInfo().registerStack;
+    stats.bvhRegisterStack = sceneGpu.spec().bvhRegisterStack();
     stats.features = sceneGpu.features();
     std::unique_ptr<WavefrontPass> wavefront;
     if (options.schedule == Schedule::Wavefront)

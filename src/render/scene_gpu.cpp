@@ -91,8 +91,6 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     bvhInfo_.buildMs = built->buildMs;
     bvhInfo_.nodes = static_cast<std::uint32_t>(bvh.nodes.size());
     bvhInfo_.maxDepth = bvh.stats.maxDepth;
-    bvhInfo_.maxStack = built->wide.maxStack;
-    bvhInfo_.registerStack = spec_.bvhRegisterStack();
     std::vector<gpu::TriangleGeom> geoms = makeTriangleGeoms(scene.positions, scene.triangles, bvh.triangleOrder);
     std::vector<gpu::TriangleShading> shading = makeShading(scene, bvh.triangleOrder);
 

@@ -24,8 +24,6 @@ struct BvhBuildInfo {
     double buildMs = 0.0;
     std::uint32_t nodes = 0;
     std::uint32_t maxDepth = 0;
-    std::uint32_t maxStack = 0;   // of the four-wide tree (WideBvh::maxStack)
-    std::uint32_t registerStack = 0;  // the kernels' kSpecBvhRegisterStack (SceneSpec::bvhRegisterStack)
 };
 
 class SceneGpu {

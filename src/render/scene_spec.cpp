@@ -76,14 +76,12 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> SceneSpec::specConstants() 
         {gpu::kSpecHasAlphaMask, b(features_.hasAlphaMask)},
         {gpu::kSpecHasShadingNormals, b(features_.hasShadingNormals)},
         {gpu::kSpecHasSpecularLobe, b(features_.hasSpecularLayer)},
-        {gpu::kSpecMaxDepth, maxDepthSpec_},
-        {gpu::kSpecBvhRegisterStack, bvhRegisterStack()}};
-    // The generic kernel: every feature compiled in, 1024 bounces, the stack in memory.
-    const auto generic = [](std::uint32_t id) {
-        return id == gpu::kSpecMaxDepth ? 1024u : id == gpu::kSpecBvhRegisterStack ? 0u : 1u;
-    };
+        {gpu::kSpecMaxDepth, maxDepthSpec_}};
     for (auto& [id, value] : spec)
-        if (genericFeatures_ & (1u << id)) value = generic(id);
+        if (genericFeatures_ & (1u << id)) value = id == gpu::kSpecMaxDepth ? 1024u : 1u;
+    // Not a feature bit: bvhRegisterStack() is already 0 (the stack in memory) for the
+    // generic kernel.
+    spec.push_back({gpu::kSpecBvhRegisterStack, bvhRegisterStack()});
     return spec;
 }
 

@@ -131,9 +131,6 @@ TEST_F(Cli, TimedGptRenderReservesTheRememberedReconstructionTime) {
     EXPECT_NE(readJson(cached)[finishKey].get<double>(), 0.0625) << "the real finishing time replaces it";
 }
 
-// A 4096x4096 render: on a device whose maxStorageBufferRange cannot hold its per-pixel
-// statistics (lavapipe: 128 MiB < 512 MiB) it is refused with one line naming the limit and
-// leaves no file behind; on a device that can, it renders a finite image.
 // `gdpt info` names the scene's features and the kernel variant it selects, including the
 // traversal stack: cornell_box's 36-triangle tree needs 4 entries (register stack of 8);
 // the procedural furnace sphere's 1280 triangles need 13 (register stack of 16).
@@ -148,6 +145,9 @@ TEST_F(Cli, InfoPrintsTheFeaturesAndTheKernelVariant) {
     EXPECT_NE(furnace.output.find("bvhRegisterStack=16]"), std::string::npos) << furnace.output;
 }
 
+// A 4096x4096 render: on a device whose maxStorageBufferRange cannot hold its per-pixel
+// statistics (lavapipe: 128 MiB < 512 MiB) it is refused with one line naming the limit and
+// leaves no file behind; on a device that can, it renders a finite image.
 TEST_F(Cli, HugeImageRendersOrIsRefusedNamingTheDeviceLimit) {
     const std::string out = path("huge.exr");
     const RunResult r = run("render " + kScene + " --width 4096 --height 4096 --spp 1 --max-depth 1 --quiet -o " + out);
