@@ -49,6 +49,7 @@ layout(set = 0, binding = kBindGptGradient1, scalar) buffer Gradient1Buf { Pixel
 layout(set = 0, binding = kBindGptGradient2, scalar) buffer Gradient2Buf { PixelStats statGradient2[]; };
 layout(set = 0, binding = kBindGptGradient3, scalar) buffer Gradient3Buf { PixelStats statGradient3[]; };
 layout(set = 0, binding = kBindGptDirect, scalar) buffer DirectBuf { PixelStats statDirect[]; };
+layout(set = 0, binding = kBindGptEdgeList, scalar) readonly buffer EdgeListBuf { uint edgeList[]; };
 layout(push_constant, scalar) uniform Push { GptFrameParams frame; };
 
 #include "lib/scene_access.glsl"
@@ -150,6 +151,16 @@ void main() {
     uint x = gl_GlobalInvocationID.x;
     uint y = gl_GlobalInvocationID.y + frame.rowOffset;
     if (x >= scene.width || y >= scene.height || gl_GlobalInvocationID.y >= frame.rowCount) return;
+    if (frame.listCount > 0u) {
+        // Edge-list mode (EdgePass): (x, y) is entry y·width + x of the list of the pixels a
+        // geometric edge crosses; the host set sampleBase, samplesPerPixel and seed to their
+        // extra samples' own streams. Everything below is the same per-pixel estimator.
+        uint item = y * scene.width + x;
+        if (item >= frame.listCount) return;
+        uint listed = edgeList[item];
+        x = listed % scene.width;
+        y = listed / scene.width;
+    }
     uint pixel = y * scene.width + x;
 
     // 0 central, 1..4 neighbor_i, 5..8 gradient_i, 9 direct.

@@ -20,7 +20,7 @@ GDPT_CONST uint kGptLeft = 2u;
 GDPT_CONST uint kGptUp = 3u;
 GDPT_CONST uint kGptNumOffsets = 4u;
 
-// Per-batch push constants of gpt.comp and gpt_resolve.comp (<= 128 bytes). 32 bytes.
+// Per-batch push constants of gpt.comp and gpt_resolve.comp (<= 128 bytes). 36 bytes.
 struct GptFrameParams {
     uint sampleBase;       // index of the first sample of this batch (per pixel)
     uint samplesPerPixel;  // samples per pixel in this batch
@@ -31,6 +31,9 @@ struct GptFrameParams {
                            // vertex is glossy/specular (half-vector shift); reference 0.001
     uint width;            // image width in pixels (gpt_resolve.comp, which has no scene)
     uint height;           // image height in pixels
+    uint listCount;        // 0: the dispatch covers image rows; > 0: edge-list mode, the
+                           // dispatch's (x, row) is entry row·width + x of kBindGptEdgeList
+                           // (rowOffset/rowCount tile those virtual rows), listCount entries
 };
 
 // Resolved per-pixel output of gpt_resolve.comp (linear RGB radiance, W/(m^2 sr)). 96 bytes;
@@ -61,11 +64,14 @@ GDPT_ENUM_BEGIN(GptBinding)
     kBindGptGradient2 = 47u,
     kBindGptGradient3 = 48u,
     kBindGptDirect = 49u,     // very-direct emission (first hit seen from the camera)
-    kBindGptResolved = 50u    // GptResolved[] written by gpt_resolve.comp
+    kBindGptResolved = 50u,   // GptResolved[] written by gpt_resolve.comp
+    kBindGptEdgeMask = 51u,   // uint per pixel written by edge.comp: 1 = a geometric edge
+                              // crosses the pixel, else 0
+    kBindGptEdgeList = 52u    // uint pixel indices (y·width + x) of the edge pixels, ascending
 GDPT_ENUM_END();
 
 #ifdef __cplusplus
-static_assert(sizeof(GptFrameParams) == 32, "GptFrameParams layout");
+static_assert(sizeof(GptFrameParams) == 36, "GptFrameParams layout");
 static_assert(sizeof(GptResolved) == 96, "GptResolved layout (scalar)");
 static_assert(std::uint32_t{kBindGptCentral} > std::uint32_t{kBindTestOutput2},
               "G-PT bindings must not collide with gdpt_shared.h's");

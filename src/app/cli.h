@@ -7,6 +7,7 @@
 
 #include <glm/glm.hpp>
 
+#include "render/edge_options.h"
 #include "render/visible_options.h"
 
 namespace gdpt {
@@ -33,6 +34,7 @@ struct RenderArgs {
     float shiftThreshold = 0.001f;
     std::string splitBounce = "auto";  // G-PT: auto, on, off (GptPassOptions::SplitBounce)
     std::uint32_t emitterSupersampling = kDefaultVisibleSupersampling;  // render/visible_pass.h
+    std::uint32_t edgeSamples = kDefaultEdgeSamples;                    // G-PT: render/edge_pass.h
     std::string recon = "l1";
     double alpha = 0.2;
     double tolerance = 1e-4;

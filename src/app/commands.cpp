@@ -113,6 +113,7 @@ int runRender(const RenderArgs& args) {
     options.workgroup = parseWorkgroup(args.workgroup);
     options.schedule = args.schedule == "wavefront" ? Schedule::Wavefront : Schedule::Megakernel;
     options.visibleSupersampling = args.emitterSupersampling;
+    options.edgeSamples = args.edgeSamples;
 
     Scene scene = loadGltf(args.scene);
     if (!scene.unsupported.empty() && !args.quiet) {
@@ -260,9 +261,12 @@ int runRender(const RenderArgs& args) {
     if (args.profile) printProfile(s.kernels);
     if (!args.quiet)
         std::fprintf(stderr,
-                     "gdpt: wrote %s (%u spp%s, %.2f s total, BVH %.1f ms, sampling %.1f ms, %.2f Mrays/s, %.3f Msamples/s)\n",
+                     "gdpt: wrote %s (%u spp%s%s, %.2f s total, BVH %.1f ms, sampling %.1f ms, %.2f Mrays/s, %.3f Msamples/s)\n",
                      args.output.c_str(), s.spp,
                      s.partialPassRows ? (" + 1 in the top " + std::to_string(s.partialPassRows) + " rows").c_str() : "",
+                     s.edgePixels ? (", x" + std::to_string(1 + s.edgeSamples) + " in " + std::to_string(s.edgePixels) +
+                                     " edge pixels").c_str()
+                                  : "",
                      seconds, s.bvhBuildMs, s.samplingMs,
                      double(s.raysTraced) / (s.samplingMs * 1e-3) * 1e-6,
                      double(s.pathsCompleted) / (s.samplingMs * 1e-3) * 1e-6);
@@ -299,7 +303,10 @@ int runRender(const RenderArgs& args) {
                   {"samples_per_s", double(s.pathsCompleted) / (s.samplingMs * 1e-3)},
                   {"kernels", kernelJson(s.kernels, s.samplingMs)},
                   {"validation_errors", ctx.validationErrors()}};
-        if (args.method == "gpt") j["gpt_split_bounce"] = s.gptSplitBounce;
+        if (args.method == "gpt") {
+            j["gpt_split_bounce"] = s.gptSplitBounce;
+            j["edge_samples"] = {{"factor", s.edgeSamples}, {"pixels", s.edgePixels}};
+        }
         j["emitter_supersampling"] = {{"factor", s.visibleSupersampling},
                                       {"rays_per_sample", s.visibleRaysPerSample},
                                       {"pixels", s.visibleRefinedPixels}};
@@ -469,6 +476,14 @@ Subcommand addRenderCommand(CLI::App& app) {
                   "a G-PT image's error, since the reconstruction does not touch this term. 0 = off")
         ->capture_default_str()
         ->check(CLI::Range(0u, kMaxVisibleSupersampling));
+    r->add_option("--edge-samples", render.edgeSamples,
+                  "G-PT: extra camera samples per camera sample in the pixels that a geometric edge "
+                  "crosses (a silhouette, a crease, a change of material; found once by a 4-ray probe "
+                  "per pixel at fixed positions, so unbiased). Their pixel-coverage noise is in the "
+                  "gradients too, so the reconstruction cannot remove it and they hold most of a G-PT "
+                  "image's error. 0 = off")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, kMaxEdgeSamples));
     r->add_option("--workgroup", render.workgroup, "Compute workgroup size WxH")->capture_default_str();
     r->add_option("--schedule", render.schedule,
                   "Kernel schedule: megakernel (one kernel per path batch) or wavefront (kernel per bounce stage)")

@@ -50,6 +50,7 @@ struct ConvergeArgs {
     std::string device;
     bool validate = false;
     std::uint32_t emitterSupersampling = kDefaultVisibleSupersampling;
+    std::uint32_t edgeSamples = kDefaultEdgeSamples;
 };
 
 // FNV-1a of the scene file's bytes and the render settings: the cache key of a made reference.
@@ -91,6 +92,7 @@ public:
         o.seed = seed;
         o.quiet = true;
         o.visibleSupersampling = a_.emitterSupersampling;
+        o.edgeSamples = a_.edgeSamples;
         // The reconstruction reserve is measured (once per method) before the clock starts:
         // it is calibration, not part of the run.
         const SolveOptions so = method == "pt" ? SolveOptions{} : solveOptions(method);
@@ -135,6 +137,7 @@ public:
         o.spp = 1;
         o.quiet = true;
         o.visibleSupersampling = a_.emitterSupersampling;
+        o.edgeSamples = a_.edgeSamples;
         if (method == "pt")
             (void)renderPt(ctx_, scene_, o);
         else
@@ -401,6 +404,11 @@ Subcommand addConvergeCommand(CLI::App& app) {
                   "(as gdpt render; 0 = off)")
         ->capture_default_str()
         ->check(CLI::Range(0u, kMaxVisibleSupersampling));
+    c->add_option("--edge-samples", a->edgeSamples,
+                  "G-PT methods: extra camera samples per camera sample in the pixels a geometric edge "
+                  "crosses (as gdpt render; 0 = off)")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, kMaxEdgeSamples));
     c->add_option("--width", a->width, "Image width")->capture_default_str()->check(CLI::Range(1, 16384));
     c->add_option("--height", a->height, "Image height")->capture_default_str()->check(CLI::Range(1, 16384));
     c->add_option("--target", a->target, "relMSE for the time-to-reach figure (default: the first method's error at "

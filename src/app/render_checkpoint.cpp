@@ -82,7 +82,10 @@ ExrAttributes renderIdentity(const RenderArgs& args, const Scene& scene, std::ui
                         {"schedule", args.schedule},
                         {"max_batch_spp", std::to_string(maxBatchSpp)},
                         {"emitter_supersampling", std::to_string(args.emitterSupersampling)}};
-    if (args.method == "gpt") id["shift_threshold"] = exact(args.shiftThreshold);
+    if (args.method == "gpt") {
+        id["shift_threshold"] = exact(args.shiftThreshold);
+        id["edge_samples"] = std::to_string(args.edgeSamples);
+    }
     return id;
 }
 

@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 
+#include "render/edge_options.h"
 #include "util/error.h"
 
 namespace gdpt {
@@ -89,6 +90,11 @@ Checkpoint readCheckpoint(const std::string& path) {
         if (key.rfind("gdpt.info.", 0) == 0) cp.info[key.substr(10)] = value;
     }
 
+    // G-PT's edge pixels hold edge_samples more samples per camera sample (edge_pass.h).
+    double maxCount = s.spp;
+    if (attributes.count("gdpt.id.edge_samples"))
+        maxCount *= 1.0 + parseCount(path, attributes, "gdpt.id.edge_samples", kMaxEdgeSamples);
+
     std::map<std::string, Image> layers;
     for (NamedLayer& layer : readExr(path)) layers[layer.name] = std::move(layer.image);
     const auto layer = [&](const std::string& name) -> const Image& {
@@ -104,11 +110,12 @@ Checkpoint readCheckpoint(const std::string& path) {
         std::vector<gpu::PixelStats> stats(mean.pixelCount());
         for (std::size_t i = 0; i < stats.size(); ++i) {
             const float n = count.plane(0)[i];
-            if (!(n >= 0.0f && n <= static_cast<float>(s.spp) && n == std::floor(n)) ||
-                count.plane(1)[i] != n || count.plane(2)[i] != n)
+            if (!(n >= 0.0f && double(n) <= maxCount && n == std::floor(n)) || count.plane(1)[i] != n ||
+                count.plane(2)[i] != n)
                 throw Error(path + ": layer " + bufferLayer(k, "count") + ": pixel " + std::to_string(i) +
-                            " has sample count " + std::to_string(n) +
-                            ", expected a whole number <= " + std::to_string(s.spp) + " (gdpt.spp)");
+                            " has sample count " + std::to_string(n) + ", expected a whole number <= " +
+                            std::to_string(static_cast<std::uint64_t>(maxCount)) +
+                            (maxCount == s.spp ? " (gdpt.spp)" : " (gdpt.spp x (1 + edge_samples))"));
             stats[i].count = static_cast<std::uint32_t>(n);
             for (int c = 0; c < 3; ++c) {
                 stats[i].mean[c] = mean.plane(c)[i];
@@ -125,14 +132,17 @@ Checkpoint readCheckpoint(const std::string& path) {
 }
 
 void checkIdentity(const std::string& path, const ExrAttributes& recorded, const ExrAttributes& expected) {
+    // Differing values first: they name the cause (another method, say) better than a key
+    // that only one of the two methods records.
     for (const auto& [key, value] : expected) {
         const auto it = recorded.find(key);
-        if (it == recorded.end())
-            throw Error(path + ": checkpoint does not record " + key + " (this render: " + value + ")");
-        if (it->second != value)
+        if (it != recorded.end() && it->second != value)
             throw Error(path + ": checkpoint was rendered with " + key + " " + it->second +
                         ", this render has " + key + " " + value + "; it cannot be resumed");
     }
+    for (const auto& [key, value] : expected)
+        if (!recorded.count(key))
+            throw Error(path + ": checkpoint does not record " + key + " (this render: " + value + ")");
     for (const auto& [key, value] : recorded)
         if (!expected.count(key))
             throw Error(path + ": checkpoint records " + key + " " + value +

@@ -49,6 +49,7 @@ vk::KernelDesc gptDesc(const SceneSpec& scene, WorkgroupSize wg, bool halfVector
     for (auto& [id, value] : d.specConstants)
         if (id == gpu::kSpecHasGlossy) value = halfVector ? 1u : 0u;
     visible.configure(d);
+    EdgePass::configure(d);
     return d;
 }
 
@@ -89,6 +90,7 @@ GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize w
       splitBounce_(splitBounceFor(ctx.info(), options.splitBounce)),
       counters_(ctx, sizeof(gpu::Counters), "gpt counters"),
       visible_(ctx, scene, wg, options.visibleSupersampling, counters_, creation),
+      edges_(ctx, scene, wg, options.edgeSamples, creation),
       kernel_(ctx, gptDesc(scene, wg, halfVector_, splitBounce_, visible_), creation),
       resolveKernel_(ctx, resolveDesc(wg, visible_), creation),
       stats_(makeStats(ctx, std::uint64_t{width_} * height_)),
@@ -104,16 +106,23 @@ GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize w
     resolveKernel_.bind(gpu::kBindGptResolved, resolved_);
     visible_.bindTo(kernel_);
     visible_.bindTo(resolveKernel_);
+    edges_.bindTo(kernel_);
     reset();
 }
 
 void GptPass::attach(const SceneGpu& scene) {
     scene.bindTo(kernel_);
     visible_.attach(scene);
+    edges_.attach(scene);
 }
 
 double GptPass::waitForPipelines() const {
-    return visible_.waitForPipeline() + kernel_.wait() + resolveKernel_.wait();
+    return visible_.waitForPipeline() + edges_.waitForPipeline() + kernel_.wait() + resolveKernel_.wait();
+}
+
+void GptPass::findEdges(vk::CommandStream& stream) {
+    edges_.find(stream);
+    edges_.bindTo(kernel_);
 }
 
 void GptPass::reset() {
@@ -132,6 +141,22 @@ void GptPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_
                     p.shiftThreshold = options_.shiftThreshold;
                     p.width = width_;
                     p.height = height_;
+                    kernel_.dispatchItems(cmd, width_, p.rowCount, &p, timer);
+                });
+    // The edge pixels' extra samples: the list as rows of `width_` entries (gpt.comp's
+    // edge-list mode), after the barrier that ends recordTiled, since both merge into the
+    // same pixels' statistics.
+    const std::uint32_t k = edges_.samplesPerSpp();
+    if (edges_.count() == 0 || k == 0 || rows < height_) return;
+    const std::uint32_t listRows = (edges_.count() + width_ - 1) / width_;
+    recordTiled(cmd, ctx_.info(), width_, listRows, sampleBase * k, spp * k, kMaxPixelSamplesPerDispatch,
+                [&](const DispatchTile& t) {
+                    gpu::GptFrameParams p{};
+                    setTileParams(p, t, edgeSampleSeed(seed));
+                    p.shiftThreshold = options_.shiftThreshold;
+                    p.width = width_;
+                    p.height = height_;
+                    p.listCount = edges_.count();
                     kernel_.dispatchItems(cmd, width_, p.rowCount, &p, timer);
                 });
 }

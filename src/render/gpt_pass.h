@@ -11,6 +11,7 @@
 
 #include "gpt_shared.h"
 #include "image/image.h"
+#include "render/edge_pass.h"
 #include "render/pt_pass.h"
 #include "render/visible_pass.h"
 #include "vk/buffer.h"
@@ -36,6 +37,9 @@ struct GptPassOptions {
     SplitBounce splitBounce = SplitBounce::Auto;
     // Rays per camera sample of emitter-silhouette supersampling (visible_pass.h; 0 = off).
     std::uint32_t visibleSupersampling = kDefaultVisibleSupersampling;
+    // Extra camera samples per camera sample in the pixels a geometric edge crosses
+    // (edge_pass.h; 0 = off).
+    std::uint32_t edgeSamples = kDefaultEdgeSamples;
 };
 
 // Whether the split bounce loop pays on this device: lavapipe with Mesa before 23, which runs
@@ -61,10 +65,16 @@ public:
     // Waits for pipelines created in the background; the seconds waited.
     double waitForPipelines() const;
 
+    // Finds the edge pixels (edge_pass.h) on `stream`, submitting and waiting; before the
+    // first record(), else the batches have no extra edge samples. Once per pass.
+    void findEdges(vk::CommandStream& stream);
     // Clears the statistics and counters.
     void reset();
-    // Records a batch of `spp` camera samples per pixel starting at sample `sampleBase`.
-    // `rows`: only the first that many image rows (a timed render's partial last pass).
+    // Records a batch of `spp` camera samples per pixel starting at sample `sampleBase`, and
+    // (after findEdges) edgeSamples × spp more in each edge pixel, from sample
+    // sampleBase × edgeSamples of the edge streams (edgeSampleSeed).
+    // `rows`: only the first that many image rows (a timed render's partial last pass; no
+    // edge samples then).
     void record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
                 vk::GpuTimer* timer, std::uint32_t rows = UINT32_MAX);
     // Records the gather into the resolved buffer (after the batches).
@@ -82,6 +92,7 @@ public:
     [[nodiscard]] bool halfVectorCompiled() const { return halfVector_; }
     [[nodiscard]] bool splitBounceCompiled() const { return splitBounce_; }
     [[nodiscard]] const VisiblePass& visible() const { return visible_; }
+    [[nodiscard]] const EdgePass& edges() const { return edges_; }
 
 private:
     const vk::Context& ctx_;
@@ -91,6 +102,7 @@ private:
     bool splitBounce_ = false;
     vk::Buffer counters_;
     VisiblePass visible_;
+    EdgePass edges_;
     vk::Kernel kernel_;
     vk::Kernel resolveKernel_;
     // central, neighbor 0..3, gradient 0..3, direct (binding kBindGptCentral + index).

@@ -25,6 +25,7 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     // while this thread builds the BVH and uploads the scene.
     gpt.shiftThreshold = options.scene.shiftThreshold;
     gpt.visibleSupersampling = options.visibleSupersampling;
+    gpt.edgeSamples = options.edgeSamples;
     SceneSpec spec(scene, options.scene);
     GptPass pass(ctx, spec, options.workgroup, gpt, vk::PipelineCreation::Background);
     SceneGpu sceneGpu(ctx, scene, options.scene, std::move(spec));
@@ -33,10 +34,13 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     stats.bvhRegisterStack = sceneGpu.spec().bvhRegisterStack();
     stats.features = sceneGpu.features();
     stats.gptSplitBounce = pass.splitBounceCompiled();
+    // The edge probe waits only for its own small pipeline and runs while the path kernel's
+    // still compiles.
+    vk::CommandStream stream(ctx, "gpt");
+    pass.findEdges(stream);
     if (options.whileCompiling) options.whileCompiling();
     stats.pipelineWaitMs = 1e3 * pass.waitForPipelines();
     vk::GpuTimer timer(ctx);
-    vk::CommandStream stream(ctx, "gpt");
     if (options.resume) pass.uploadStats(options.resume->buffers);
     stats.uploadMs = phase.ms() - stats.bvhBuildMs;
 
@@ -93,6 +97,8 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     stats.visibleSupersampling = pass.visible().samplesPerSpp();
     stats.visibleRaysPerSample = visible.raysPerSample;
     stats.visibleRefinedPixels = visible.refinedPixels;
+    stats.edgeSamples = pass.edges().samplesPerSpp();
+    stats.edgePixels = pass.edges().count();
     stats.kernels = timer.totals();
     return result;
 }

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "image/image.h"
+#include "render/edge_options.h"
 #include "render/pt_pass.h"
 #include "render/sampler_state.h"
 #include "render/scene_gpu.h"
@@ -39,6 +40,9 @@ struct RenderOptions {
     // Rays per camera sample in the pixels of emitter-silhouette supersampling
     // (render/visible_pass.h); 0 = off.
     std::uint32_t visibleSupersampling = kDefaultVisibleSupersampling;
+    // G-PT: extra camera samples per camera sample in the pixels a geometric edge crosses
+    // (render/edge_pass.h); 0 = off. PT ignores it.
+    std::uint32_t edgeSamples = kDefaultEdgeSamples;
     std::uint32_t maxBatchSpp = 16;  // largest batch (samples per pixel per submission)
     const std::atomic<bool>* cancel = nullptr;  // set asynchronously to stop between batches
     // Continue from this state (its statistics and batch-schedule position) instead of from
@@ -76,6 +80,8 @@ struct RenderStats {
     std::uint32_t visibleSupersampling = 0;  // emitter-silhouette supersampling factor (0 = off)
     std::uint32_t visibleRaysPerSample = 0;  // rays per camera sample it took (after its ray budget)
     std::uint32_t visibleRefinedPixels = 0;  // pixels it covered
+    std::uint32_t edgeSamples = 0;  // G-PT: extra samples per camera sample in edge pixels (0 = off)
+    std::uint32_t edgePixels = 0;   // G-PT: pixels a geometric edge crosses
     bool cancelled = false;
     std::map<std::string, vk::KernelTime> kernels;
     SceneFeatures features;

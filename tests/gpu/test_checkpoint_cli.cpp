@@ -61,6 +61,16 @@ std::uint64_t pathsCompleted(const std::string& jsonPath) {
     return nlohmann::json::parse(in)["paths_completed"].get<std::uint64_t>();
 }
 
+// Paths per camera sample of a render's --json: one per pixel, and G-PT's edge pixels
+// (render/edge_pass.h) `factor` more each.
+std::uint64_t pathsPerSample(const std::string& jsonPath, std::uint64_t pixels) {
+    std::ifstream in(jsonPath);
+    const auto j = nlohmann::json::parse(in);
+    if (j.contains("edge_samples"))
+        pixels += j["edge_samples"]["factor"].get<std::uint64_t>() * j["edge_samples"]["pixels"].get<std::uint64_t>();
+    return pixels;
+}
+
 // A finished 15 spp render (batches 1+2+4+8, none truncated) continued to 63 spp equals a
 // 63 spp render; the resumed run traced only the 48 new samples per pixel, so the state
 // was used rather than re-rendered.
@@ -74,7 +84,7 @@ TEST_P(CheckpointCli, ResumedRenderEqualsUninterruptedRender) {
     ASSERT_EQ(resumed.code, 0) << resumed.output;
     ASSERT_EQ(test::runGdpt(render("--spp 63 -o " + path("u.exr"))).code, 0);
     expectSameLayers(path("r.exr"), path("u.exr"));
-    EXPECT_EQ(pathsCompleted(path("r.json")), 16u * 16u * 48u);
+    EXPECT_EQ(pathsCompleted(path("r.json")), 48u * pathsPerSample(path("r.json"), 16u * 16u));
 }
 
 // SIGINT during a long render (polled until the first periodic checkpoint exists, so the
@@ -159,6 +169,16 @@ TEST_F(CheckpointRefusal, CheckpointOfAnotherRenderIsRefused) {
     EXPECT_EQ(r.code, 1) << r.output;
     EXPECT_NE(r.output.find("scene_fingerprint"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(path("out.exr")));
+}
+
+// G-PT records its edge samples per camera sample (render/edge_pass.h): a checkpoint
+// continues only with the same factor.
+TEST_F(CheckpointRefusal, GptCheckpointWithOtherEdgeSamplesIsRefused) {
+    const std::string c = path("g.exr");
+    const RunResult r = test::runGdpt("render " + kScene + kSize + "--spp 2 --seed 7 --method gpt --edge-samples 2 "
+                                      "--quiet --checkpoint " + c + " -o " + path("g_out.exr"));
+    ASSERT_EQ(r.code, 0) << r.output;
+    expectRefused(c, kSize + "--spp 4 --seed 7 --method gpt --edge-samples 3", "edge_samples");
 }
 
 TEST_F(CheckpointRefusal, CorruptOrForeignCheckpointIsRefused) {

@@ -131,6 +131,34 @@ TEST_F(Cli, TimedGptRenderReservesTheRememberedReconstructionTime) {
     EXPECT_NE(readJson(cached)[finishKey].get<double>(), 0.0625) << "the real finishing time replaces it";
 }
 
+// --edge-samples: the factor and the edge pixels found come back in --json (G-PT only), 0
+// turns the probe off, and values above the bound are usage errors.
+TEST_F(Cli, GptRenderReportsItsEdgeSamples) {
+    auto render = [&](const std::string& flags) {
+        return run("render " + kScene + " --method gpt -o " + path("e.exr") +
+                   " --width 32 --height 32 --spp 2 --quiet --validate --json " + path("e.json") + flags);
+    };
+    auto readJson = [&] {
+        std::ifstream in(path("e.json"));
+        return nlohmann::json::parse(in);
+    };
+    RunResult r = render(" --edge-samples 3");
+    ASSERT_EQ(r.code, 0) << r.output;
+    nlohmann::json j = readJson();
+    EXPECT_EQ(j["edge_samples"]["factor"].get<int>(), 3);
+    const int pixels = j["edge_samples"]["pixels"].get<int>();
+    EXPECT_GT(pixels, 0) << "the Cornell box's walls and boxes have edges";
+    EXPECT_LT(pixels, 32 * 32 / 2);
+    EXPECT_EQ(j["paths_completed"].get<long>(), 2L * (32 * 32 + 3 * pixels)) << "2 spp, 3 more per edge pixel";
+    r = render(" --edge-samples 0");
+    ASSERT_EQ(r.code, 0) << r.output;
+    j = readJson();
+    EXPECT_EQ(j["edge_samples"]["factor"].get<int>(), 0);
+    EXPECT_EQ(j["edge_samples"]["pixels"].get<int>(), 0);
+    EXPECT_EQ(j["paths_completed"].get<long>(), 2L * 32 * 32);
+    EXPECT_EQ(render(" --edge-samples 65").code, 2);
+}
+
 // `gdpt info` names the scene's features and the kernel variant it selects, including the
 // traversal stack: cornell_box's 36-triangle tree needs 4 entries (register stack of 8);
 // the procedural furnace sphere's 1280 triangles need 13 (register stack of 16).

@@ -180,6 +180,9 @@ TEST_F(GptRender, DiffuseCornellGradientsAndPrimalMatchPathTracer) {
     const Scene scene = makeCornellBox();
     const RenderResultGpt g = renderGpt(ctx(), scene, renderOptions(24, 24, 256, 101));
     const RenderResult pt = renderPt(ctx(), scene, renderOptions(24, 24, 512, 202));
+    // The default extra samples in edge pixels (edge_pass.h) are part of what is checked.
+    EXPECT_EQ(g.stats.edgeSamples, kDefaultEdgeSamples);
+    EXPECT_GT(g.stats.edgePixels, 0u);
     checkAgainstPt(g, pt, 6, "cornell");
 }
 

@@ -1,0 +1,202 @@
+// G-PT's extra samples in the pixels that a geometric edge crosses (edge.comp,
+// render/edge_pass.h), against closed forms: with the camera looking straight down at planes
+// parallel to the image, a rectangle's edges project to straight image lines, placed here on
+// pixel centres, so the pixels whose quarter probes (at x + 0.25 and x + 0.75) straddle an
+// edge are known exactly, with a quarter pixel to spare on either side. The probe must find
+// exactly those for a step in depth between faces of one material and for a change of
+// material within one plane, and nothing on a plane split into triangles of one material or
+// inside a smooth sphere. Then every edge pixel gets edgeSamples × spp more samples in its
+// statistics and every other pixel none. That the estimates stay unbiased with the extra
+// samples is checked by test_gpt_render.cpp's comparisons with the path tracer, which run
+// with them on (the default).
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "gpu_fixture.h"
+#include "render/gpt_pass.h"
+#include "render/scene_gpu.h"
+#include "scene/procedural.h"
+#include "scene_builders.h"
+#include "vk/commands.h"
+
+namespace gdpt {
+namespace {
+
+class EdgeSamples : public test::GpuTest {};
+
+// 64², camera at height 2 looking down with a 90° field of view: the plane z maps world x to
+// pixel (x / (2 − z) + 1) · 32 (y mirrored, symmetric here).
+constexpr int kSize = 64;
+constexpr float kCameraHeight = 2.0f;
+
+// Rectangle [x0, x1] x [y0, y1] in the plane z, facing +z (the camera).
+void addRect(Scene& s, float x0, float x1, float y0, float y1, float z, std::uint32_t mat) {
+    const auto base = static_cast<std::uint32_t>(s.positions.size());
+    s.positions.insert(s.positions.end(), {{x0, y0, z}, {x1, y0, z}, {x1, y1, z}, {x0, y1, z}});
+    s.triangles.emplace_back(base, base + 1, base + 2);
+    s.triangles.emplace_back(base, base + 2, base + 3);
+    s.triangleMaterial.insert(s.triangleMaterial.end(), {mat, mat});
+}
+
+Scene lookingDown() {
+    Scene s;
+    s.materials.push_back(test::lambert(glm::vec3(0.5f)));
+    s.materials.push_back(test::lambert(glm::vec3(0.2f, 0.6f, 0.3f)));
+    s.materials.push_back(test::lambert(glm::vec3(0.0f), glm::vec3(2.0f)));  // a light
+    s.cameras.push_back(test::lookDown(kCameraHeight, 90.0f));
+    // A light far above the camera's view (outside the image), facing down, so that the
+    // scenes have something to render.
+    const auto base = static_cast<std::uint32_t>(s.positions.size());
+    s.positions.insert(s.positions.end(), {{-1, -1, 4}, {1, -1, 4}, {1, 1, 4}, {-1, 1, 4}});
+    s.triangles.emplace_back(base, base + 2, base + 1);
+    s.triangles.emplace_back(base, base + 3, base + 2);
+    s.triangleMaterial.insert(s.triangleMaterial.end(), {2u, 2u});
+    return s;
+}
+
+// The mask of EdgePass on `scene` at kSize², as a set of (x, y).
+std::set<std::pair<int, int>> probe(const vk::Context& ctx, const Scene& scene) {
+    SceneGpuOptions o;
+    o.width = kSize;
+    o.height = kSize;
+    SceneGpu gpu(ctx, scene, o);
+    EdgePass pass(ctx, gpu.spec(), WorkgroupSize{}, 1, vk::PipelineCreation::Now);
+    pass.attach(gpu);
+    vk::CommandStream stream(ctx, "edge test");
+    pass.find(stream);
+    std::set<std::pair<int, int>> out;
+    const std::vector<std::uint32_t>& mask = pass.mask();
+    EXPECT_EQ(mask.size(), std::size_t{kSize} * kSize);
+    for (std::size_t i = 0; i < mask.size(); ++i)
+        if (mask[i] != 0) out.insert({int(i % kSize), int(i / kSize)});
+    EXPECT_EQ(out.size(), pass.count());
+    return out;
+}
+
+// A square of half-size 0.515625 at z = 1 projects to [15.5, 48.5]² (pixel centres), in front
+// of a wall at z = 0: its outline is the pixels of columns 15 and 48 and rows 15 and 48
+// between them.
+std::set<std::pair<int, int>> squareOutline() {
+    std::set<std::pair<int, int>> out;
+    for (int i = 15; i <= 48; ++i) {
+        out.insert({15, i});
+        out.insert({48, i});
+        out.insert({i, 15});
+        out.insert({i, 48});
+    }
+    return out;
+}
+
+// The square of squareOutline() in front of a wall, both of material 0.
+Scene stepScene() {
+    Scene s = lookingDown();
+    addRect(s, -10, 10, -10, 10, 0.0f, 0);
+    addRect(s, -0.515625f, 0.515625f, -0.515625f, 0.515625f, 1.0f, 0);
+    return s;
+}
+
+TEST_F(EdgeSamples, ProbeFindsExactlyTheSilhouetteOfAStepInDepthWithinOneMaterial) {
+    const auto found = probe(ctx(), stepScene());
+    EXPECT_EQ(found, squareOutline());
+    EXPECT_EQ(found.size(), 132u);
+}
+
+TEST_F(EdgeSamples, ProbeFindsAChangeOfMaterialWithinAPlaneAndNotATriangleBoundary) {
+    // Split at world x = 0.53125, which z = 0 maps to pixel x 40.5: column 40 changes
+    // material; the split at x = -0.53125 (pixel 23.5) has the same material on both sides.
+    Scene s = lookingDown();
+    addRect(s, -10, -0.53125f, -10, 10, 0.0f, 0);
+    addRect(s, -0.53125f, 0.53125f, -10, 10, 0.0f, 0);
+    addRect(s, 0.53125f, 10, -10, 10, 0.0f, 1);
+    std::set<std::pair<int, int>> expected;
+    for (int y = 0; y < kSize; ++y) expected.insert({40, y});
+    EXPECT_EQ(probe(ctx(), s), expected);
+}
+
+TEST_F(EdgeSamples, SmoothSphereSeenFromInsideHasNoEdges) {
+    // The furnace's icosphere (1280 facets, neighbours about 10° apart, one material).
+    EXPECT_TRUE(probe(ctx(), makeFurnaceSphere(0.5f, glm::vec3(0.5f), 3)).empty());
+}
+
+// A G-PT pass over stepScene() at kSize² with `edgeSamples`, its edges found.
+struct StepPass {
+    StepPass(const vk::Context& ctx, std::uint32_t edgeSamples)
+        : gpu(ctx, stepScene(), sceneOptions()),
+          pass(ctx, gpu, WorkgroupSize{}, passOptions(edgeSamples)),
+          stream(ctx, "edge test") {
+        pass.findEdges(stream);
+    }
+    static SceneGpuOptions sceneOptions() {
+        SceneGpuOptions o;
+        o.width = kSize;
+        o.height = kSize;
+        return o;
+    }
+    static GptPassOptions passOptions(std::uint32_t edgeSamples) {
+        GptPassOptions o;
+        o.edgeSamples = edgeSamples;
+        return o;
+    }
+    SceneGpu gpu;
+    GptPass pass;
+    vk::CommandStream stream;
+};
+
+// Each edge pixel's statistics count (1 + edgeSamples) × spp samples, every other pixel spp;
+// a partial pass (rows < height) adds no edge samples.
+TEST_F(EdgeSamples, EdgePixelsGetTheirExtraSamplesAndOnlyThey) {
+    StepPass step(ctx(), 3);
+    GptPass& pass = step.pass;
+    vk::CommandStream& stream = step.stream;
+    ASSERT_EQ(pass.edges().count(), 132u);
+    const std::uint32_t seed = 7;
+    auto batch = [&](std::uint32_t first, std::uint32_t n, std::uint32_t rows) {
+        pass.record(stream.begin(), first, n, seed, nullptr, rows);
+        stream.submitAndWait();
+    };
+    batch(0, 2, kSize);
+    batch(2, 3, kSize);
+    batch(5, 1, 10);  // partial pass: rows 0..9 only
+    const auto stats = pass.downloadStats();
+    const auto outline = squareOutline();
+    const std::vector<gpu::PixelStats>& central = stats[0];
+    int wrong = 0;
+    for (int y = 0; y < kSize; ++y)
+        for (int x = 0; x < kSize; ++x) {
+            const std::uint32_t expected = (outline.count({x, y}) ? 5u * 4u : 5u) + (y < 10 ? 1u : 0u);
+            const std::uint32_t got = central[std::size_t(y) * kSize + x].count;
+            if (got != expected && wrong++ < 5)
+                ADD_FAILURE() << "pixel " << x << "," << y << ": " << got << " samples, expected "
+                              << expected;
+        }
+    EXPECT_EQ(wrong, 0);
+}
+
+TEST_F(EdgeSamples, OffMeansNoProbeAndNoExtraSamples) {
+    StepPass step(ctx(), 0);
+    GptPass& pass = step.pass;
+    vk::CommandStream& stream = step.stream;
+    EXPECT_FALSE(pass.edges().enabled());
+    EXPECT_EQ(pass.edges().count(), 0u);
+    pass.record(stream.begin(), 0, 2, 1, nullptr);
+    stream.submitAndWait();
+    const auto stats = pass.downloadStats();
+    for (const gpu::PixelStats& p : stats[0]) ASSERT_EQ(p.count, 2u);
+}
+
+TEST(EdgeSampleSeed, DiffersFromTheSeedAndKeepsSeedsApart) {
+    std::set<std::uint32_t> seen;
+    for (std::uint32_t seed = 0; seed < 1000; ++seed) {
+        EXPECT_NE(edgeSampleSeed(seed), seed);
+        seen.insert(edgeSampleSeed(seed));
+    }
+    EXPECT_EQ(seen.size(), 1000u);
+}
+
+}  // namespace
+}  // namespace gdpt
