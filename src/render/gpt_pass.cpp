@@ -131,43 +131,42 @@ void GptPass::reset() {
     visible_.reset();
 }
 
-void GptPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
-                     vk::GpuTimer* timer, std::uint32_t rows) {
-    visible_.record(cmd, sampleBase, spp, seed, timer);
-    recordTiled(cmd, ctx_.info(), width_, std::min(rows, height_), sampleBase, spp, kMaxPixelSamplesPerDispatch,
-                [&](const DispatchTile& t) {
-                    gpu::GptFrameParams p{};
-                    setTileParams(p, t, seed);
-                    p.shiftThreshold = options_.shiftThreshold;
-                    p.width = width_;
-                    p.height = height_;
-                    kernel_.dispatchItems(cmd, width_, p.rowCount, &p, timer);
-                });
-    // The edge pixels' extra samples: the list as rows of `width_` entries (gpt.comp's
-    // edge-list mode), after the barrier that ends recordTiled, since both merge into the
-    // same pixels' statistics.
-    const std::uint32_t k = edges_.samplesPerSpp();
-    if (edges_.count() == 0 || k == 0 || rows < height_) return;
-    const std::uint32_t listRows = (edges_.count() + width_ - 1) / width_;
-    recordTiled(cmd, ctx_.info(), width_, listRows, sampleBase * k, spp * k, kMaxPixelSamplesPerDispatch,
-                [&](const DispatchTile& t) {
-                    gpu::GptFrameParams p{};
-                    setTileParams(p, t, edgeSampleSeed(seed));
-                    p.shiftThreshold = options_.shiftThreshold;
-                    p.width = width_;
-                    p.height = height_;
-                    p.listCount = edges_.count();
-                    kernel_.dispatchItems(cmd, width_, p.rowCount, &p, timer);
-                });
-}
-
-void GptPass::resolve(VkCommandBuffer cmd, vk::GpuTimer* timer) {
+gpu::GptFrameParams GptPass::frameParams() const {
     gpu::GptFrameParams p{};
-    p.rowOffset = 0;
-    p.rowCount = height_;
     p.shiftThreshold = options_.shiftThreshold;
     p.width = width_;
     p.height = height_;
+    return p;
+}
+
+void GptPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
+                     vk::GpuTimer* timer, std::uint32_t rows) {
+    visible_.record(cmd, sampleBase, spp, seed, timer);
+    // gpt.comp over `tileRows` rows of `width_` items: image rows, or (listCount > 0) the
+    // edge list's entries in rows of `width_` (its edge-list mode).
+    const auto dispatchTiled = [&](std::uint32_t tileRows, std::uint32_t first, std::uint32_t n,
+                                   std::uint32_t tileSeed, std::uint32_t listCount) {
+        recordTiled(cmd, ctx_.info(), width_, tileRows, first, n, kMaxPixelSamplesPerDispatch,
+                    [&](const DispatchTile& t) {
+                        gpu::GptFrameParams p = frameParams();
+                        setTileParams(p, t, tileSeed);
+                        p.listCount = listCount;
+                        kernel_.dispatchItems(cmd, width_, p.rowCount, &p, timer);
+                    });
+    };
+    dispatchTiled(std::min(rows, height_), sampleBase, spp, seed, 0);
+    // The edge pixels' extra samples, after the barrier that ends recordTiled, since both
+    // merge into the same pixels' statistics.
+    const std::uint32_t k = edges_.samplesPerSpp();
+    if (edges_.count() == 0 || k == 0 || rows < height_) return;
+    dispatchTiled((edges_.count() + width_ - 1) / width_, sampleBase * k, spp * k, edgeSampleSeed(seed),
+                  edges_.count());
+}
+
+void GptPass::resolve(VkCommandBuffer cmd, vk::GpuTimer* timer) {
+    gpu::GptFrameParams p = frameParams();
+    p.rowOffset = 0;
+    p.rowCount = height_;
     resolveKernel_.dispatchItems(cmd, width_, height_, &p, timer);
     vk::computeBarrier(cmd);
 }

@@ -95,6 +95,9 @@ public:
     [[nodiscard]] const EdgePass& edges() const { return edges_; }
 
 private:
+    // The push constants every dispatch of this pass shares (threshold, image size).
+    [[nodiscard]] gpu::GptFrameParams frameParams() const;
+
     const vk::Context& ctx_;
     std::uint32_t width_, height_;
     GptPassOptions options_;

@@ -59,12 +59,16 @@ Scene lookingDown() {
     return s;
 }
 
-// The mask of EdgePass on `scene` at kSize², as a set of (x, y).
-std::set<std::pair<int, int>> probe(const vk::Context& ctx, const Scene& scene) {
+SceneGpuOptions sizeOptions() {
     SceneGpuOptions o;
     o.width = kSize;
     o.height = kSize;
-    SceneGpu gpu(ctx, scene, o);
+    return o;
+}
+
+// The mask of EdgePass on `scene` at kSize², as a set of (x, y).
+std::set<std::pair<int, int>> probe(const vk::Context& ctx, const Scene& scene) {
+    SceneGpu gpu(ctx, scene, sizeOptions());
     EdgePass pass(ctx, gpu.spec(), WorkgroupSize{}, 1, vk::PipelineCreation::Now);
     pass.attach(gpu);
     vk::CommandStream stream(ctx, "edge test");
@@ -126,16 +130,10 @@ TEST_F(EdgeSamples, SmoothSphereSeenFromInsideHasNoEdges) {
 // A G-PT pass over stepScene() at kSize² with `edgeSamples`, its edges found.
 struct StepPass {
     StepPass(const vk::Context& ctx, std::uint32_t edgeSamples)
-        : gpu(ctx, stepScene(), sceneOptions()),
+        : gpu(ctx, stepScene(), sizeOptions()),
           pass(ctx, gpu, WorkgroupSize{}, passOptions(edgeSamples)),
           stream(ctx, "edge test") {
         pass.findEdges(stream);
-    }
-    static SceneGpuOptions sceneOptions() {
-        SceneGpuOptions o;
-        o.width = kSize;
-        o.height = kSize;
-        return o;
     }
     static GptPassOptions passOptions(std::uint32_t edgeSamples) {
         GptPassOptions o;
