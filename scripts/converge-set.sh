@@ -3,7 +3,8 @@
 # on the Cornell box of ../shared/scenes/cbox (against its independent reference) and on each
 # scene of scenes/ (against a PT reference made and cached with --make-reference), each into
 # OUT/<scene>/ (results.json, results.csv, error_vs_time.png), then prints every scene's
-# equal-time table. Not a test: a long benchmark (hours with the defaults on 2 cores).
+# equal-time table with each method's gain over PT. Not a test: a long benchmark (hours with
+# the defaults on 2 cores).
 #
 #   scripts/converge-set.sh [-o OUT] [--times 4,8,16,32] [--repeats 3] [--reference-spp 4096]
 #                           [--methods pt,gpt-l1,gpt-l2,gpt-wl2] [--size 256] [--scenes a,b,...]
@@ -20,7 +21,7 @@ while (($#)); do
     --methods) methods=$2; shift 2 ;;
     --size) size=$2; shift 2 ;;
     --scenes) scenes=$2; shift 2 ;;
-    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
     *) echo "converge-set.sh: unknown option '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -45,9 +46,13 @@ d = json.load(open(sys.argv[1]))
 rows = d["summary"]
 methods = list(dict.fromkeys(r["method"] for r in rows))
 budgets = sorted({r["budget_s"] for r in rows})
-print("budget_s " + " ".join(f"{m:>12}" for m in methods))
+# relMSE medians per method, then each other method's gain over PT (PT's error / its error).
+others = [m for m in methods if m != "pt"] if "pt" in methods else []
+print("budget_s " + " ".join(f"{m:>12}" for m in methods) + "".join(f" {m + ' gain':>12}" for m in others))
 for b in budgets:
     cells = {r["method"]: r["relmse_median"] for r in rows if r["budget_s"] == b}
-    print(f"{b:8g} " + " ".join(f"{cells.get(m, float('nan')):12.5g}" for m in methods))
+    gains = [cells.get("pt", float("nan")) / cells[m] if cells.get(m) else float("nan") for m in others]
+    print(f"{b:8g} " + " ".join(f"{cells.get(m, float('nan')):12.5g}" for m in methods)
+          + "".join(f" {g:11.2f}x" for g in gains))
 PY
 done
