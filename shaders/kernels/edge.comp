@@ -1,6 +1,7 @@
 // edge.comp — finds the pixels that a geometric edge crosses, for G-PT's extra samples there
 // (EdgePass, src/render/edge_pass.h). One invocation = one pixel; writes mask[p] = 1 if the
-// pixel holds an edge, else 0.
+// pixel holds an edge, else 0, and probe[p] = what its first probe ray hit (EdgeProbe), which
+// the host compares across neighbouring pixels for first-hit demodulation.
 //
 // Why: at a geometric edge (a silhouette, a crease, a change of material) the pixel's value
 // depends on which surface each camera sample lands on, and so do the gradients of its four
@@ -30,14 +31,12 @@ layout(local_size_x_id = kSpecWorkgroupX, local_size_y_id = kSpecWorkgroupY) in;
 
 #include "lib/scene_buffers.glsl"
 layout(set = 0, binding = kBindGptEdgeMask, scalar) buffer EdgeMaskBuf { uint edgeMask[]; };
+layout(set = 0, binding = kBindGptEdgeProbe, scalar) buffer EdgeProbeBuf { EdgeProbe edgeProbe[]; };
 
 #include "lib/scene_access.glsl"
 #define GDPT_ANYHIT_FILTER(tri, u, v) alphaPasses(tri, u, v)
 #include "lib/bvh_traverse.glsl"
 #include "lib/camera.glsl"
-
-const float kEdgeNormalCos = 0.9;      // normals further apart than ~26° are a crease
-const float kEdgeTangentSlope = 0.25;  // off-plane distance / in-plane distance of a step
 
 void main() {
     loadScene();
@@ -77,5 +76,12 @@ void main() {
                    abs(dot(n0, e)) > kEdgeTangentSlope * length(e - dot(n0, e) * n0);
         }
     }
-    edgeMask[y * scene.width + x] = edge ? 1u : 0u;
+    uint pixel = y * scene.width + x;
+    edgeMask[pixel] = edge ? 1u : 0u;
+    EdgeProbe probe;
+    probe.position = p0;
+    probe.material = material0;
+    probe.normal = n0;
+    probe.hit = miss0 ? 0u : 1u;
+    edgeProbe[pixel] = probe;
 }

@@ -23,6 +23,16 @@
 //   direct(p)       emission seen directly from the camera (never shifted); zero in the
 //                   pixels of emitter-silhouette supersampling (visible.comp), whose
 //                   estimate gpt_resolve.comp takes instead
+//   modulation(p)   with kDemodulate only: the base paths' first-hit modulation m
+//
+// First-hit texture demodulation (kDemodulate, a specialisation constant): in the pixels the
+// host marks in demodMask (away from geometric edges), a path divides its contributions by m,
+// the base-colour texture at its first hit (Lambertian-only materials), so central,
+// neighbor_i and gradient_i estimate J = I / m̄ there, with m̄ the pixel mean of m. A
+// gradient between two texels then carries (J' − J), the lighting difference, instead of
+// (t' − t) times the lighting estimate, and the host multiplies the reconstruction of J by
+// m̄. This assumes m and J uncorrelated inside a pixel, which fails where a pixel spans two
+// surfaces: hence the mask (bench/RESULTS.md, twelfth session).
 // Each invocation writes only its own pixel: no races, no float atomics, deterministic.
 // gpt_resolve.comp gathers the neighbours' terms.
 #version 460
@@ -50,6 +60,9 @@ layout(set = 0, binding = kBindGptGradient2, scalar) buffer Gradient2Buf { Pixel
 layout(set = 0, binding = kBindGptGradient3, scalar) buffer Gradient3Buf { PixelStats statGradient3[]; };
 layout(set = 0, binding = kBindGptDirect, scalar) buffer DirectBuf { PixelStats statDirect[]; };
 layout(set = 0, binding = kBindGptEdgeList, scalar) readonly buffer EdgeListBuf { uint edgeList[]; };
+layout(set = 0, binding = kBindGptDemodMask, scalar) readonly buffer DemodMaskBuf { uint demodMask[]; };
+layout(set = 0, binding = kBindGptModulation, scalar) buffer ModulationBuf { PixelStats statModulation[]; };
+layout(constant_id = kSpecGptDemodulate) const bool kDemodulate = false;
 layout(push_constant, scalar) uniform Push { GptFrameParams frame; };
 
 #include "lib/scene_access.glsl"
@@ -77,15 +90,33 @@ const ivec2 kOffsetDelta[4] = ivec2[4](ivec2(1, 0), ivec2(0, 1), ivec2(-1, 0), i
 // bit for bit either way (bench/RESULTS.md, fourth session).
 
 // Offset i has a vertex of its own (NOT_CONNECTED); never in the fast form (general false).
+// A texture value below this (per channel) demodulates by this instead: keeps 1/m finite
+// where a texel is black (its samples then underestimate J a little).
+const float kMinModulation = 1.0 / 64.0;
+
+// Demodulation factor m of a path whose camera sample lies in `pixel` and whose first hit is
+// h: the base-colour texture there if the pixel is marked and the material's BSDF is that
+// texture times a Lambertian lobe (no metal, no specular layer), else 1.
+vec3 firstHitModulation(SurfaceHit h, uint pixel) {
+    if (!kDemodulate || demodMask[pixel] == 0u) return vec3(1.0);
+    Material m = material(h.material);
+    if (m.baseColorTex < 0 || m.metallic != 0.0 || m.specular != 0.0 || m.metallicRoughnessTex >= 0)
+        return vec3(1.0);
+    return max(sampleTexture(m.baseColorTex, h.uv).xyz, vec3(kMinModulation));
+}
 bool ownVertex(OffsetPath o, bool general) { return general && o.state == kShiftNotConnected; }
 
 // Base + 4 offsets for one camera sample at pixelPos (continuous pixel coordinates).
 // countDirect false: the emission seen by the camera ray is left to emitter-silhouette
 // supersampling (visible_emission.glsl) and `direct` stays zero.
+// baseModulation: the base's first-hit modulation (1 unless kDemodulate; offs[i].modulation
+// the offsets').
 void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, bool countDirect, inout uint rays,
-                 out vec3 direct, inout OffsetPath offs[4]) {
+                 out vec3 direct, out vec3 baseModulation, inout OffsetPath offs[4]) {
     direct = vec3(0.0);
+    baseModulation = vec3(1.0);
     for (uint i = 0u; i < 4u; ++i) {
+        offs[i].modulation = vec3(1.0);
         offs[i].alive = gptPairExists(px, py, i);
         offs[i].shifted = false;
         offs[i].baseSum = vec3(0.0);
@@ -107,6 +138,7 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     }
     SurfaceHit sh = makeSurfaceHit(hit.triangle, hit.u, hit.v, d);
     if (kHasLightTris && countDirect) direct += surfaceEmission(sh);
+    if (kDemodulate) baseModulation = firstHitModulation(sh, py * scene.width + px);
     for (uint i = 0u; i < 4u; ++i) {
         offs[i].shifted = offs[i].alive;
         if (!offs[i].alive) continue;
@@ -119,6 +151,10 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
         }
         offs[i].hit = makeSurfaceHit(hi.triangle, hi.u, hi.v, di);
         offs[i].woWorld = -di;
+        if (kDemodulate) {
+            ivec2 q = ivec2(px, py) + kOffsetDelta[i];  // inside the image: the pair exists
+            offs[i].modulation = firstHitModulation(offs[i].hit, uint(q.y) * scene.width + uint(q.x));
+        }
     }
 
     vec3 beta = vec3(1.0);  // base f/p
@@ -169,6 +205,9 @@ void main() {
         acc[k].mean = vec3(0.0);
         acc[k].m2 = vec3(0.0);
     }
+    Welford accModulation;  // kDemodulate only
+    accModulation.mean = vec3(0.0);
+    accModulation.m2 = vec3(0.0);
     uint n = 0u;
     uint rays = 0u;
     uint nan = 0u;
@@ -180,8 +219,14 @@ void main() {
         Rng rng = rngInit(pixel, frame.sampleBase + s, frame.seed);
         LdSample lds = ldSampleInit(pixel, frame.sampleBase + s, frame.seed);
         vec2 jitter = ldGet2(lds, kLdDimPixel);
-        vec3 direct;
-        traceSample(lds, rng, vec2(x, y) + jitter, x, y, countDirect, rays, direct, offs);
+        vec3 direct, baseModulation;
+        traceSample(lds, rng, vec2(x, y) + jitter, x, y, countDirect, rays, direct, baseModulation, offs);
+        if (kDemodulate) {
+            for (uint i = 0u; i < 4u; ++i) {
+                offs[i].baseSum /= baseModulation;
+                offs[i].offSum /= offs[i].modulation;
+            }
+        }
         for (uint i = 0u; i < 4u; ++i) {
             shiftPairs += offs[i].shifted ? 1u : 0u;
             shiftFailures += offs[i].shifted && !offs[i].alive ? 1u : 0u;
@@ -193,6 +238,7 @@ void main() {
             finite = finite && isFinite(offs[i].baseSum) && isFinite(offs[i].offSum);
         }
         n++;
+        if (kDemodulate) welfordAdd(accModulation, baseModulation, n);
         if (!finite) {
             // Counted, never written: the whole sample (all quantities) becomes zero so the
             // pairs stay consistent.
@@ -218,6 +264,7 @@ void main() {
         statGradient2[pixel] = chanMerge(statGradient2[pixel], acc[7], n);
         statGradient3[pixel] = chanMerge(statGradient3[pixel], acc[8], n);
         statDirect[pixel] = chanMerge(statDirect[pixel], acc[9], n);
+        if (kDemodulate) statModulation[pixel] = chanMerge(statModulation[pixel], accModulation, n);
     }
     atomicAdd(counters.raysTraced, rays);
     atomicAdd(counters.pathsCompleted, n);

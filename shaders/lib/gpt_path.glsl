@@ -21,6 +21,7 @@ struct OffsetPath {
     bool shifted;     // the pair exists and the base's primary ray hit: a shift was attempted
     vec3 baseSum;     // Σ w·f_base over this pair (part of central)
     vec3 offSum;      // Σ w·f_offset over this pair (neighbor_i)
+    vec3 modulation;  // first-hit demodulation factor of the offset (1 = none; gpt.comp)
 };
 
 // The pair (p, p + δ_i) exists only inside the image; at borders p has fewer pairs.

@@ -309,7 +309,8 @@ GDPT_ENUM_BEGIN(SpecId)
     kSpecVisibleEmission = 10u,  // path kernels: emitter-silhouette supersampling is on (visible_emission.glsl)
     kSpecHasShadingNormals = 11u,  // some triangle carries kTriFlagHasNormals (features.h)
     kSpecHasSpecularLobe = 12u,  // some material has a metal/dielectric lobe (features.h hasSpecularLayer)
-    kSpecBvhRegisterStack = 13u  // entries of the register traversal stack (8, 16), 0 = in memory (bvh_traverse.glsl)
+    kSpecBvhRegisterStack = 13u,  // entries of the register traversal stack (8, 16), 0 = in memory (bvh_traverse.glsl)
+    kSpecGptDemodulate = 14u  // gpt.comp: first-hit texture demodulation is on (gpt_shared.h kBindGptDemodMask)
 GDPT_ENUM_END();
 
 // A ray of the BVH tests (tests/gpu/test_bvh_gpu.cpp). 32 bytes.

@@ -49,6 +49,22 @@ struct GptResolved {
     vec3 varDirect;   // variance of the direct estimate
 };
 
+// Where edge.comp sees an edge between two probe points (and the host between two pixels'
+// probes, demodulationMask): normals further apart than ~26° are a crease; a point further off
+// the other's tangent plane than this fraction of its in-plane distance is a step in depth.
+GDPT_CONST float kEdgeNormalCos = 0.9f;
+GDPT_CONST float kEdgeTangentSlope = 0.25f;
+
+// What the edge probe (edge.comp) saw at a pixel's first probe point: the host compares it
+// with the neighbours' to keep first-hit demodulation away from edges that lie between two
+// pixels' probe points (demodulationMask, gpt_pass.h). 32 bytes.
+struct EdgeProbe {
+    vec3 position;  // world-space first hit (0 on a miss)
+    uint material;  // material index of the hit (0 on a miss)
+    vec3 normal;    // unit geometric normal facing the camera ray's side (0 on a miss)
+    uint hit;       // 1 = the probe ray hit a surface, 0 = it missed
+};
+
 // Descriptor bindings of the G-PT pipelines (set 0). The scene uses kBindTriGeom ..
 // kBindSceneConst and the counters kBindCounters of gdpt_shared.h; the per-pixel statistics
 // (PixelStats each, one buffer per quantity so none exceeds 128 MiB) follow here, above
@@ -67,12 +83,21 @@ GDPT_ENUM_BEGIN(GptBinding)
     kBindGptResolved = 50u,   // GptResolved[] written by gpt_resolve.comp
     kBindGptEdgeMask = 51u,   // uint per pixel written by edge.comp: 1 = a geometric edge
                               // crosses the pixel, else 0
-    kBindGptEdgeList = 52u    // uint pixel indices (y·width + x) of the edge pixels, ascending
+    kBindGptEdgeList = 52u,   // uint pixel indices (y·width + x) of the edge pixels, ascending
+    // First-hit texture demodulation (kSpecGptDemodulate; gpt_pass.h): a path whose camera
+    // sample lies in a pixel with kBindGptDemodMask 1 divides its contributions by the
+    // modulation m = the base-colour texture at its first hit (Lambertian-only materials;
+    // else 1), so that pixel's statistics estimate J = I / m̄ (m̄ = the pixel mean of m).
+    kBindGptDemodMask = 53u,  // uint per pixel: 1 = demodulate the paths that start in it
+    kBindGptModulation = 54u, // PixelStats per pixel: m at the base paths' first hits (1 where
+                              // not demodulated, also on a miss)
+    kBindGptEdgeProbe = 55u   // EdgeProbe per pixel written by edge.comp
 GDPT_ENUM_END();
 
 #ifdef __cplusplus
 static_assert(sizeof(GptFrameParams) == 36, "GptFrameParams layout");
 static_assert(sizeof(GptResolved) == 96, "GptResolved layout (scalar)");
+static_assert(sizeof(EdgeProbe) == 32, "EdgeProbe layout (scalar)");
 static_assert(std::uint32_t{kBindGptCentral} > std::uint32_t{kBindTestOutput2},
               "G-PT bindings must not collide with gdpt_shared.h's");
 }  // namespace gdpt::gpu

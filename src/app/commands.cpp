@@ -114,6 +114,7 @@ int runRender(const RenderArgs& args) {
     options.schedule = args.schedule == "wavefront" ? Schedule::Wavefront : Schedule::Megakernel;
     options.visibleSupersampling = args.emitterSupersampling;
     options.edgeSamples = args.edgeSamples;
+    options.demodulate = parseDemodulation(args.demodulate);
 
     Scene scene = loadGltf(args.scene);
     if (!scene.unsupported.empty() && !args.quiet) {
@@ -226,14 +227,15 @@ int runRender(const RenderArgs& args) {
             return recon;
         };
         const Image recon = solve(0);
-        layers = {{"", addImages(recon, g.direct)}, {"recon_" + args.recon, recon}};
+        layers = {{"", gptFinal(g, recon)}, {"recon_" + args.recon, recon}};
         for (std::size_t k = 1; k < recons.size(); ++k) layers.push_back({"recon_" + recons[k], solve(k)});
         if (!reserve.key.empty()) reconCache.put(reserve.key, stats.reconstructionMs * 1e-3);
         const std::vector<NamedLayer> buffers = {
             {"primal", g.primal}, {"dx", g.dx},         {"dy", g.dy},         {"direct", g.direct},
             {"var_primal", g.varPrimal}, {"var_dx", g.varDx}, {"var_dy", g.varDy}, {"var_direct", g.varDirect},
-            {"primal_plus_direct", addImages(g.primal, g.direct)}};
+            {"primal_plus_direct", gptFinal(g, g.primal)}};
         layers.insert(layers.end(), buffers.begin(), buffers.end());
+        if (g.stats.demodulated) layers.push_back({"modulation", g.modulation});
     } else {
         RenderResult r = renderPt(ctx, scene, options);
         afterSampling = total.seconds() - r.stats.readbackMs * 1e-3;
@@ -261,12 +263,13 @@ int runRender(const RenderArgs& args) {
     if (args.profile) printProfile(s.kernels);
     if (!args.quiet)
         std::fprintf(stderr,
-                     "gdpt: wrote %s (%u spp%s%s, %.2f s total, BVH %.1f ms, sampling %.1f ms, %.2f Mrays/s, %.3f Msamples/s)\n",
+                     "gdpt: wrote %s (%u spp%s%s%s, %.2f s total, BVH %.1f ms, sampling %.1f ms, %.2f Mrays/s, %.3f Msamples/s)\n",
                      args.output.c_str(), s.spp,
                      s.partialPassRows ? (" + 1 in the top " + std::to_string(s.partialPassRows) + " rows").c_str() : "",
                      s.edgePixels ? (", x" + std::to_string(1 + s.edgeSamples) + " in " + std::to_string(s.edgePixels) +
                                      " edge pixels").c_str()
                                   : "",
+                     s.demodulated ? (", demodulated in " + std::to_string(s.demodulatedPixels) + " pixels").c_str() : "",
                      seconds, s.bvhBuildMs, s.samplingMs,
                      double(s.raysTraced) / (s.samplingMs * 1e-3) * 1e-6,
                      double(s.pathsCompleted) / (s.samplingMs * 1e-3) * 1e-6);
@@ -306,6 +309,7 @@ int runRender(const RenderArgs& args) {
         if (args.method == "gpt") {
             j["gpt_split_bounce"] = s.gptSplitBounce;
             j["edge_samples"] = {{"factor", s.edgeSamples}, {"pixels", s.edgePixels}};
+            j["demodulation"] = {{"on", s.demodulated}, {"pixels", s.demodulatedPixels}};
         }
         j["emitter_supersampling"] = {{"factor", s.visibleSupersampling},
                                       {"rays_per_sample", s.visibleRaysPerSample},
@@ -484,6 +488,15 @@ Subcommand addRenderCommand(CLI::App& app) {
                   "image's error. 0 = off")
         ->capture_default_str()
         ->check(CLI::Range(0u, kMaxEdgeSamples));
+    r->add_option("--demodulate", render.demodulate,
+                  "G-PT: first-hit texture demodulation. In the pixels away from geometric edges (found by "
+                  "the edge probe inside a pixel or between neighbouring pixels), each path divides its contributions by the base-colour texture at "
+                  "its first hit (Lambertian materials), so the gradients carry the lighting differences "
+                  "instead of the texture's times the lighting noise; the reconstruction is multiplied by "
+                  "the pixel-mean texture (the `modulation` layer; primal/dx/dy are then divided by it). "
+                  "auto: on when some Lambertian material has a base-colour texture")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"auto", "on", "off"}));
     r->add_option("--workgroup", render.workgroup, "Compute workgroup size WxH")->capture_default_str();
     r->add_option("--schedule", render.schedule,
                   "Kernel schedule: megakernel (one kernel per path batch) or wavefront (kernel per bounce stage)")

@@ -51,6 +51,7 @@ struct ConvergeArgs {
     bool validate = false;
     std::uint32_t emitterSupersampling = kDefaultVisibleSupersampling;
     std::uint32_t edgeSamples = kDefaultEdgeSamples;
+    std::string demodulate = "auto";
 };
 
 // FNV-1a of the scene file's bytes and the render settings: the cache key of a made reference.
@@ -93,6 +94,7 @@ public:
         o.quiet = true;
         o.visibleSupersampling = a_.emitterSupersampling;
         o.edgeSamples = a_.edgeSamples;
+        o.demodulate = parseDemodulation(a_.demodulate);
         // The reconstruction reserve is measured (once per method) before the clock starts:
         // it is calibration, not part of the run.
         const SolveOptions so = method == "pt" ? SolveOptions{} : solveOptions(method);
@@ -117,7 +119,7 @@ public:
             // budgets of this method reserve the longest reconstruction seen so far.
             double& longest = reconCache_[method];
             longest = std::max(longest, r.reconSeconds);
-            result = addImages(solved, g.direct);
+            result = gptFinal(g, solved);
             r.spp = g.stats.spp;
             r.partialPassRows = g.stats.partialPassRows;
         }
@@ -138,6 +140,7 @@ public:
         o.quiet = true;
         o.visibleSupersampling = a_.emitterSupersampling;
         o.edgeSamples = a_.edgeSamples;
+        o.demodulate = parseDemodulation(a_.demodulate);
         if (method == "pt")
             (void)renderPt(ctx_, scene_, o);
         else
@@ -409,6 +412,10 @@ Subcommand addConvergeCommand(CLI::App& app) {
                   "crosses (as gdpt render; 0 = off)")
         ->capture_default_str()
         ->check(CLI::Range(0u, kMaxEdgeSamples));
+    c->add_option("--demodulate", a->demodulate,
+                  "G-PT methods: first-hit texture demodulation (as gdpt render: auto, on, off)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"auto", "on", "off"}));
     c->add_option("--width", a->width, "Image width")->capture_default_str()->check(CLI::Range(1, 16384));
     c->add_option("--height", a->height, "Image height")->capture_default_str()->check(CLI::Range(1, 16384));
     c->add_option("--target", a->target, "relMSE for the time-to-reach figure (default: the first method's error at "

@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <vector>
 
+#include "render/gpt_renderer.h"
+
 namespace gdpt {
 namespace {
 
@@ -85,6 +87,7 @@ ExrAttributes renderIdentity(const RenderArgs& args, const Scene& scene, std::ui
     if (args.method == "gpt") {
         id["shift_threshold"] = exact(args.shiftThreshold);
         id["edge_samples"] = std::to_string(args.edgeSamples);
+        id["demodulate"] = demodulates(scene, parseDemodulation(args.demodulate)) ? "on" : "off";
     }
     return id;
 }

@@ -1,7 +1,8 @@
 // solve_command.cpp — `gdpt solve`: screened Poisson reconstruction of a gradient-domain
 // render on the GPU. Reads the primal/dx/dy (and optional direct, var_*) layers of a gdpt
 // EXR, or separate --primal/--dx/--dy EXR files, and writes the final image (reconstruction
-// + direct) in the default channels plus a `recon` layer (tmp + rename).
+// + direct; modulation × reconstruction + direct where the EXR has the `modulation` layer of a
+// demodulated render) in the default channels plus a `recon` layer (tmp + rename).
 #include <cstdio>
 #include <memory>
 
@@ -59,7 +60,7 @@ int runSolve(const SolveArgs& a) {
 
     std::vector<NamedLayer> layers;
     Image primal, dx, dy;
-    const Image *direct = nullptr, *varP = nullptr, *varX = nullptr, *varY = nullptr;
+    const Image *direct = nullptr, *modulation = nullptr, *varP = nullptr, *varX = nullptr, *varY = nullptr;
     if (separate) {
         primal = readExrLayer(a.primal);
         dx = readExrLayer(a.dx);
@@ -79,10 +80,11 @@ int runSolve(const SolveArgs& a) {
         dx = need("dx");
         dy = need("dy");
         direct = findLayer(layers, "direct");
+        modulation = findLayer(layers, "modulation");
         varP = findLayer(layers, "var_primal");
         varX = findLayer(layers, "var_dx");
         varY = findLayer(layers, "var_dy");
-        for (const Image* im : {direct, varP, varX, varY})
+        for (const Image* im : {direct, modulation, varP, varX, varY})
             if (im && !im->sameSize(primal)) throw Error(a.input + ": layers differ in size");
     }
     if (needsVariance(o.method) && !(varP && varX && varY))
@@ -112,9 +114,12 @@ int runSolve(const SolveArgs& a) {
         progress.finish(std::to_string(report.iterations) + " iterations");
     }
     Image final = recon;
-    if (direct)
-        for (int c = 0; c < 3; ++c)
-            for (std::size_t i = 0; i < final.pixelCount(); ++i) final.plane(c)[i] += direct->plane(c)[i];
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < final.pixelCount(); ++i) {
+            float& v = final.plane(c)[i];
+            if (modulation) v *= modulation->plane(c)[i];
+            if (direct) v += direct->plane(c)[i];
+        }
     writeExr(a.output, {{"", final}, {"recon", recon}});
     if (!a.quiet) {
         std::fprintf(

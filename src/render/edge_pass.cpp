@@ -31,21 +31,25 @@ std::uint32_t edgeSampleSeed(std::uint32_t seed) {
 }
 
 EdgePass::EdgePass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize wg,
-                   std::uint32_t samplesPerSpp, vk::PipelineCreation creation)
+                   std::uint32_t samplesPerSpp, vk::PipelineCreation creation, bool maskNeeded)
     : ctx_(ctx),
       width_(scene.width()),
       height_(scene.height()),
       samplesPerSpp_(checkedFactor(samplesPerSpp)),
+      maskNeeded_(maskNeeded),
       // Disabled: 16-byte placeholders.
       maskBuffer_(ctx, enabled() ? std::uint64_t{width_} * height_ * sizeof(std::uint32_t) : 0, "edge mask"),
+      probeBuffer_(ctx, enabled() ? std::uint64_t{width_} * height_ * sizeof(gpu::EdgeProbe) : 0,
+                   "edge probe"),
       list_(ctx, 0, "edge list") {
     if (!enabled()) return;
     ctx.checkStorageBufferSize(maskBuffer_.size(), "the edge mask of a " + std::to_string(width_) + "x" +
                                                        std::to_string(height_) + " image");
-    vk::KernelDesc d =
-        scene.kernelDesc(vk::kernelDesc("edge", GDPT_KERNEL_SPIRV(edge)), wg, {gpu::kBindGptEdgeMask}, 0);
+    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("edge", GDPT_KERNEL_SPIRV(edge)), wg,
+                                        {gpu::kBindGptEdgeMask, gpu::kBindGptEdgeProbe}, 0);
     kernel_.emplace(ctx, d, creation);
     kernel_->bind(gpu::kBindGptEdgeMask, maskBuffer_);
+    kernel_->bind(gpu::kBindGptEdgeProbe, probeBuffer_);
 }
 
 void EdgePass::attach(const SceneGpu& scene) {
@@ -68,6 +72,7 @@ void EdgePass::find(vk::CommandStream& stream) {
     stream.setWhat("edge probe (" + std::to_string(width_) + "x" + std::to_string(height_) + ")");
     stream.submitAndWait();
     mask_ = maskBuffer_.downloadVector<std::uint32_t>(std::size_t{width_} * height_);
+    if (maskNeeded_) probes_ = probeBuffer_.downloadVector<gpu::EdgeProbe>(std::size_t{width_} * height_);
     std::vector<std::uint32_t> list;
     for (std::uint32_t i = 0; i < mask_.size(); ++i)
         if (mask_[i] != 0) list.push_back(i);

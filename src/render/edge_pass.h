@@ -11,6 +11,7 @@
 #include <optional>
 #include <vector>
 
+#include "gpt_shared.h"
 #include "render/edge_options.h"
 #include "render/scene_gpu.h"
 #include "vk/buffer.h"
@@ -25,14 +26,16 @@ class CommandStream;
 
 class EdgePass {
 public:
-    // samplesPerSpp in [0, kMaxEdgeSamples]; 0 disables the pass (no pipeline, no pixels).
+    // samplesPerSpp in [0, kMaxEdgeSamples]; 0 without maskNeeded disables the pass (no
+    // pipeline, no pixels). maskNeeded: probe for mask() even without extra samples (G-PT's
+    // first-hit demodulation keeps away from the edges).
     EdgePass(const vk::Context& ctx, const SceneSpec& spec, WorkgroupSize wg, std::uint32_t samplesPerSpp,
-             vk::PipelineCreation creation);
+             vk::PipelineCreation creation, bool maskNeeded = false);
     void attach(const SceneGpu& scene);
     // Waits for a pipeline created in the background; the seconds waited.
     double waitForPipeline() const { return kernel_ ? kernel_->wait() : 0.0; }
 
-    [[nodiscard]] bool enabled() const { return samplesPerSpp_ > 0; }
+    [[nodiscard]] bool enabled() const { return samplesPerSpp_ > 0 || maskNeeded_; }
     [[nodiscard]] std::uint32_t samplesPerSpp() const { return samplesPerSpp_; }
     // Adds the list binding (kBindGptEdgeList) to a kernel's descriptor.
     static void configure(vk::KernelDesc& desc);
@@ -44,17 +47,22 @@ public:
     void find(vk::CommandStream& stream);
     // Edge pixels found (0 before find() or when disabled).
     [[nodiscard]] std::uint32_t count() const { return count_; }
-    // The per-pixel mask of the last find() (1 = edge), for tests; empty before.
+    // The per-pixel mask of the last find() (1 = edge); empty before.
     [[nodiscard]] const std::vector<std::uint32_t>& mask() const { return mask_; }
+    // What each pixel's first probe ray hit (with maskNeeded; empty before find() or without).
+    [[nodiscard]] const std::vector<gpu::EdgeProbe>& probes() const { return probes_; }
 
 private:
     const vk::Context& ctx_;
     std::uint32_t width_, height_;
     std::uint32_t samplesPerSpp_;
+    bool maskNeeded_;
     std::optional<vk::Kernel> kernel_;
     vk::Buffer maskBuffer_;
+    vk::Buffer probeBuffer_;
     vk::Buffer list_;
     std::vector<std::uint32_t> mask_;
+    std::vector<gpu::EdgeProbe> probes_;
     std::uint32_t count_ = 0;
     bool found_ = false;
 };

@@ -1,6 +1,8 @@
 #include "render/gpt_pass.h"
 
 #include <algorithm>
+#include <cmath>
+#include <glm/glm.hpp>
 #include <string>
 
 #include "gpt.spv.h"
@@ -40,14 +42,15 @@ bool splitBounceFor(const vk::DeviceInfo& device, GptPassOptions::SplitBounce s)
 }
 
 vk::KernelDesc gptDesc(const SceneSpec& scene, WorkgroupSize wg, bool halfVector, bool splitBounce,
-                       const VisiblePass& visible) {
-    std::vector<std::uint32_t> extra = {gpu::kBindCounters};
+                       bool demodulate, const VisiblePass& visible) {
+    std::vector<std::uint32_t> extra = {gpu::kBindCounters, gpu::kBindGptDemodMask, gpu::kBindGptModulation};
     for (std::uint32_t i = 0; i < kNumStats; ++i) extra.push_back(gpu::kBindGptCentral + i);
     vk::KernelDesc d = scene.kernelDesc(splitBounce ? vk::kernelDesc("gpt", GDPT_KERNEL_SPIRV(gpt_split))
                                                     : vk::kernelDesc("gpt", GDPT_KERNEL_SPIRV(gpt)),
                                         wg, extra, sizeof(gpu::GptFrameParams));
     for (auto& [id, value] : d.specConstants)
         if (id == gpu::kSpecHasGlossy) value = halfVector ? 1u : 0u;
+    d.specConstants.push_back({gpu::kSpecGptDemodulate, demodulate ? 1u : 0u});
     visible.configure(d);
     EdgePass::configure(d);
     return d;
@@ -75,6 +78,46 @@ bool splitBounceDefault(const vk::DeviceInfo& device) {
     return device.lavapipeBeforeMesa23;
 }
 
+bool demodulationApplies(const Scene& scene) {
+    for (const gpu::Material& m : scene.materials)
+        if (m.baseColorTex >= 0 && m.metallic == 0.0f && m.specular == 0.0f && m.metallicRoughnessTex < 0)
+            return true;
+    return false;
+}
+
+namespace {
+// edge.comp's test between two probe points, applied to two pixels' first probes.
+bool sameSurface(const gpu::EdgeProbe& a, const gpu::EdgeProbe& b) {
+    if (a.hit != b.hit) return false;
+    if (a.hit == 0) return true;
+    if (a.material != b.material) return false;
+    const glm::vec3 na = a.normal, e = b.position - a.position;
+    if (glm::dot(na, b.normal) < gpu::kEdgeNormalCos) return false;
+    const float off = glm::dot(na, e);
+    return std::abs(off) <= gpu::kEdgeTangentSlope * glm::length(e - off * na);
+}
+}  // namespace
+
+std::vector<std::uint32_t> demodulationMask(const std::vector<std::uint32_t>& edgeMask,
+                                            const std::vector<gpu::EdgeProbe>& probes, std::uint32_t width,
+                                            std::uint32_t height) {
+    const std::size_t n = std::size_t{width} * height;
+    GDPT_CHECK(edgeMask.size() == n && probes.size() == n);
+    std::vector<std::uint32_t> out(n, 0u);
+    for (std::uint32_t y = 0; y < height; ++y)
+        for (std::uint32_t x = 0; x < width; ++x) {
+            const std::size_t p = std::size_t{y} * width + x;
+            bool safe = true;
+            for (std::uint32_t v = y > 0 ? y - 1 : 0; safe && v <= std::min(y + 1, height - 1); ++v)
+                for (std::uint32_t u = x > 0 ? x - 1 : 0; safe && u <= std::min(x + 1, width - 1); ++u) {
+                    const std::size_t q = std::size_t{v} * width + u;
+                    safe = edgeMask[q] == 0 && sameSurface(probes[p], probes[q]);
+                }
+            out[p] = safe ? 1u : 0u;
+        }
+    return out;
+}
+
 GptPass::GptPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg, GptPassOptions options)
     : GptPass(ctx, scene.spec(), wg, options, vk::PipelineCreation::Now) {
     attach(scene);
@@ -90,11 +133,16 @@ GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize w
       splitBounce_(splitBounceFor(ctx.info(), options.splitBounce)),
       counters_(ctx, sizeof(gpu::Counters), "gpt counters"),
       visible_(ctx, scene, wg, options.visibleSupersampling, counters_, creation),
-      edges_(ctx, scene, wg, options.edgeSamples, creation),
-      kernel_(ctx, gptDesc(scene, wg, halfVector_, splitBounce_, visible_), creation),
+      edges_(ctx, scene, wg, options.edgeSamples, creation, options.demodulate),
+      kernel_(ctx, gptDesc(scene, wg, halfVector_, splitBounce_, options.demodulate, visible_), creation),
       resolveKernel_(ctx, resolveDesc(wg, visible_), creation),
       stats_(makeStats(ctx, std::uint64_t{width_} * height_)),
-      resolved_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::GptResolved), "gpt resolved") {
+      resolved_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::GptResolved), "gpt resolved"),
+      // Without demodulation: 16-byte placeholders.
+      demodMask_(ctx, options.demodulate ? std::uint64_t{width_} * height_ * sizeof(std::uint32_t) : 0,
+                 "gpt demodulation mask"),
+      modulation_(ctx, options.demodulate ? std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats) : 0,
+                  "gpt modulation") {
     const std::string what = " of a " + std::to_string(width_) + "x" + std::to_string(height_) + " image";
     ctx.checkStorageBufferSize(stats_[0].size(), "each G-PT per-pixel statistics buffer" + what);
     ctx.checkStorageBufferSize(resolved_.size(), "the resolved G-PT images" + what);
@@ -104,6 +152,9 @@ GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize w
         resolveKernel_.bind(gpu::kBindGptCentral + i, stats_[i]);
     }
     resolveKernel_.bind(gpu::kBindGptResolved, resolved_);
+    kernel_.bind(gpu::kBindGptDemodMask, demodMask_);  // all 0 (no pixel) until findEdges()
+    kernel_.bind(gpu::kBindGptModulation, modulation_);
+    demodMask_.zero();
     visible_.bindTo(kernel_);
     visible_.bindTo(resolveKernel_);
     edges_.bindTo(kernel_);
@@ -123,10 +174,18 @@ double GptPass::waitForPipelines() const {
 void GptPass::findEdges(vk::CommandStream& stream) {
     edges_.find(stream);
     edges_.bindTo(kernel_);
+    if (options_.demodulate && !edges_.mask().empty()) {
+        const std::vector<std::uint32_t> mask =
+            demodulationMask(edges_.mask(), edges_.probes(), width_, height_);
+        demodMask_.uploadVector(mask);
+        demodulatedPixels_ = 0;
+        for (std::uint32_t v : mask) demodulatedPixels_ += v;
+    }
 }
 
 void GptPass::reset() {
     for (auto& b : stats_) b.zero();
+    modulation_.zero();
     counters_.zero();
     visible_.reset();
 }
@@ -183,18 +242,22 @@ std::vector<std::vector<gpu::PixelStats>> GptPass::downloadStats() const {
     for (const auto& b : stats_)
         out.push_back(b.downloadVector<gpu::PixelStats>(std::size_t{width_} * height_));
     out.push_back(visible_.downloadStats());
+    if (options_.demodulate)
+        out.push_back(modulation_.downloadVector<gpu::PixelStats>(std::size_t{width_} * height_));
     return out;
 }
 
 void GptPass::uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats) {
     const std::size_t pixels = std::size_t{width_} * height_;
-    bool sizesMatch = stats.size() == stats_.size() + 1;
+    const std::size_t expected = stats_.size() + 1 + (options_.demodulate ? 1 : 0);
+    bool sizesMatch = stats.size() == expected;
     for (std::size_t i = 0; sizesMatch && i < stats.size(); ++i) sizesMatch = stats[i].size() == pixels;
     if (!sizesMatch)
-        throw Error("gpt pixel statistics: expected " + std::to_string(stats_.size() + 1) + " buffers of " +
+        throw Error("gpt pixel statistics: expected " + std::to_string(expected) + " buffers of " +
                     std::to_string(pixels) + " entries");
     for (std::size_t i = 0; i < stats_.size(); ++i) stats_[i].uploadVector(stats[i]);
-    visible_.uploadStats(stats.back());
+    visible_.uploadStats(stats[stats_.size()]);
+    if (options_.demodulate) modulation_.uploadVector(stats.back());
 }
 
 GptImages GptPass::readback() const {
@@ -214,6 +277,14 @@ GptImages GptPass::readback() const {
             out.varDy.plane(c)[i] = r.varDy[c];
             out.varDirect.plane(c)[i] = r.varDirect[c];
         }
+    }
+    if (options_.demodulate) {
+        // m̄ per pixel; 1 where no sample has arrived (nothing to modulate there).
+        const auto m = modulation_.downloadVector<gpu::PixelStats>(px.size());
+        out.modulation = Image(w, h, 1.0f);
+        for (std::size_t i = 0; i < m.size(); ++i)
+            if (m[i].count > 0)
+                for (int c = 0; c < 3; ++c) out.modulation.plane(c)[i] = m[i].mean[c];
     }
     return out;
 }

@@ -14,6 +14,7 @@
 #include "render/edge_pass.h"
 #include "render/pt_pass.h"
 #include "render/visible_pass.h"
+#include "scene/scene.h"
 #include "vk/buffer.h"
 #include "vk/context.h"
 #include "vk/kernel.h"
@@ -40,7 +41,24 @@ struct GptPassOptions {
     // Extra camera samples per camera sample in the pixels a geometric edge crosses
     // (edge_pass.h; 0 = off).
     std::uint32_t edgeSamples = kDefaultEdgeSamples;
+    // First-hit texture demodulation (gpt.comp, kSpecGptDemodulate) in the pixels farther
+    // than one pixel from every edge the edge probe finds; GptImages::modulation then holds
+    // m̄ and primal/dx/dy are of J = I / m̄.
+    bool demodulate = false;
 };
+
+// Whether first-hit demodulation can act on a scene: some material has a base-colour texture
+// and a Lambertian-only BSDF (the rule of gpt.comp's firstHitModulation).
+bool demodulationApplies(const Scene& scene);
+
+// The pixels where gpt.comp demodulates: 1 where every pixel q of the 3x3 neighbourhood of p
+// (p included) holds no edge (edgeMask 0) and q's probe saw the same surface as p's (both
+// missed, or the same material with edge.comp's normal and tangent-plane tests passed), else
+// 0. The neighbour test catches the edges that lie between two pixels' probe points, such as
+// an axis-aligned silhouette crossing a pixel near its border.
+std::vector<std::uint32_t> demodulationMask(const std::vector<std::uint32_t>& edgeMask,
+                                            const std::vector<gpu::EdgeProbe>& probes, std::uint32_t width,
+                                            std::uint32_t height);
 
 // Whether the split bounce loop pays on this device: lavapipe with Mesa before 23, which runs
 // every branch under lane masks (15-25 % faster samples there); elsewhere the single loop,
@@ -48,9 +66,11 @@ struct GptPassOptions {
 // creation time (bench/RESULTS.md, fourth session).
 bool splitBounceDefault(const vk::DeviceInfo& device);
 
-// The resolved images (see gpt_resolve.comp for the estimators).
+// The resolved images (see gpt_resolve.comp for the estimators). With demodulation, primal,
+// dx, dy and their variances are of J = I / m̄ and `modulation` is m̄ (the final image is
+// modulation × reconstruction + direct); else `modulation` is empty.
 struct GptImages {
-    Image primal, dx, dy, direct, varPrimal, varDx, varDy, varDirect;
+    Image primal, dx, dy, direct, varPrimal, varDx, varDy, varDirect, modulation;
 };
 
 class GptPass {
@@ -84,13 +104,16 @@ public:
     // Reads the resolved images (after the fence of a resolve()).
     [[nodiscard]] GptImages readback() const;
     // The raw per-pixel statistics of the 10 buffers, in binding order, then the supersampled
-    // visible emission's (after the fence), and their replacement (before the next record())
-    // to continue a checkpointed render.
+    // visible emission's, then (with demodulation) the modulation's (after the fence), and
+    // their replacement (before the next record()) to continue a checkpointed render.
     [[nodiscard]] std::vector<std::vector<gpu::PixelStats>> downloadStats() const;
     void uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats);
     // Whether the half-vector branch is compiled in (kHasGlossy as specialised).
     [[nodiscard]] bool halfVectorCompiled() const { return halfVector_; }
     [[nodiscard]] bool splitBounceCompiled() const { return splitBounce_; }
+    [[nodiscard]] bool demodulating() const { return options_.demodulate; }
+    // Pixels marked for demodulation by the last findEdges() (0 before).
+    [[nodiscard]] std::uint32_t demodulatedPixels() const { return demodulatedPixels_; }
     [[nodiscard]] const VisiblePass& visible() const { return visible_; }
     [[nodiscard]] const EdgePass& edges() const { return edges_; }
 
@@ -111,6 +134,9 @@ private:
     // central, neighbor 0..3, gradient 0..3, direct (binding kBindGptCentral + index).
     std::array<vk::Buffer, 10> stats_;
     vk::Buffer resolved_;
+    vk::Buffer demodMask_;   // uint per pixel (16-byte placeholder without demodulation)
+    vk::Buffer modulation_;  // PixelStats per pixel (placeholder without demodulation)
+    std::uint32_t demodulatedPixels_ = 0;
 };
 
 }  // namespace gdpt

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "render/batch_loop.h"
+#include "util/error.h"
 #include "util/timer.h"
 #include "vk/commands.h"
 #include "vk/context.h"
@@ -13,6 +14,28 @@ namespace gdpt {
 
 RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const RenderOptions& options) {
     return renderGpt(ctx, scene, options, GptPassOptions{});
+}
+
+Demodulation parseDemodulation(const std::string& text) {
+    if (text == "auto") return Demodulation::Auto;
+    if (text == "on") return Demodulation::On;
+    if (text == "off") return Demodulation::Off;
+    throw UsageError("--demodulate '" + text + "' must be auto, on or off");
+}
+
+bool demodulates(const Scene& scene, Demodulation d) {
+    return d == Demodulation::On || (d == Demodulation::Auto && demodulationApplies(scene));
+}
+
+Image gptFinal(const RenderResultGpt& result, const Image& recon) {
+    Image out = recon;
+    const bool modulate = !result.modulation.empty();
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < out.pixelCount(); ++i)
+            out.plane(c)[i] =
+                (modulate ? result.modulation.plane(c)[i] * recon.plane(c)[i] : recon.plane(c)[i]) +
+                result.direct.plane(c)[i];
+    return out;
 }
 
 RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const RenderOptions& options,
@@ -26,6 +49,7 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     gpt.shiftThreshold = options.scene.shiftThreshold;
     gpt.visibleSupersampling = options.visibleSupersampling;
     gpt.edgeSamples = options.edgeSamples;
+    gpt.demodulate = demodulates(scene, options.demodulate);
     SceneSpec spec(scene, options.scene);
     GptPass pass(ctx, spec, options.workgroup, gpt, vk::PipelineCreation::Background);
     SceneGpu sceneGpu(ctx, scene, options.scene, std::move(spec));
@@ -61,8 +85,11 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
         GptImages images = pass.readback();
         state.preview = std::move(images.primal);
         for (int c = 0; c < 3; ++c)
-            for (std::size_t i = 0; i < state.preview.pixelCount(); ++i)
-                state.preview.plane(c)[i] += images.direct.plane(c)[i];
+            for (std::size_t i = 0; i < state.preview.pixelCount(); ++i) {
+                float& v = state.preview.plane(c)[i];
+                if (!images.modulation.empty()) v *= images.modulation.plane(c)[i];
+                v += images.direct.plane(c)[i];
+            }
     };
 
     runBatchLoop(options, "render gpt", total, stats,
@@ -92,13 +119,16 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     result.varDx = std::move(images.varDx);
     result.varDy = std::move(images.varDy);
     result.varDirect = std::move(images.varDirect);
+    result.modulation = std::move(images.modulation);
     stats.readbackMs = phase.ms();
     const gpu::VisibleCounter visible = pass.visible().report();
     stats.visibleSupersampling = pass.visible().samplesPerSpp();
     stats.visibleRaysPerSample = visible.raysPerSample;
     stats.visibleRefinedPixels = visible.refinedPixels;
     stats.edgeSamples = pass.edges().samplesPerSpp();
-    stats.edgePixels = pass.edges().count();
+    stats.edgePixels = stats.edgeSamples > 0 ? pass.edges().count() : 0;
+    stats.demodulated = pass.demodulating();
+    stats.demodulatedPixels = pass.demodulatedPixels();
     stats.kernels = timer.totals();
     return result;
 }

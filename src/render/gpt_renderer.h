@@ -4,6 +4,8 @@
 // per-pixel variances of the estimates.
 #pragma once
 
+#include <string>
+
 #include "render/gpt_pass.h"
 #include "render/renderer.h"
 
@@ -18,6 +20,10 @@ struct RenderResultGpt {
     Image varDx;      // variance of the dx estimate
     Image varDy;      // variance of the dy estimate
     Image varDirect;  // variance of the direct estimate
+    // With demodulation (stats.demodulated): m̄, the pixel mean of the first-hit modulation;
+    // primal, dx, dy and their variances are then of J = I / m̄, and final = modulation ×
+    // reconstruction + direct (gptFinal). Empty without.
+    Image modulation;
     RenderStats stats;  // spp = camera samples per pixel (each = 1 base + 4 offset paths)
 };
 
@@ -25,6 +31,16 @@ struct RenderResultGpt {
 // options.timeBudget, seed, profile (per-kernel ms in stats.kernels: "gpt", "gpt_resolve"),
 // quiet, workgroup, maxBatchSpp and cancel, exactly as renderPt interprets them.
 RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const RenderOptions& options);
+
+// "auto" | "on" | "off"; throws gdpt::UsageError otherwise.
+Demodulation parseDemodulation(const std::string& text);
+
+// Whether renderGpt demodulates with these options on this scene.
+bool demodulates(const Scene& scene, Demodulation d);
+
+// The final image from a reconstruction of result's primal/dx/dy: modulation × recon + direct
+// (recon + direct without demodulation).
+Image gptFinal(const RenderResultGpt& result, const Image& recon);
 
 // Same, with G-PT-only settings (e.g. forcing the half-vector branch in for measurement).
 // gpt.shiftThreshold is overridden by options.scene.shiftThreshold.

@@ -27,6 +27,10 @@ class Context;
 // (megakernel, the default: measured faster on lavapipe) or a kernel per bounce stage.
 enum class Schedule { Megakernel, Wavefront };
 
+// G-PT's first-hit texture demodulation (render/gpt_pass.h): Auto = on where it can act
+// (demodulationApplies: a base-colour texture on a Lambertian-only material).
+enum class Demodulation { Auto, On, Off };
+
 struct RenderOptions {
     SceneGpuOptions scene;
     std::uint32_t spp = 16;        // samples per pixel (ignored when timeBudget > 0)
@@ -43,6 +47,8 @@ struct RenderOptions {
     // G-PT: extra camera samples per camera sample in the pixels a geometric edge crosses
     // (render/edge_pass.h); 0 = off. PT ignores it.
     std::uint32_t edgeSamples = kDefaultEdgeSamples;
+    // G-PT: first-hit texture demodulation (render/gpt_pass.h). PT ignores it.
+    Demodulation demodulate = Demodulation::Auto;
     std::uint32_t maxBatchSpp = 16;  // largest batch (samples per pixel per submission)
     const std::atomic<bool>* cancel = nullptr;  // set asynchronously to stop between batches
     // Continue from this state (its statistics and batch-schedule position) instead of from
@@ -82,6 +88,8 @@ struct RenderStats {
     std::uint32_t visibleRefinedPixels = 0;  // pixels it covered
     std::uint32_t edgeSamples = 0;  // G-PT: extra samples per camera sample in edge pixels (0 = off)
     std::uint32_t edgePixels = 0;   // G-PT: pixels a geometric edge crosses
+    bool demodulated = false;             // G-PT: first-hit texture demodulation was on
+    std::uint32_t demodulatedPixels = 0;  // G-PT: pixels it acted in (away from the edges)
     bool cancelled = false;
     std::map<std::string, vk::KernelTime> kernels;
     SceneFeatures features;
