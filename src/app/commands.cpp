@@ -372,6 +372,8 @@ int runInfo(const InfoArgs& args) {
                 f.hasTextures, f.hasPunctual, f.hasLightTris, f.hasEnv, f.hasGlossy, f.hasAlphaMask,
                 f.hasShadingNormals, f.hasSpecularLayer, visibleEmissionPossible(f),
                 spec ? spec->bvhRegisterStack() : 0u);
+    // G-PT's first-hit texture demodulation as --demodulate auto chooses it (gpt_pass.h).
+    std::printf("gpt variant: demodulate=%d\n", demodulationApplies(scene) ? 1 : 0);
     for (const auto& u : scene.unsupported) std::printf("  unsupported: %s\n", u.c_str());
     return 0;
 }

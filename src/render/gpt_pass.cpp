@@ -282,9 +282,14 @@ GptImages GptPass::readback() const {
         // m̄ per pixel; 1 where no sample has arrived (nothing to modulate there).
         const auto m = modulation_.downloadVector<gpu::PixelStats>(px.size());
         out.modulation = Image(w, h, 1.0f);
-        for (std::size_t i = 0; i < m.size(); ++i)
-            if (m[i].count > 0)
-                for (int c = 0; c < 3; ++c) out.modulation.plane(c)[i] = m[i].mean[c];
+        out.varModulation = Image(w, h, 0.0f);
+        for (std::size_t i = 0; i < m.size(); ++i) {
+            const double n = m[i].count;
+            for (int c = 0; c < 3 && n > 0; ++c) {
+                out.modulation.plane(c)[i] = m[i].mean[c];
+                if (n > 1) out.varModulation.plane(c)[i] = static_cast<float>(m[i].m2[c] / (n - 1.0) / n);
+            }
+        }
     }
     return out;
 }

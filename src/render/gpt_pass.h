@@ -67,10 +67,11 @@ std::vector<std::uint32_t> demodulationMask(const std::vector<std::uint32_t>& ed
 bool splitBounceDefault(const vk::DeviceInfo& device);
 
 // The resolved images (see gpt_resolve.comp for the estimators). With demodulation, primal,
-// dx, dy and their variances are of J = I / m̄ and `modulation` is m̄ (the final image is
-// modulation × reconstruction + direct); else `modulation` is empty.
+// dx, dy and their variances are of J = I / m̄, `modulation` is m̄ (the final image is
+// modulation × reconstruction + direct) and `varModulation` its variance (of the mean); else
+// both are empty.
 struct GptImages {
-    Image primal, dx, dy, direct, varPrimal, varDx, varDy, varDirect, modulation;
+    Image primal, dx, dy, direct, varPrimal, varDx, varDy, varDirect, modulation, varModulation;
 };
 
 class GptPass {

@@ -120,6 +120,7 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     result.varDy = std::move(images.varDy);
     result.varDirect = std::move(images.varDirect);
     result.modulation = std::move(images.modulation);
+    result.varModulation = std::move(images.varModulation);
     stats.readbackMs = phase.ms();
     const gpu::VisibleCounter visible = pass.visible().report();
     stats.visibleSupersampling = pass.visible().samplesPerSpp();

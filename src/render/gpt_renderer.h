@@ -24,6 +24,7 @@ struct RenderResultGpt {
     // primal, dx, dy and their variances are then of J = I / m̄, and final = modulation ×
     // reconstruction + direct (gptFinal). Empty without.
     Image modulation;
+    Image varModulation;  // its variance (of the mean); empty without demodulation
     RenderStats stats;  // spp = camera samples per pixel (each = 1 base + 4 offset paths)
 };
 

@@ -181,6 +181,15 @@ TEST_F(CheckpointRefusal, GptCheckpointWithOtherEdgeSamplesIsRefused) {
     expectRefused(c, kSize + "--spp 4 --seed 7 --method gpt --edge-samples 3", "edge_samples");
 }
 
+TEST_F(CheckpointRefusal, GptCheckpointWithOtherDemodulationIsRefused) {
+    // The Cornell box has no texture: auto is off there, on still changes the statistics kept.
+    const std::string c = path("d.exr");
+    const RunResult r = test::runGdpt("render " + kScene + kSize + "--spp 2 --seed 7 --method gpt --demodulate on "
+                                      "--quiet --checkpoint " + c + " -o " + path("d_out.exr"));
+    ASSERT_EQ(r.code, 0) << r.output;
+    expectRefused(c, kSize + "--spp 4 --seed 7 --method gpt --demodulate off", "demodulate");
+}
+
 TEST_F(CheckpointRefusal, CorruptOrForeignCheckpointIsRefused) {
     const std::string flags = kSize + "--spp 8 --seed 7";
     // Truncated.

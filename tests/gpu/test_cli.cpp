@@ -12,6 +12,7 @@
 
 #include "cli_runner.h"
 #include "image/exr_io.h"
+#include "image/metrics.h"
 
 namespace gdpt {
 namespace {
@@ -159,6 +160,43 @@ TEST_F(Cli, GptRenderReportsItsEdgeSamples) {
     EXPECT_EQ(render(" --edge-samples 65").code, 2);
 }
 
+// A textured scene demodulates by default: the JSON says where, the EXR gains the modulation
+// layer, and `gdpt solve` of that EXR multiplies its reconstruction by it again (the same
+// final image as the render's, up to the solver's float rounding); --demodulate off has none.
+TEST_F(Cli, GptRenderOfATexturedSceneDemodulatesAndSolveUsesItsModulation) {
+    const std::string textured = std::string(GDPT_SOURCE_DIR) + "/scenes/textured.gltf";
+    auto render = [&](const std::string& flags) {
+        return run("render " + textured + " --method gpt -o " + path("t.exr") +
+                   " --width 32 --height 32 --spp 2 --quiet --validate --json " + path("t.json") + flags);
+    };
+    auto demodulation = [&] {
+        std::ifstream in(path("t.json"));
+        return nlohmann::json::parse(in)["demodulation"];
+    };
+    auto hasModulation = [&] {
+        for (const NamedLayer& l : readExr(path("t.exr")))
+            if (l.name == "modulation") return true;
+        return false;
+    };
+    RunResult r = render("");
+    ASSERT_EQ(r.code, 0) << r.output;
+    nlohmann::json d = demodulation();
+    EXPECT_TRUE(d["on"].get<bool>());
+    EXPECT_GT(d["pixels"].get<int>(), 32 * 32 / 4);
+    EXPECT_LT(d["pixels"].get<int>(), 32 * 32) << "the box edges and the walls' corners stay out";
+    EXPECT_TRUE(hasModulation());
+    r = run("solve " + path("t.exr") + " --recon l1 --quiet -o " + path("s.exr"));
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_LT(relMse(readExrLayer(path("s.exr")), readExrLayer(path("t.exr"))), 1e-6);
+    r = render(" --demodulate off");
+    ASSERT_EQ(r.code, 0) << r.output;
+    d = demodulation();
+    EXPECT_FALSE(d["on"].get<bool>());
+    EXPECT_EQ(d["pixels"].get<int>(), 0);
+    EXPECT_FALSE(hasModulation());
+    EXPECT_EQ(render(" --demodulate sometimes").code, 2);
+}
+
 // `gdpt info` names the scene's features and the kernel variant it selects, including the
 // traversal stack: cornell_box's 36-triangle tree needs 4 entries (register stack of 8);
 // the procedural furnace sphere's 1280 triangles need 13 (register stack of 16).
@@ -171,6 +209,10 @@ TEST_F(Cli, InfoPrintsTheFeaturesAndTheKernelVariant) {
     const RunResult furnace = run("info " + std::string(GDPT_SOURCE_DIR) + "/scenes/furnace.gltf");
     ASSERT_EQ(furnace.code, 0) << furnace.output;
     EXPECT_NE(furnace.output.find("bvhRegisterStack=16]"), std::string::npos) << furnace.output;
+    EXPECT_NE(box.output.find("gpt variant: demodulate=0"), std::string::npos) << box.output;
+    const RunResult textured = run("info " + std::string(GDPT_SOURCE_DIR) + "/scenes/textured.gltf");
+    ASSERT_EQ(textured.code, 0) << textured.output;
+    EXPECT_NE(textured.output.find("gpt variant: demodulate=1"), std::string::npos) << textured.output;
 }
 
 // A 4096x4096 render: on a device whose maxStorageBufferRange cannot hold its per-pixel
