@@ -134,6 +134,15 @@ protected:
     }
     // Resuming with `flags` (default: the checkpoint's own settings) fails with exit 1, one
     // line naming `file` and containing `why`, and no output file.
+    // A 2-spp G-PT checkpoint written with `written` must not continue with `resumed`.
+    void expectGptOptionRefused(const std::string& written, const std::string& resumed, const std::string& why) {
+        const std::string c = path("g.exr");
+        const RunResult r = test::runGdpt("render " + kScene + kSize + "--spp 2 --seed 7 --method gpt " + written +
+                                          " --quiet --checkpoint " + c + " -o " + path("g_out.exr"));
+        ASSERT_EQ(r.code, 0) << r.output;
+        expectRefused(c, kSize + "--spp 4 --seed 7 --method gpt " + resumed, why);
+    }
+
     void expectRefused(const std::string& file, const std::string& flags, const std::string& why) {
         const std::string out = path("out.exr");
         const RunResult r =
@@ -174,20 +183,13 @@ TEST_F(CheckpointRefusal, CheckpointOfAnotherRenderIsRefused) {
 // G-PT records its edge samples per camera sample (render/edge_pass.h): a checkpoint
 // continues only with the same factor.
 TEST_F(CheckpointRefusal, GptCheckpointWithOtherEdgeSamplesIsRefused) {
-    const std::string c = path("g.exr");
-    const RunResult r = test::runGdpt("render " + kScene + kSize + "--spp 2 --seed 7 --method gpt --edge-samples 2 "
-                                      "--quiet --checkpoint " + c + " -o " + path("g_out.exr"));
-    ASSERT_EQ(r.code, 0) << r.output;
-    expectRefused(c, kSize + "--spp 4 --seed 7 --method gpt --edge-samples 3", "edge_samples");
+    expectGptOptionRefused("--edge-samples 2", "--edge-samples 3", "edge_samples");
 }
 
+// Demodulation keeps other statistics (gpt_pass.h); the Cornell box has no texture, so auto
+// is off there and on differs.
 TEST_F(CheckpointRefusal, GptCheckpointWithOtherDemodulationIsRefused) {
-    // The Cornell box has no texture: auto is off there, on still changes the statistics kept.
-    const std::string c = path("d.exr");
-    const RunResult r = test::runGdpt("render " + kScene + kSize + "--spp 2 --seed 7 --method gpt --demodulate on "
-                                      "--quiet --checkpoint " + c + " -o " + path("d_out.exr"));
-    ASSERT_EQ(r.code, 0) << r.output;
-    expectRefused(c, kSize + "--spp 4 --seed 7 --method gpt --demodulate off", "demodulate");
+    expectGptOptionRefused("--demodulate on", "--demodulate off", "demodulate");
 }
 
 TEST_F(CheckpointRefusal, CorruptOrForeignCheckpointIsRefused) {

@@ -73,15 +73,19 @@ TEST(DemodulationMask, KeepsOnlyPixelsWhoseNeighbourhoodShowsOneSurface) {
 
 class Demodulation : public test::GpuTest {};
 
+RenderOptions options(int size, std::uint32_t spp, std::uint32_t seed) {
+    RenderOptions o;
+    o.scene.width = o.scene.height = size;
+    o.spp = spp;
+    o.seed = seed;
+    o.quiet = true;
+    return o;
+}
+
 TEST_F(Demodulation, LeavesAnUntexturedSceneBitForBitAlone) {
     const Scene scene = makeCornellBox();
     ASSERT_FALSE(demodulationApplies(scene));
-    RenderOptions o;
-    o.scene.width = 24;
-    o.scene.height = 24;
-    o.spp = 2;
-    o.seed = 3;
-    o.quiet = true;
+    RenderOptions o = options(24, 2, 3);
     o.demodulate = gdpt::Demodulation::Off;
     const RenderResultGpt off = renderGpt(ctx(), scene, o);
     o.demodulate = gdpt::Demodulation::On;
@@ -131,13 +135,8 @@ Scene checkerUnderSky() {
 TEST_F(Demodulation, ModulatedPrimalOfATexturedPlaneUnderASkyMatchesThePathTracer) {
     const Scene scene = checkerUnderSky();
     ASSERT_TRUE(demodulationApplies(scene));
-    RenderOptions o;
-    o.scene.width = 48;
-    o.scene.height = 48;
+    RenderOptions o = options(48, 32, 11);
     o.scene.envRadiance = glm::vec3(1.0f);
-    o.quiet = true;
-    o.spp = 32;
-    o.seed = 11;
     const RenderResultGpt g = renderGpt(ctx(), scene, o);  // Auto: on
     ASSERT_TRUE(g.stats.demodulated);
     EXPECT_GT(g.stats.demodulatedPixels, 48u * 48u * 9 / 10);
