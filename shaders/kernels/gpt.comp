@@ -89,7 +89,6 @@ const ivec2 kOffsetDelta[4] = ivec2[4](ivec2(1, 0), ivec2(0, 1), ivec2(-1, 0), i
 // constant, because lavapipe spends that time on the dead loop too. The image is the same
 // bit for bit either way (bench/RESULTS.md, fourth session).
 
-// Offset i has a vertex of its own (NOT_CONNECTED); never in the fast form (general false).
 // A texture value below this (per channel) demodulates by this instead: keeps 1/m finite
 // where a texel is black (its samples then underestimate J a little).
 const float kMinModulation = 1.0 / 64.0;
@@ -104,6 +103,8 @@ vec3 firstHitModulation(SurfaceHit h, uint pixel) {
         return vec3(1.0);
     return max(sampleTexture(m.baseColorTex, h.uv).xyz, vec3(kMinModulation));
 }
+
+// Offset i has a vertex of its own (NOT_CONNECTED); never in the fast form (general false).
 bool ownVertex(OffsetPath o, bool general) { return general && o.state == kShiftNotConnected; }
 
 // Base + 4 offsets for one camera sample at pixelPos (continuous pixel coordinates).
