@@ -37,6 +37,7 @@ layout(set = 0, binding = kBindGptEdgeProbe, scalar) buffer EdgeProbeBuf { EdgeP
 #define GDPT_ANYHIT_FILTER(tri, u, v) alphaPasses(tri, u, v)
 #include "lib/bvh_traverse.glsl"
 #include "lib/camera.glsl"
+#include "lib/surface_rules.glsl"
 
 void main() {
     loadScene();
@@ -71,9 +72,7 @@ void main() {
         } else if (miss != miss0) {
             edge = true;
         } else if (!miss) {
-            vec3 e = p - p0;
-            edge = edge || material != material0 || dot(n, n0) < kEdgeNormalCos ||
-                   abs(dot(n0, e)) > kEdgeTangentSlope * length(e - dot(n0, e) * n0);
+            edge = edge || !probeHitsAgree(material0, p0, n0, material, p, n);
         }
     }
     uint pixel = y * scene.width + x;

@@ -77,6 +77,7 @@ const ivec2 kOffsetDelta[4] = ivec2[4](ivec2(1, 0), ivec2(0, 1), ivec2(-1, 0), i
 #include "lib/camera.glsl"
 #include "lib/visible_emission.glsl"
 #include "lib/gpt_path.glsl"
+#include "lib/surface_rules.glsl"
 
 // Split bounce loop (GDPT_GPT_SPLIT_BOUNCE: a second build of this kernel, gpt_split; the
 // host picks one per device, splitBounceDefault in gpt_pass.cpp). Once every live offset
@@ -99,8 +100,7 @@ const float kMinModulation = 1.0 / 64.0;
 vec3 firstHitModulation(SurfaceHit h, uint pixel) {
     if (!kDemodulate || demodMask[pixel] == 0u) return vec3(1.0);
     Material m = material(h.material);
-    if (m.baseColorTex < 0 || m.metallic != 0.0 || m.specular != 0.0 || m.metallicRoughnessTex >= 0)
-        return vec3(1.0);
+    if (!modulatesLambertian(m)) return vec3(1.0);
     return max(sampleTexture(m.baseColorTex, h.uv).xyz, vec3(kMinModulation));
 }
 

@@ -9,6 +9,7 @@
 #include "app/subcommand.h"
 #include "image/exr_io.h"
 #include "poisson/poisson_gpu.h"
+#include "render/gpt_renderer.h"
 #include "util/error.h"
 #include "util/progress.h"
 #include "util/timer.h"
@@ -113,14 +114,7 @@ int runSolve(const SolveArgs& a) {
         progress.update(1.0);
         progress.finish(std::to_string(report.iterations) + " iterations");
     }
-    Image final = recon;
-    for (int c = 0; c < 3; ++c)
-        for (std::size_t i = 0; i < final.pixelCount(); ++i) {
-            float& v = final.plane(c)[i];
-            if (modulation) v *= modulation->plane(c)[i];
-            if (direct) v += direct->plane(c)[i];
-        }
-    writeExr(a.output, {{"", final}, {"recon", recon}});
+    writeExr(a.output, {{"", gptFinal(recon, modulation, direct)}, {"recon", recon}});
     if (!a.quiet) {
         std::fprintf(
             stderr,

@@ -1,13 +1,12 @@
 #include "render/gpt_pass.h"
 
 #include <algorithm>
-#include <cmath>
-#include <glm/glm.hpp>
 #include <string>
 
 #include "gpt.spv.h"
 #include "gpt_split.spv.h"
 #include "gpt_resolve.spv.h"
+#include "lib/surface_rules.glsl"
 #include "render/scene_gpu.h"
 #include "util/error.h"
 #include "vk/commands.h"
@@ -79,22 +78,14 @@ bool splitBounceDefault(const vk::DeviceInfo& device) {
 }
 
 bool demodulationApplies(const Scene& scene) {
-    for (const gpu::Material& m : scene.materials)
-        if (m.baseColorTex >= 0 && m.metallic == 0.0f && m.specular == 0.0f && m.metallicRoughnessTex < 0)
-            return true;
-    return false;
+    return std::any_of(scene.materials.begin(), scene.materials.end(), gpu::modulatesLambertian);
 }
 
 namespace {
 // edge.comp's test between two probe points, applied to two pixels' first probes.
 bool sameSurface(const gpu::EdgeProbe& a, const gpu::EdgeProbe& b) {
     if (a.hit != b.hit) return false;
-    if (a.hit == 0) return true;
-    if (a.material != b.material) return false;
-    const glm::vec3 na = a.normal, e = b.position - a.position;
-    if (glm::dot(na, b.normal) < gpu::kEdgeNormalCos) return false;
-    const float off = glm::dot(na, e);
-    return std::abs(off) <= gpu::kEdgeTangentSlope * glm::length(e - off * na);
+    return a.hit == 0 || gpu::probeHitsAgree(a.material, a.position, a.normal, b.material, b.position, b.normal);
 }
 }  // namespace
 

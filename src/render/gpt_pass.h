@@ -41,9 +41,10 @@ struct GptPassOptions {
     // Extra camera samples per camera sample in the pixels a geometric edge crosses
     // (edge_pass.h; 0 = off).
     std::uint32_t edgeSamples = kDefaultEdgeSamples;
-    // First-hit texture demodulation (gpt.comp, kSpecGptDemodulate) in the pixels farther
-    // than one pixel from every edge the edge probe finds; GptImages::modulation then holds
-    // m̄ and primal/dx/dy are of J = I / m̄.
+    // First-hit texture demodulation (gpt.comp, kSpecGptDemodulate) in the pixels that
+    // demodulationMask keeps (away from the edge probe's edges and from neighbours whose probe
+    // saw another surface); GptImages::modulation then holds m̄ and primal/dx/dy are of
+    // J = I / m̄.
     bool demodulate = false;
 };
 

@@ -27,15 +27,19 @@ bool demodulates(const Scene& scene, Demodulation d) {
     return d == Demodulation::On || (d == Demodulation::Auto && demodulationApplies(scene));
 }
 
-Image gptFinal(const RenderResultGpt& result, const Image& recon) {
-    Image out = recon;
-    const bool modulate = !result.modulation.empty();
+Image gptFinal(const Image& image, const Image* modulation, const Image* direct) {
+    Image out = image;
     for (int c = 0; c < 3; ++c)
-        for (std::size_t i = 0; i < out.pixelCount(); ++i)
-            out.plane(c)[i] =
-                (modulate ? result.modulation.plane(c)[i] * recon.plane(c)[i] : recon.plane(c)[i]) +
-                result.direct.plane(c)[i];
+        for (std::size_t i = 0; i < out.pixelCount(); ++i) {
+            float& v = out.plane(c)[i];
+            if (modulation) v *= modulation->plane(c)[i];
+            if (direct) v += direct->plane(c)[i];
+        }
     return out;
+}
+
+Image gptFinal(const RenderResultGpt& result, const Image& recon) {
+    return gptFinal(recon, result.modulation.empty() ? nullptr : &result.modulation, &result.direct);
 }
 
 RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const RenderOptions& options,
@@ -82,14 +86,9 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     const auto snapshot = [&](SamplerState& state) {
         state.buffers = pass.downloadStats();
         resolveNow();
-        GptImages images = pass.readback();
-        state.preview = std::move(images.primal);
-        for (int c = 0; c < 3; ++c)
-            for (std::size_t i = 0; i < state.preview.pixelCount(); ++i) {
-                float& v = state.preview.plane(c)[i];
-                if (!images.modulation.empty()) v *= images.modulation.plane(c)[i];
-                v += images.direct.plane(c)[i];
-            }
+        const GptImages images = pass.readback();
+        state.preview = gptFinal(images.primal, images.modulation.empty() ? nullptr : &images.modulation,
+                                 &images.direct);
     };
 
     runBatchLoop(options, "render gpt", total, stats,

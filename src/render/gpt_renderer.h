@@ -39,8 +39,10 @@ Demodulation parseDemodulation(const std::string& text);
 // Whether renderGpt demodulates with these options on this scene.
 bool demodulates(const Scene& scene, Demodulation d);
 
-// The final image from a reconstruction of result's primal/dx/dy: modulation × recon + direct
-// (recon + direct without demodulation).
+// modulation × image + direct, per pixel and channel; a null modulation or direct is left out.
+// The final image from a reconstruction (or the primal) of a G-PT render's layers.
+Image gptFinal(const Image& image, const Image* modulation, const Image* direct);
+// The same for a reconstruction of result's primal/dx/dy, with its modulation (if any) and direct.
 Image gptFinal(const RenderResultGpt& result, const Image& recon);
 
 // Same, with G-PT-only settings (e.g. forcing the half-vector branch in for measurement).
