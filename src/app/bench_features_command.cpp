@@ -15,9 +15,8 @@
 #include "app/bench_util.h"
 #include "app/subcommand.h"
 #include "image/metrics.h"
-#include "render/features.h"
-#include "render/gpt_renderer.h"
-#include "render/renderer.h"
+#include "render/device_scene/features.h"
+#include "integrator/integrator.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
 #include "vk/context.h"
@@ -68,8 +67,8 @@ struct Variant {
 };
 
 // One render of `method` with the variant's generic features; returns samples/s and the
-// image (G-PT: primal + direct, the estimator before reconstruction).
-double renderOnce(const vk::Context& ctx, const Scene& scene, const BenchFeaturesArgs& a, bool gpt,
+// image (G-PT without reconstruction: primal + direct, the estimator the kernels compute).
+double renderOnce(const vk::Context& ctx, const Scene& scene, const BenchFeaturesArgs& a, const std::string& method,
                   std::uint32_t generic, std::uint32_t seed, Image* image) {
     RenderOptions ro;
     ro.scene.width = a.width;
@@ -78,24 +77,18 @@ double renderOnce(const vk::Context& ctx, const Scene& scene, const BenchFeature
     ro.spp = a.spp;
     ro.seed = seed;
     ro.quiet = true;
-    ro.maxBatchSpp = batchLimit(a.width, a.height, gpt);
-    if (!gpt) {
-        RenderResult r = renderPt(ctx, scene, ro);
-        if (image) *image = std::move(r.image);
-        return static_cast<double>(r.stats.pathsCompleted) / (r.stats.samplingMs * 1e-3);
-    }
-    GptPassOptions go;
-    go.forceHalfVector = (generic & (1u << gpu::kSpecHasGlossy)) != 0;
-    RenderResultGpt r = renderGpt(ctx, scene, ro, go);
-    if (image) *image = addImages(r.primal, r.direct);
-    return static_cast<double>(r.stats.pathsCompleted) / (r.stats.samplingMs * 1e-3);
+    MethodOptions m;
+    m.gpt.sampling.forceHalfVector = (generic & (1u << gpu::kSpecHasGlossy)) != 0;
+    m.gpt.reconstructions.clear();
+    RenderOutput out = makeIntegrator(method, m)->render(ctx, scene, ro);
+    if (image) *image = std::move(out.layers.front().image);
+    return static_cast<double>(out.stats.pathsCompleted) / (out.stats.samplingMs * 1e-3);
 }
 
 int runBenchFeatures(const BenchFeaturesArgs& a) {
     using nlohmann::json;
     const std::vector<std::string> methods = splitList(a.methods);
-    for (const std::string& m : methods)
-        if (m != "pt" && m != "gpt") throw UsageError("--methods: unknown method '" + m + "' (pt, gpt)");
+    for (const std::string& m : methods) (void)makeIntegrator(m);  // unknown names fail first
     vk::ContextOptions co;
     co.device = a.device;
     vk::Context ctx(co);
@@ -124,12 +117,12 @@ int runBenchFeatures(const BenchFeaturesArgs& a) {
             // land in the first repeat's sampling time.
             BenchFeaturesArgs warm = a;
             warm.spp = 1;
-            for (const Variant& v : variants) renderOnce(ctx, scene, warm, gpt, v.generic, 0, nullptr);
+            for (const Variant& v : variants) renderOnce(ctx, scene, warm, method, v.generic, 0, nullptr);
             for (int r = 0; r < a.repeats; ++r)
                 for (Variant& v : variants) {
                     std::fprintf(stderr, "gdpt bench-features: %s %s %s (repeat %d)\n", path.c_str(),
                                  method.c_str(), v.name.c_str(), r + 1);
-                    v.samplesPerS.push_back(renderOnce(ctx, scene, a, gpt, v.generic,
+                    v.samplesPerS.push_back(renderOnce(ctx, scene, a, method, v.generic,
                                                        static_cast<std::uint32_t>(r),
                                                        r == 0 ? &v.image : nullptr));
                 }

@@ -1,5 +1,5 @@
-// bench_util.h — small helpers shared by the benchmark and render subcommands: medians,
-// comma-separated lists, the deterministic batch size of a render, and text output.
+// bench_util.h — small helpers shared by the subcommands: medians, comma-separated lists,
+// and text output.
 #pragma once
 
 #include <algorithm>
@@ -28,17 +28,6 @@ inline std::vector<std::string> splitList(const std::string& text) {
     while (std::getline(in, item, ','))
         if (!item.empty()) out.push_back(item);
     return out;
-}
-
-// Largest batch (samples per pixel per submission) such that one batch is about 2^18
-// pixel-samples of PT work (G-PT: 2^16, it costs more per sample). Depends only on the
-// image size, so the batch schedule -- and hence the bits of the result -- is the same on
-// every run, and a batch stays well under a second on lavapipe, so an interrupt is served
-// promptly.
-inline std::uint32_t batchLimit(int width, int height, bool gpt) {
-    const std::uint64_t pixels = std::uint64_t(width) * std::uint64_t(height);
-    const std::uint64_t budget = gpt ? (1u << 16) : (1u << 18);
-    return static_cast<std::uint32_t>(std::clamp<std::uint64_t>(budget / pixels, 1, 16));
 }
 
 // A command's text output: stdout for "-", else the file, written atomically (tmp + rename).

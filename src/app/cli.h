@@ -7,8 +7,8 @@
 
 #include <glm/glm.hpp>
 
-#include "render/edge_options.h"
-#include "render/visible_options.h"
+#include "render/passes/edge_options.h"
+#include "render/passes/emitter_supersampling_options.h"
 
 namespace gdpt {
 
@@ -28,12 +28,11 @@ struct RenderArgs {
     std::string json;
     bool quiet = false;
     bool validate = false;
-    std::string method = "pt";
+    std::string method = "gpt";
     std::string workgroup = "8x8";
-    std::string schedule = "megakernel";
     float shiftThreshold = 0.001f;
     std::string splitBounce = "auto";  // G-PT: auto, on, off (GptPassOptions::SplitBounce)
-    std::uint32_t emitterSupersampling = kDefaultVisibleSupersampling;  // render/visible_pass.h
+    std::uint32_t emitterSupersampling = kDefaultEmitterSupersampling;  // render/passes/emitter_supersampling_pass.h
     std::uint32_t edgeSamples = kDefaultEdgeSamples;                    // G-PT: render/edge_pass.h
     std::string demodulate = "auto";  // G-PT: auto, on, off (Demodulation, render/gpt_pass.h)
     std::string recon = "l1";

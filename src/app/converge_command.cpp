@@ -17,14 +17,12 @@
 #include <nlohmann/json.hpp>
 
 #include "app/bench_util.h"
-#include "app/recon_reserve.h"
 #include "app/subcommand.h"
 #include "image/atomic_write.h"
 #include "image/exr_io.h"
 #include "image/metrics.h"
-#include "poisson/poisson_gpu.h"
-#include "render/gpt_renderer.h"
-#include "render/renderer.h"
+#include "integrator/integrator.h"
+#include "integrator/pt_sampler.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
 #include "util/timer.h"
@@ -49,7 +47,7 @@ struct ConvergeArgs {
     std::string output = "converge";
     std::string device;
     bool validate = false;
-    std::uint32_t emitterSupersampling = kDefaultVisibleSupersampling;
+    std::uint32_t emitterSupersampling = kDefaultEmitterSupersampling;
     std::uint32_t edgeSamples = kDefaultEdgeSamples;
     std::string demodulate = "auto";
 };
@@ -78,6 +76,9 @@ struct Run {
     ImageErrorStats error;
 };
 
+// One integrator per method, kept across runs (the G-PT solver compiles its pipelines once,
+// as in a long-running application; that one-time compilation is excluded from the timings,
+// like scene parsing).
 class Converger {
 public:
     Converger(const vk::Context& ctx, const Scene& scene, const ConvergeArgs& a) : ctx_(ctx), scene_(scene), a_(a) {}
@@ -87,44 +88,21 @@ public:
         Run r;
         r.method = method;
         r.budget = budget;
-        RenderOptions o;
-        o.scene.width = a_.width;
-        o.scene.height = a_.height;
+        Integrator& integrator = integratorFor(method);
+        RenderOptions o = options();
         o.seed = seed;
-        o.quiet = true;
-        o.visibleSupersampling = a_.emitterSupersampling;
-        o.edgeSamples = a_.edgeSamples;
-        o.demodulate = parseDemodulation(a_.demodulate);
-        // The reconstruction reserve is measured (once per method) before the clock starts:
-        // it is calibration, not part of the run.
-        const SolveOptions so = method == "pt" ? SolveOptions{} : solveOptions(method);
-        const double reserve = method == "pt" ? 0.0 : reconSeconds(method, so);
+        // The time the method needs after sampling (G-PT: the reconstruction) is measured
+        // before the clock starts: it is calibration, not part of the run. Sampling gets the
+        // rest.
+        const double reserve = integrator.reserveAfterSampling(ctx_, a_.width, a_.height);
+        o.timeBudget = reserve > 0.0 ? std::max(0.05 * budget, budget - reserve) : budget;
         Timer total;
-        Image result;
-        if (method == "pt") {
-            o.timeBudget = budget;
-            RenderResult res = renderPt(ctx_, scene_, o);
-            result = std::move(res.image);
-            r.spp = res.stats.spp;
-            r.partialPassRows = res.stats.partialPassRows;
-        } else {
-            // Sampling gets what is left after the (measured) reconstruction time.
-            o.timeBudget = std::max(0.05 * budget, budget - reserve);
-            o.maxBatchSpp = batchLimit(a_.width, a_.height, true);
-            RenderResultGpt g = renderGpt(ctx_, scene_, o);
-            Timer recon;
-            const Image solved = solve(g.primal, g.dx, g.dy, &g.varPrimal, &g.varDx, &g.varDy, so);
-            r.reconSeconds = recon.seconds();
-            // Real inputs can need more solver iterations than the synthetic estimate: later
-            // budgets of this method reserve the longest reconstruction seen so far.
-            double& longest = reconCache_[method];
-            longest = std::max(longest, r.reconSeconds);
-            result = gptFinal(g, solved);
-            r.spp = g.stats.spp;
-            r.partialPassRows = g.stats.partialPassRows;
-        }
+        const RenderOutput out = integrator.render(ctx_, scene_, o);
         r.seconds = total.seconds();
-        r.error = compareImages(result, reference);
+        r.reconSeconds = out.stats.reconstructionMs * 1e-3;
+        r.spp = out.stats.spp;
+        r.partialPassRows = out.stats.partialPassRows;
+        r.error = compareImages(out.image(), reference);
         return r;
     }
 
@@ -132,64 +110,41 @@ public:
     // dispatch (later processes hit Mesa's shader cache), which would otherwise land in the
     // first budget's sampling time (measured: a cold G-PT render at 13 k instead of
     // 117 k samples/s).
+    // A throwaway integrator, so that this render's reconstruction (its first, the slowest)
+    // is not the longest the kept one reserves for.
     void warmUp(const std::string& method) {
-        RenderOptions o;
-        o.scene.width = a_.width;
-        o.scene.height = a_.height;
+        RenderOptions o = options();
         o.spp = 1;
-        o.quiet = true;
-        o.visibleSupersampling = a_.emitterSupersampling;
-        o.edgeSamples = a_.edgeSamples;
-        o.demodulate = parseDemodulation(a_.demodulate);
-        if (method == "pt")
-            (void)renderPt(ctx_, scene_, o);
-        else
-            (void)renderGpt(ctx_, scene_, o);
+        (void)makeIntegrator(method, methodOptions())->render(ctx_, scene_, o);
     }
 
 private:
-    static SolveOptions solveOptions(const std::string& method) {
-        SolveOptions so;
-        if (method == "gpt-l1") so.method = Reconstruction::L1;
-        else if (method == "gpt-l2") so.method = Reconstruction::L2;
-        else if (method == "gpt-wl2") so.method = Reconstruction::WeightedL2;
-        else if (method == "gpt-wl1") so.method = Reconstruction::WeightedL1;
-        else throw UsageError("--methods: unknown method '" + method + "' (pt, gpt-l1, gpt-l2, gpt-wl2, gpt-wl1)");
-        return so;
+    RenderOptions options() const {
+        RenderOptions o;
+        o.scene.width = a_.width;
+        o.scene.height = a_.height;
+        o.quiet = true;
+        o.emitterSupersampling = a_.emitterSupersampling;
+        return o;
     }
 
-    // One solver for every run: its pipelines are compiled once, as in a long-running
-    // application (the one-time compilation is excluded from the timings, like scene parsing).
-    Image solve(const Image& primal, const Image& dx, const Image& dy, const Image* vp, const Image* vx,
-                const Image* vy, const SolveOptions& so) {
-        if (!solver_) solver_ = std::make_unique<PoissonSolverGpu>(ctx_, a_.width, a_.height);
-        PoissonInput in;
-        in.primal = &primal;
-        in.dx = &dx;
-        in.dy = &dy;
-        in.varPrimal = vp;
-        in.varDx = vx;
-        in.varDy = vy;
-        Image out;
-        solver_->solve(in, so, out);
-        return out;
+    Integrator& integratorFor(const std::string& method) {
+        auto it = integrators_.find(method);
+        if (it != integrators_.end()) return *it->second;
+        return *(integrators_[method] = makeIntegrator(method, methodOptions()));
     }
 
-    // Reconstruction time of `method` at this image size, measured once on synthetic noisy
-    // input (after a warm-up solve that compiles the pipelines), then raised to the longest
-    // real reconstruction of the method (run()).
-    double reconSeconds(const std::string& method, const SolveOptions& so) {
-        auto it = reconCache_.find(method);
-        if (it != reconCache_.end()) return it->second;
-        if (!solver_) solver_ = std::make_unique<PoissonSolverGpu>(ctx_, a_.width, a_.height);
-        return reconCache_[method] = calibrateReconSeconds(*solver_, so, /*warmUp=*/true);
+    MethodOptions methodOptions() const {
+        MethodOptions m;
+        m.gpt.sampling.edgeSamples = a_.edgeSamples;
+        m.gpt.sampling.demodulate = parseDemodulation(a_.demodulate);
+        return m;
     }
 
     const vk::Context& ctx_;
     const Scene& scene_;
     const ConvergeArgs& a_;
-    std::map<std::string, double> reconCache_;
-    std::unique_ptr<PoissonSolverGpu> solver_;
+    std::map<std::string, std::unique_ptr<Integrator>> integrators_;
 };
 
 void writePlot(const fs::path& dir, const std::vector<std::string>& methods, const json& summary) {
@@ -275,6 +230,8 @@ int runConverge(const ConvergeArgs& a) {
                     std::to_string(a.height) + " (use --width/--height)");
 
     const auto methods = splitList(a.methods);
+    if (methods.empty()) throw UsageError("--methods: no method given");
+    for (const std::string& m : methods) (void)makeIntegrator(m);  // unknown names fail before any render
     std::vector<double> times;
     for (const auto& t : splitList(a.times)) {
         try {
@@ -397,7 +354,7 @@ Subcommand addConvergeCommand(CLI::App& app) {
     c->add_option("scene", a->scene, "glTF 2.0 scene")->required()->check(CLI::ExistingFile);
     c->add_option("--reference", a->reference, "Converged reference EXR (same size and camera)")->check(CLI::ExistingFile);
     c->add_option("--make-reference", a->makeReference, "Render a PT reference with this many spp (cached by scene hash)");
-    c->add_option("--methods", a->methods, "Methods: pt, gpt-l1, gpt-l2, gpt-wl2, gpt-wl1")->capture_default_str();
+    c->add_option("--methods", a->methods, "Methods: pt, gpt (= gpt-l1), gpt-l1, gpt-l2, gpt-wl2, gpt-wl1")->capture_default_str();
     c->add_option("--times", a->times, "Time budgets in seconds (comma-separated)")->capture_default_str();
     c->add_option("--repeats", a->repeats, "Independent repeats per budget (median reported)")
         ->capture_default_str()
@@ -406,7 +363,7 @@ Subcommand addConvergeCommand(CLI::App& app) {
                   "Rays per camera sample at the edges of directly visible emission, every method "
                   "(as gdpt render; 0 = off)")
         ->capture_default_str()
-        ->check(CLI::Range(0u, kMaxVisibleSupersampling));
+        ->check(CLI::Range(0u, kMaxEmitterSupersampling));
     c->add_option("--edge-samples", a->edgeSamples,
                   "G-PT methods: extra camera samples per camera sample in the pixels a geometric edge "
                   "crosses (as gdpt render; 0 = off)")

@@ -9,7 +9,7 @@
 #include "app/subcommand.h"
 #include "image/exr_io.h"
 #include "poisson/poisson_gpu.h"
-#include "render/gpt_renderer.h"
+#include "integrator/gpt_sampler.h"
 #include "util/error.h"
 #include "util/progress.h"
 #include "util/timer.h"

@@ -14,7 +14,7 @@
 #include "bvh/traverse_cpu.h"
 #include "bvh/wide_bvh.h"
 #include "gpu_fixture.h"
-#include "render/scene_spec.h"
+#include "render/device_scene/scene_spec.h"
 #include "trace_rays.spv.h"
 #include "vk/buffer.h"
 #include "vk/commands.h"

@@ -28,7 +28,7 @@
 #include "gpu_fixture.h"
 #include "image/exr_io.h"
 #include "image/metrics.h"
-#include "render/renderer.h"
+#include "integrator/pt_sampler.h"
 #include "scene/gltf_loader.h"
 #include "stats_normal.h"
 

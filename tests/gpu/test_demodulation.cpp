@@ -22,9 +22,10 @@
 #include <vector>
 
 #include "gpu_fixture.h"
-#include "render/gpt_pass.h"
-#include "render/gpt_renderer.h"
-#include "render/renderer.h"
+#include "render/passes/gpt_pass.h"
+#include "integrator/gpt_sampler.h"
+#include "integrator/pt_sampler.h"
+#include "integrator/render_options.h"
 #include "scene/procedural.h"
 #include "scene_builders.h"
 #include "stats_normal.h"
@@ -86,10 +87,11 @@ TEST_F(Demodulation, LeavesAnUntexturedSceneBitForBitAlone) {
     const Scene scene = makeCornellBox();
     ASSERT_FALSE(demodulationApplies(scene));
     RenderOptions o = options(24, 2, 3);
-    o.demodulate = gdpt::Demodulation::Off;
-    const RenderResultGpt off = renderGpt(ctx(), scene, o);
-    o.demodulate = gdpt::Demodulation::On;
-    const RenderResultGpt on = renderGpt(ctx(), scene, o);
+    GptSamplingOptions g;
+    g.demodulate = gdpt::Demodulation::Off;
+    const RenderResultGpt off = renderGpt(ctx(), scene, o, g);
+    g.demodulate = gdpt::Demodulation::On;
+    const RenderResultGpt on = renderGpt(ctx(), scene, o, g);
     EXPECT_FALSE(off.stats.demodulated);
     EXPECT_TRUE(off.modulation.empty());
     ASSERT_TRUE(on.stats.demodulated);

@@ -27,8 +27,9 @@
 #include <gtest/gtest.h>
 
 #include "gpu_fixture.h"
-#include "render/gpt_renderer.h"
-#include "render/renderer.h"
+#include "integrator/gpt_sampler.h"
+#include "integrator/pt_sampler.h"
+#include "integrator/render_options.h"
 #include "scene/gltf_loader.h"
 #include "scene/procedural.h"
 #include "stats_normal.h"
@@ -294,9 +295,9 @@ TEST_F(GptRender, SplitBounceLoopGivesTheSameBitsAsTheSingleLoop) {
         RenderOptions o = renderOptions(20, 16, 6, 11);
         o.scene.shiftThreshold = c.threshold;
         o.scene.envRadiance = c.env;
-        GptPassOptions split;
+        GptSamplingOptions split;
         split.splitBounce = GptPassOptions::SplitBounce::On;
-        GptPassOptions single;
+        GptSamplingOptions single;
         single.splitBounce = GptPassOptions::SplitBounce::Off;
         const Scene& scene = *c.scene;
         const RenderResultGpt a = renderGpt(ctx(), scene, o, split);

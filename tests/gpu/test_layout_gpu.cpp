@@ -11,7 +11,7 @@
 #include "gdpt_shared.h"
 #include "gpu_fixture.h"
 #include "layout_probe.spv.h"
-#include "render/scene_spec.h"
+#include "render/device_scene/scene_spec.h"
 #include "table_probe.spv.h"
 #include "util/error.h"
 #include "vk/buffer.h"

@@ -8,7 +8,7 @@
 
 #include "gpu_fixture.h"
 #include "scene_builders.h"
-#include "render/renderer.h"
+#include "integrator/pt_sampler.h"
 
 namespace gdpt {
 namespace {

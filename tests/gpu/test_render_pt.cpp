@@ -8,9 +8,9 @@
 #include <gtest/gtest.h>
 
 #include "gpu_fixture.h"
-#include "render/batch_loop.h"
-#include "render/pt_pass.h"
-#include "render/renderer.h"
+#include "integrator/sampling_loop.h"
+#include "render/passes/pt_pass.h"
+#include "integrator/pt_sampler.h"
 #include "vk/commands.h"
 #include "scene/procedural.h"
 #include "stats_normal.h"

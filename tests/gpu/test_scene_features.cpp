@@ -8,10 +8,11 @@
 
 #include "gpu_fixture.h"
 #include "same_bits.h"
-#include "render/features.h"
-#include "render/gpt_renderer.h"
-#include "render/renderer.h"
-#include "render/scene_spec.h"
+#include "render/device_scene/features.h"
+#include "integrator/gpt_sampler.h"
+#include "integrator/pt_sampler.h"
+#include "integrator/render_options.h"
+#include "render/device_scene/scene_spec.h"
 #include "scene/gltf_loader.h"
 #include "scene/procedural.h"
 

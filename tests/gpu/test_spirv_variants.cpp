@@ -7,8 +7,9 @@
 
 #include "gpu_fixture.h"
 #include "same_bits.h"
-#include "render/gpt_renderer.h"
-#include "render/renderer.h"
+#include "integrator/gpt_sampler.h"
+#include "integrator/pt_sampler.h"
+#include "integrator/render_options.h"
 #include "scene/gltf_loader.h"
 #include "vk/kernel.h"
 #include "util/error.h"
@@ -51,9 +52,9 @@ TEST_F(SpirvVariantsGpu, OptimizedAndRawSpirvRenderTheSameImage) {
     RenderOptions o = renderOptions(24, 24, 2, 5);
     ::setenv("GDPT_SPIRV", "raw", 1);
     const Image ptRaw = renderPt(ctx(), scene, o).image;
-    GptPassOptions split;
+    GptSamplingOptions split;
     split.splitBounce = GptPassOptions::SplitBounce::On;
-    GptPassOptions single;
+    GptSamplingOptions single;
     single.splitBounce = GptPassOptions::SplitBounce::Off;
     const RenderResultGpt splitRaw = renderGpt(ctx(), scene, o, split);
     const RenderResultGpt singleRaw = renderGpt(ctx(), scene, o, single);

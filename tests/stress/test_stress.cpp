@@ -11,9 +11,10 @@
 
 #include "gpu_fixture.h"
 #include "image/metrics.h"
-#include "render/features.h"
-#include "render/gpt_renderer.h"
-#include "render/renderer.h"
+#include "render/device_scene/features.h"
+#include "integrator/gpt_sampler.h"
+#include "integrator/pt_sampler.h"
+#include "integrator/render_options.h"
 #include "scene/gltf_loader.h"
 #include "scene/procedural.h"
 

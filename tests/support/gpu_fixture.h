@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "render/renderer.h"
+#include "integrator/render_options.h"
 #include "vk/commands.h"
 #include "vk/context.h"
 #include "vk/kernel.h"

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "image/image.h"
-#include "render/gpt_renderer.h"
+#include "integrator/gpt_sampler.h"
 
 namespace gdpt::test {
 

@@ -1,4 +1,4 @@
-// sobol.glsl: the scrambled 2-D Sobol' points that emitter-silhouette supersampling uses;
+// sobol.glsl: the scrambled 2-D Sobol' points that emitter supersampling uses;
 // sampler.glsl: the padded, shuffled patterns of the path decisions built from them.
 // Checked against the definition of a (0,2)-sequence (every aligned block of 2^m points is
 // a (0,m,2)-net: one point in each elementary interval of every shape 2^a x 2^(m-a)), and
@@ -83,7 +83,7 @@ TEST(Sobol, EveryAlignedBlockIsANetForEveryScramble) {
 
 TEST(Sobol, EachScrambledPointIsUniform) {
     // Point index 5 (any fixed index) over 2^16 scramble seed pairs, 16 x 16 cells:
-    // expected 256 per cell. The seeds are hashed as in visible.comp: the scramble's first
+    // expected 256 per cell. The seeds are hashed as in emitter_supersampling.comp: the scramble's first
     // k digits depend on the seed's low k bits only, so seeds that share their low bits
     // (such as s·a + b and s·c + d) would give correlated coordinates.
     constexpr int kCells = 16;

@@ -1,0 +1,371 @@
+// render_command.cpp — `gdpt render SCENE`: parses the options, makes the integrator of
+// --method, renders, and writes the EXR (every layer), the PNG preview and the JSON summary.
+// Time budgets, checkpoints and interrupts are handled here; the method is the integrator's.
+#include <algorithm>
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "app/bench_util.h"
+#include "app/commands.h"
+#include "app/subcommand.h"
+#include "image/exr_io.h"
+#include "image/png_preview.h"
+#include "integrator/checkpoint.h"
+#include "integrator/integrator.h"
+#include "integrator/recon_reserve.h"
+#include "integrator/render_identity.h"
+#include "scene/gltf_loader.h"
+#include "util/error.h"
+#include "util/timer.h"
+#include "vk/context.h"
+
+namespace gdpt {
+namespace {
+
+using nlohmann::json;
+
+// Set by SIGINT/SIGTERM; the sampling loop stops at the next batch boundary.
+std::atomic<bool> gInterrupted{false};
+
+extern "C" void onInterrupt(int) { gInterrupted.store(true); }
+
+WorkgroupSize parseWorkgroup(const std::string& text) {
+    unsigned x = 0, y = 0;
+    char sep = 0;
+    std::istringstream in(text);
+    if (!(in >> x >> sep >> y) || sep != 'x' || x == 0 || y == 0 || x * y > 1024)
+        throw UsageError("--workgroup '" + text + "' must be WxH with W*H <= 1024, e.g. 8x8");
+    return {x, y};
+}
+
+std::string previewPath(const std::string& exrPath) {
+    const auto dot = exrPath.rfind('.');
+    const auto slash = exrPath.rfind('/');
+    const bool hasExt = dot != std::string::npos && (slash == std::string::npos || dot > slash);
+    return (hasExt ? exrPath.substr(0, dot) : exrPath) + ".png";
+}
+
+json kernelJson(const std::map<std::string, vk::KernelTime>& kernels, double frameMs) {
+    json k = json::object();
+    for (const auto& [name, t] : kernels)
+        k[name] = {{"count", t.count},
+                   {"total_ms", t.totalMs},
+                   {"ms_per_call", t.count ? t.totalMs / double(t.count) : 0.0},
+                   {"share", frameMs > 0 ? t.totalMs / frameMs : 0.0}};
+    return k;
+}
+
+void printProfile(const std::map<std::string, vk::KernelTime>& kernels) {
+    double total = 0.0;
+    for (const auto& [name, t] : kernels) total += t.totalMs;
+    std::fprintf(stderr, "%-24s %8s %12s %12s %7s\n", "kernel", "count", "total ms", "ms/call", "share");
+    for (const auto& [name, t] : kernels)
+        std::fprintf(stderr, "%-24s %8llu %12.3f %12.3f %6.1f%%\n", name.c_str(),
+                     static_cast<unsigned long long>(t.count), t.totalMs,
+                     t.count ? t.totalMs / double(t.count) : 0.0, total > 0 ? 100.0 * t.totalMs / total : 0.0);
+}
+
+// The integrator of args.method with the method options from the command line.
+std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTimeCache* cache) {
+    MethodOptions m;
+    GptOptions& g = m.gpt;
+    g.sampling.splitBounce = args.splitBounce == "on"    ? GptPassOptions::SplitBounce::On
+                             : args.splitBounce == "off" ? GptPassOptions::SplitBounce::Off
+                                                         : GptPassOptions::SplitBounce::Auto;
+    g.sampling.edgeSamples = args.edgeSamples;
+    g.sampling.demodulate = parseDemodulation(args.demodulate);
+    g.reconstructions = {parseReconstruction(args.recon)};
+    if (args.allRecon)
+        for (const char* other : {"l1", "l2", "wl2", "wl1"})
+            if (args.recon != other) g.reconstructions.push_back(parseReconstruction(other));
+    g.alpha = args.alpha;
+    g.tolerance = args.tolerance;
+    // Timed renders remember each configuration's reconstruction time.
+    if (args.time > 0.0) g.reconCache = cache;
+    return makeIntegrator(args.method, m);
+}
+
+RenderOptions renderOptionsFor(const RenderArgs& args) {
+    RenderOptions o;
+    o.scene.width = args.width;
+    o.scene.height = args.height;
+    o.scene.maxDepth = args.maxDepth;
+    o.scene.envRadiance = parseColor(args.env, "--env");
+    o.scene.camera = args.camera;
+    o.scene.shiftThreshold = args.shiftThreshold;
+    o.spp = args.spp;
+    o.timeBudget = args.time;
+    o.seed = args.seed;
+    o.profile = args.profile;
+    o.quiet = args.quiet;
+    o.workgroup = parseWorkgroup(args.workgroup);
+    o.emitterSupersampling = args.emitterSupersampling;
+    o.cancel = &gInterrupted;
+    return o;
+}
+
+json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrator& integrator,
+                 const RenderStats& s, double seconds, double reserved, double finishReserved, double writeMs) {
+    json j = {{"scene", args.scene},
+              {"output", args.output},
+              {"method", args.method},
+              {"device", ctx.info().name},
+              {"driver", ctx.info().driverInfo},
+              {"width", args.width},
+              {"height", args.height},
+              {"spp", s.spp},
+              {"partial_pass_rows", s.partialPassRows},
+              {"seed", args.seed},
+              {"batches", s.batches},
+              {"bvh_register_stack", s.bvhRegisterStack},
+              {"time_s",
+               {{"total", seconds},
+                {"bvh_build", s.bvhBuildMs * 1e-3},
+                {"upload", s.uploadMs * 1e-3},
+                {"pipeline_wait", s.pipelineWaitMs * 1e-3},
+                {"sampling", s.samplingMs * 1e-3},
+                {"readback", s.readbackMs * 1e-3},
+                {"reconstruction", s.reconstructionMs * 1e-3},
+                {"reconstruction_reserved", reserved},
+                {"finish_reserved", finishReserved},
+                {"write", writeMs * 1e-3}}},
+              {"rays_traced", s.raysTraced},
+              {"paths_completed", s.pathsCompleted},
+              {"nan_samples", s.nanSamples},
+              {"shift_pairs", s.shiftPairs},
+              {"shift_failures", s.shiftFailures},
+              {"shift_failure_rate", s.shiftPairs ? double(s.shiftFailures) / double(s.shiftPairs) : 0.0},
+              {"rays_per_s", double(s.raysTraced) / (s.samplingMs * 1e-3)},
+              {"samples_per_s", double(s.pathsCompleted) / (s.samplingMs * 1e-3)},
+              {"kernels", kernelJson(s.kernels, s.samplingMs)},
+              {"validation_errors", ctx.validationErrors()}};
+    integrator.describe(j, s);
+    j["emitter_supersampling"] = {{"factor", s.emitterSupersampling},
+                                  {"rays_per_sample", s.emitterRaysPerSample},
+                                  {"pixels", s.emitterSupersampledPixels}};
+    return j;
+}
+
+}  // namespace
+
+int runRender(const RenderArgs& args) {
+    Timer total;
+    RenderOptions options = renderOptionsFor(args);
+    const ReconTimeCache cache(ReconTimeCache::defaultPath());
+    const std::unique_ptr<Integrator> integrator = integratorFor(args, &cache);
+
+    const Scene scene = loadGltf(args.scene);
+    if (!scene.unsupported.empty() && !args.quiet) {
+        std::string list;
+        for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
+        std::fprintf(stderr, "gdpt: warning: %s: not rendered: %s\n", args.scene.c_str(), list.c_str());
+    }
+    vk::ContextOptions ctxOptions;
+    ctxOptions.device = args.device;
+    ctxOptions.validation = args.validate;
+    vk::Context ctx(ctxOptions);
+    if (!args.quiet)
+        std::fprintf(stderr, "gdpt: device '%s' (%s, %s)\n", ctx.info().name.c_str(), ctx.info().type.c_str(),
+                     ctx.info().driverInfo.c_str());
+
+    // --time covers the whole render: sampling stops early by what the method needs after it
+    // (G-PT: the reconstructions) and by what the rest took the last time for this device,
+    // method, size and settings (readback, output layers, EXR + PNG; nothing the first time).
+    const bool timed = args.time > 0.0;
+    const double reserved = timed ? integrator->reserveAfterSampling(ctx, args.width, args.height) : 0.0;
+    const std::string finishKey = "finish|" + reservationKey(ctx, args.width, args.height) + "|" + args.method +
+                                  (args.method == "gpt" ? "|" + std::to_string(args.allRecon ? 4 : 1) + " solves" : "");
+    const double finishReserved = timed ? cache.get(finishKey).value_or(0.0) : 0.0;
+    if (timed) options.timeBudget = std::max(0.05 * args.time, args.time - reserved - finishReserved);
+    options.elapsedBefore = total.seconds();
+
+    // Checkpoints: the identity of this render is recorded in every checkpoint written, and a
+    // checkpoint resumed from must have the same (render_identity.h).
+    const ExrAttributes identity = renderIdentity(*integrator, scene, options);
+    std::optional<Checkpoint> resumed;
+    if (!args.resume.empty()) {
+        resumed = readCheckpoint(args.resume);
+        checkIdentity(args.resume, resumed->identity, identity);
+        if (!timed && resumed->state.spp > args.spp)
+            throw Error(args.resume + ": checkpoint already has " + std::to_string(resumed->state.spp) +
+                        " spp, more than --spp " + std::to_string(args.spp));
+        if (!args.quiet && resumed->info.count("device") && resumed->info["device"] != ctx.info().name)
+            std::fprintf(stderr,
+                         "gdpt: warning: %s was rendered on '%s'; continuing on '%s' (same statistics, "
+                         "not the same bits)\n",
+                         args.resume.c_str(), resumed->info["device"].c_str(), ctx.info().name.c_str());
+        options.resume = &resumed->state;
+    }
+    if (!args.checkpoint.empty()) {
+        const ExrAttributes info = {{"device", ctx.info().name}, {"scene_file", args.scene}};
+        options.checkpoint = [&args, identity, info](const SamplerState& state) {
+            writeCheckpoint(args.checkpoint, identity, info, state);
+        };
+        options.checkpointEvery = args.checkpointEvery;
+    }
+    std::signal(SIGINT, onInterrupt);
+    std::signal(SIGTERM, onInterrupt);
+
+    const RenderOutput out = integrator->render(ctx, scene, options);
+    const RenderStats& s = out.stats;
+    const double afterSampling = total.seconds() - (s.readbackMs + s.reconstructionMs) * 1e-3;
+    if (s.cancelled) {
+        if (args.checkpoint.empty())
+            std::fprintf(stderr, "gdpt: interrupted after %u spp; no output written\n", s.spp);
+        else
+            std::fprintf(stderr,
+                         "gdpt: interrupted after %u spp; checkpoint written to %s (continue with --resume %s)\n",
+                         s.spp, args.checkpoint.c_str(), args.checkpoint.c_str());
+        return 130;
+    }
+    Timer writeTimer;
+    writeExr(args.output, out.layers);
+    writePngPreview(previewPath(args.output), out.image());
+    const double writeMs = writeTimer.ms();
+    const double seconds = total.seconds();
+    if (timed) cache.put(finishKey, std::max(0.0, seconds - afterSampling - s.reconstructionMs * 1e-3));
+    if (args.profile) printProfile(s.kernels);
+    if (!args.quiet) {
+        const std::string partial =
+            s.partialPassRows ? " + 1 in the top " + std::to_string(s.partialPassRows) + " rows" : "";
+        std::fprintf(stderr,
+                     "gdpt: wrote %s (%u spp%s%s, %.2f s total, BVH %.1f ms, sampling %.1f ms, %.2f Mrays/s, "
+                     "%.3f Msamples/s)\n",
+                     args.output.c_str(), s.spp, partial.c_str(), integrator->summary(s).c_str(), seconds,
+                     s.bvhBuildMs, s.samplingMs, double(s.raysTraced) / (s.samplingMs * 1e-3) * 1e-6,
+                     double(s.pathsCompleted) / (s.samplingMs * 1e-3) * 1e-6);
+    }
+    if (!args.json.empty())
+        writeTextOutput(args.json,
+                        summaryJson(args, ctx, *integrator, s, seconds, reserved, finishReserved, writeMs).dump(2) +
+                            "\n");
+    if (ctx.validationErrors() > 0) {
+        std::fprintf(stderr, "gdpt: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
+        return 1;
+    }
+    return 0;
+}
+
+}  // namespace gdpt
+
+namespace gdpt {
+
+Subcommand addRenderCommand(CLI::App& app) {
+    auto args = std::make_shared<RenderArgs>();
+    RenderArgs& a = *args;
+    CLI::App* r = app.add_subcommand("render", "Render a glTF 2.0 scene to OpenEXR (every layer) + a PNG preview");
+    r->add_option("scene", a.scene, "glTF 2.0 scene (.gltf or .glb)")->required()->check(CLI::ExistingFile);
+
+    const char* image = "Scene and image";
+    r->add_option("-o,--output", a.output, "Output EXR; the PNG preview is written beside it")
+        ->capture_default_str()
+        ->group(image);
+    r->add_option("--width", a.width, "Image width in pixels")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 16384))
+        ->group(image);
+    r->add_option("--height", a.height, "Image height in pixels")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 16384))
+        ->group(image);
+    r->add_option("--camera", a.camera, "Camera index in the glTF (default: the first, else a framing camera)")
+        ->check(CLI::NonNegativeNumber)
+        ->group(image);
+    r->add_option("--env", a.env, "Constant environment radiance R,G,B (or one value for grey)")
+        ->capture_default_str()
+        ->group(image);
+
+    const char* sampling = "Sampling";
+    r->add_option("--method", a.method, "gpt: gradient-domain path tracing; pt: path tracing (docs/gpt.md)")
+        ->capture_default_str()
+        ->check(CLI::IsMember(methodNames()))
+        ->group(sampling);
+    r->add_option("--spp", a.spp, "Samples per pixel (G-PT: camera samples, each a base + 4 offset paths)")
+        ->capture_default_str()
+        ->check(CLI::Range(1u, 1u << 24))
+        ->group(sampling);
+    r->add_option("--seed", a.seed, "Random seed; renders are bit-reproducible per seed and device")
+        ->capture_default_str()
+        ->group(sampling);
+    r->add_option("--max-depth", a.maxDepth, "Maximum bounces (1 = direct light only)")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, 1023u))
+        ->group(sampling);
+    r->add_option("--emitter-supersampling", a.emitterSupersampling,
+                  "Rays per camera sample for directly seen emission at the edges of lights (0 = off)")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, kMaxEmitterSupersampling))
+        ->group(sampling);
+
+    const char* gpt = "G-PT";
+    r->add_option("--recon", a.recon, "Reconstruction of the final image: l1, l2, wl2 or wl1 (docs/reconstruction.md)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"l1", "l2", "wl2", "wl1"}))
+        ->group(gpt);
+    r->add_flag("--all-recon", a.allRecon, "Also write the other reconstructions as layers recon_*")->group(gpt);
+    r->add_option("--alpha", a.alpha, "Weight of the primal term of the screened Poisson energy")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1e3))
+        ->group(gpt);
+    r->add_option("--tolerance", a.tolerance, "Relative residual at which the solver stops")
+        ->capture_default_str()
+        ->check(CLI::Range(1e-9, 1.0))
+        ->group(gpt);
+    r->add_option("--shift-threshold", a.shiftThreshold,
+                  "Roughness at or below which a vertex takes the half-vector shift instead of reconnection")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0f, 1.0f))
+        ->group(gpt);
+    r->add_option("--edge-samples", a.edgeSamples,
+                  "Extra camera samples per sample in pixels a geometric edge crosses (0 = off)")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, kMaxEdgeSamples))
+        ->group(gpt);
+    r->add_option("--demodulate", a.demodulate,
+                  "First-hit texture demodulation: auto (on for textured Lambertian scenes), on, off")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"auto", "on", "off"}))
+        ->group(gpt);
+    r->add_option("--split-bounce", a.splitBounce,
+                  "Split bounce loop (same image): auto = on for lavapipe before Mesa 23, on, off")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"auto", "on", "off"}))
+        ->group(gpt);
+
+    const char* budget = "Time budget and checkpoints";
+    r->add_option("--time", a.time, "Seconds for the whole render, reconstruction included; overrides --spp")
+        ->check(CLI::Range(0.0, 1e7))
+        ->group(budget);
+    CLI::Option* checkpoint =
+        r->add_option("--checkpoint", a.checkpoint,
+                      "Write the samples so far to this EXR on interrupt, periodically and at the end")
+            ->group(budget);
+    r->add_option("--checkpoint-every", a.checkpointEvery, "Seconds between periodic checkpoints (0 = none)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1e7))
+        ->needs(checkpoint)
+        ->group(budget);
+    r->add_option("--resume", a.resume, "Continue a checkpoint of the same render; --spp counts the total")
+        ->check(CLI::ExistingFile)
+        ->group(budget);
+
+    const char* diagnostics = "Device and diagnostics";
+    r->add_option("--device", a.device, "Vulkan device index or name substring (default: lavapipe)")
+        ->group(diagnostics);
+    r->add_option("--workgroup", a.workgroup, "Compute workgroup size WxH")->capture_default_str()->group(diagnostics);
+    r->add_flag("--profile", a.profile, "Print GPU time per kernel (timestamp queries)")->group(diagnostics);
+    r->add_option("--json", a.json, "Write the render's statistics as JSON to this file ('-' = stdout)")
+        ->group(diagnostics);
+    r->add_flag("--quiet", a.quiet, "No progress or summary output")->group(diagnostics);
+    r->add_flag("--validate", a.validate, "Enable Vulkan validation layers (errors fail the run)")->group(diagnostics);
+
+    return {r, [args] { return runRender(*args); }};
+}
+
+}  // namespace gdpt

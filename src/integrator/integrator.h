@@ -1,0 +1,99 @@
+// integrator.h — one interface for every rendering method. A method is an object made by
+// name (makeIntegrator); the commands (render, converge, bench-features) parse options and
+// call it, and never assemble a method themselves. Its render() reads as the method's
+// stages: for PT "sample"; for G-PT "sample base and offset paths, reconstruct, compose".
+// docs/integrators.md says how the coming methods (temporal G-PT, gradient-domain MLT,
+// distributed rendering) plug in.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "image/exr_io.h"
+#include "integrator/gpt_sampler.h"
+#include "integrator/render_options.h"
+#include "poisson/poisson_gpu.h"
+#include "scene/scene.h"
+
+namespace gdpt {
+
+namespace vk {
+class Context;
+}
+class ReconTimeCache;
+
+// What a render produces: named layers, the first being the final image (an EXR's default
+// channels, the PNG preview), then the method's own (e.g. G-PT's primal, dx, dy); and the
+// statistics of its sampling.
+struct RenderOutput {
+    std::vector<NamedLayer> layers;
+    RenderStats stats;
+    [[nodiscard]] const Image& image() const { return layers.front().image; }
+};
+
+class Integrator {
+public:
+    virtual ~Integrator() = default;
+
+    // The method's name as the command line spells it ("pt", "gpt").
+    [[nodiscard]] virtual std::string name() const = 0;
+    // Largest batch of the sampling schedule for this image size (fixes the merge order of
+    // the per-pixel statistics, hence the bits of the result).
+    [[nodiscard]] virtual std::uint32_t maxBatchSpp(int width, int height) const = 0;
+    // The checkpoint identity entries of the method's own settings (the common ones, scene,
+    // size, seed, ..., are added by renderIdentity).
+    [[nodiscard]] virtual ExrAttributes identity(const Scene& scene, const RenderOptions& options) const = 0;
+    // Seconds a timed render of this size must leave after sampling for the method's own
+    // later stages (G-PT: the reconstructions); measured or remembered, see the method.
+    virtual double reserveAfterSampling(const vk::Context& ctx, int width, int height) {
+        (void)ctx, (void)width, (void)height;
+        return 0.0;
+    }
+    // Renders: samples with `options` (spp or time budget, checkpoints, cancellation), then
+    // runs the method's later stages, unless sampling was cancelled (stats.cancelled; then
+    // the layers are empty).
+    virtual RenderOutput render(const vk::Context& ctx, const Scene& scene, const RenderOptions& options) = 0;
+    // Adds the method's own keys to a render's JSON summary.
+    virtual void describe(nlohmann::json& summary, const RenderStats& stats) const {
+        (void)summary, (void)stats;
+    }
+    // A phrase for the render's one-line summary ("" if none): what the method adapted.
+    [[nodiscard]] virtual std::string summary(const RenderStats& stats) const {
+        (void)stats;
+        return "";
+    }
+};
+
+// The settings of G-PT beyond sampling.
+struct GptOptions {
+    GptSamplingOptions sampling;
+    // Screened Poisson reconstructions (Kettunen et al. 2015, §4): the first gives the final
+    // image; each is written as layer recon_<name>. Empty: none; the final image is then the
+    // primal (× modulation) + direct, the estimate before reconstruction.
+    std::vector<Reconstruction> reconstructions = {Reconstruction::L1};
+    double alpha = 0.2;        // weight of the primal term
+    double tolerance = 1e-4;   // relative residual at which each solve stops
+    // Timed renders: the reconstruction time remembered per configuration (recon_reserve.h);
+    // null: measured once per integrator and raised to its longest real reconstruction.
+    const ReconTimeCache* reconCache = nullptr;
+};
+
+// Every method's own settings; each integrator reads its part.
+struct MethodOptions {
+    GptOptions gpt;
+};
+
+// Makes the integrator of `name`: a method name ("pt", "gpt"), or "gpt-<reconstruction>"
+// (gpt-l1, gpt-l2, gpt-wl1, gpt-wl2: G-PT with that reconstruction alone, as `converge`
+// names its methods). Throws gdpt::UsageError naming the known methods otherwise.
+std::unique_ptr<Integrator> makeIntegrator(const std::string& name, const MethodOptions& options = {});
+
+// The method names makeIntegrator knows, and with the gpt-<reconstruction> forms.
+const std::vector<std::string>& methodNames();
+const std::vector<std::string>& methodVariantNames();
+
+}  // namespace gdpt

@@ -1,0 +1,89 @@
+#include "integrator/pixel_sampling.h"
+
+#include <algorithm>
+#include <utility>
+
+#include "integrator/sampling_loop.h"
+#include "render/passes/emitter_supersampling_pass.h"
+#include "vk/context.h"
+
+namespace gdpt {
+
+std::uint32_t maxBatchSppFor(int width, int height, std::uint64_t pixelSamplesPerBatch) {
+    const std::uint64_t pixels = std::uint64_t(std::max(width, 1)) * std::uint64_t(std::max(height, 1));
+    return static_cast<std::uint32_t>(std::clamp<std::uint64_t>(pixelSamplesPerBatch / pixels, 1, 16));
+}
+
+RenderOptions withBatchLimit(RenderOptions options, std::uint64_t pixelSamplesPerBatch) {
+    if (options.maxBatchSpp == 0)
+        options.maxBatchSpp = maxBatchSppFor(options.scene.width, options.scene.height, pixelSamplesPerBatch);
+    return options;
+}
+
+PixelSampling::PixelSampling(const vk::Context& ctx, const Scene& scene, const RenderOptions& options,
+                             std::string kind, const MakePass& makePass)
+    : ctx_(ctx), options_(options), kind_(std::move(kind)), timer_(ctx), stream_(ctx, kind_) {
+    Timer phase;
+    // The pipelines compile on worker threads (lavapipe: most of the set-up, on one core)
+    // while this thread builds the BVH and uploads the scene.
+    SceneSpec spec(scene, options.scene);
+    pass_ = makePass(spec);
+    scene_ = std::make_unique<SceneGpu>(ctx, scene, options.scene, std::move(spec));
+    pass_->attach(*scene_);
+    stats_.bvhBuildMs = scene_->bvhInfo().buildMs;
+    stats_.bvhRegisterStack = scene_->spec().bvhRegisterStack();
+    stats_.features = scene_->features();
+    stats_.uploadMs = phase.ms() - stats_.bvhBuildMs;
+}
+
+void PixelSampling::submitAndWait(const std::string& what, const std::function<void(VkCommandBuffer)>& work) {
+    VkCommandBuffer cmd = stream_.begin();
+    if (options_.profile) timer_.reset(cmd);
+    work(cmd);
+    stream_.setWhat(what);
+    stream_.submit();
+    stream_.waitAll();
+    if (options_.profile) timer_.collect();
+}
+
+void PixelSampling::run(const std::function<Image()>& preview) {
+    Timer phase;
+    // The pass's own set-up waits only for its small pipelines and runs while the main
+    // kernel still compiles.
+    pass_->prepare(stream_);
+    if (options_.whileCompiling) options_.whileCompiling();
+    stats_.pipelineWaitMs = 1e3 * pass_->waitForPipelines();
+    if (options_.resume) pass_->uploadStats(options_.resume->buffers);
+    stats_.uploadMs += phase.ms();
+
+    const auto snapshot = [&](SamplerState& state) {
+        state.buffers = pass_->downloadStats();
+        state.preview = preview();
+    };
+    const std::string label = kind_ == "pt" ? "render" : "render " + kind_;
+    runBatchLoop(options_, label.c_str(), total_, stats_,
+                 [&](std::uint32_t first, std::uint32_t n, std::uint32_t rows, const std::function<void()>& onWait) {
+                     VkCommandBuffer cmd = stream_.begin();
+                     if (options_.profile) timer_.reset(cmd);
+                     pass_->record(cmd, first, n, options_.seed, timer(), rows);
+                     stream_.setWhat(kind_ + " batch " + std::to_string(stats_.batches) + " (samples " +
+                                     std::to_string(first) + ".." + std::to_string(first + n - 1) + ", seed " +
+                                     std::to_string(options_.seed) + ")");
+                     stream_.submit();
+                     stream_.waitAll(onWait);
+                     if (options_.profile) timer_.collect();
+                     return pass_->takeCounters();
+                 },
+                 snapshot);
+}
+
+void PixelSampling::finish() {
+    const EmitterSupersamplingPass& emitter = pass_->emitterSupersampling();
+    const gpu::VisibleCounter counter = emitter.report();
+    stats_.emitterSupersampling = emitter.samplesPerSpp();
+    stats_.emitterRaysPerSample = counter.raysPerSample;
+    stats_.emitterSupersampledPixels = counter.refinedPixels;
+    stats_.kernels = timer_.totals();
+}
+
+}  // namespace gdpt

@@ -1,0 +1,90 @@
+// recon_reserve.cpp — reconstruction-time estimates for timed G-PT renders (recon_reserve.h).
+#include "integrator/recon_reserve.h"
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "image/atomic_write.h"
+#include "util/timer.h"
+#include "vk/context.h"
+
+namespace gdpt {
+
+double calibrateReconSeconds(PoissonSolverGpu& solver, const SolveOptions& options, bool warmUp) {
+    const SyntheticReconProblem p = syntheticReconProblem(solver.engine().width(), solver.engine().height());
+    PoissonInput in;
+    in.primal = &p.primal;
+    in.dx = &p.dx;
+    in.dy = &p.dy;
+    in.varPrimal = in.varDx = in.varDy = &p.variance;
+    Image out;
+    if (warmUp) (void)solver.solve(in, options, out);
+    Timer t;
+    (void)solver.solve(in, options, out);
+    return t.seconds();
+}
+
+std::string ReconTimeCache::defaultPath() {
+    namespace fs = std::filesystem;
+    if (const char* d = std::getenv("GDPT_CACHE_DIR"); d && *d)
+        return (fs::path(d) / "recon_times.json").string();
+    if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d)
+        return (fs::path(d) / "gdpt" / "recon_times.json").string();
+    if (const char* d = std::getenv("HOME"); d && *d)
+        return (fs::path(d) / ".cache" / "gdpt" / "recon_times.json").string();
+    return {};
+}
+
+namespace {
+
+nlohmann::json readCache(const std::string& path) {
+    if (path.empty()) return nlohmann::json::object();
+    std::ifstream in(path);
+    nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    return j.is_object() ? j : nlohmann::json::object();
+}
+
+}  // namespace
+
+std::optional<double> ReconTimeCache::get(const std::string& key) const {
+    const nlohmann::json j = readCache(path_);
+    const auto it = j.find(key);
+    if (it == j.end() || !it->is_number() || !(it->get<double>() >= 0.0)) return std::nullopt;
+    return it->get<double>();
+}
+
+void ReconTimeCache::put(const std::string& key, double seconds) const {
+    if (path_.empty()) return;
+    try {
+        nlohmann::json j = readCache(path_);
+        j[key] = seconds;
+        std::filesystem::create_directories(std::filesystem::path(path_).parent_path());
+        writeTextFileAtomically(path_, j.dump(1) + "\n");
+    } catch (const std::exception&) {
+        // A cache that cannot be written only costs the next run a calibration solve.
+    }
+}
+
+std::string reservationKey(const vk::Context& ctx, std::uint32_t width, std::uint32_t height) {
+    return ctx.info().name + "|" + ctx.info().driverInfo + "|" + std::to_string(width) + "x" + std::to_string(height);
+}
+
+ReconReservation reserveReconstruction(const vk::Context& ctx, PoissonSolverGpu& solver,
+                                       const std::vector<SolveOptions>& solves, const ReconTimeCache& cache) {
+    ReconReservation r;
+    r.key = reservationKey(ctx, solver.engine().width(), solver.engine().height());
+    for (const SolveOptions& so : solves)
+        r.key += std::string("|") + toString(so.method) + " alpha " + std::to_string(so.alpha) + " tol " +
+                 std::to_string(so.tolerance);
+    if (const std::optional<double> known = cache.get(r.key)) {
+        r.seconds = *known;
+    } else {
+        for (const SolveOptions& so : solves)
+            r.seconds += calibrateReconSeconds(solver, so, /*warmUp=*/false);
+    }
+    return r;
+}
+
+}  // namespace gdpt

@@ -1,0 +1,90 @@
+// render_options.h — what every integrator is asked (RenderOptions: image, sampling, time
+// budget, checkpoints, cancellation) and what its sampling reports (RenderStats), plus the
+// path tracer's sampled images (RenderResult). Method-specific settings live with their
+// integrator (integrator/gpt_integrator.h).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+
+#include "image/image.h"
+#include "integrator/sampler_state.h"
+#include "render/device_scene/features.h"
+#include "render/device_scene/scene_spec.h"
+#include "render/passes/emitter_supersampling_options.h"
+#include "vk/timing.h"
+
+namespace gdpt {
+
+// Largest batch (samples per pixel per submission) of a width x height render such that one
+// batch is about `pixelSamplesPerBatch` pixel-samples (clamped to 1..16). It depends only on
+// the image size and the method, so the batch schedule (1, 2, 4, ... this) -- and hence the
+// merge order and every bit of the result -- is the same on every run, and a batch stays
+// well under a second on lavapipe, so an interrupt is served promptly.
+std::uint32_t maxBatchSppFor(int width, int height, std::uint64_t pixelSamplesPerBatch);
+
+struct RenderOptions {
+    SceneGpuOptions scene;
+    std::uint32_t spp = 16;        // samples per pixel (ignored when timeBudget > 0)
+    double timeBudget = 0.0;       // seconds for the whole render (0 = use spp)
+    double elapsedBefore = 0.0;    // seconds already spent (e.g. loading) counted in the budget
+    std::uint32_t seed = 0;
+    bool profile = false;
+    bool quiet = false;
+    WorkgroupSize workgroup;
+    // Rays per camera sample in the pixels of emitter supersampling
+    // (render/passes/emitter_supersampling_pass.h); 0 = off.
+    std::uint32_t emitterSupersampling = kDefaultEmitterSupersampling;
+    // Largest batch (samples per pixel per submission); 0 = the method's default for the
+    // image size (maxBatchSppFor), what the command line uses.
+    std::uint32_t maxBatchSpp = 0;
+    const std::atomic<bool>* cancel = nullptr;  // set asynchronously to stop between batches
+    // Continue from this state (its statistics and batch-schedule position) instead of from
+    // zero samples; the caller has checked that it belongs to this scene, size, seed and
+    // method. spp / timeBudget then count the total / this run's time as usual.
+    const SamplerState* resume = nullptr;
+    // If set, called with the current state at a batch boundary every checkpointEvery
+    // seconds (0 = never) and once when sampling ends, finished or cancelled.
+    std::function<void(const SamplerState&)> checkpoint;
+    double checkpointEvery = 0.0;
+    // If set, run on the calling thread after the scene is on the device, while the kernels'
+    // pipelines may still be compiling on worker threads (vk::PipelineCreation::Background),
+    // before sampling; for set-up of the caller's own that should overlap that compile (the
+    // reconstruction's pipelines). Its time counts in the budget like everything else.
+    std::function<void()> whileCompiling;
+};
+
+struct RenderStats {
+    std::uint32_t spp = 0;              // samples in every pixel
+    std::uint32_t partialPassRows = 0;  // timed renders: rows (from the top) with one sample more
+    std::uint32_t batches = 0;
+    double bvhBuildMs = 0.0;
+    std::uint32_t bvhRegisterStack = 0;  // entries of the kernels' register traversal stack (0: in memory)
+    double uploadMs = 0.0;       // scene upload + pipeline creation (the part not overlapped)
+    double pipelineWaitMs = 0.0; // of which: waiting for the pipelines after the scene upload
+    double samplingMs = 0.0;     // wall time of the batch loop
+    double readbackMs = 0.0;
+    double reconstructionMs = 0.0;  // G-PT: screened Poisson solve(s)
+    std::uint64_t raysTraced = 0;
+    std::uint64_t pathsCompleted = 0;
+    std::uint64_t nanSamples = 0;
+    std::uint64_t shiftPairs = 0;     // G-PT: shifts attempted (offsets in the image, base hit)
+    std::uint64_t shiftFailures = 0;  // G-PT: shifts that failed (pair fell back to the base)
+    bool gptSplitBounce = false;      // G-PT: the kernel ran the split bounce loop
+    std::uint32_t emitterSupersampling = 0;  // emitter supersampling factor (0 = off)
+    std::uint32_t emitterRaysPerSample = 0;  // rays per camera sample it took (after its ray budget)
+    std::uint32_t emitterSupersampledPixels = 0;  // pixels it covered
+    std::uint32_t edgeSamples = 0;  // G-PT: extra samples per camera sample in edge pixels (0 = off)
+    std::uint32_t edgePixels = 0;   // G-PT: pixels a geometric edge crosses
+    bool demodulated = false;             // G-PT: first-hit texture demodulation was on
+    std::uint32_t demodulatedPixels = 0;  // G-PT: pixels it acted in (away from the edges)
+    bool cancelled = false;
+    std::map<std::string, vk::KernelTime> kernels;
+    SceneFeatures features;
+};
+
+
+}  // namespace gdpt

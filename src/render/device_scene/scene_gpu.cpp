@@ -1,0 +1,184 @@
+#include "render/device_scene/scene_gpu.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/packing.hpp>
+
+#include "bvh/builder.h"
+#include "bvh/wide_bvh.h"
+#include "scene/gltf_loader.h"
+#include "util/error.h"
+#include "vk/context.h"
+#include "vk/kernel.h"
+
+namespace gdpt {
+namespace {
+
+constexpr float kPi = 3.14159265358979f;
+
+float luminance(glm::vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+// The buffer of scene binding `binding`, checked against the limit of how the kernels read
+// it: a texel buffer of its SceneSpec::sceneTexelBindings format, else a storage buffer.
+template <typename T>
+vk::Buffer makeBuffer(const vk::Context& ctx, const std::vector<T>& data, const std::string& name,
+                      std::uint32_t binding) {
+    const std::uint64_t bytes = data.size() * sizeof(T);
+    const VkFormat format = vk::texelFormat(SceneSpec::sceneTexelBindings(), binding);
+    if (format != VK_FORMAT_UNDEFINED)
+        ctx.checkTexelBufferSize(bytes / vk::texelBytes(format), name);
+    else
+        ctx.checkStorageBufferSize(bytes, name);
+    vk::Buffer b(ctx, bytes, name);
+    b.uploadVector(data);
+    return b;
+}
+
+// Triangle shading records in BVH leaf order.
+std::vector<gpu::TriangleShading> makeShading(const Scene& scene, const std::vector<std::uint32_t>& order) {
+    std::vector<gpu::TriangleShading> out(order.size());
+    const bool normals = !scene.normals.empty();
+    const bool uvs = !scene.uvs.empty();
+    for (std::size_t i = 0; i < order.size(); ++i) {
+        const glm::uvec3 t = scene.triangles[order[i]];
+        gpu::TriangleShading s{};
+        s.material = scene.triangleMaterial[order[i]];
+        s.area = triangleArea(scene, order[i]);
+        if (normals && triangleHasShadingNormals(scene, order[i])) {
+            s.n0 = scene.normals[t.x];
+            s.n1 = scene.normals[t.y];
+            s.n2 = scene.normals[t.z];
+            s.flags |= gpu::kTriFlagHasNormals;
+        }
+        if (uvs) {
+            s.uv0 = scene.uvs[t.x];
+            s.uv1 = scene.uvs[t.y];
+            s.uv2 = scene.uvs[t.z];
+        }
+        s.lightIndex = gpu::kInvalidIndex;
+        out[i] = s;
+    }
+    return out;
+}
+
+}  // namespace
+
+void setCamera(gpu::SceneConstants& c, const Camera& camera, int width, int height) {
+    c.camPosition = camera.position;
+    c.camForward = glm::normalize(camera.forward);
+    c.camRight = glm::normalize(glm::cross(c.camForward, camera.up));
+    c.camUp = glm::cross(c.camRight, c.camForward);
+    c.tanHalfFovY = std::tan(0.5f * camera.yfov);
+    c.aspect = static_cast<float>(width) / static_cast<float>(height);
+    c.width = static_cast<std::uint32_t>(width);
+    c.height = static_cast<std::uint32_t>(height);
+}
+
+SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOptions& options)
+    : SceneGpu(ctx, scene, options, SceneSpec(scene, options)) {}
+
+SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOptions& options, SceneSpec spec)
+    : spec_(std::move(spec)) {
+    if (scene.triangles.empty()) throw Error("scene has no triangles to render");
+    if (options.width < 1 || options.height < 1) throw Error("image size must be at least 1x1");
+
+    // BVH over the world-space triangles (the spec's, for a small scene); everything
+    // per-triangle is laid out in leaf order.
+    std::shared_ptr<const SceneBvh> built = spec_.bvh();
+    if (!built) built = std::make_shared<const SceneBvh>(buildSceneBvh(scene));
+    const Bvh& bvh = built->binary;
+    bvhInfo_.buildMs = built->buildMs;
+    bvhInfo_.nodes = static_cast<std::uint32_t>(bvh.nodes.size());
+    bvhInfo_.maxDepth = bvh.stats.maxDepth;
+    std::vector<gpu::TriangleGeom> geoms = makeTriangleGeoms(scene.positions, scene.triangles, bvh.triangleOrder);
+    std::vector<gpu::TriangleShading> shading = makeShading(scene, bvh.triangleOrder);
+
+    // Emissive triangles, with a CDF proportional to power = area * luminance(Le) * pi
+    // (x2 for double-sided emitters). Emissive textures are not in the weight (factor only).
+    std::vector<gpu::LightTriangle> lights;
+    double total = 0.0;
+    std::vector<double> power;
+    for (std::uint32_t i = 0; i < shading.size(); ++i) {
+        const double p = emitterPower(scene, bvh.triangleOrder[i], shading[i].area);
+        if (!(p > 0.0)) continue;
+        shading[i].lightIndex = static_cast<std::uint32_t>(lights.size());
+        lights.push_back({i, 0.0f, 0.0f, 0.0f});
+        power.push_back(p);
+        total += p;
+    }
+    double running = 0.0;
+    for (std::size_t i = 0; i < lights.size(); ++i) {
+        running += power[i];
+        lights[i].pmf = static_cast<float>(power[i] / total);
+        lights[i].cdf = i + 1 == lights.size() ? 1.0f : static_cast<float>(running / total);
+    }
+    // The spec counted the same lights (emitterPower) to specialise the kernels.
+    GDPT_CHECK(lights.size() == spec_.features().emissiveTriangles);
+
+    double punctualPower = 0.0;
+    for (const auto& l : scene.punctualLights) punctualPower += 4.0 * kPi * std::max(1e-12, double(luminance(l.intensity)));
+
+    // Textures: linear RGBA as packed halves.
+    std::vector<gpu::TextureInfo> texInfo;
+    std::vector<glm::uvec2> texels;
+    for (const Texture& t : scene.textures) {
+        gpu::TextureInfo info{};
+        info.offset = static_cast<std::uint32_t>(texels.size());
+        info.width = static_cast<std::uint32_t>(t.width);
+        info.height = static_cast<std::uint32_t>(t.height);
+        for (const glm::vec4& c : t.texels)
+            texels.emplace_back(glm::packHalf2x16(glm::vec2(c.x, c.y)), glm::packHalf2x16(glm::vec2(c.z, c.w)));
+        texInfo.push_back(info);
+    }
+
+    Camera camera;
+    if (options.camera >= 0) {
+        if (options.camera >= static_cast<int>(scene.cameras.size()))
+            throw Error("--camera " + std::to_string(options.camera) + " is out of range: the scene has " +
+                        std::to_string(scene.cameras.size()) + " camera(s)");
+        camera = scene.cameras[static_cast<std::size_t>(options.camera)];
+    } else {
+        camera = scene.cameras.empty() ? defaultCamera(scene) : scene.cameras.front();
+    }
+    setCamera(constants_, camera, options.width, options.height);
+    constants_.envRadiance = options.envRadiance;
+    constants_.numLightTriangles = static_cast<std::uint32_t>(lights.size());
+    constants_.numPunctualLights = static_cast<std::uint32_t>(scene.punctualLights.size());
+    constants_.lightTrianglePower = static_cast<float>(total);
+    constants_.punctualPower = static_cast<float>(punctualPower);
+    constants_.maxDepth = options.maxDepth;
+    constants_.rrDepth = options.rrDepth;
+    constants_.numTriangles = static_cast<std::uint32_t>(geoms.size());
+    const Bounds b = scene.bounds();
+    constants_.sceneRadius = 0.5f * glm::length(b.max - b.min);
+
+    triGeom_ = makeBuffer(ctx, geoms, "triangle geometry", gpu::kBindTriGeom);
+    triShading_ = makeBuffer(ctx, shading, "triangle shading", gpu::kBindTriShading);
+    bvh_ = makeBuffer(ctx, built->wide.nodes, "BVH nodes (4-wide)", gpu::kBindBvh);
+    materials_ = makeBuffer(ctx, scene.materials, "materials", gpu::kBindMaterials);
+    texInfo_ = makeBuffer(ctx, texInfo, "texture table", gpu::kBindTexInfo);
+    texels_ = makeBuffer(ctx, texels, "texels", gpu::kBindTexels);
+    lightTris_ = makeBuffer(ctx, lights, "light triangles", gpu::kBindLightTris);
+    punctual_ = makeBuffer(ctx, scene.punctualLights, "punctual lights", gpu::kBindPunctual);
+    sceneConst_ = makeBuffer(ctx, std::vector<gpu::SceneConstants>{constants_}, "scene constants", gpu::kBindSceneConst);
+}
+
+void SceneGpu::bindTo(vk::Kernel& kernel) const {
+    kernel.bind(gpu::kBindTriGeom, triGeom_);
+    kernel.bind(gpu::kBindTriShading, triShading_);
+    kernel.bind(gpu::kBindBvh, bvh_);
+    kernel.bind(gpu::kBindMaterials, materials_);
+    kernel.bind(gpu::kBindTexInfo, texInfo_);
+    kernel.bind(gpu::kBindTexels, texels_);
+    kernel.bind(gpu::kBindLightTris, lightTris_);
+    kernel.bind(gpu::kBindPunctual, punctual_);
+    kernel.bind(gpu::kBindSceneConst, sceneConst_);
+}
+
+std::uint64_t SceneGpu::deviceBytes() const {
+    return triGeom_.size() + triShading_.size() + bvh_.size() + materials_.size() + texInfo_.size() +
+           texels_.size() + lightTris_.size() + punctual_.size() + sceneConst_.size();
+}
+
+}  // namespace gdpt

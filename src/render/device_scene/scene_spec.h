@@ -1,0 +1,104 @@
+// scene_spec.h — what the scene kernels are compiled for: the scene's features (features.h)
+// as specialisation constants, and the descriptor of a kernel that reads the scene buffers.
+// It needs no device memory, so a pass can start creating its pipelines
+// (vk::PipelineCreation::Background) before SceneGpu uploads the scene. A small scene's BVH
+// (at most kSpecBvhTriangles triangles: a few milliseconds at most) is built here, so
+// that the kernels can be specialised to its tree (the register traversal stack); a larger
+// one is built by SceneGpu while the pipelines are created.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "bvh/builder.h"
+#include "bvh/wide_bvh.h"
+#include "gdpt_shared.h"
+#include "render/device_scene/features.h"
+#include "scene/scene.h"
+#include "vk/kernel.h"
+
+namespace gdpt {
+
+// Compute workgroup size (a specialisation constant of every scene kernel).
+struct WorkgroupSize {
+    std::uint32_t x = 8;
+    std::uint32_t y = 8;
+};
+
+struct SceneGpuOptions {
+    int width = 256;
+    int height = 256;
+    std::uint32_t maxDepth = 64;  // bounces
+    std::uint32_t rrDepth = 5;    // Russian roulette from this many segments on
+    glm::vec3 envRadiance{0.0f};
+    int camera = -1;  // index into Scene::cameras; -1 = first, or a framing default
+    // G-PT: perceptual roughness at or below which a vertex is glossy (half-vector shift)
+    // instead of reconnectable; the one place this setting is held.
+    float shiftThreshold = 0.001f;
+    // Bits (1u << kSpec*) of scene features to compile in whatever the scene needs (the
+    // generic kernel; kSpecMaxDepth: the 1024-bounce cap; kSpecBvhRegisterStack: the stack
+    // in memory, which every tree fits). For `gdpt bench-features`, which
+    // measures what each specialisation saves; renders leave it 0.
+    std::uint32_t genericFeatures = 0;
+};
+
+// The scene's BVH: the binary tree (its triangle order lays out every per-triangle table)
+// and the four-wide tree the kernels traverse.
+struct SceneBvh {
+    Bvh binary;
+    WideBvh wide;
+    double buildMs = 0.0;  // both trees
+};
+SceneBvh buildSceneBvh(const Scene& scene);
+
+// Scenes up to this many triangles have their BVH built by SceneSpec, before the pipelines
+// (cbox's 36 take 0.08 ms, 5k triangles about 5 ms); larger trees need more than
+// kBvhRegisterStackMax stack entries anyway (a 5k-triangle soup of spheres needs 20).
+inline constexpr std::size_t kSpecBvhTriangles = 4096;
+
+class SceneSpec {
+public:
+    SceneSpec(const Scene& scene, const SceneGpuOptions& options);
+
+    // The features, with the emissive-triangle count of the light table SceneGpu uploads
+    // (emitters with zero area or power are not lights).
+    [[nodiscard]] const SceneFeatures& features() const { return features_; }
+    [[nodiscard]] std::uint32_t width() const { return width_; }
+    [[nodiscard]] std::uint32_t height() const { return height_; }
+    // G-PT: perceptual roughness at or below which a vertex is glossy (half-vector shift).
+    [[nodiscard]] float shiftThreshold() const { return shiftThreshold_; }
+    // The BVH built with the spec (small scenes), or null: SceneGpu builds it.
+    [[nodiscard]] const std::shared_ptr<const SceneBvh>& bvh() const { return bvh_; }
+    // Entries of the register traversal stack the kernels use (kSpecBvhRegisterStack: 8 or
+    // 16, the fewest that hold the tree's maxStack), or 0: the stack in memory (the tree is
+    // not known yet, or needs more than kBvhRegisterStackMax; or the generic kernel).
+    [[nodiscard]] std::uint32_t bvhRegisterStack() const;
+    // Specialisation constants for the scene features (ids from gdpt_shared.h).
+    [[nodiscard]] std::vector<std::pair<std::uint32_t, std::uint32_t>> specConstants() const;
+    // The bindings of the scene (kBindTriGeom..kBindSceneConst).
+    [[nodiscard]] static std::vector<std::uint32_t> sceneBindings();
+    // The scene bindings that the kernels read as texel buffers, with their view formats;
+    // the geometry's (triangles and BVH, scene_geometry.glsl) alone for ray-query kernels.
+    [[nodiscard]] static std::vector<std::pair<std::uint32_t, VkFormat>> geometryTexelBindings();
+    [[nodiscard]] static std::vector<std::pair<std::uint32_t, VkFormat>> sceneTexelBindings();
+    // Completes `base` (name + SPIR-V) into the descriptor of a kernel that reads the scene:
+    // the scene bindings plus `extraBindings`, `pushBytes` of push constants, the scene's
+    // feature specialisation constants and the workgroup size.
+    [[nodiscard]] vk::KernelDesc kernelDesc(vk::KernelDesc base, WorkgroupSize wg,
+                                            const std::vector<std::uint32_t>& extraBindings,
+                                            std::uint32_t pushBytes = sizeof(gpu::FrameParams)) const;
+
+private:
+    SceneFeatures features_;
+    std::uint32_t width_ = 0, height_ = 0;
+    float shiftThreshold_ = 0.001f;
+    std::uint32_t maxDepthSpec_ = 1024;
+    std::uint32_t genericFeatures_ = 0;
+    std::shared_ptr<const SceneBvh> bvh_;
+};
+
+}  // namespace gdpt
