@@ -72,7 +72,9 @@ layout(push_constant, scalar) uniform Push { GptFrameParams frame; };
 #include "lib/gpt_light.glsl"
 
 const float kInf = 1.0 / 0.0;
-const ivec2 kOffsetDelta[4] = ivec2[4](ivec2(1, 0), ivec2(0, 1), ivec2(-1, 0), ivec2(0, -1));
+// Pixel offset δ_i of offset path i, in gpt_shared.h's order (kGptRight, kGptDown, kGptLeft,
+// kGptUp; +y = next image row).
+const ivec2 kOffsetDelta[kGptNumOffsets] = ivec2[kGptNumOffsets](ivec2(1, 0), ivec2(0, 1), ivec2(-1, 0), ivec2(0, -1));
 
 #include "lib/camera.glsl"
 #include "lib/visible_emission.glsl"
@@ -113,10 +115,10 @@ bool ownVertex(OffsetPath o, bool general) { return general && o.state == kShift
 // baseModulation: the base's first-hit modulation (1 unless kDemodulate; offs[i].modulation
 // the offsets').
 void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, bool countDirect, inout uint rays,
-                 out vec3 direct, out vec3 baseModulation, inout OffsetPath offs[4]) {
+                 out vec3 direct, out vec3 baseModulation, inout OffsetPath offs[kGptNumOffsets]) {
     direct = vec3(0.0);
     baseModulation = vec3(1.0);
-    for (uint i = 0u; i < 4u; ++i) {
+    for (uint i = 0u; i < kGptNumOffsets; ++i) {
         offs[i].modulation = vec3(1.0);
         offs[i].alive = gptPairExists(px, py, i);
         offs[i].shifted = false;
@@ -140,7 +142,7 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     SurfaceHit sh = makeSurfaceHit(hit.triangle, hit.u, hit.v, d);
     if (kHasLightTris && countDirect) direct += surfaceEmission(sh);
     if (kDemodulate) baseModulation = firstHitModulation(sh, py * scene.width + px);
-    for (uint i = 0u; i < 4u; ++i) {
+    for (uint i = 0u; i < kGptNumOffsets; ++i) {
         offs[i].shifted = offs[i].alive;
         if (!offs[i].alive) continue;
         vec3 di = cameraRay(pixelPos + vec2(kOffsetDelta[i]));
@@ -166,7 +168,7 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     for (; depth < kMaxDepth && depth < scene.maxDepth; ++depth) {
 #ifdef GDPT_GPT_SPLIT_BOUNCE
         bool own = false;
-        for (uint i = 0u; i < 4u; ++i) own = own || (offs[i].alive && ownVertex(offs[i], true));
+        for (uint i = 0u; i < kGptNumOffsets; ++i) own = own || (offs[i].alive && ownVertex(offs[i], true));
         if (!own) break;
 #endif
 #define GDPT_GPT_GENERAL true
@@ -182,6 +184,14 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     }
 #endif
 }
+
+// The quantities gpt.comp accumulates per pixel, as indices into main's accumulators: central,
+// neighbor_i and gradient_i (i in kOffsetDelta's order), direct.
+const uint kAccCentral = 0u;
+const uint kAccNeighbor = 1u;
+const uint kAccGradient = kAccNeighbor + kGptNumOffsets;
+const uint kAccDirect = kAccGradient + kGptNumOffsets;
+const uint kAccCount = kAccDirect + 1u;
 
 void main() {
     loadScene();
@@ -200,20 +210,14 @@ void main() {
     }
     uint pixel = y * scene.width + x;
 
-    // 0 central, 1..4 neighbor_i, 5..8 gradient_i, 9 direct.
-    Welford acc[10];
-    for (uint k = 0u; k < 10u; ++k) {
-        acc[k].mean = vec3(0.0);
-        acc[k].m2 = vec3(0.0);
-    }
-    Welford accModulation;  // kDemodulate only
-    accModulation.mean = vec3(0.0);
-    accModulation.m2 = vec3(0.0);
+    Welford acc[kAccCount];
+    for (uint k = 0u; k < kAccCount; ++k) acc[k] = welfordInit();
+    Welford accModulation = welfordInit();  // kDemodulate only
     uint n = 0u;
     uint rays = 0u;
     uint nan = 0u;
     uint shiftPairs = 0u, shiftFailures = 0u;
-    OffsetPath offs[4];
+    OffsetPath offs[kGptNumOffsets];
     bool countDirect = !emissionSupersampled(pixel);
     for (uint s = 0u; s < frame.samplesPerPixel; ++s) {
         // Same stream as pt.comp's sample s: the base path is PT's path.
@@ -223,50 +227,44 @@ void main() {
         vec3 direct, baseModulation;
         traceSample(lds, rng, vec2(x, y) + jitter, x, y, countDirect, rays, direct, baseModulation, offs);
         if (kDemodulate) {
-            for (uint i = 0u; i < 4u; ++i) {
+            for (uint i = 0u; i < kGptNumOffsets; ++i) {
                 offs[i].baseSum /= baseModulation;
                 offs[i].offSum /= offs[i].modulation;
             }
         }
-        for (uint i = 0u; i < 4u; ++i) {
+        for (uint i = 0u; i < kGptNumOffsets; ++i) {
             shiftPairs += offs[i].shifted ? 1u : 0u;
             shiftFailures += offs[i].shifted && !offs[i].alive ? 1u : 0u;
         }
         vec3 central = vec3(0.0);
         bool finite = isFinite(direct);
-        for (uint i = 0u; i < 4u; ++i) {
+        for (uint i = 0u; i < kGptNumOffsets; ++i) {
             central += offs[i].baseSum;
             finite = finite && isFinite(offs[i].baseSum) && isFinite(offs[i].offSum);
         }
         n++;
         if (kDemodulate) welfordAdd(accModulation, baseModulation, n);
-        if (!finite) {
-            // Counted, never written: the whole sample (all quantities) becomes zero so the
-            // pairs stay consistent.
-            nan++;
-            for (uint k = 0u; k < 10u; ++k) welfordAdd(acc[k], vec3(0.0), n);
-            continue;
+        // The non-finite policy of pixel_stats.glsl over the whole sample: one non-finite
+        // quantity makes every quantity of it zero, so the pairs stay consistent.
+        if (!finite) nan++;
+        welfordAdd(acc[kAccCentral], statsSample(central, finite), n);
+        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+            welfordAdd(acc[kAccNeighbor + i], statsSample(offs[i].offSum, finite), n);
+            welfordAdd(acc[kAccGradient + i], statsSample(offs[i].offSum - offs[i].baseSum, finite), n);
         }
-        welfordAdd(acc[0], central, n);
-        for (uint i = 0u; i < 4u; ++i) {
-            welfordAdd(acc[1u + i], offs[i].offSum, n);
-            welfordAdd(acc[5u + i], offs[i].offSum - offs[i].baseSum, n);
-        }
-        welfordAdd(acc[9], direct, n);
+        welfordAdd(acc[kAccDirect], statsSample(direct, finite), n);
     }
-    if (n > 0u) {
-        statCentral[pixel] = chanMerge(statCentral[pixel], acc[0], n);
-        statNeighbor0[pixel] = chanMerge(statNeighbor0[pixel], acc[1], n);
-        statNeighbor1[pixel] = chanMerge(statNeighbor1[pixel], acc[2], n);
-        statNeighbor2[pixel] = chanMerge(statNeighbor2[pixel], acc[3], n);
-        statNeighbor3[pixel] = chanMerge(statNeighbor3[pixel], acc[4], n);
-        statGradient0[pixel] = chanMerge(statGradient0[pixel], acc[5], n);
-        statGradient1[pixel] = chanMerge(statGradient1[pixel], acc[6], n);
-        statGradient2[pixel] = chanMerge(statGradient2[pixel], acc[7], n);
-        statGradient3[pixel] = chanMerge(statGradient3[pixel], acc[8], n);
-        statDirect[pixel] = chanMerge(statDirect[pixel], acc[9], n);
-        if (kDemodulate) statModulation[pixel] = chanMerge(statModulation[pixel], accModulation, n);
-    }
+    statCentral[pixel] = chanMerge(statCentral[pixel], acc[kAccCentral], n);
+    statNeighbor0[pixel] = chanMerge(statNeighbor0[pixel], acc[kAccNeighbor + kGptRight], n);
+    statNeighbor1[pixel] = chanMerge(statNeighbor1[pixel], acc[kAccNeighbor + kGptDown], n);
+    statNeighbor2[pixel] = chanMerge(statNeighbor2[pixel], acc[kAccNeighbor + kGptLeft], n);
+    statNeighbor3[pixel] = chanMerge(statNeighbor3[pixel], acc[kAccNeighbor + kGptUp], n);
+    statGradient0[pixel] = chanMerge(statGradient0[pixel], acc[kAccGradient + kGptRight], n);
+    statGradient1[pixel] = chanMerge(statGradient1[pixel], acc[kAccGradient + kGptDown], n);
+    statGradient2[pixel] = chanMerge(statGradient2[pixel], acc[kAccGradient + kGptLeft], n);
+    statGradient3[pixel] = chanMerge(statGradient3[pixel], acc[kAccGradient + kGptUp], n);
+    statDirect[pixel] = chanMerge(statDirect[pixel], acc[kAccDirect], n);
+    if (kDemodulate) statModulation[pixel] = chanMerge(statModulation[pixel], accModulation, n);
     atomicAdd(counters.raysTraced, rays);
     atomicAdd(counters.pathsCompleted, n);
     if (nan > 0u) atomicAdd(counters.nanSamples, nan);

@@ -25,6 +25,7 @@
 #extension GL_GOOGLE_include_directive : require
 
 #include "gpt_shared.h"
+#include "lib/pixel_stats.glsl"
 
 layout(local_size_x_id = kSpecWorkgroupX, local_size_y_id = kSpecWorkgroupY) in;
 
@@ -41,13 +42,6 @@ layout(set = 0, binding = kBindGptDirect, scalar) readonly buffer DirectBuf { Pi
 #include "lib/visible_emission.glsl"
 layout(set = 0, binding = kBindGptResolved, scalar) writeonly buffer ResolvedBuf { GptResolved resolved[]; };
 layout(push_constant, scalar) uniform Push { GptFrameParams frame; };
-
-// Variance of the mean of one statistic (unbiased sample variance / n).
-vec3 varianceOfMean(PixelStats s) {
-    if (s.count < 2u) return vec3(0.0);
-    float n = float(s.count);
-    return s.m2 / ((n - 1.0) * n);
-}
 
 void main() {
     uint x = gl_GlobalInvocationID.x;

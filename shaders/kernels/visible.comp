@@ -111,9 +111,8 @@ void main() {
 
     // Welford over the camera samples, each the mean of its k rays (so that the statistics
     // count camera samples, like every other per-pixel estimate).
-    Welford acc;
-    acc.mean = vec3(0.0);
-    acc.m2 = vec3(0.0);
+    Welford acc = welfordInit();
+    uint nan = 0u;
     vec3 firstValue = vec3(0.0);
     bool agree = true;
     for (uint s = 0u; s < samples; ++s) {
@@ -125,7 +124,10 @@ void main() {
             agree = agree && all(equal(e, firstValue));
             sum += e;
         }
-        welfordAdd(acc, sum / float(raysPerSample), s + 1u);
+        vec3 value = sum / float(raysPerSample);
+        bool finite = isFinite(value);
+        if (!finite) nan++;
+        welfordAdd(acc, statsSample(value, finite), s + 1u);
     }
     atomicAdd(counters.raysTraced, samples * raysPerSample);
     if (params.phase == kVisiblePhaseProbe) {
@@ -133,4 +135,5 @@ void main() {
         return;
     }
     visibleStats[pixel] = chanMerge(visibleStats[pixel], acc, samples);
+    if (nan > 0u) atomicAdd(counters.nanSamples, nan);
 }

@@ -50,15 +50,13 @@ void main() {
         atomicAdd(counters.pad, 1u);
         return;
     }
-    vec3 L = s.radiance;
-    uint nan = 0u;
-    if (!isFinite(L)) {
-        nan = 1u;
-        L = vec3(0.0);
-    }
-    PixelStats acc = accum[i];
-    mergeStats(acc, 1u, L, vec3(0.0));
-    accum[i] = acc;
+    // One sample: its Welford accumulator is (L, 0).
+    bool finite = isFinite(s.radiance);
+    Welford one;
+    one.mean = statsSample(s.radiance, finite);
+    one.m2 = vec3(0.0);
+    accum[i] = chanMerge(accum[i], one, 1u);
+    uint nan = finite ? 0u : 1u;
     atomicAdd(counters.raysTraced, s.rays);
     atomicAdd(counters.pathsCompleted, 1u);
     if (nan > 0u) atomicAdd(counters.nanSamples, nan);

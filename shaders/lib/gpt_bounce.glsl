@@ -15,7 +15,7 @@
     // One-sided back faces absorb: the base path ends; an offset there cannot continue
     // (its reverse shift does not exist), so its pair falls back to the base alone.
     if (oneSidedBack(sh)) { pathEnded = true; break; }
-    for (uint i = 0u; i < 4u; ++i) {
+    for (uint i = 0u; i < kGptNumOffsets; ++i) {
         if (offs[i].alive && ownVertex(offs[i], GDPT_GPT_GENERAL) && oneSidedBack(offs[i].hit))
             offs[i].alive = false;
     }
@@ -27,9 +27,9 @@
     vec3 origin = offsetRayOriginScaled(sh.p, sh.ng, scene.sceneRadius);
 
     // Offsets' own BSDFs and frames (NOT_CONNECTED only).
-    BsdfParams offBsdf[4];
-    vec3 offT[4], offB[4], offWo[4];
-    for (uint i = 0u; i < 4u; ++i) {
+    BsdfParams offBsdf[kGptNumOffsets];
+    vec3 offT[kGptNumOffsets], offB[kGptNumOffsets], offWo[kGptNumOffsets];
+    for (uint i = 0u; i < kGptNumOffsets; ++i) {
         offBsdf[i] = bsdf;  // placeholder for shared / dead offsets (never read)
         if (!offs[i].alive) continue;
         if (ownVertex(offs[i], GDPT_GPT_GENERAL)) {
@@ -53,8 +53,8 @@
     // a mirror coat count its light twice: NEE with four strategies, and again through
     // the half-vector branch, which has no light strategy).
     bool baseRoughNee = roughAll(bsdf);
-    bool lightActive[4];
-    for (uint i = 0u; i < 4u; ++i) {
+    bool lightActive[kGptNumOffsets];
+    for (uint i = 0u; i < kGptNumOffsets; ++i) {
         // A Dirac-only offset vertex fails every shift of both techniques, so its pair is
         // the lone base's (PT weights, light strategy included).
         lightActive[i] = !offs[i].alive || !ownVertex(offs[i], GDPT_GPT_GENERAL) ||
@@ -77,7 +77,7 @@
         float pdfBsdfV = visible ? pdfBsdf : 0.0;  // BSDF density including visibility
         // Per pair one weight and one addPair, whichever case it is: on lavapipe before Mesa
         // 23 (every branch runs under lane masks) each case's own copy cost its time.
-        for (uint i = 0u; i < 4u; ++i) {
+        for (uint i = 0u; i < kGptNumOffsets; ++i) {
             if (!gptPairExists(px, py, i)) continue;
             bool own = offs[i].alive && ownVertex(offs[i], GDPT_GPT_GENERAL);
             bool sharedVertex = offs[i].alive && !own;
@@ -184,7 +184,7 @@
     bool baseCurRough = roughAll(bsdf);
 
     // ---- Shift every live offset over this segment (§1.4) ----
-    for (uint i = 0u; i < 4u; ++i) {
+    for (uint i = 0u; i < kGptNumOffsets; ++i) {
         if (!offs[i].alive) continue;
         if (offs[i].state == kShiftConnected) {
             offs[i].beta *= bs.weight * rrInv;  // shares the vertex: same f and p
@@ -311,7 +311,7 @@
     // ---- Emission reached by the BSDF sample: environment or an emitter (§1.6) ----
     if (kHasEnv && baseMissed) {  // (kHasEnv: else the path ended above; lets the compiler drop this)
         vec3 le = scene.envRadiance;
-        for (uint i = 0u; i < 4u; ++i) {
+        for (uint i = 0u; i < kGptNumOffsets; ++i) {
             if (!gptPairExists(px, py, i)) continue;
             if (!offs[i].alive) {
                 addPair(offs[i], 1.0, beta * le, vec3(0.0));
@@ -329,7 +329,7 @@
             vec3 nl = triangleUnitNormal(nextSh.triangle);
             pdfLight = lightTrianglePdf(nextSh.triangle, prevP, nextSh.p, nl);
         }
-        for (uint i = 0u; i < 4u; ++i) {
+        for (uint i = 0u; i < kGptNumOffsets; ++i) {
             if (!gptPairExists(px, py, i)) continue;
             // The light strategy competes only where NEE counted for this pair.
             float pdfLightPair = lightActive[i] ? pdfLight : 0.0;
@@ -352,7 +352,7 @@
     // Nothing left to carry (e.g. the base and all offsets sit on a black emitter): every
     // later contribution of every pair would be w·0, so stop tracing.
     bool carries = maxComponent(beta) > 0.0;
-    for (uint i = 0u; i < 4u; ++i) carries = carries || (offs[i].alive && maxComponent(offs[i].beta) > 0.0);
+    for (uint i = 0u; i < kGptNumOffsets; ++i) carries = carries || (offs[i].alive && maxComponent(offs[i].beta) > 0.0);
     if (!carries) { pathEnded = true; break; }
     sh = nextSh;
     d = wi;

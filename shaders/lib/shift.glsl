@@ -31,30 +31,9 @@ GDPT_CONST uint kShiftConnected = 2u;          // offset shares every later vert
 // Vertex classification (GPT_REFERENCE §1.3)
 // ---------------------------------------------------------------------------------------------
 
-// Roughness of the component the base path sampled, applied to a (base or offset) BSDF: the
-// reference's rule (GPT_REFERENCE §1.3). gpt.comp classifies by shiftRoughnessAll instead
-// (a symmetric rule; see the comment there) and keeps this for comparison and tests.
-// Wraps bsdfRoughnessForShift, which assumes the lobe exists: a material without a
-// glossy/mirror layer has only its diffuse lobe, so it counts as fully rough (1) whatever
-// the base sampled (e.g. a Lambertian with roughnessFactor 0 is not a mirror).
-GDPT_INLINE float shiftRoughnessSampled(BsdfParams m, uint sampledLobe) {
-    if (sampledLobe == kLobeDiffuse || !bsdfHasGlossyOrMirror(m)) {
-        return 1.0f;
-    }
-    return bsdfRoughnessForShift(m, sampledLobe);
-}
-
-// Lowest roughness over the smooth (non-Dirac) components: the classification of a vertex
-// for next-event estimation, which evaluates only those (reference: BSDF::ESmooth).
-GDPT_INLINE float shiftRoughnessSmooth(BsdfParams m) {
-    if (bsdfHasGlossyOrMirror(m) && m.alpha >= kDeltaAlpha) {
-        return sqrt(m.alpha);
-    }
-    return 1.0f;
-}
-
-// Lowest roughness over all components present (reference: BSDF::EAll), used for the base's
-// next vertex before it has sampled anything there. A Dirac layer counts as 0. A BSDF with
+// Lowest roughness over all components present (Mitsuba's BSDF::EAll): gpt.comp's
+// classification of every vertex (see roughAll in gpt_path.glsl for why not the sampled
+// component's). A Dirac layer counts as 0. A BSDF with
 // no lobe at all (a black emitter) is rough: nothing can be half-vector shifted through it.
 GDPT_INLINE float shiftRoughnessAll(BsdfParams m) {
     if (bsdfHasGlossyOrMirror(m)) {

@@ -256,29 +256,20 @@ TEST(ShiftMis, RatioFormSurvivesExtremePdfsAndRejectsBadInput) {
 // Vertex classification
 // ---------------------------------------------------------------------------------------------
 
-TEST(ShiftClassification, ByLobeAndComponents) {
+TEST(ShiftClassification, ByLowestRoughnessOverAllComponents) {
     const vec3 c(0.5f);
-    const BsdfParams lambert = makeBsdfParams(c, 0.0f, 1.0f, 0.0f, vec3(1.0f), 1.5f);
     const BsdfParams lambertRough0 = makeBsdfParams(c, 0.0f, 0.0f, 0.0f, vec3(1.0f), 1.5f);
     const BsdfParams metal = makeBsdfParams(c, 1.0f, 0.3f, 1.0f, vec3(1.0f), 1.5f);
-    const BsdfParams mirror = makeBsdfParams(c, 1.0f, 0.0f, 1.0f, vec3(1.0f), 1.5f);
     const BsdfParams coatedMirror = makeBsdfParams(c, 0.0f, 0.0f, 1.0f, vec3(1.0f), 1.5f);
     const float thr = 0.001f;
-    // Lambertian: rough whatever the lobe id, even with roughnessFactor 0.
-    EXPECT_TRUE(shiftIsRough(shiftRoughnessSampled(lambert, kLobeDiffuse), thr));
-    EXPECT_TRUE(shiftIsRough(shiftRoughnessSampled(lambertRough0, kLobeGlossy), thr));
+    // Lambertian: rough even with roughnessFactor 0.
     EXPECT_TRUE(shiftIsRough(shiftRoughnessAll(lambertRough0), thr));
     // GGX 0.3 metal: rough at the default threshold, glossy above 0.3.
-    EXPECT_FLOAT_EQ(shiftRoughnessSampled(metal, kLobeGlossy), 0.3f);
+    EXPECT_FLOAT_EQ(shiftRoughnessAll(metal), 0.3f);
     EXPECT_TRUE(shiftIsRough(shiftRoughnessAll(metal), thr));
     EXPECT_FALSE(shiftIsRough(shiftRoughnessAll(metal), 0.3f));
-    // Mirror: glossy; coated mirror: its diffuse lobe is rough, the vertex as a whole is not,
-    // and NEE (smooth components only) sees the diffuse lobe.
-    EXPECT_FALSE(shiftIsRough(shiftRoughnessSampled(mirror, kLobeSpecular), thr));
-    EXPECT_TRUE(shiftIsRough(shiftRoughnessSampled(coatedMirror, kLobeDiffuse), thr));
+    // Coated mirror: its diffuse lobe is rough, the vertex as a whole is not.
     EXPECT_FALSE(shiftIsRough(shiftRoughnessAll(coatedMirror), thr));
-    EXPECT_TRUE(shiftIsRough(shiftRoughnessSmooth(coatedMirror), thr));
-    EXPECT_FALSE(shiftIsRough(shiftRoughnessSmooth(makeBsdfParams(c, 1.0f, 0.02f, 1.0f, vec3(1.0f), 1.5f)), 0.05f));
     // Black emitter material: nothing to shift through, counts as rough.
     EXPECT_TRUE(shiftIsRough(shiftRoughnessAll(makeBsdfParams(vec3(0.0f), 0.0f, 1.0f, 0.0f, vec3(1.0f), 1.5f)), thr));
 }
