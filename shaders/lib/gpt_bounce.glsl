@@ -193,11 +193,13 @@
         }
         if (offs[i].state == kShiftRecentlyConnected) {
             // Shared vertex, own incoming direction: re-evaluate f and p (never Dirac: a
-            // reconnection target has no Dirac lobe, shiftRoughnessAll).
+            // reconnection target has no Dirac lobe, shiftRoughnessAll); the direction is the
+            // base's, so J = 1.
             vec3 fo = bsdfEval(bsdf, offWo[i], bs.wi);
             float po = bsdfPdf(bsdf, offWo[i], bs.wi);
-            offs[i].beta *= fo * (rrInv / bs.pdf);
-            offs[i].r *= po / bs.pdf;
+            SegmentShift seg = shiftSegment(fo, po, 1.0, rrInv, bs.pdf);
+            offs[i].beta *= seg.throughput;
+            offs[i].r *= seg.pdfRatio;
             offs[i].rLight = offs[i].r;
             offs[i].state = kShiftConnected;
             continue;
@@ -208,25 +210,12 @@
         vec3 ohOrigin = offsetRayOriginScaled(oh.p, oh.ng, scene.sceneRadius);
         bool offCurRough = roughAll(ob);
         if (shiftUseReconnection(baseCurRough, baseNextRough, offCurRough)) {
-            // Reconnection shift: connect to the base's next vertex (or the environment
-            // in the same direction, J = 1); occlusion = failure.
-            vec3 wiO = wi;
-            float jacobianShift = 1.0;
-            bool ok;
-            float dist = kInf;
-            if (baseMissed) {
-                ok = dot(wiO, oh.ng) > 0.0;
-            } else {
-                vec3 e = nextSh.p - oh.p;
-                dist = length(e);
-                wiO = e / dist;
-                jacobianShift = reconnectionJacobian(sh.p, oh.p, nextSh.p, nextSh.ng);
-                // Same side of the target as the base (else it is another surface point
-                // for BSDF and emission), leaving above the offset's geometric surface.
-                ok = dist > 0.0 && jacobianShift > 0.0 && dot(wiO, oh.ng) > 0.0 &&
-                     dot(wiO, nextSh.ng) < 0.0;
-            }
-            if (!ok) {
+            // Reconnection shift to the base's next vertex, or the environment shift in the
+            // same direction; occlusion = failure.
+            ConnectionShift c;
+            if (baseMissed) c = shiftEnvironment(wi, oh.ng);
+            else c = shiftReconnect(sh.p, oh.p, oh.ng, nextSh.p, nextSh.ng);
+            if (!c.ok) {
                 offs[i].alive = false;  // no offset path: the reverse never maps here
                 continue;
             }
@@ -234,11 +223,12 @@
             // Light strategy at the target: p'_L J = p_L, so the offset's light density in
             // the base's measure is rPrefix·p_L (zero if the offset vertex cannot do NEE).
             offs[i].rLight = bsdfIsDeltaOnly(ob) ? 0.0 : rPrefix;
-            offs[i].woWorld = -wiO;
+            offs[i].woWorld = -c.wi;
             offs[i].state = kShiftRecentlyConnected;
-            // Visibility from the offset vertex (for the environment too: the 2019 fix).
+            // Visibility from the offset vertex, for the environment too (an escaping offset
+            // that is occluded has no density either).
             rays++;
-            if (traceAny(ohOrigin, wiO, 0.0, baseMissed ? kInf : dist * (1.0 - 1e-4))) {
+            if (traceAny(ohOrigin, c.wi, 0.0, baseMissed ? kInf : c.dist * (1.0 - 1e-4))) {
                 // Occluded: the offset path has no BSDF density and no contribution, but
                 // light sampling could still produce it, so its light density stays in
                 // this vertex's emission weight. r = 0 and beta' = 0 then act as a failed
@@ -247,11 +237,12 @@
                 offs[i].r = 0.0;
                 continue;
             }
-            vec3 wiLocalO = toLocal(wiO, offT[i], offB[i], oh.ns);
+            vec3 wiLocalO = toLocal(c.wi, offT[i], offB[i], oh.ns);
             vec3 fo = bsdfEval(ob, offWo[i], wiLocalO);
             float po = bsdfPdf(ob, offWo[i], wiLocalO);
-            offs[i].beta *= fo * (jacobianShift * rrInv / bs.pdf);
-            offs[i].r *= po * jacobianShift / bs.pdf;
+            SegmentShift seg = shiftSegment(fo, po, c.jacobian, rrInv, bs.pdf);
+            offs[i].beta *= seg.throughput;
+            offs[i].r *= seg.pdfRatio;
             continue;
         }
         if (!kHasGlossy) {
@@ -259,35 +250,15 @@
             continue;
         }
         // Half-vector copy shift (reflection only: gdpt has no transmission).
-        bool baseDirac = bs.lobe == kLobeSpecular;
-        if (baseDirac ? !bsdfHasDelta(ob) : bsdfIsDeltaOnly(ob)) {
-            offs[i].alive = false;  // Dirac and smooth never shift into each other
-            continue;
-        }
-        vec3 wiLocalO;
-        vec3 fo;
-        float po;
-        float jacobianShift = 1.0;
-        if (baseDirac) {
-            // Mirror: h = n; Dirac weight F(cos_o) and discrete pdf P(mirror lobe), J = 1.
-            wiLocalO = vec3(-offWo[i].x, -offWo[i].y, offWo[i].z);
-            fo = glossyFresnel(ob, offWo[i].z);
-            po = offWo[i].z > 0.0 ? glossySelectProb(ob, offWo[i]) : 0.0;
-        } else {
-            if (!halfVectorReflect(woLocal, bs.wi, offWo[i], wiLocalO, jacobianShift)) {
-                offs[i].alive = false;
-                continue;
-            }
-            fo = bsdfEval(ob, offWo[i], wiLocalO);
-            po = bsdfPdf(ob, offWo[i], wiLocalO);
-        }
-        vec3 wiO = toWorld(wiLocalO, offT[i], offB[i], oh.ns);
-        if (!(po > 0.0) || !(wiLocalO.z > 0.0) || dot(wiO, oh.ng) <= 0.0) {
+        HalfVectorShift h = shiftHalfVector(ob, woLocal, bs.wi, bs.lobe == kLobeSpecular, offWo[i]);
+        vec3 wiO = toWorld(h.wiLocal, offT[i], offB[i], oh.ns);
+        if (!h.ok || dot(wiO, oh.ng) <= 0.0) {
             offs[i].alive = false;
             continue;
         }
-        offs[i].beta *= fo * (jacobianShift * rrInv / bs.pdf);
-        offs[i].r *= po * jacobianShift / bs.pdf;
+        SegmentShift seg = shiftSegment(h.f, h.pdf, h.jacobian, rrInv, bs.pdf);
+        offs[i].beta *= seg.throughput;
+        offs[i].r *= seg.pdfRatio;
         Hit ho = traceClosest(ohOrigin, wiO, 0.0, kInf);
         rays++;
         bool offMissed = ho.triangle == kInvalidIndex;

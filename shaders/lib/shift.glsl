@@ -122,6 +122,107 @@ GDPT_INLINE bool halfVectorReflect(vec3 woBase, vec3 wiBase, vec3 woOffset, GDPT
 }
 
 // ---------------------------------------------------------------------------------------------
+// The shift mappings of one path segment (Kettunen et al. 2015 §4.2)
+// ---------------------------------------------------------------------------------------------
+
+// Where a reconnection (or environment) shift sends the offset's segment. wi: world-space
+// unit direction from the offset vertex; dist: distance to the target (0 for the environment,
+// which has no vertex); jacobian: |dω'/dω| of the segment's direction; ok: false where the
+// shift fails (the offset path has zero density and the pair falls back to the base alone).
+struct ConnectionShift {
+    vec3 wi;
+    float dist;
+    float jacobian;
+    bool ok;
+};
+
+// Reconnection shift (Kettunen et al. 2015 §4.2; Lehtinen et al. 2013 §5.1): the offset
+// vertex offsetFrom (geometric normal offsetNormal) connects to the base's next vertex
+// `target` (geometric normal targetNormal), which the base reached from baseFrom. It fails
+// where the connection leaves below the offset's geometric surface, arrives at the other
+// side of the target than the base's (another surface point for the BSDF and the emission)
+// or degenerates (jacobian 0). Visibility is the caller's (a ray query).
+GDPT_INLINE ConnectionShift shiftReconnect(vec3 baseFrom, vec3 offsetFrom, vec3 offsetNormal, vec3 target,
+                                           vec3 targetNormal) {
+    ConnectionShift c;
+    vec3 e = target - offsetFrom;
+    c.dist = length(e);
+    c.wi = e / c.dist;
+    c.jacobian = reconnectionJacobian(baseFrom, offsetFrom, target, targetNormal);
+    c.ok = c.dist > 0.0f && c.jacobian > 0.0f && dot(c.wi, offsetNormal) > 0.0f && dot(c.wi, targetNormal) < 0.0f;
+    return c;
+}
+
+// Environment (escape) shift: the base left the scene in direction wiBase; the offset leaves
+// in the same direction. The environment is a function of direction alone, so the map is the
+// identity (jacobian 1); it fails where wiBase points below the offset's geometric surface.
+GDPT_INLINE ConnectionShift shiftEnvironment(vec3 wiBase, vec3 offsetNormal) {
+    ConnectionShift c;
+    c.wi = wiBase;
+    c.dist = 0.0f;
+    c.jacobian = 1.0f;
+    c.ok = dot(wiBase, offsetNormal) > 0.0f;
+    return c;
+}
+
+// Half-vector copy shift of one sampled BSDF direction (Kettunen et al. 2015 §4.2; Lehtinen
+// et al. 2013 §5.2), in the offset vertex's local frame. A base Dirac (mirror) sample maps to
+// the offset's mirror direction with its Dirac weight F(cos θ_o) and discrete selection
+// probability (jacobian 1); a smooth sample keeps the base's half vector (halfVectorReflect).
+// Dirac and smooth never shift into each other: a base Dirac sample needs a Dirac lobe at the
+// offset, a smooth one a smooth lobe. wiLocal, f (BSDF value or Dirac weight along wiLocal)
+// and pdf (the offset's density of sampling wiLocal) are valid where ok.
+struct HalfVectorShift {
+    vec3 wiLocal;
+    vec3 f;
+    float pdf;
+    float jacobian;
+    bool ok;
+};
+
+GDPT_INLINE HalfVectorShift shiftHalfVector(BsdfParams offsetBsdf, vec3 woBase, vec3 wiBase, bool baseDirac,
+                                            vec3 woOffset) {
+    HalfVectorShift h;
+    h.wiLocal = vec3(0.0f, 0.0f, 1.0f);
+    h.f = vec3(0.0f);
+    h.pdf = 0.0f;
+    h.jacobian = 1.0f;
+    h.ok = baseDirac ? bsdfHasDelta(offsetBsdf) : !bsdfIsDeltaOnly(offsetBsdf);
+    if (h.ok && baseDirac) {
+        h.wiLocal = vec3(-woOffset.x, -woOffset.y, woOffset.z);
+        h.f = glossyFresnel(offsetBsdf, woOffset.z);
+        h.pdf = woOffset.z > 0.0f ? glossySelectProb(offsetBsdf, woOffset) : 0.0f;
+    } else if (h.ok) {
+        h.ok = halfVectorReflect(woBase, wiBase, woOffset, h.wiLocal, h.jacobian);
+        if (h.ok) {
+            h.f = bsdfEval(offsetBsdf, woOffset, h.wiLocal);
+            h.pdf = bsdfPdf(offsetBsdf, woOffset, h.wiLocal);
+        }
+    }
+    h.ok = h.ok && h.pdf > 0.0f && h.wiLocal.z > 0.0f;
+    return h;
+}
+
+// What one shifted segment does to the offset's ratio-form state (see the top of this file;
+// a path's contribution, density and Jacobian are products over its segments, Kettunen et
+// al. 2015 §4): with the base's density pdfBase of the sampled segment, the offset's density
+// pdfOffset of its shifted segment, its BSDF value f and the segment's Jacobian J,
+//   β' ← β' · f·J·rrInv / pdfBase      (offset contribution over the base's density)
+//   r  ← r  · pdfOffset·J / pdfBase     (offset density in the base's measure over the base's)
+// rrInv = 1/q of the base's Russian roulette, shared by the offsets.
+struct SegmentShift {
+    vec3 throughput;  // factor of β'
+    float pdfRatio;   // factor of r
+};
+
+GDPT_INLINE SegmentShift shiftSegment(vec3 f, float pdfOffset, float jacobian, float rrInv, float pdfBase) {
+    SegmentShift s;
+    s.throughput = f * (jacobian * rrInv / pdfBase);
+    s.pdfRatio = pdfOffset * jacobian / pdfBase;
+    return s;
+}
+
+// ---------------------------------------------------------------------------------------------
 // MIS between base and offset (GPT_REFERENCE §1.6, §7.1), ratio form
 // ---------------------------------------------------------------------------------------------
 
