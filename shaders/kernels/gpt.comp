@@ -1,5 +1,6 @@
-// gpt.comp — gradient-domain path tracing megakernel, sampling half (Kettunen et al. 2015;
-// the reference algorithm is GPT_REFERENCE §1). One invocation = one pixel p, a batch of
+// gpt.comp — gradient-domain path tracing megakernel, sampling half (Kettunen, Manzi,
+// Aittala, Lehtinen, Durand and Zwicker 2015, "Gradient-Domain Path Tracing", ACM TOG 34(4),
+// §4). One invocation = one pixel p, a batch of
 // camera samples per dispatch, the structure of pt.comp.
 //
 // Per camera sample: the base path (exactly pt.comp's path for the same random stream:
@@ -8,9 +9,10 @@
 // row), built by the shift mapping (shift.glsl): reconnection when base current, base next
 // and offset current vertices are rough, else the half-vector copy; NEE shifted with the
 // same light point. Each pixel pair (p, p+δ_i) is estimated with MIS between the forward and
-// reverse shift (power heuristic, ratio form, GPT_REFERENCE §1.6 and §7.1).
+// reverse shift (power heuristic, Veach 1997 eq. 9.13, in ratio form, shift.glsl). The steps
+// of a bounce are named functions (gpt_steps.glsl), put together in gpt_bounce.glsl.
 //
-// Offset state (ratio form, GPT_REFERENCE §7.1): beta' = f'/p (offset contribution over the
+// Offset state (ratio form, shift.glsl): beta' = f'/p (offset contribution over the
 // BASE path's pdf, Jacobians included) and r = J·p'/p (offset density in the base's measure
 // over the base's density), rLight = the prefix ratio that applies to the light strategy at
 // the next vertex. RR: q from the base; p and every p' get the factor q (beta and every
@@ -32,7 +34,7 @@
 // gradient between two texels then carries (J' − J), the lighting difference, instead of
 // (t' − t) times the lighting estimate, and the host multiplies the reconstruction of J by
 // m̄. This assumes m and J uncorrelated inside a pixel, which fails where a pixel spans two
-// surfaces: hence the mask (bench/RESULTS.md, twelfth session).
+// surfaces: hence the mask (bench/RESULTS.md).
 // Each invocation writes only its own pixel: no races, no float atomics, deterministic.
 // gpt_resolve.comp gathers the neighbours' terms.
 #version 460
@@ -71,7 +73,6 @@ layout(push_constant, scalar) uniform Push { GptFrameParams frame; };
 #include "lib/shift.glsl"
 #include "lib/gpt_light.glsl"
 
-const float kInf = 1.0 / 0.0;
 // Pixel offset δ_i of offset path i, in gpt_shared.h's order (kGptRight, kGptDown, kGptLeft,
 // kGptUp; +y = next image row).
 const ivec2 kOffsetDelta[kGptNumOffsets] = ivec2[kGptNumOffsets](ivec2(1, 0), ivec2(0, 1), ivec2(-1, 0), ivec2(0, -1));
@@ -80,6 +81,7 @@ const ivec2 kOffsetDelta[kGptNumOffsets] = ivec2[kGptNumOffsets](ivec2(1, 0), iv
 #include "lib/visible_emission.glsl"
 #include "lib/gpt_path.glsl"
 #include "lib/surface_rules.glsl"
+#include "lib/gpt_steps.glsl"
 
 // Split bounce loop (GDPT_GPT_SPLIT_BOUNCE: a second build of this kernel, gpt_split; the
 // host picks one per device, splitBounceDefault in gpt_pass.cpp). Once every live offset
@@ -90,7 +92,7 @@ const ivec2 kOffsetDelta[kGptNumOffsets] = ivec2[kGptNumOffsets](ivec2(1, 0), iv
 // loop is 15-25 % faster on it, neutral on Mesa 25 (which skips such branches), and its
 // pipeline takes about 0.37 s longer to create. A second build rather than a specialisation
 // constant, because lavapipe spends that time on the dead loop too. The image is the same
-// bit for bit either way (bench/RESULTS.md, fourth session).
+// bit for bit either way (bench/RESULTS.md).
 
 // A texture value below this (per channel) demodulates by this instead: keeps 1/m finite
 // where a texel is black (its samples then underestimate J a little).
@@ -137,7 +139,7 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     rays++;
     if (hit.triangle == kInvalidIndex) {
         if (kHasEnv && countDirect) direct += scene.envRadiance;
-        return;  // nothing is shifted (GPT_REFERENCE §1.2)
+        return;  // nothing is shifted: the environment seen directly is very direct
     }
     SurfaceHit sh = makeSurfaceHit(hit.triangle, hit.u, hit.v, d);
     if (kHasLightTris && countDirect) direct += surfaceEmission(sh);

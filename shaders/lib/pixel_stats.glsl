@@ -50,17 +50,16 @@ GDPT_INLINE void welfordAdd(GDPT_INOUT(Welford) a, vec3 x, uint n) {
 }
 
 // Chan et al. 1979 pairwise merge of a batch (n samples, Welford a) into stored statistics.
-// Merging an empty batch (n = 0) leaves acc as it is.
+// Merging an empty batch (n = 0) leaves acc as it is. (One exit, so that spirv-opt inlines it.)
 GDPT_INLINE PixelStats chanMerge(PixelStats acc, Welford a, uint n) {
-    if (n == 0u) {
-        return acc;
+    if (n > 0u) {
+        uint total = acc.count + n;
+        vec3 delta = a.mean - acc.mean;
+        float fb = float(n) / float(total);
+        acc.mean += delta * fb;
+        acc.m2 += a.m2 + delta * delta * float(acc.count) * fb;
+        acc.count = total;
     }
-    uint total = acc.count + n;
-    vec3 delta = a.mean - acc.mean;
-    float fb = float(n) / float(total);
-    acc.mean += delta * fb;
-    acc.m2 += a.m2 + delta * delta * float(acc.count) * fb;
-    acc.count = total;
     return acc;
 }
 
