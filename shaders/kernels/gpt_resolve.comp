@@ -1,5 +1,5 @@
-// gpt_resolve.comp — gathers the per-pixel statistics of gpt.comp into the G-PT images
-// (GPT_REFERENCE §1.7). One invocation = one pixel p; it only reads its own and its four
+// gpt_resolve.comp — gathers the per-pixel statistics of gpt.comp into the G-PT images: the
+// primal and gradient estimates of Kettunen et al. 2015 and their variances. One invocation = one pixel p; it only reads its own and its four
 // neighbours' statistics and writes its own GptResolved: deterministic, no atomics.
 //
 // Notation: m_X(p) = mean of quantity X at pixel p over its N samples, v_X(p) = variance of
@@ -10,7 +10,7 @@
 // offset part from q's samples (their MIS weights sum to 1, shift.glsl). central(p) holds
 // the base parts of the k(p) pairs and p receives exactly k(p) neighbour parts, so the
 // average of the k(p) pair estimators is unbiased at borders and corners too. (The
-// reference always divides by 4N; it has no border rule because Mitsuba films splat off the
+// authors' implementation always divides by 4N; it has no border rule because Mitsuba films splat off the
 // image with a weight.)
 //   dx(p) = m_gradient_right(p) − m_gradient_left(p + (1,0))   estimates I(x+1,y) − I(x,y)
 //   dy(p) = m_gradient_down(p)  − m_gradient_up(p + (0,1))     estimates I(x,y+1) − I(x,y)

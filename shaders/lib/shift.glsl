@@ -1,15 +1,15 @@
 // shift.glsl — the pure mathematics of the gradient-domain shift mapping (Kettunen et al.
-// 2015, "Gradient-Domain Path Tracing", §4 and the reference code summarised in
-// GPT_REFERENCE §1.3–1.6), in the GLSL/C++ common subset so the CPU unit tests run exactly
-// the code gpt.comp runs.
+// 2015, "Gradient-Domain Path Tracing", §4; Lehtinen et al. 2013, "Gradient-Domain
+// Metropolis Light Transport", §5), in the GLSL/C++ common subset so the CPU unit tests run
+// exactly the code gpt.comp runs.
 //
 // Conventions (as bsdf.glsl): local shading space is z-up; `wo` points from a vertex back
 // towards the previous vertex (the camera side), `wi` is the direction the path continues
 // in (the sampled direction). All pdfs are per steradian (pdfSolidAngle) unless the name
 // says otherwise; Dirac lobes use their discrete selection probability.
 //
-// Ratio form (GPT_REFERENCE §7.1): a path's pdf product can underflow float32 after a few
-// bounces, so gpt.comp never forms it. It carries, per offset, the throughput f'/p (offset
+// Ratio form (gdpt's own formulation of the same weights): a path's pdf product can
+// underflow float32 after a few bounces, so gpt.comp never forms it. It carries, per offset, the throughput f'/p (offset
 // measurement contribution divided by the BASE path's pdf, Jacobians included) and the
 // ratio r = J·p'/p of the offset path's density (in the base's measure) to the base's. MIS
 // weights are written in terms of per-segment pdfs and that ratio.
@@ -22,13 +22,14 @@
 
 GDPT_NAMESPACE_BEGIN
 
-// Connection status of an offset path (Kettunen et al. 2015 §4.2; reference gpt.cpp).
+// Connection status of an offset path (Kettunen et al. 2015 §4.2, as in the authors'
+// Mitsuba implementation).
 GDPT_CONST uint kShiftNotConnected = 0u;       // offset has its own vertices so far
 GDPT_CONST uint kShiftRecentlyConnected = 1u;  // offset reconnected to the base's current vertex
 GDPT_CONST uint kShiftConnected = 2u;          // offset shares every later vertex with the base
 
 // ---------------------------------------------------------------------------------------------
-// Vertex classification (GPT_REFERENCE §1.3)
+// Vertex classification (Kettunen et al. 2015 §4.2)
 // ---------------------------------------------------------------------------------------------
 
 // Lowest roughness over all components present (Mitsuba's BSDF::EAll): gpt.comp's
@@ -42,13 +43,13 @@ GDPT_INLINE float shiftRoughnessAll(BsdfParams m) {
     return 1.0f;
 }
 
-// "Diffuse" (reconnectable) iff roughness > threshold (GPT_REFERENCE §1.1 shiftThreshold).
+// "Diffuse" (reconnectable) iff roughness > threshold (threshold: GptFrameParams::shiftThreshold).
 GDPT_INLINE bool shiftIsRough(float roughness, float threshold) {
     return roughness > threshold;
 }
 
 // Reconnection shift iff base current, base next and offset current vertices are all rough
-// (GPT_REFERENCE §1.4); otherwise the half-vector copy shift.
+// (Kettunen et al. 2015 §4.2); otherwise the half-vector copy shift.
 GDPT_INLINE bool shiftUseReconnection(bool baseCurRough, bool baseNextRough, bool offsetCurRough) {
     return baseCurRough && baseNextRough && offsetCurRough;
 }
@@ -56,13 +57,14 @@ GDPT_INLINE bool shiftUseReconnection(bool baseCurRough, bool baseNextRough, boo
 // Invertibility of a half-vector step: the reverse shift (offset path as base) reconnects iff
 // its current vertex (the offset's), its next vertex (the offset's new one) and its offset
 // vertex (the base's current one) are all rough. Then the forward half-vector step has no
-// inverse and must fail (GPT_REFERENCE §1.4 "invertibility check").
+// inverse and must fail (Kettunen et al. 2015 §4.2: a shift must be
+// invertible for the pair's weights to sum to one).
 GDPT_INLINE bool shiftHalfVectorInvertible(bool baseCurRough, bool offsetCurRough, bool offsetNextRough) {
     return !(baseCurRough && offsetCurRough && offsetNextRough);
 }
 
 // ---------------------------------------------------------------------------------------------
-// Jacobians (Kettunen et al. 2015 §4.2, eqs. 11–12; GPT_REFERENCE §1.4)
+// Jacobians (Kettunen et al. 2015 §4.2, eqs. 11–12)
 // ---------------------------------------------------------------------------------------------
 
 // Reconnection shift: the base continues from baseFrom to `target` (geometric normal
@@ -223,11 +225,11 @@ GDPT_INLINE SegmentShift shiftSegment(vec3 f, float pdfOffset, float jacobian, f
 }
 
 // ---------------------------------------------------------------------------------------------
-// MIS between base and offset (GPT_REFERENCE §1.6, §7.1), ratio form
+// MIS between base and offset (Kettunen et al. 2015 §4; Veach 1997 ch. 9), ratio form
 // ---------------------------------------------------------------------------------------------
 
 // Power heuristic over the four strategies {own technique, other technique} × {base, offset}
-// (Veach 1997 eq. 9.13 with the path-prefix pdf divided out, GPT_REFERENCE §7.1):
+// (Veach 1997 eq. 9.13 with the path-prefix pdf divided out):
 //   w = pOwn² / (pOwn² + pOther² + qOwn² + qOther²)
 // pOwn/pOther: the base's last-segment pdfs (e.g. BSDF and light, solid angle at the base
 // vertex); qOwn/qOther: the offset's, multiplied by the prefix ratio r = J·p'/p and by the

@@ -102,7 +102,7 @@ struct BvhNode {
 // e_a = byte a of `exponents`. The power-of-two scale makes q·2^e exact, so a decoded bound
 // is one rounding of origin + q·2^e whichever way a compiler evaluates it; the builder picks
 // each q so that the decoded box contains the child's exact box (wideQuantise in
-// wide_bvh.cpp). 64 bytes instead of 128 (bench/RESULTS.md, sixth session: G-PT 7-15 %
+// wide_bvh.cpp). 64 bytes instead of 128 (bench/RESULTS.md: G-PT 7-15 %
 // faster per sample on Mesa 25, neutral to 4 % on Mesa 22.3).
 struct BvhWideNode {
     vec3 origin;     // lower corner of the node's box (world space)

@@ -197,7 +197,8 @@ TEST(ShiftMappings, ReconnectionResultMatchesGeometryAndFiniteDifferences) {
         const dvec3 offsetNormal = glm::normalize(src.point(1.0) + dvec3(0, 0, 1e-3));
         // The target's normal faces the base (the base arrives at its front side).
         const dvec3 targetNormal = glm::dot(a - y0, n) > 0.0 ? n : -n;
-        const ConnectionShift c = shiftReconnect(toF(a), toF(aOffset), toF(offsetNormal), toF(y0), toF(targetNormal));
+        const ConnectionShift c =
+            shiftReconnect(toF(a), toF(aOffset), toF(offsetNormal), toF(y0), toF(targetNormal));
         const dvec3 e = y0 - aOffset;
         EXPECT_NEAR(c.dist, glm::length(e), 1e-5 * glm::length(e)) << i;
         EXPECT_NEAR(glm::length(toD(c.wi) - glm::normalize(e)), 0.0, 1e-5) << i;
@@ -206,7 +207,8 @@ TEST(ShiftMappings, ReconnectionResultMatchesGeometryAndFiniteDifferences) {
         if (above && sameSide) {
             EXPECT_TRUE(c.ok) << i;
         }
-        if (glm::dot(glm::normalize(e), offsetNormal) < -1e-4 || glm::dot(glm::normalize(e), targetNormal) > 1e-4) {
+        if (glm::dot(glm::normalize(e), offsetNormal) < -1e-4 ||
+            glm::dot(glm::normalize(e), targetNormal) > 1e-4) {
             EXPECT_FALSE(c.ok) << i;
         }
         const double cosBase = std::abs(glm::dot(glm::normalize(a - y0), n));
@@ -267,7 +269,9 @@ TEST(ShiftMappings, HalfVectorResultEvaluatesTheOffsetBsdfAndInverts) {
         EXPECT_EQ(h.f, bsdfEval(ob, woOffset, h.wiLocal));
         EXPECT_EQ(h.pdf, bsdfPdf(ob, woOffset, h.wiLocal));
         if (h.jacobian > 0.2f && h.jacobian < 5.0f) {
-            auto map = [&](dvec3 w) { return toD(shiftHalfVector(ob, woBase, toF(w), false, woOffset).wiLocal); };
+            auto map = [&](dvec3 w) {
+                return toD(shiftHalfVector(ob, woBase, toF(w), false, woOffset).wiLocal);
+            };
             EXPECT_NEAR(h.jacobian / finiteDifferenceJacobian(toD(wiBase), 2e-3, map), 1.0, 3e-3) << i;
         }
         const HalfVectorShift back = shiftHalfVector(ob, woOffset, h.wiLocal, false, woBase);
