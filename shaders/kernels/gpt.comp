@@ -75,7 +75,8 @@ layout(push_constant, scalar) uniform Push { GptFrameParams frame; };
 
 // Pixel offset δ_i of offset path i, in gpt_shared.h's order (kGptRight, kGptDown, kGptLeft,
 // kGptUp; +y = next image row).
-const ivec2 kOffsetDelta[kGptNumOffsets] = ivec2[kGptNumOffsets](ivec2(1, 0), ivec2(0, 1), ivec2(-1, 0), ivec2(0, -1));
+const ivec2 kOffsetDelta[kGptNumOffsets] =
+    ivec2[kGptNumOffsets](ivec2(1, 0), ivec2(0, 1), ivec2(-1, 0), ivec2(0, -1));
 
 #include "lib/camera.glsl"
 #include "lib/visible_emission.glsl"

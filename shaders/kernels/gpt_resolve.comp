@@ -1,6 +1,7 @@
 // gpt_resolve.comp — gathers the per-pixel statistics of gpt.comp into the G-PT images: the
-// primal and gradient estimates of Kettunen et al. 2015 and their variances. One invocation = one pixel p; it only reads its own and its four
-// neighbours' statistics and writes its own GptResolved: deterministic, no atomics.
+// primal and gradient estimates of Kettunen et al. 2015 and their variances. One invocation
+// = one pixel p; it only reads its own and its four neighbours' statistics and writes its
+// own GptResolved: deterministic, no atomics.
 //
 // Notation: m_X(p) = mean of quantity X at pixel p over its N samples, v_X(p) = variance of
 // that mean = M2 / (N − 1) / N; δ_i = right, down, left, up.
@@ -10,8 +11,8 @@
 // offset part from q's samples (their MIS weights sum to 1, shift.glsl). central(p) holds
 // the base parts of the k(p) pairs and p receives exactly k(p) neighbour parts, so the
 // average of the k(p) pair estimators is unbiased at borders and corners too. (The
-// authors' implementation always divides by 4N; it has no border rule because Mitsuba films splat off the
-// image with a weight.)
+// authors' implementation always divides by 4N; it has no border rule because Mitsuba
+// films splat off the image with a weight.)
 //   dx(p) = m_gradient_right(p) − m_gradient_left(p + (1,0))   estimates I(x+1,y) − I(x,y)
 //   dy(p) = m_gradient_down(p)  − m_gradient_up(p + (0,1))     estimates I(x,y+1) − I(x,y)
 // (both endpoints' estimators of the pair, MIS weights summing to 1); zero in the last

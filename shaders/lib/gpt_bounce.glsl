@@ -51,7 +51,8 @@
             if (!gptPairExists(px, py, i)) continue;
             bool own = offs[i].alive && ownVertex(offs[i], GDPT_GPT_GENERAL);
             OffsetNee on = gptPairNee(offs[i], offV[i], own, lightStrategy[i], nee, bsdf, sh.p, rays);
-            if (on.counts) addPair(offs[i], gptMisWeight(ls.pdf, nee.pdfBsdf, on.qLight, on.qBsdf), nee.fBase, on.f);
+            float w = gptMisWeight(ls.pdf, nee.pdfBsdf, on.qLight, on.qBsdf);
+            if (on.counts) addPair(offs[i], w, nee.fBase, on.f);
         }
     }
 
@@ -104,7 +105,8 @@
     // Nothing left to carry (e.g. the base and all offsets sit on a black emitter): every
     // later contribution of every pair would be w·0, so stop tracing.
     bool carries = maxComponent(beta) > 0.0;
-    for (uint i = 0u; i < kGptNumOffsets; ++i) carries = carries || (offs[i].alive && maxComponent(offs[i].beta) > 0.0);
+    for (uint i = 0u; i < kGptNumOffsets; ++i)
+        carries = carries || (offs[i].alive && maxComponent(offs[i].beta) > 0.0);
     if (!carries) { pathEnded = true; break; }
     sh = seg.next;
     d = seg.wi;

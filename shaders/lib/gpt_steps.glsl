@@ -1,9 +1,9 @@
 // gpt_steps.glsl — the named steps of one G-PT bounce (gpt_bounce.glsl), mostly for one pixel
 // pair (base, offset i): the offset's vertex, next-event estimation with the base's light
 // point, the base's BSDF sample and Russian roulette, the shift of the offset over the base's
-// new segment, and the emission the pair reaches
-// (Kettunen et al. 2015 §4; the shift mappings themselves are shift.glsl's). GLSL only: needs
-// gpt.comp's scene buffers, bvh_traverse.glsl, gpt_light.glsl and gpt_path.glsl.
+// new segment, and the emission the pair reaches (Kettunen et al. 2015 §4; the shift mappings
+// themselves are shift.glsl's). GLSL only: needs gpt.comp's scene buffers, bvh_traverse.glsl,
+// gpt_light.glsl and gpt_path.glsl.
 //
 // Every function here has one exit: spirv-opt then inlines it (it leaves calls of functions
 // with an early return to the driver), so the SPIR-V that lavapipe lowers keeps the shape of
@@ -43,12 +43,12 @@ OffsetVertex gptOffsetVertex(OffsetPath o, bool own, BsdfParams baseBsdf, vec3 t
 // (failed shift) and a shared vertex; for separate vertices only if both are rough (area
 // lights; BSDF sampling never hits a punctual light). The BSDF-sampled emission of the next
 // vertex then competes with it or not. Rough means rough over ALL components (not only the
-// smooth ones NEE evaluates, Mitsuba's choice): only then does the BSDF step reconnect to the
-// light point, so NEE and BSDF sampling use the same shift and their pair weights sum to one
-// (the smooth-only rule made a diffuse lobe under a mirror coat count its light twice: NEE
-// with four strategies, and again through the half-vector branch, which has no light
-// strategy). A Dirac-only offset vertex fails every shift of both techniques, so its pair is
-// the lone base's (PT weights, light strategy included).
+// smooth ones NEE evaluates, the authors' implementation's choice): only then does the BSDF
+// step reconnect to the light point, so NEE and BSDF sampling use the same shift and their
+// pair weights sum to one (the smooth-only rule made a diffuse lobe under a mirror coat count
+// its light twice: NEE with four strategies, and again through the half-vector branch, which
+// has no light strategy). A Dirac-only offset vertex fails every shift of both techniques, so
+// its pair is the lone base's (PT weights, light strategy included).
 bool gptPairHasLightStrategy(bool own, BsdfParams offsetBsdf, bool baseRough) {
     return !own || bsdfIsDeltaOnly(offsetBsdf) || (baseRough && roughAll(offsetBsdf));
 }

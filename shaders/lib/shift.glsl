@@ -9,10 +9,11 @@
 // says otherwise; Dirac lobes use their discrete selection probability.
 //
 // Ratio form (gdpt's own formulation of the same weights): a path's pdf product can
-// underflow float32 after a few bounces, so gpt.comp never forms it. It carries, per offset, the throughput f'/p (offset
-// measurement contribution divided by the BASE path's pdf, Jacobians included) and the
-// ratio r = J·p'/p of the offset path's density (in the base's measure) to the base's. MIS
-// weights are written in terms of per-segment pdfs and that ratio.
+// underflow float32 after a few bounces, so gpt.comp never forms it. It carries, per
+// offset, the throughput f'/p (offset measurement contribution divided by the BASE path's
+// pdf, Jacobians included) and the ratio r = J·p'/p of the offset path's density (in the
+// base's measure) to the base's. MIS weights are written in terms of per-segment pdfs and
+// that ratio.
 #ifndef GDPT_LIB_SHIFT
 #define GDPT_LIB_SHIFT
 
@@ -151,7 +152,8 @@ GDPT_INLINE ConnectionShift shiftReconnect(vec3 baseFrom, vec3 offsetFrom, vec3 
     c.dist = length(e);
     c.wi = e / c.dist;
     c.jacobian = reconnectionJacobian(baseFrom, offsetFrom, target, targetNormal);
-    c.ok = c.dist > 0.0f && c.jacobian > 0.0f && dot(c.wi, offsetNormal) > 0.0f && dot(c.wi, targetNormal) < 0.0f;
+    c.ok = c.dist > 0.0f && c.jacobian > 0.0f && dot(c.wi, offsetNormal) > 0.0f &&
+           dot(c.wi, targetNormal) < 0.0f;
     return c;
 }
 
