@@ -1,4 +1,4 @@
-// visible.comp — emitter-silhouette supersampling: a separate estimate of the emission that
+// emitter_supersampling.comp — emitter supersampling: a separate estimate of the emission that
 // the camera sees at its first hit (the environment for a ray that misses), in the pixels
 // where that emission changes within the pixel's neighbourhood (the edges of lights seen
 // directly, of the sky, of emissive texture detail). Elsewhere the path kernels estimate it
@@ -9,8 +9,8 @@
 // c(1−c)L² per sample, large against the pixel's own value. G-PT's reconstruction does not
 // touch this term (it is added to the reconstructed indirect image, Kettunen et al. 2015 §5),
 // so at low sample counts these few pixels hold most of a G-PT image's relMSE (the Cornell
-// box at 5 spp: the light's rim, 0.1 % of the pixels, gave 60 %; bench/RESULTS.md, fifth
-// session). Here each such pixel gets samplesPerSpp first-hit rays per camera sample, at
+// box at 5 spp: the light's rim, 0.1 % of the pixels, gave 60 %;
+// bench/RESULTS.md). Here each such pixel gets samplesPerSpp first-hit rays per camera sample, at
 // scrambled Sobol' positions (sobol.glsl), which stratify the pixel as they accumulate.
 //
 // Phases (push constant `phase`, one dispatch each over the whole image):
@@ -111,9 +111,8 @@ void main() {
 
     // Welford over the camera samples, each the mean of its k rays (so that the statistics
     // count camera samples, like every other per-pixel estimate).
-    Welford acc;
-    acc.mean = vec3(0.0);
-    acc.m2 = vec3(0.0);
+    Welford acc = welfordInit();
+    uint nan = 0u;
     vec3 firstValue = vec3(0.0);
     bool agree = true;
     for (uint s = 0u; s < samples; ++s) {
@@ -125,7 +124,10 @@ void main() {
             agree = agree && all(equal(e, firstValue));
             sum += e;
         }
-        welfordAdd(acc, sum / float(raysPerSample), s + 1u);
+        vec3 value = sum / float(raysPerSample);
+        bool finite = isFinite(value);
+        if (!finite) nan++;
+        welfordAdd(acc, statsSample(value, finite), s + 1u);
     }
     atomicAdd(counters.raysTraced, samples * raysPerSample);
     if (params.phase == kVisiblePhaseProbe) {
@@ -133,4 +135,5 @@ void main() {
         return;
     }
     visibleStats[pixel] = chanMerge(visibleStats[pixel], acc, samples);
+    if (nan > 0u) atomicAdd(counters.nanSamples, nan);
 }

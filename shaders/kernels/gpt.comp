@@ -1,5 +1,6 @@
-// gpt.comp — gradient-domain path tracing megakernel, sampling half (Kettunen et al. 2015;
-// the reference algorithm is GPT_REFERENCE §1). One invocation = one pixel p, a batch of
+// gpt.comp — gradient-domain path tracing megakernel, sampling half (Kettunen, Manzi,
+// Aittala, Lehtinen, Durand and Zwicker 2015, "Gradient-Domain Path Tracing", ACM TOG 34(4),
+// §4). One invocation = one pixel p, a batch of
 // camera samples per dispatch, the structure of pt.comp.
 //
 // Per camera sample: the base path (exactly pt.comp's path for the same random stream:
@@ -8,9 +9,10 @@
 // row), built by the shift mapping (shift.glsl): reconnection when base current, base next
 // and offset current vertices are rough, else the half-vector copy; NEE shifted with the
 // same light point. Each pixel pair (p, p+δ_i) is estimated with MIS between the forward and
-// reverse shift (power heuristic, ratio form, GPT_REFERENCE §1.6 and §7.1).
+// reverse shift (power heuristic, Veach 1997 eq. 9.13, in ratio form, shift.glsl). The steps
+// of a bounce are named functions (gpt_steps.glsl), put together in gpt_bounce.glsl.
 //
-// Offset state (ratio form, GPT_REFERENCE §7.1): beta' = f'/p (offset contribution over the
+// Offset state (ratio form, shift.glsl): beta' = f'/p (offset contribution over the
 // BASE path's pdf, Jacobians included) and r = J·p'/p (offset density in the base's measure
 // over the base's density), rLight = the prefix ratio that applies to the light strategy at
 // the next vertex. RR: q from the base; p and every p' get the factor q (beta and every
@@ -21,7 +23,7 @@
 //   neighbor_i(p)   offset i's MIS-weighted radiance (an estimate for pixel p + δ_i)
 //   gradient_i(p)   MIS-weighted (f_offset − f_base) of direction i
 //   direct(p)       emission seen directly from the camera (never shifted); zero in the
-//                   pixels of emitter-silhouette supersampling (visible.comp), whose
+//                   pixels of emitter supersampling (emitter_supersampling.comp), whose
 //                   estimate gpt_resolve.comp takes instead
 //   modulation(p)   with kDemodulate only: the base paths' first-hit modulation m
 //
@@ -32,7 +34,7 @@
 // gradient between two texels then carries (J' − J), the lighting difference, instead of
 // (t' − t) times the lighting estimate, and the host multiplies the reconstruction of J by
 // m̄. This assumes m and J uncorrelated inside a pixel, which fails where a pixel spans two
-// surfaces: hence the mask (bench/RESULTS.md, twelfth session).
+// surfaces: hence the mask (bench/RESULTS.md).
 // Each invocation writes only its own pixel: no races, no float atomics, deterministic.
 // gpt_resolve.comp gathers the neighbours' terms.
 #version 460
@@ -71,13 +73,16 @@ layout(push_constant, scalar) uniform Push { GptFrameParams frame; };
 #include "lib/shift.glsl"
 #include "lib/gpt_light.glsl"
 
-const float kInf = 1.0 / 0.0;
-const ivec2 kOffsetDelta[4] = ivec2[4](ivec2(1, 0), ivec2(0, 1), ivec2(-1, 0), ivec2(0, -1));
+// Pixel offset δ_i of offset path i, in gpt_shared.h's order (kGptRight, kGptDown, kGptLeft,
+// kGptUp; +y = next image row).
+const ivec2 kOffsetDelta[kGptNumOffsets] =
+    ivec2[kGptNumOffsets](ivec2(1, 0), ivec2(0, 1), ivec2(-1, 0), ivec2(0, -1));
 
 #include "lib/camera.glsl"
 #include "lib/visible_emission.glsl"
 #include "lib/gpt_path.glsl"
 #include "lib/surface_rules.glsl"
+#include "lib/gpt_steps.glsl"
 
 // Split bounce loop (GDPT_GPT_SPLIT_BOUNCE: a second build of this kernel, gpt_split; the
 // host picks one per device, splitBounceDefault in gpt_pass.cpp). Once every live offset
@@ -88,7 +93,7 @@ const ivec2 kOffsetDelta[4] = ivec2[4](ivec2(1, 0), ivec2(0, 1), ivec2(-1, 0), i
 // loop is 15-25 % faster on it, neutral on Mesa 25 (which skips such branches), and its
 // pipeline takes about 0.37 s longer to create. A second build rather than a specialisation
 // constant, because lavapipe spends that time on the dead loop too. The image is the same
-// bit for bit either way (bench/RESULTS.md, fourth session).
+// bit for bit either way (bench/RESULTS.md).
 
 // A texture value below this (per channel) demodulates by this instead: keeps 1/m finite
 // where a texel is black (its samples then underestimate J a little).
@@ -113,10 +118,10 @@ bool ownVertex(OffsetPath o, bool general) { return general && o.state == kShift
 // baseModulation: the base's first-hit modulation (1 unless kDemodulate; offs[i].modulation
 // the offsets').
 void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, bool countDirect, inout uint rays,
-                 out vec3 direct, out vec3 baseModulation, inout OffsetPath offs[4]) {
+                 out vec3 direct, out vec3 baseModulation, inout OffsetPath offs[kGptNumOffsets]) {
     direct = vec3(0.0);
     baseModulation = vec3(1.0);
-    for (uint i = 0u; i < 4u; ++i) {
+    for (uint i = 0u; i < kGptNumOffsets; ++i) {
         offs[i].modulation = vec3(1.0);
         offs[i].alive = gptPairExists(px, py, i);
         offs[i].shifted = false;
@@ -135,12 +140,12 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     rays++;
     if (hit.triangle == kInvalidIndex) {
         if (kHasEnv && countDirect) direct += scene.envRadiance;
-        return;  // nothing is shifted (GPT_REFERENCE §1.2)
+        return;  // nothing is shifted: the environment seen directly is very direct
     }
     SurfaceHit sh = makeSurfaceHit(hit.triangle, hit.u, hit.v, d);
     if (kHasLightTris && countDirect) direct += surfaceEmission(sh);
     if (kDemodulate) baseModulation = firstHitModulation(sh, py * scene.width + px);
-    for (uint i = 0u; i < 4u; ++i) {
+    for (uint i = 0u; i < kGptNumOffsets; ++i) {
         offs[i].shifted = offs[i].alive;
         if (!offs[i].alive) continue;
         vec3 di = cameraRay(pixelPos + vec2(kOffsetDelta[i]));
@@ -166,7 +171,7 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     for (; depth < kMaxDepth && depth < scene.maxDepth; ++depth) {
 #ifdef GDPT_GPT_SPLIT_BOUNCE
         bool own = false;
-        for (uint i = 0u; i < 4u; ++i) own = own || (offs[i].alive && ownVertex(offs[i], true));
+        for (uint i = 0u; i < kGptNumOffsets; ++i) own = own || (offs[i].alive && ownVertex(offs[i], true));
         if (!own) break;
 #endif
 #define GDPT_GPT_GENERAL true
@@ -182,6 +187,14 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     }
 #endif
 }
+
+// The quantities gpt.comp accumulates per pixel, as indices into main's accumulators: central,
+// neighbor_i and gradient_i (i in kOffsetDelta's order), direct.
+const uint kAccCentral = 0u;
+const uint kAccNeighbor = 1u;
+const uint kAccGradient = kAccNeighbor + kGptNumOffsets;
+const uint kAccDirect = kAccGradient + kGptNumOffsets;
+const uint kAccCount = kAccDirect + 1u;
 
 void main() {
     loadScene();
@@ -200,20 +213,14 @@ void main() {
     }
     uint pixel = y * scene.width + x;
 
-    // 0 central, 1..4 neighbor_i, 5..8 gradient_i, 9 direct.
-    Welford acc[10];
-    for (uint k = 0u; k < 10u; ++k) {
-        acc[k].mean = vec3(0.0);
-        acc[k].m2 = vec3(0.0);
-    }
-    Welford accModulation;  // kDemodulate only
-    accModulation.mean = vec3(0.0);
-    accModulation.m2 = vec3(0.0);
+    Welford acc[kAccCount];
+    for (uint k = 0u; k < kAccCount; ++k) acc[k] = welfordInit();
+    Welford accModulation = welfordInit();  // kDemodulate only
     uint n = 0u;
     uint rays = 0u;
     uint nan = 0u;
     uint shiftPairs = 0u, shiftFailures = 0u;
-    OffsetPath offs[4];
+    OffsetPath offs[kGptNumOffsets];
     bool countDirect = !emissionSupersampled(pixel);
     for (uint s = 0u; s < frame.samplesPerPixel; ++s) {
         // Same stream as pt.comp's sample s: the base path is PT's path.
@@ -223,50 +230,44 @@ void main() {
         vec3 direct, baseModulation;
         traceSample(lds, rng, vec2(x, y) + jitter, x, y, countDirect, rays, direct, baseModulation, offs);
         if (kDemodulate) {
-            for (uint i = 0u; i < 4u; ++i) {
+            for (uint i = 0u; i < kGptNumOffsets; ++i) {
                 offs[i].baseSum /= baseModulation;
                 offs[i].offSum /= offs[i].modulation;
             }
         }
-        for (uint i = 0u; i < 4u; ++i) {
+        for (uint i = 0u; i < kGptNumOffsets; ++i) {
             shiftPairs += offs[i].shifted ? 1u : 0u;
             shiftFailures += offs[i].shifted && !offs[i].alive ? 1u : 0u;
         }
         vec3 central = vec3(0.0);
         bool finite = isFinite(direct);
-        for (uint i = 0u; i < 4u; ++i) {
+        for (uint i = 0u; i < kGptNumOffsets; ++i) {
             central += offs[i].baseSum;
             finite = finite && isFinite(offs[i].baseSum) && isFinite(offs[i].offSum);
         }
         n++;
         if (kDemodulate) welfordAdd(accModulation, baseModulation, n);
-        if (!finite) {
-            // Counted, never written: the whole sample (all quantities) becomes zero so the
-            // pairs stay consistent.
-            nan++;
-            for (uint k = 0u; k < 10u; ++k) welfordAdd(acc[k], vec3(0.0), n);
-            continue;
+        // The non-finite policy of pixel_stats.glsl over the whole sample: one non-finite
+        // quantity makes every quantity of it zero, so the pairs stay consistent.
+        if (!finite) nan++;
+        welfordAdd(acc[kAccCentral], statsSample(central, finite), n);
+        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+            welfordAdd(acc[kAccNeighbor + i], statsSample(offs[i].offSum, finite), n);
+            welfordAdd(acc[kAccGradient + i], statsSample(offs[i].offSum - offs[i].baseSum, finite), n);
         }
-        welfordAdd(acc[0], central, n);
-        for (uint i = 0u; i < 4u; ++i) {
-            welfordAdd(acc[1u + i], offs[i].offSum, n);
-            welfordAdd(acc[5u + i], offs[i].offSum - offs[i].baseSum, n);
-        }
-        welfordAdd(acc[9], direct, n);
+        welfordAdd(acc[kAccDirect], statsSample(direct, finite), n);
     }
-    if (n > 0u) {
-        statCentral[pixel] = chanMerge(statCentral[pixel], acc[0], n);
-        statNeighbor0[pixel] = chanMerge(statNeighbor0[pixel], acc[1], n);
-        statNeighbor1[pixel] = chanMerge(statNeighbor1[pixel], acc[2], n);
-        statNeighbor2[pixel] = chanMerge(statNeighbor2[pixel], acc[3], n);
-        statNeighbor3[pixel] = chanMerge(statNeighbor3[pixel], acc[4], n);
-        statGradient0[pixel] = chanMerge(statGradient0[pixel], acc[5], n);
-        statGradient1[pixel] = chanMerge(statGradient1[pixel], acc[6], n);
-        statGradient2[pixel] = chanMerge(statGradient2[pixel], acc[7], n);
-        statGradient3[pixel] = chanMerge(statGradient3[pixel], acc[8], n);
-        statDirect[pixel] = chanMerge(statDirect[pixel], acc[9], n);
-        if (kDemodulate) statModulation[pixel] = chanMerge(statModulation[pixel], accModulation, n);
-    }
+    statCentral[pixel] = chanMerge(statCentral[pixel], acc[kAccCentral], n);
+    statNeighbor0[pixel] = chanMerge(statNeighbor0[pixel], acc[kAccNeighbor + kGptRight], n);
+    statNeighbor1[pixel] = chanMerge(statNeighbor1[pixel], acc[kAccNeighbor + kGptDown], n);
+    statNeighbor2[pixel] = chanMerge(statNeighbor2[pixel], acc[kAccNeighbor + kGptLeft], n);
+    statNeighbor3[pixel] = chanMerge(statNeighbor3[pixel], acc[kAccNeighbor + kGptUp], n);
+    statGradient0[pixel] = chanMerge(statGradient0[pixel], acc[kAccGradient + kGptRight], n);
+    statGradient1[pixel] = chanMerge(statGradient1[pixel], acc[kAccGradient + kGptDown], n);
+    statGradient2[pixel] = chanMerge(statGradient2[pixel], acc[kAccGradient + kGptLeft], n);
+    statGradient3[pixel] = chanMerge(statGradient3[pixel], acc[kAccGradient + kGptUp], n);
+    statDirect[pixel] = chanMerge(statDirect[pixel], acc[kAccDirect], n);
+    if (kDemodulate) statModulation[pixel] = chanMerge(statModulation[pixel], accModulation, n);
     atomicAdd(counters.raysTraced, rays);
     atomicAdd(counters.pathsCompleted, n);
     if (nan > 0u) atomicAdd(counters.nanSamples, nan);

@@ -1,6 +1,7 @@
-// gpt_resolve.comp — gathers the per-pixel statistics of gpt.comp into the G-PT images
-// (GPT_REFERENCE §1.7). One invocation = one pixel p; it only reads its own and its four
-// neighbours' statistics and writes its own GptResolved: deterministic, no atomics.
+// gpt_resolve.comp — gathers the per-pixel statistics of gpt.comp into the G-PT images: the
+// primal and gradient estimates of Kettunen et al. 2015 and their variances. One invocation
+// = one pixel p; it only reads its own and its four neighbours' statistics and writes its
+// own GptResolved: deterministic, no atomics.
 //
 // Notation: m_X(p) = mean of quantity X at pixel p over its N samples, v_X(p) = variance of
 // that mean = M2 / (N − 1) / N; δ_i = right, down, left, up.
@@ -10,8 +11,8 @@
 // offset part from q's samples (their MIS weights sum to 1, shift.glsl). central(p) holds
 // the base parts of the k(p) pairs and p receives exactly k(p) neighbour parts, so the
 // average of the k(p) pair estimators is unbiased at borders and corners too. (The
-// reference always divides by 4N; it has no border rule because Mitsuba films splat off the
-// image with a weight.)
+// authors' implementation always divides by 4N; it has no border rule because Mitsuba
+// films splat off the image with a weight.)
 //   dx(p) = m_gradient_right(p) − m_gradient_left(p + (1,0))   estimates I(x+1,y) − I(x,y)
 //   dy(p) = m_gradient_down(p)  − m_gradient_up(p + (0,1))     estimates I(x,y+1) − I(x,y)
 // (both endpoints' estimators of the pair, MIS weights summing to 1); zero in the last
@@ -25,6 +26,7 @@
 #extension GL_GOOGLE_include_directive : require
 
 #include "gpt_shared.h"
+#include "lib/pixel_stats.glsl"
 
 layout(local_size_x_id = kSpecWorkgroupX, local_size_y_id = kSpecWorkgroupY) in;
 
@@ -41,13 +43,6 @@ layout(set = 0, binding = kBindGptDirect, scalar) readonly buffer DirectBuf { Pi
 #include "lib/visible_emission.glsl"
 layout(set = 0, binding = kBindGptResolved, scalar) writeonly buffer ResolvedBuf { GptResolved resolved[]; };
 layout(push_constant, scalar) uniform Push { GptFrameParams frame; };
-
-// Variance of the mean of one statistic (unbiased sample variance / n).
-vec3 varianceOfMean(PixelStats s) {
-    if (s.count < 2u) return vec3(0.0);
-    float n = float(s.count);
-    return s.m2 / ((n - 1.0) * n);
-}
 
 void main() {
     uint x = gl_GlobalInvocationID.x;
@@ -97,8 +92,8 @@ void main() {
         r.dy = a.mean - b.mean;
         r.varDy = varianceOfMean(a) + varianceOfMean(b);
     }
-    // Emitter-silhouette supersampling estimated this pixel's very-direct emission instead
-    // (visible.comp; gpt.comp then left statDirect zero here).
+    // emitter supersampling estimated this pixel's very-direct emission instead
+    // (emitter_supersampling.comp; gpt.comp then left statDirect zero here).
     PixelStats dir = statDirect[p];
     if (emissionSupersampled(p)) dir = visibleStats[p];
     r.direct = dir.mean;

@@ -1,10 +1,9 @@
 // pt.comp — unidirectional path tracing, megakernel schedule: one invocation = one pixel,
 // which traces `samplesPerPixel` whole paths (estimator in lib/pt_core.glsl).
 //
-// Accumulation: each invocation folds its batch into per-pixel (mean, M2, count) with
-// Welford's update and merges that into the running PixelStats by Chan et al.'s pairwise
-// formula, so the stored values stay bounded and float32 keeps ~1e-6 relative accuracy over
-// 10^5 samples; the variance feeds the statistical tests.
+// Accumulation: each invocation folds its batch into a Welford accumulator and merges that
+// into the pixel's running PixelStats (lib/pixel_stats.glsl, which also states the policy for
+// non-finite samples); the variance feeds the statistical tests.
 #version 460
 #extension GL_EXT_scalar_block_layout : require
 #extension GL_GOOGLE_include_directive : require
@@ -32,8 +31,7 @@ void main() {
     uint y = gl_GlobalInvocationID.y + frame.rowOffset;
     if (x >= scene.width || y >= scene.height || gl_GlobalInvocationID.y >= frame.rowCount) return;
 
-    vec3 mean = vec3(0.0);
-    vec3 m2 = vec3(0.0);
+    Welford acc = welfordInit();
     uint n = 0u;
     uint nan = 0u;
     uint rays = 0u;
@@ -44,12 +42,13 @@ void main() {
             ptProcessHit(s, hit);
         }
         rays += s.rays;
-        welfordAdd(mean, m2, n, nan, s.radiance);
+        bool finite = isFinite(s.radiance);
+        if (!finite) nan++;
+        n++;
+        welfordAdd(acc, statsSample(s.radiance, finite), n);
     }
     uint pixel = y * scene.width + x;
-    PixelStats acc = accum[pixel];
-    mergeStats(acc, n, mean, m2);
-    accum[pixel] = acc;
+    accum[pixel] = chanMerge(accum[pixel], acc, n);
     atomicAdd(counters.raysTraced, rays);
     atomicAdd(counters.pathsCompleted, n);
     if (nan > 0u) atomicAdd(counters.nanSamples, nan);

@@ -33,16 +33,17 @@ bool gptPairExists(uint px, uint py, uint i) {
 // Vertex classification; a scene without glossy/specular vertices (kHasGlossy false) has
 // every vertex rough, which the compiler folds away with the half-vector branch.
 //
-// Deviation from the reference (GPT_REFERENCE §1.3), which classifies the base's current
-// vertex by the component it sampled and the offset's by that same component: the sampled
-// component is not a function of the path (a mixture reaches one direction through several
-// lobes), and an offset may lack the component altogether (base samples the diffuse lobe of
-// a wall, the offset sits on a metal), so the forward and the reverse shift of one pair can
-// pick different shift types and the pair's MIS weights stop summing to one. Here every
-// vertex is classified by its lowest roughness over all components (shiftRoughnessAll), a
-// property of the vertex alone, so the rule is symmetric. Cost: a diffuse lobe under a
-// smooth coat never reconnects (half-vector copies instead). On the test scenes (metals and
-// Lambertian walls) both rules pass the same tests; the difference is argued, not measured.
+// Deviation from the authors' Mitsuba implementation of Kettunen et al. 2015, which classifies
+// the base's current vertex by the component it sampled and the offset's by that same
+// component: the sampled component is not a function of the path (a mixture reaches one
+// direction through several lobes), and an offset may lack the component altogether (base
+// samples the diffuse lobe of a wall, the offset sits on a metal), so the forward and the
+// reverse shift of one pair can pick different shift types and the pair's MIS weights stop
+// summing to one. Here every vertex is classified by its lowest roughness over all components
+// (shiftRoughnessAll), a property of the vertex alone, so the rule is symmetric. Cost: a
+// diffuse lobe under a smooth coat never reconnects (half-vector copies instead). On the test
+// scenes (metals and Lambertian walls) both rules pass the same tests; the difference is
+// argued, not measured.
 bool roughAll(BsdfParams m) {
     return !kHasGlossy || shiftIsRough(shiftRoughnessAll(m), frame.shiftThreshold);
 }
@@ -51,7 +52,8 @@ bool oneSidedBack(SurfaceHit h) {
     return !h.frontFace && (material(h.material).flags & kMatFlagDoubleSided) == 0u;
 }
 
-// Adds one estimator sample of a pair with MIS weight w (GPT_REFERENCE §1.6).
+// Adds one estimator sample of a pair with MIS weight w: Σ w·f over the pair's
+// strategies (base and offset, each by its own techniques) estimates the pair's integral.
 void addPair(inout OffsetPath op, float w, vec3 fBase, vec3 fOffset) {
     op.baseSum += w * fBase;
     op.offSum += w * fOffset;

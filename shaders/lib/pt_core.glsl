@@ -14,6 +14,7 @@
 #define GDPT_LIB_PT_CORE
 
 #include "lib/camera.glsl"
+#include "lib/pixel_stats.glsl"
 #include "lib/sampler.glsl"
 #include "lib/visible_emission.glsl"
 
@@ -50,7 +51,7 @@ void ptProcessHit(inout PathState s, Hit hit) {
     lds.index = s.sampleIndex;
     s.rays++;
     s.flags &= ~kPathFlagAlive;  // set again below if the path continues
-    // Emission seen by the camera ray itself: left to emitter-silhouette supersampling in
+    // Emission seen by the camera ray itself: left to emitter supersampling in
     // the pixels it covers (visible_emission.glsl).
     bool countEmission = s.depth > 0u || !emissionSupersampled(s.pixel);
     if (hit.triangle == kInvalidIndex) {
@@ -121,29 +122,6 @@ void ptProcessHit(inout PathState s, Hit hit) {
         if (survive) s.flags |= kPathFlagAlive;
     }
     s.rng = rng.state;
-}
-
-// Folds one sample into per-invocation Welford statistics (NaN/Inf counted, not written).
-void welfordAdd(inout vec3 mean, inout vec3 m2, inout uint n, inout uint nan, vec3 L) {
-    if (!isFinite(L)) {
-        nan++;
-        L = vec3(0.0);
-    }
-    n++;
-    vec3 delta = L - mean;
-    mean += delta / float(n);
-    m2 += delta * (L - mean);
-}
-
-// Chan et al. 1979 pairwise merge of (n, mean, m2) into the running PixelStats.
-void mergeStats(inout PixelStats acc, uint n, vec3 mean, vec3 m2) {
-    uint total = acc.count + n;
-    if (total == 0u) return;
-    vec3 delta = mean - acc.mean;
-    float fb = float(n) / float(total);
-    acc.mean += delta * fb;
-    acc.m2 += m2 + delta * delta * float(acc.count) * fb;
-    acc.count = total;
 }
 
 #endif  // GDPT_LIB_PT_CORE

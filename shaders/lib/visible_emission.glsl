@@ -1,5 +1,5 @@
-// visible_emission.glsl — what the path kernels need of emitter-silhouette supersampling
-// (visible.comp, render/visible_pass.h): pixels whose camera-visible emission is estimated
+// visible_emission.glsl — what the path kernels need of emitter supersampling
+// (emitter_supersampling.comp, render/passes/emitter_supersampling_pass.h): pixels whose camera-visible emission is estimated
 // by that pass (its statistics have samples) leave the emission of their first hit, or the
 // environment seen by a camera ray that misses, out of their own estimate. GLSL only.
 #ifndef GDPT_LIB_VISIBLE_EMISSION

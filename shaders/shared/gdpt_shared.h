@@ -102,7 +102,7 @@ struct BvhNode {
 // e_a = byte a of `exponents`. The power-of-two scale makes q·2^e exact, so a decoded bound
 // is one rounding of origin + q·2^e whichever way a compiler evaluates it; the builder picks
 // each q so that the decoded box contains the child's exact box (wideQuantise in
-// wide_bvh.cpp). 64 bytes instead of 128 (bench/RESULTS.md, sixth session: G-PT 7-15 %
+// wide_bvh.cpp). 64 bytes instead of 128 (bench/RESULTS.md: G-PT 7-15 %
 // faster per sample on Mesa 25, neutral to 4 % on Mesa 22.3).
 struct BvhWideNode {
     vec3 origin;     // lower corner of the node's box (world space)
@@ -217,7 +217,7 @@ struct FrameParams {
     uint pad2;
 };
 
-// Push constants of visible.comp (emitter-silhouette supersampling).
+// Push constants of emitter_supersampling.comp (emitter supersampling).
 struct VisibleParams {
     uint phase;           // kVisiblePhase*
     uint sampleBase;      // refine: first camera sample of this batch (per pixel)
@@ -232,7 +232,7 @@ GDPT_CONST uint kVisiblePhaseProbe = 0u;   // 4 stratified rays per pixel -> sig
 GDPT_CONST uint kVisiblePhaseCount = 1u;   // count the pixels to supersample
 GDPT_CONST uint kVisiblePhaseRefine = 2u;  // supersample them (one batch)
 
-// Written by visible.comp's count phase. 16 bytes.
+// Written by emitter_supersampling.comp's count phase. 16 bytes.
 struct VisibleCounter {
     uint refinedPixels;   // pixels whose neighbourhood sees an emission edge
     uint raysPerSample;   // refine rays per camera sample in them (after the ray budget)
@@ -255,7 +255,7 @@ struct Counters {
     uint raysTraced;      // low 32 bits; host accumulates into 64-bit per batch
     uint pathsCompleted;
     uint nanSamples;      // samples dropped because they were NaN/Inf
-    uint pad;             // wavefront schedule: paths still alive (wf_shade.comp)
+    uint pad;             // unused (keeps the struct's layout)
     uint shiftPairs;      // G-PT: offsets inside the image whose base's primary ray hit
     uint shiftFailures;   // G-PT: of those, offsets whose shift failed (pair fell back to the base)
 };
@@ -276,9 +276,7 @@ GDPT_ENUM_BEGIN(SceneBinding)
     kBindAccum = 9u,
     kBindCounters = 10u,
     kBindCount = 11u,
-    kBindPathState = 12u,   // wavefront schedule: PathState per path
-    kBindPathHits = 13u,    // wavefront schedule: closest hit per path (t, u, v, triangle bits)
-    // Emitter-silhouette supersampling (visible.comp, render/visible_pass.h): the
+    // emitter supersampling (emitter_supersampling.comp, render/passes/emitter_supersampling_pass.h): the
     // supersampled estimate of the emission seen at the camera's first hit (PixelStats; a
     // count > 0 tells the path kernels to leave that term to it), the probe signature
     // per pixel (uint) and the pass's counter (VisibleCounter).
@@ -306,7 +304,7 @@ GDPT_ENUM_BEGIN(SpecId)
     kSpecHasAlphaMask = 7u,
     kSpecMaxDepth = 8u,
     kSpecPoissonFlags = 9u,  // poisson_*.comp: the kPoissonFlag* bits of this pipeline variant
-    kSpecVisibleEmission = 10u,  // path kernels: emitter-silhouette supersampling is on (visible_emission.glsl)
+    kSpecVisibleEmission = 10u,  // path kernels: emitter supersampling is on (visible_emission.glsl)
     kSpecHasShadingNormals = 11u,  // some triangle carries kTriFlagHasNormals (features.h)
     kSpecHasSpecularLobe = 12u,  // some material has a metal/dielectric lobe (features.h hasSpecularLayer)
     kSpecBvhRegisterStack = 13u,  // entries of the register traversal stack (8, 16), 0 = in memory (bvh_traverse.glsl)
@@ -321,8 +319,7 @@ struct TestRay {
     float tMax;
 };
 
-// State of one path between the kernels of the wavefront schedule (wf_extend.comp,
-// wf_shade.comp); the megakernel keeps the same struct in registers. 80 bytes.
+// State of one path between bounces of pt.comp (pt_core.glsl), kept in registers. 80 bytes.
 struct PathState {
     vec3 origin;     // world-space origin of the next segment
     uint pixel;      // y * width + x

@@ -12,8 +12,8 @@
 namespace gdpt::gpu {
 #endif
 
-// Neighbour order of the offset paths (GPT_REFERENCE §1.2): right, down, left, up, with
-// +y = next image row. Offset i starts at the base's sub-pixel position + kGptOffset[i].
+// Neighbour order of the offset paths: right, down, left, up, with +y = next image row.
+// Offset i starts at the base's sub-pixel position + δ_i (gpt.comp's kOffsetDelta).
 GDPT_CONST uint kGptRight = 0u;
 GDPT_CONST uint kGptDown = 1u;
 GDPT_CONST uint kGptLeft = 2u;

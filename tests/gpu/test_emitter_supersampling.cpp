@@ -1,4 +1,4 @@
-// Emitter-silhouette supersampling (emitter_supersampling.comp, render/passes/emitter_supersampling_pass.h) against the closed
+// emitter supersampling (emitter_supersampling.comp, render/passes/emitter_supersampling_pass.h) against the closed
 // form: a black-backed emissive square parallel to the image plane projects to an
 // axis-aligned rectangle, so each pixel's expected value is L × (the fraction of the pixel
 // square it covers), and with one ray per camera sample the estimate's variance is

@@ -111,8 +111,7 @@ public:
     // their replacement (before the next record()) to continue a checkpointed render.
     [[nodiscard]] std::vector<std::vector<gpu::PixelStats>> downloadStats() const override;
     void uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats) override;
-    // Whether the half-vector branch is compiled in (kHasGlossy as specialised).
-    [[nodiscard]] bool halfVectorCompiled() const { return halfVector_; }
+    // Whether the kernel is the split bounce loop build (gpt_split, see gpt.comp).
     [[nodiscard]] bool splitBounceCompiled() const { return splitBounce_; }
     [[nodiscard]] bool demodulating() const { return options_.demodulate; }
     // Pixels marked for demodulation by the last findEdges() (0 before).

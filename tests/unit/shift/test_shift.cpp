@@ -180,6 +180,151 @@ TEST(ShiftHalfVector, PreservesHalfVectorAndIsIdentityForEqualWo) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Shift mappings as gpt.comp calls them (result structs)
+// ---------------------------------------------------------------------------------------------
+
+// shiftReconnect: the direction and distance to the target, the Jacobian of the finite
+// difference of ω → normalize(y(ω) − a') as above, and success exactly when the connection
+// leaves above the offset's surface and arrives at the target's side that the base saw.
+TEST(ShiftMappings, ReconnectionResultMatchesGeometryAndFiniteDifferences) {
+    Source src(41);
+    int tested = 0;
+    for (int i = 0; i < 200; ++i) {
+        const dvec3 y0 = src.point(1.0);
+        const dvec3 n = glm::normalize(src.point(1.0) + dvec3(0, 0, 1e-3));
+        const dvec3 a = y0 + src.uniform(0.5, 3.0) * glm::normalize(n + 0.8 * src.point(1.0));
+        const dvec3 aOffset = a + 0.3 * src.point(1.0);
+        const dvec3 offsetNormal = glm::normalize(src.point(1.0) + dvec3(0, 0, 1e-3));
+        // The target's normal faces the base (the base arrives at its front side).
+        const dvec3 targetNormal = glm::dot(a - y0, n) > 0.0 ? n : -n;
+        const ConnectionShift c =
+            shiftReconnect(toF(a), toF(aOffset), toF(offsetNormal), toF(y0), toF(targetNormal));
+        const dvec3 e = y0 - aOffset;
+        EXPECT_NEAR(c.dist, glm::length(e), 1e-5 * glm::length(e)) << i;
+        EXPECT_NEAR(glm::length(toD(c.wi) - glm::normalize(e)), 0.0, 1e-5) << i;
+        const bool above = glm::dot(glm::normalize(e), offsetNormal) > 1e-4;
+        const bool sameSide = glm::dot(glm::normalize(e), targetNormal) < -1e-4;
+        if (above && sameSide) {
+            EXPECT_TRUE(c.ok) << i;
+        }
+        if (glm::dot(glm::normalize(e), offsetNormal) < -1e-4 ||
+            glm::dot(glm::normalize(e), targetNormal) > 1e-4) {
+            EXPECT_FALSE(c.ok) << i;
+        }
+        const double cosBase = std::abs(glm::dot(glm::normalize(a - y0), n));
+        const double cosOffset = std::abs(glm::dot(glm::normalize(aOffset - y0), n));
+        if (!c.ok || cosBase < 0.15 || cosOffset < 0.15 || !sameSide) continue;
+        auto shift = [&](dvec3 w) {
+            const double t = glm::dot(y0 - a, n) / glm::dot(w, n);
+            return glm::normalize(a + t * w - aOffset);
+        };
+        const double fd = finiteDifferenceJacobian(glm::normalize(y0 - a), 1e-5, shift);
+        EXPECT_NEAR(c.jacobian / fd, 1.0, 2e-4) << "config " << i;
+        ++tested;
+    }
+    EXPECT_GT(tested, 20);
+}
+
+// shiftEnvironment: the identity on directions (a finite-difference Jacobian of exactly 1),
+// failing below the offset's geometric surface.
+TEST(ShiftMappings, EnvironmentShiftIsTheIdentityAboveTheOffsetSurface) {
+    Source src(42);
+    for (int i = 0; i < 100; ++i) {
+        const dvec3 w = glm::normalize(src.point(1.0) + dvec3(0, 0, 1e-3));
+        const dvec3 n = glm::normalize(src.point(1.0) + dvec3(0, 0, 1e-3));
+        const ConnectionShift c = shiftEnvironment(toF(w), toF(n));
+        EXPECT_EQ(c.wi, toF(w));
+        EXPECT_EQ(c.jacobian, 1.0f);
+        EXPECT_EQ(c.ok, glm::dot(toF(w), toF(n)) > 0.0f);
+        const double fd = finiteDifferenceJacobian(w, 1e-4, [](dvec3 v) { return v; });
+        EXPECT_NEAR(fd, 1.0, 1e-9);
+    }
+}
+
+// shiftHalfVector, smooth lobe: the direction and Jacobian of halfVectorReflect (checked
+// against finite differences of the map), the offset BSDF's value and density there, and
+// forward ∘ reverse = identity with J·J_rev = 1, so the pair's two MIS weights (ratio form,
+// r = p'·J/p forward and p·J_rev/p' reverse) sum to one.
+TEST(ShiftMappings, HalfVectorResultEvaluatesTheOffsetBsdfAndInverts) {
+    Source src(43);
+    const BsdfParams glossy = makeBsdfParams(vec3(0.6f), 1.0f, 0.2f, 1.0f, vec3(1.0f), 1.5f);
+    const BsdfParams plastic = makeBsdfParams(vec3(0.4f), 0.0f, 0.3f, 1.0f, vec3(1.0f), 1.5f);
+    int tested = 0;
+    for (int i = 0; i < 300; ++i) {
+        const vec3 woBase = toF(src.hemisphere(0.2));
+        const vec3 wiBase = toF(src.hemisphere(0.2));
+        const vec3 woOffset = toF(glm::normalize(toD(woBase) + 0.4 * src.point(1.0)));
+        const BsdfParams& ob = (i % 2) ? glossy : plastic;
+        const HalfVectorShift h = shiftHalfVector(ob, woBase, wiBase, false, woOffset);
+        vec3 wiRef;
+        float jRef = 0.0f;
+        const bool refOk = halfVectorReflect(woBase, wiBase, woOffset, wiRef, jRef);
+        if (!refOk || wiRef.z <= 0.0f || woOffset.z <= 0.0f) {
+            EXPECT_FALSE(h.ok && wiRef.z <= 0.0f) << i;
+            continue;
+        }
+        ASSERT_TRUE(h.ok) << i;
+        EXPECT_EQ(h.wiLocal, wiRef);
+        EXPECT_EQ(h.jacobian, jRef);
+        EXPECT_EQ(h.f, bsdfEval(ob, woOffset, h.wiLocal));
+        EXPECT_EQ(h.pdf, bsdfPdf(ob, woOffset, h.wiLocal));
+        if (h.jacobian > 0.2f && h.jacobian < 5.0f) {
+            auto map = [&](dvec3 w) {
+                return toD(shiftHalfVector(ob, woBase, toF(w), false, woOffset).wiLocal);
+            };
+            EXPECT_NEAR(h.jacobian / finiteDifferenceJacobian(toD(wiBase), 2e-3, map), 1.0, 3e-3) << i;
+        }
+        const HalfVectorShift back = shiftHalfVector(ob, woOffset, h.wiLocal, false, woBase);
+        const vec3 hv = glm::normalize(woBase + wiBase);
+        if (glm::dot(wiBase, hv) < 0.1f || std::abs(glm::dot(woOffset, hv)) < 0.1f || !back.ok) continue;
+        EXPECT_NEAR(glm::length(back.wiLocal - wiBase), 0.0f, 5e-5f) << i;
+        EXPECT_NEAR(h.jacobian * back.jacobian, 1.0f, 1e-4f) << i;
+        const float p = bsdfPdf(ob, woBase, wiBase);
+        const float rForward = shiftSegment(h.f, h.pdf, h.jacobian, 1.0f, p).pdfRatio;
+        const float rReverse = shiftSegment(vec3(1.0f), p, back.jacobian, 1.0f, h.pdf).pdfRatio;
+        EXPECT_NEAR(gptMisWeightPair(rForward) + gptMisWeightPair(rReverse), 1.0f, 1e-4f) << i;
+        ++tested;
+    }
+    EXPECT_GT(tested, 50);
+}
+
+// shiftHalfVector, Dirac lobe: the offset's mirror direction with its Fresnel weight and lobe
+// selection probability, Jacobian 1; Dirac and smooth never shift into each other.
+TEST(ShiftMappings, HalfVectorDiracAndLobeMismatch) {
+    const vec3 c(0.5f);
+    const BsdfParams mirror = makeBsdfParams(c, 1.0f, 0.0f, 1.0f, vec3(1.0f), 1.5f);
+    const BsdfParams coatedMirror = makeBsdfParams(c, 0.0f, 0.0f, 1.0f, vec3(1.0f), 1.5f);
+    const BsdfParams lambert = makeBsdfParams(c, 0.0f, 1.0f, 0.0f, vec3(1.0f), 1.5f);
+    const vec3 woBase = glm::normalize(vec3(0.3f, -0.2f, 0.9f));
+    const vec3 wiBase(-woBase.x, -woBase.y, woBase.z);
+    const vec3 woOffset = glm::normalize(vec3(-0.4f, 0.1f, 0.8f));
+    for (const BsdfParams& ob : {mirror, coatedMirror}) {
+        const HalfVectorShift h = shiftHalfVector(ob, woBase, wiBase, true, woOffset);
+        ASSERT_TRUE(h.ok);
+        EXPECT_EQ(h.wiLocal, vec3(-woOffset.x, -woOffset.y, woOffset.z));
+        EXPECT_EQ(h.jacobian, 1.0f);
+        EXPECT_EQ(h.f, glossyFresnel(ob, woOffset.z));
+        EXPECT_EQ(h.pdf, glossySelectProb(ob, woOffset));
+    }
+    // A base mirror sample at an offset without a Dirac lobe, a smooth base sample at a
+    // Dirac-only offset, and an offset seen from below: the shift fails.
+    EXPECT_FALSE(shiftHalfVector(lambert, woBase, wiBase, true, woOffset).ok);
+    EXPECT_FALSE(shiftHalfVector(mirror, woBase, glm::normalize(vec3(0.1f, 0.2f, 0.9f)), false, woOffset).ok);
+    EXPECT_FALSE(shiftHalfVector(mirror, woBase, wiBase, true, vec3(woOffset.x, woOffset.y, -woOffset.z)).ok);
+}
+
+// shiftSegment: the ratio-form update factors f·J·rrInv/p and p'·J/p.
+TEST(ShiftMappings, SegmentFactorsOfTheRatioForm) {
+    const SegmentShift s = shiftSegment(vec3(0.5f, 0.25f, 1.0f), 3.0f, 2.0f, 4.0f, 8.0f);
+    EXPECT_EQ(s.throughput, vec3(0.5f, 0.25f, 1.0f));
+    EXPECT_EQ(s.pdfRatio, 0.75f);
+    // Jacobian 1 (a shared vertex): exactly f·rrInv/p and p'/p.
+    const SegmentShift t = shiftSegment(vec3(0.3f), 0.7f, 1.0f, 1.0f / 0.9f, 1.3f);
+    EXPECT_EQ(t.throughput, vec3(0.3f) * ((1.0f / 0.9f) / 1.3f));
+    EXPECT_EQ(t.pdfRatio, 0.7f / 1.3f);
+}
+
+// ---------------------------------------------------------------------------------------------
 // MIS of a pixel pair
 // ---------------------------------------------------------------------------------------------
 
@@ -256,29 +401,20 @@ TEST(ShiftMis, RatioFormSurvivesExtremePdfsAndRejectsBadInput) {
 // Vertex classification
 // ---------------------------------------------------------------------------------------------
 
-TEST(ShiftClassification, ByLobeAndComponents) {
+TEST(ShiftClassification, ByLowestRoughnessOverAllComponents) {
     const vec3 c(0.5f);
-    const BsdfParams lambert = makeBsdfParams(c, 0.0f, 1.0f, 0.0f, vec3(1.0f), 1.5f);
     const BsdfParams lambertRough0 = makeBsdfParams(c, 0.0f, 0.0f, 0.0f, vec3(1.0f), 1.5f);
     const BsdfParams metal = makeBsdfParams(c, 1.0f, 0.3f, 1.0f, vec3(1.0f), 1.5f);
-    const BsdfParams mirror = makeBsdfParams(c, 1.0f, 0.0f, 1.0f, vec3(1.0f), 1.5f);
     const BsdfParams coatedMirror = makeBsdfParams(c, 0.0f, 0.0f, 1.0f, vec3(1.0f), 1.5f);
     const float thr = 0.001f;
-    // Lambertian: rough whatever the lobe id, even with roughnessFactor 0.
-    EXPECT_TRUE(shiftIsRough(shiftRoughnessSampled(lambert, kLobeDiffuse), thr));
-    EXPECT_TRUE(shiftIsRough(shiftRoughnessSampled(lambertRough0, kLobeGlossy), thr));
+    // Lambertian: rough even with roughnessFactor 0.
     EXPECT_TRUE(shiftIsRough(shiftRoughnessAll(lambertRough0), thr));
     // GGX 0.3 metal: rough at the default threshold, glossy above 0.3.
-    EXPECT_FLOAT_EQ(shiftRoughnessSampled(metal, kLobeGlossy), 0.3f);
+    EXPECT_FLOAT_EQ(shiftRoughnessAll(metal), 0.3f);
     EXPECT_TRUE(shiftIsRough(shiftRoughnessAll(metal), thr));
     EXPECT_FALSE(shiftIsRough(shiftRoughnessAll(metal), 0.3f));
-    // Mirror: glossy; coated mirror: its diffuse lobe is rough, the vertex as a whole is not,
-    // and NEE (smooth components only) sees the diffuse lobe.
-    EXPECT_FALSE(shiftIsRough(shiftRoughnessSampled(mirror, kLobeSpecular), thr));
-    EXPECT_TRUE(shiftIsRough(shiftRoughnessSampled(coatedMirror, kLobeDiffuse), thr));
+    // Coated mirror: its diffuse lobe is rough, the vertex as a whole is not.
     EXPECT_FALSE(shiftIsRough(shiftRoughnessAll(coatedMirror), thr));
-    EXPECT_TRUE(shiftIsRough(shiftRoughnessSmooth(coatedMirror), thr));
-    EXPECT_FALSE(shiftIsRough(shiftRoughnessSmooth(makeBsdfParams(c, 1.0f, 0.02f, 1.0f, vec3(1.0f), 1.5f)), 0.05f));
     // Black emitter material: nothing to shift through, counts as rough.
     EXPECT_TRUE(shiftIsRough(shiftRoughnessAll(makeBsdfParams(vec3(0.0f), 0.0f, 1.0f, 0.0f, vec3(1.0f), 1.5f)), thr));
 }
