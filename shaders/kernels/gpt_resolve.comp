@@ -1,6 +1,7 @@
 // gpt_resolve.comp — gathers the per-pixel statistics of gpt.comp into the G-PT images
-// (GPT_REFERENCE §1.7). One invocation = one pixel p; it only reads its own and its four
-// neighbours' statistics and writes its own GptResolved: deterministic, no atomics.
+// (primal and forward-difference gradients, Kettunen et al. 2015). One invocation = one
+// pixel p; it only reads its own and its four neighbours' statistics and writes its own
+// GptResolved: deterministic, no atomics.
 //
 // Notation: m_X(p) = mean of quantity X at pixel p over its N samples, v_X(p) = variance of
 // that mean = M2 / (N − 1) / N; δ_i = right, down, left, up.

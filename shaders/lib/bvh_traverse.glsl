@@ -4,7 +4,7 @@
 // Two parts:
 //  * The pure part (ray/box slab test, safe inverse direction, Möller–Trumbore triangle
 //    test, struct Hit) is written in the GLSL/C++ common subset of common.glsl, so that
-//    src/bvh/traverse_cpu.cpp runs the very same arithmetic on the host (GUIDE §2).
+//    src/bvh/traverse_cpu.cpp runs the very same arithmetic on the host.
 //  * The traversal loops (traceClosest, traceAny) read the scene's texel buffers and exist in
 //    GLSL only. src/bvh/traverse_cpu.cpp mirrors them statement for statement; change both.
 //

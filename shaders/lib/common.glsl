@@ -1,7 +1,7 @@
 // common.glsl — compatibility layer that lets the shader math library compile both as
 // GLSL 460 (included by kernels) and as C++17 (included by host code and unit tests).
 //
-// The library is written in the GLSL/GLM common subset (GUIDE §2, after Falcor's
+// The library is written in the GLSL/GLM common subset (after Falcor's
 // HostDeviceShared.slangh): no swizzles, no references except through GDPT_INOUT/OUT, no
 // overloading that depends on qualifiers, explicit float literals (`1.0f`; GLSL >= 1.30
 // accepts the suffix) and explicit constructor-style conversions (`float(u)`), which are

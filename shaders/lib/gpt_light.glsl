@@ -1,5 +1,5 @@
 // gpt_light.glsl — next-event estimation of an offset path with the base's light point
-// (Kettunen et al. 2015 §4.2; GPT_REFERENCE §1.5). GLSL only: needs the scene buffers and
+// (Kettunen et al. 2015 §4.2). GLSL only: needs the scene buffers and
 // scene_access.glsl. Kept out of scene_access.glsl, which the PT kernel shares.
 #ifndef GDPT_LIB_GPT_LIGHT
 #define GDPT_LIB_GPT_LIGHT

@@ -33,7 +33,8 @@ bool gptPairExists(uint px, uint py, uint i) {
 // Vertex classification; a scene without glossy/specular vertices (kHasGlossy false) has
 // every vertex rough, which the compiler folds away with the half-vector branch.
 //
-// Deviation from the reference (GPT_REFERENCE §1.3), which classifies the base's current
+// Deviation from the authors' reference code (gradientdomain-mitsuba, the implementation of
+// Kettunen et al. 2015), which classifies the base's current
 // vertex by the component it sampled and the offset's by that same component: the sampled
 // component is not a function of the path (a mixture reaches one direction through several
 // lobes), and an offset may lack the component altogether (base samples the diffuse lobe of
@@ -51,7 +52,8 @@ bool oneSidedBack(SurfaceHit h) {
     return !h.frontFace && (material(h.material).flags & kMatFlagDoubleSided) == 0u;
 }
 
-// Adds one estimator sample of a pair with MIS weight w (GPT_REFERENCE §1.6).
+// Adds one estimator sample of a pair with MIS weight w (each pixel pair is estimated from
+// both ends, sampled at one pixel and shifted to the other, with power-heuristic weights).
 void addPair(inout OffsetPath op, float w, vec3 fBase, vec3 fOffset) {
     op.baseSum += w * fBase;
     op.offSum += w * fOffset;

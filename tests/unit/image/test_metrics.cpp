@@ -94,7 +94,7 @@ TEST(Metrics, CboxReferenceAgainstItselfAndReadmeMean) {
     EXPECT_EQ(s.relMse, 0.0);
     EXPECT_EQ(s.mse, 0.0);
     EXPECT_EQ(s.nonFinitePixels, 0u);
-    // Values from /work/shared/scenes/README.md (given to 5 decimals).
+    // The mean RGB published with the reference image (rounded to 5 decimals).
     const auto mean = reference.meanRgb();
     EXPECT_NEAR(mean[0], 0.19617, 1e-4);
     EXPECT_NEAR(mean[1], 0.12765, 1e-4);

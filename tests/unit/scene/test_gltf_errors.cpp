@@ -1,5 +1,5 @@
 // test_gltf_errors.cpp — every malformed input gives gdpt::Error naming the file and the
-// element (GUIDE §5); no input crashes the loader. Each case starts from a valid file
+// element; no input crashes the loader. Each case starts from a valid file
 // (oneTriangle) and breaks exactly one thing, so a loader that ignored the defect would load
 // successfully and fail the test.
 #include <cmath>

@@ -75,12 +75,16 @@ void expectSameScene(const Scene& a, const Scene& b, float normalTol) {
 // The shared Cornell box and our own scenes/
 // ---------------------------------------------------------------------------------------
 
+// ../shared/scenes/cbox/cbox.gltf: the Cornell box in Bitterli's layout, the scene of the
+// independent reference image that tests/gpu/test_cbox_reference.cpp compares against (data
+// outside the repository, so that gdpt's tests cannot have shaped it).
+
 std::string sharedCbox() { return std::string(GDPT_SHARED_DIR) + "/scenes/cbox/cbox.gltf"; }
 
 TEST(GltfLoader, SharedCornellBox) {
     if (!std::filesystem::exists(sharedCbox())) GTEST_SKIP() << sharedCbox() << " absent";
     const Scene s = loadGltf(sharedCbox());
-    // 5 walls x 2 + 2 boxes x 12 + light x 2 (see ../shared/scenes/README.md).
+    // 5 walls x 2 + 2 boxes x 12 + light x 2.
     EXPECT_EQ(s.triangles.size(), 36u);
     EXPECT_EQ(s.triangleMaterial.size(), 36u);
     EXPECT_EQ(s.normals.size(), s.positions.size());
@@ -94,7 +98,7 @@ TEST(GltfLoader, SharedCornellBox) {
     expectNear(light.emissive, {17, 12, 4}, 1e-5f);
     EXPECT_TRUE(light.flags & gpu::kMatFlagEmissive);
     expectNear(faceNormal(s, 35), {0, -1, 0}, 1e-6f);
-    // Diffuse walls: pure Lambertian per the README (metallic 0, specular 0).
+    // Diffuse walls: pure Lambertian (metallic 0, KHR_materials_specular factor 0).
     EXPECT_EQ(s.materials[0].metallic, 0.0f);
     EXPECT_EQ(s.materials[0].specular, 0.0f);
     EXPECT_EQ(s.materials[0].flags & gpu::kMatFlagEmissive, 0u);
