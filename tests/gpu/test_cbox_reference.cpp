@@ -22,7 +22,6 @@
 // that its relMSE equals the stated floor. Šidák correction over 8x8x3 tests, family
 // alpha = 0.01.
 #include <cmath>
-#include <filesystem>
 
 #include <gtest/gtest.h>
 
@@ -31,6 +30,7 @@
 #include "image/metrics.h"
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
+#include "shared_data.h"
 #include "stats_normal.h"
 
 namespace gdpt {
@@ -42,8 +42,9 @@ constexpr double kReferenceFloor = 6.6e-4;
 class CboxReference : public test::GpuTest {};
 
 TEST_F(CboxReference, PathTracerMatchesIndependentRenderer) {
-    const std::string dir = std::string(GDPT_SHARED_DIR) + "/scenes/cbox/";
-    if (!std::filesystem::exists(dir + "reference.exr")) GTEST_SKIP() << "no " << dir;
+    const std::string dir = test::sharedDataPath("scenes/cbox/");
+    GDPT_REQUIRE_SHARED_DATA(dir + "reference.exr");
+    GDPT_REQUIRE_SHARED_DATA(dir + "cbox.gltf");
     const Image ref = readExrLayer(dir + "reference.exr");
     const Scene scene = loadGltf(dir + "cbox.gltf");
     RenderOptions o;

@@ -4,7 +4,6 @@
 // worked out by hand in the comments, not computed with the code under test.
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 
 #include <glm/gtc/constants.hpp>
 #include <gtest/gtest.h>
@@ -13,6 +12,7 @@
 #include "gltf_test_writer.h"
 #include "scene/gltf_loader.h"
 #include "scene/procedural.h"
+#include "shared_data.h"
 #include "util/error.h"
 
 namespace gdpt {
@@ -79,10 +79,12 @@ void expectSameScene(const Scene& a, const Scene& b, float normalTol) {
 // independent reference image that tests/gpu/test_cbox_reference.cpp compares against (data
 // outside the repository, so that gdpt's tests cannot have shaped it).
 
-std::string sharedCbox() { return std::string(GDPT_SHARED_DIR) + "/scenes/cbox/cbox.gltf"; }
+std::string sharedCbox() {
+    return test::sharedDataPath("scenes/cbox/cbox.gltf");
+}
 
 TEST(GltfLoader, SharedCornellBox) {
-    if (!std::filesystem::exists(sharedCbox())) GTEST_SKIP() << sharedCbox() << " absent";
+    GDPT_REQUIRE_SHARED_DATA(sharedCbox());
     const Scene s = loadGltf(sharedCbox());
     // 5 walls x 2 + 2 boxes x 12 + light x 2.
     EXPECT_EQ(s.triangles.size(), 36u);
@@ -111,7 +113,7 @@ TEST(GltfLoader, SharedCornellBox) {
 }
 
 TEST(GltfLoader, SharedCornellBoxMatchesProcedural) {
-    if (!std::filesystem::exists(sharedCbox())) GTEST_SKIP() << sharedCbox() << " absent";
+    GDPT_REQUIRE_SHARED_DATA(sharedCbox());
     // Normals: the file's are normalised in double by its generator, ours in float.
     expectSameScene(loadGltf(sharedCbox()), makeCornellBox(), 2e-7f);
 }
