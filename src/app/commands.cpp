@@ -429,7 +429,7 @@ Subcommand addRenderCommand(CLI::App& app) {
     auto args = std::make_shared<RenderArgs>();
     auto& render = *args;
     CLI::App* r = app.add_subcommand("render", "Render a glTF 2.0 scene to OpenEXR (+ PNG preview)");
-    r->add_option("scene", render.scene, "glTF 2.0 scene (.gltf or .glb)")->required()->check(CLI::ExistingFile);
+    r->add_option("scene", render.scene, "glTF 2.0 scene (.gltf or .glb)")->required()->check(InputFile);
     r->add_option("-o,--output", render.output, "Output EXR; a tone-mapped PNG preview is written beside it")
         ->capture_default_str();
     r->add_option("--spp", render.spp, "Samples per pixel")->capture_default_str()->check(CLI::Range(1u, 1u << 24));
@@ -522,7 +522,7 @@ Subcommand addRenderCommand(CLI::App& app) {
                   "Continue from a checkpoint of the same scene, method, size, seed, depth, env, camera and "
                   "schedule; --spp is the total including its samples (bit-identical to an uninterrupted run "
                   "when it was written by an interrupt or a periodic checkpoint)")
-        ->check(CLI::ExistingFile);
+        ->check(InputFile);
 
     return {r, [args] { return runRender(*args); }};
 }
@@ -531,8 +531,8 @@ Subcommand addDiffCommand(CLI::App& app) {
     auto args = std::make_shared<DiffArgs>();
     auto& diff = *args;
     CLI::App* d = app.add_subcommand("diff", "Compare two EXR images: relMSE (Kettunen et al. 2015), MSE, MAE, max error");
-    d->add_option("test", diff.test, "Image to evaluate")->required()->check(CLI::ExistingFile);
-    d->add_option("reference", diff.reference, "Reference image")->required()->check(CLI::ExistingFile);
+    d->add_option("test", diff.test, "Image to evaluate")->required()->check(InputFile);
+    d->add_option("reference", diff.reference, "Reference image")->required()->check(InputFile);
     d->add_option("--json", diff.json, "Write the metrics as JSON to this file ('-' = stdout)");
 
     return {d, [args] { return runDiff(*args); }};
@@ -542,7 +542,7 @@ Subcommand addInfoCommand(CLI::App& app) {
     auto args = std::make_shared<InfoArgs>();
     auto& info = *args;
     CLI::App* i = app.add_subcommand("info", "Print a scene's features and the kernel variant gdpt will run");
-    i->add_option("scene", info.scene, "glTF 2.0 scene")->required()->check(CLI::ExistingFile);
+    i->add_option("scene", info.scene, "glTF 2.0 scene")->required()->check(InputFile);
     i->add_option("--env", info.env, "Constant environment radiance R,G,B")->capture_default_str();
 
     return {i, [args] { return runInfo(*args); }};

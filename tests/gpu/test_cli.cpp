@@ -47,7 +47,27 @@ TEST_F(Cli, UsageErrorsExitWithTwo) {
     EXPECT_EQ(run("render " + kScene + " --env 1,2").code, 2);
     EXPECT_EQ(run("render").code, 2);
     EXPECT_EQ(run("frobnicate").code, 2);
-    EXPECT_EQ(run("render " + path("missing.gltf")).code, 2);
+}
+
+// A missing or unreadable input is an input error (1), not a usage error: one line naming the
+// file and the reason, whichever command and option names it.
+TEST_F(Cli, MissingInputFilesAreErrorsNamingTheFile) {
+    const std::string missing = path("missing.gltf");
+    const std::string exr = path("missing.exr");
+    for (const std::string& args :
+         {"render " + missing, "info " + missing, "converge " + missing,
+          "render " + kScene + " --resume " + exr, "converge " + kScene + " --reference " + exr,
+          "diff " + exr + " " + exr, "solve " + exr,
+          "clone --source " + exr + " --target " + exr + " --mask " + exr, "render " + dir_.string()}) {
+        const RunResult r = run(args);
+        EXPECT_EQ(r.code, 1) << args << ": " << r.output;
+        EXPECT_EQ(r.output.rfind("gdpt: error: ", 0), 0u) << args << ": " << r.output;
+        EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << "one line: " << r.output;
+    }
+    const RunResult r = run("render " + missing + " -o " + path("out.exr"));
+    EXPECT_EQ(r.output, "gdpt: error: " + missing + ": no such file or directory\n");
+    EXPECT_NE(run("render " + dir_.string()).output.find("is a directory"), std::string::npos);
+    EXPECT_FALSE(fs::exists(path("out.exr")));
 }
 
 TEST_F(Cli, MalformedSceneIsAnErrorNamingTheFileAndWritesNothing) {
