@@ -26,6 +26,7 @@
 #include "render/gpt_renderer.h"
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
+#include "scene/light_sources.h"
 #include "util/error.h"
 #include "util/timer.h"
 #include "vk/context.h"
@@ -122,6 +123,8 @@ int runRender(const RenderArgs& args) {
         for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
         std::fprintf(stderr, "gdpt: warning: %s: not rendered: %s\n", args.scene.c_str(), list.c_str());
     }
+    if (const auto black = blackImageWarning(scene, options.scene.envRadiance); black && !args.quiet)
+        std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
     vk::ContextOptions ctxOptions;
     ctxOptions.device = args.device;
     ctxOptions.validation = args.validate;
@@ -375,6 +378,8 @@ int runInfo(const InfoArgs& args) {
     // G-PT's first-hit texture demodulation as --demodulate auto chooses it (gpt_pass.h).
     std::printf("gpt variant: demodulate=%d\n", demodulationApplies(scene) ? 1 : 0);
     for (const auto& u : scene.unsupported) std::printf("  unsupported: %s\n", u.c_str());
+    if (const auto black = blackImageWarning(scene, so.envRadiance))
+        std::printf("warning: %s\n", black->c_str());
     return 0;
 }
 

@@ -26,6 +26,7 @@
 #include "render/gpt_renderer.h"
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
+#include "scene/light_sources.h"
 #include "util/error.h"
 #include "util/timer.h"
 #include "vk/context.h"
@@ -241,6 +242,8 @@ double timeToReach(const json& summary, const std::string& method, double target
 
 int runConverge(const ConvergeArgs& a) {
     const Scene scene = loadGltf(a.scene);
+    if (const auto black = blackImageWarning(scene, glm::vec3(0.0f), /*envOption=*/false))
+        std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
     vk::ContextOptions co;
     co.device = a.device;
     co.validation = a.validate;

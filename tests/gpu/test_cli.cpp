@@ -83,6 +83,35 @@ TEST_F(Cli, MalformedSceneIsAnErrorNamingTheFileAndWritesNothing) {
     EXPECT_FALSE(fs::exists(out + ".tmp"));
 }
 
+// A scene with nothing that emits light renders black: render and info say so (and what to
+// try), a render with --env does not.
+TEST_F(Cli, SceneWithoutLightWarnsThatTheImageWillBeBlack) {
+    const std::string dark = path("dark.gltf");
+    // One triangle (0,0,0), (1,0,0), (0,1,0), default material; the buffer as a data URI.
+    std::ofstream(dark) << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [0, 0, 0], "max": [1, 1, 0]}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}],
+        "buffers": [{"byteLength": 36,
+                     "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]})";
+    const std::string warning =
+        dark +
+        ": no light source (no emissive surface, no punctual light, no --env): the image will be black; "
+        "try --env 1,1,1";
+    const std::string small = " --width 8 --height 8 --spp 1 -o " + path("out.exr");
+    const RunResult r = run("render " + dark + small);
+    EXPECT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("gdpt: warning: " + warning + "\n"), std::string::npos) << r.output;
+    const RunResult lit = run("render " + dark + small + " --env 1,1,1");
+    EXPECT_EQ(lit.code, 0) << lit.output;
+    EXPECT_EQ(lit.output.find("no light source"), std::string::npos) << lit.output;
+    const RunResult info = run("info " + dark);
+    EXPECT_EQ(info.code, 0) << info.output;
+    EXPECT_NE(info.output.find(warning), std::string::npos) << info.output;
+    EXPECT_EQ(run("info " + kScene).output.find("no light source"), std::string::npos);
+}
+
 TEST_F(Cli, SmallValidatedRenderWritesExrPngAndJson) {
     const std::string out = path("cb.exr");
     const std::string json = path("cb.json");
