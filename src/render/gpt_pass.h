@@ -111,7 +111,6 @@ public:
     [[nodiscard]] std::vector<std::vector<gpu::PixelStats>> downloadStats() const;
     void uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats);
     // Whether the half-vector branch is compiled in (kHasGlossy as specialised).
-    [[nodiscard]] bool halfVectorCompiled() const { return halfVector_; }
     [[nodiscard]] bool splitBounceCompiled() const { return splitBounce_; }
     [[nodiscard]] bool demodulating() const { return options_.demodulate; }
     // Pixels marked for demodulation by the last findEdges() (0 before).
