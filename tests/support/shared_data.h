@@ -59,7 +59,8 @@ inline std::string missingSharedData(const std::string& path) {
     do {                                                                             \
         const std::string gdptMissingShared = ::gdpt::test::missingSharedData(path); \
         if (!gdptMissingShared.empty()) {                                            \
-            if (::gdpt::test::runningInCi()) FAIL() << gdptMissingShared << " (CI)"; \
+            if (::gdpt::test::runningInCi())                                         \
+                FAIL() << gdptMissingShared << " (in CI a test fails without it)";   \
             GTEST_SKIP() << gdptMissingShared;                                       \
         }                                                                            \
     } while (false)
