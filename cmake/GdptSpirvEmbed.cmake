@@ -5,7 +5,7 @@
 # 2. spirv-opt: inlining, scalar replacement and local-variable elimination to SSA, then dead
 #    code. The SPIR-V glslang emits keeps every local in memory and every function call;
 #    lavapipe's vkCreateComputePipelines spends its time lowering that in NIR, on one core, and
-#    at a 4 s budget that time is the render's (bench/RESULTS.md, ninth session: gpt_split
+#    at a 4 s budget that time is the render's (bench/RESULTS.md, spirv-opt: gpt_split
 #    0.75 s -> 0.40 s, the kernel runs as fast; Mesa 25 runs it ~12 % slower, hence both
 #    variants). Specialisation constants stay constants. No -O: its extra passes made the
 #    G-PT kernel run 4 % slower on lavapipe 22.3.

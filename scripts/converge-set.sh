@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Error against time for the whole benchmark scene set, in one command: runs `gdpt converge`
-# on the Cornell box of ../shared/scenes/cbox (against its independent reference) and on each
+# on the Cornell box of ../shared/scenes/cbox (a glTF scene outside the repository with
+# reference.exr, a converged render by an independent path tracer) and on each
 # scene of scenes/ (against a PT reference made and cached with --make-reference), each into
 # OUT/<scene>/ (results.json, results.csv, error_vs_time.png), then prints every scene's
 # equal-time table with each method's gain over PT. Not a test: a long benchmark (hours with

@@ -9,7 +9,7 @@
 // noise is in the gradients as much as in the primal, so the screened Poisson reconstruction
 // cannot smooth it away, and these pixels hold most of a G-PT image's error (the Cornell box
 // at 16 spp: 2 % of the pixels; doubling their samples alone took relMSE 0.0039 -> 0.0034,
-// bench/RESULTS.md).
+// bench/RESULTS.md, edge samples).
 //
 // The test: four rays at the centres of the pixel's quarters; the pixel holds an edge when
 // they disagree on hit or miss, on the material, on the geometric normal (more than ~26°

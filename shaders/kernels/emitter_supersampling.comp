@@ -9,9 +9,9 @@
 // c(1−c)L² per sample, large against the pixel's own value. G-PT's reconstruction does not
 // touch this term (it is added to the reconstructed indirect image, Kettunen et al. 2015 §5),
 // so at low sample counts these few pixels hold most of a G-PT image's relMSE (the Cornell
-// box at 5 spp: the light's rim, 0.1 % of the pixels, gave 60 %;
-// bench/RESULTS.md). Here each such pixel gets samplesPerSpp first-hit rays per camera sample, at
-// scrambled Sobol' positions (sobol.glsl), which stratify the pixel as they accumulate.
+// box at 5 spp: the light's rim, 0.1 % of the pixels, gave 60 %; bench/RESULTS.md, emitter
+// supersampling). Here each such pixel gets samplesPerSpp first-hit rays per camera sample,
+// at scrambled Sobol' positions (sobol.glsl), which stratify the pixel as they accumulate.
 //
 // Phases (push constant `phase`, one dispatch each over the whole image):
 //   probe   4 rays per pixel (the first four scrambled Sobol' points: one per quarter);

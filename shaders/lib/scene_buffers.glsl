@@ -122,7 +122,7 @@ layout(set = 0, binding = kBindSceneConst, scalar) readonly buffer SceneConstBuf
 // The scene constants as a private copy that every kernel's main() fills first (loadScene),
 // so that later reads are registers: lavapipe before Mesa 23 loads a storage-buffer value
 // lane by lane, in a loop with a branch per lane and component, at every read, even at a
-// uniform address (bench/RESULTS.md).
+// uniform address (bench/RESULTS.md, scene constants).
 SceneConstants scene;
 void loadScene() { scene = sceneStored; }
 

@@ -4,7 +4,8 @@
 //
 // Why texel buffers and not storage buffers: lavapipe before Mesa 23 compiles each
 // storage-buffer load into a loop over the SIMD lanes with a branch per lane and component,
-// whereas texelFetch from a buffer is a vector gather (bench/RESULTS.md).
+// whereas texelFetch from a buffer is a vector gather (bench/RESULTS.md, texel
+// buffers).
 // Both structs are whole 16-byte texels (a node is four, a triangle three), so the layout in
 // memory is the same as the storage-buffer one; the host binds the same buffers with a view
 // (KernelDesc::texelBindings).

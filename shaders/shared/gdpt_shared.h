@@ -2,12 +2,15 @@
 //
 // This one file compiles as C++17 (included from src/) and as GLSL 460 (included from
 // shaders/). Every struct that crosses the host/device boundary, every descriptor binding
-// number and every specialisation-constant id is defined here and nowhere else.
+// number and every specialisation-constant id is defined here or in the two headers that
+// extend this one under the same rules (gpt_shared.h: gradient-domain path tracing;
+// poisson_shared.h: the GPU Poisson solver), and nowhere else.
 //
-// Rules (see docs in the repo README, "Host/shader interface"):
+// Rules (see the README, Design notes, "Host/shader interface"):
 //  * All storage blocks use layout(scalar) (GL_EXT_scalar_block_layout); glm's 12-byte vec3
 //    then matches GLSL. Sizes and offsets are pinned by static_asserts in
-//    tests/unit/test_shared_layout.cpp and by a GPU sentinel test.
+//    tests/unit/util/test_shared_layout.cpp and by a GPU sentinel test
+//    (tests/gpu/test_layout_gpu.cpp).
 //  * No bool in shared structs: use uint flags.
 //  * Append-only: new fields go at the end of a struct. Every field says its units/space.
 #ifndef GDPT_SHARED_H
@@ -102,7 +105,7 @@ struct BvhNode {
 // e_a = byte a of `exponents`. The power-of-two scale makes q·2^e exact, so a decoded bound
 // is one rounding of origin + q·2^e whichever way a compiler evaluates it; the builder picks
 // each q so that the decoded box contains the child's exact box (wideQuantise in
-// wide_bvh.cpp). 64 bytes instead of 128 (bench/RESULTS.md: G-PT 7-15 %
+// wide_bvh.cpp). 64 bytes instead of 128 (bench/RESULTS.md, quantised BVH nodes: G-PT 7-15 %
 // faster per sample on Mesa 25, neutral to 4 % on Mesa 22.3).
 struct BvhWideNode {
     vec3 origin;     // lower corner of the node's box (world space)

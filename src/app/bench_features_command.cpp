@@ -150,7 +150,7 @@ Subcommand addBenchFeaturesCommand(CLI::App& app) {
     CLI::App* b = app.add_subcommand(
         "bench-features",
         "What each specialisation constant saves: samples/s of specialised vs generic kernels (JSON)");
-    b->add_option("scenes", args->scenes, "glTF 2.0 scenes")->required()->check(CLI::ExistingFile);
+    b->add_option("scenes", args->scenes, "glTF 2.0 scenes")->required()->check(InputFile);
     b->add_option("--methods", args->methods, "Comma-separated: pt, gpt")->capture_default_str();
     b->add_option("--width", args->width, "Image width")->capture_default_str()->check(CLI::Range(1, 4096));
     b->add_option("--height", args->height, "Image height")

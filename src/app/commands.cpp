@@ -14,6 +14,7 @@
 #include "integrator/gpt_sampler.h"
 #include "render/device_scene/features.h"
 #include "scene/gltf_loader.h"
+#include "scene/light_sources.h"
 #include "util/error.h"
 #include "vk/context.h"
 
@@ -92,6 +93,8 @@ int runInfo(const InfoArgs& args) {
     // G-PT's first-hit texture demodulation as --demodulate auto chooses it (gpt_pass.h).
     std::printf("gpt variant: demodulate=%d\n", demodulationApplies(scene) ? 1 : 0);
     for (const auto& u : scene.unsupported) std::printf("  unsupported: %s\n", u.c_str());
+    if (const auto black = blackImageWarning(scene, so.envRadiance))
+        std::printf("warning: %s\n", black->c_str());
     return 0;
 }
 
@@ -146,8 +149,8 @@ Subcommand addDiffCommand(CLI::App& app) {
     auto args = std::make_shared<DiffArgs>();
     auto& diff = *args;
     CLI::App* d = app.add_subcommand("diff", "Compare two EXR images: relMSE (Kettunen et al. 2015), MSE, MAE, max error");
-    d->add_option("test", diff.test, "Image to evaluate")->required()->check(CLI::ExistingFile);
-    d->add_option("reference", diff.reference, "Reference image")->required()->check(CLI::ExistingFile);
+    d->add_option("test", diff.test, "Image to evaluate")->required()->check(InputFile);
+    d->add_option("reference", diff.reference, "Reference image")->required()->check(InputFile);
     d->add_option("--json", diff.json, "Write the metrics as JSON to this file ('-' = stdout)");
 
     return {d, [args] { return runDiff(*args); }};
@@ -157,7 +160,7 @@ Subcommand addInfoCommand(CLI::App& app) {
     auto args = std::make_shared<InfoArgs>();
     auto& info = *args;
     CLI::App* i = app.add_subcommand("info", "Print a scene's features and the kernel variant gdpt will run");
-    i->add_option("scene", info.scene, "glTF 2.0 scene")->required()->check(CLI::ExistingFile);
+    i->add_option("scene", info.scene, "glTF 2.0 scene")->required()->check(InputFile);
     i->add_option("--env", info.env, "Constant environment radiance R,G,B")->capture_default_str();
 
     return {i, [args] { return runInfo(*args); }};

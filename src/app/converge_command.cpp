@@ -24,6 +24,7 @@
 #include "integrator/integrator.h"
 #include "integrator/pt_sampler.h"
 #include "scene/gltf_loader.h"
+#include "scene/light_sources.h"
 #include "util/error.h"
 #include "util/timer.h"
 #include "vk/context.h"
@@ -196,6 +197,8 @@ double timeToReach(const json& summary, const std::string& method, double target
 
 int runConverge(const ConvergeArgs& a) {
     const Scene scene = loadGltf(a.scene);
+    if (const auto black = blackImageWarning(scene, glm::vec3(0.0f), /*envOption=*/false))
+        std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
     vk::ContextOptions co;
     co.device = a.device;
     co.validation = a.validate;
@@ -351,8 +354,8 @@ int runConverge(const ConvergeArgs& a) {
 Subcommand addConvergeCommand(CLI::App& app) {
     auto a = std::make_shared<ConvergeArgs>();
     CLI::App* c = app.add_subcommand("converge", "Error against time: each method at each time budget vs a reference");
-    c->add_option("scene", a->scene, "glTF 2.0 scene")->required()->check(CLI::ExistingFile);
-    c->add_option("--reference", a->reference, "Converged reference EXR (same size and camera)")->check(CLI::ExistingFile);
+    c->add_option("scene", a->scene, "glTF 2.0 scene")->required()->check(InputFile);
+    c->add_option("--reference", a->reference, "Converged reference EXR (same size and camera)")->check(InputFile);
     c->add_option("--make-reference", a->makeReference, "Render a PT reference with this many spp (cached by scene hash)");
     c->add_option("--methods", a->methods, "Methods: pt, gpt (= gpt-l1), gpt-l1, gpt-l2, gpt-wl2, gpt-wl1")->capture_default_str();
     c->add_option("--times", a->times, "Time budgets in seconds (comma-separated)")->capture_default_str();

@@ -33,6 +33,9 @@ int main(int argc, char** argv) {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return app.exit(e) == 0 ? 0 : 2;
+    } catch (const Error& e) {  // an input the options name is missing or unreadable (InputFile)
+        std::fprintf(stderr, "gdpt: error: %s\n", e.what());
+        return 1;
     }
     try {
         for (const Subcommand& c : commands)

@@ -21,6 +21,8 @@
 #include "integrator/recon_reserve.h"
 #include "integrator/render_identity.h"
 #include "scene/gltf_loader.h"
+#include "scene/light_sources.h"
+#include "app/input_file.h"
 #include "util/error.h"
 #include "util/timer.h"
 #include "vk/context.h"
@@ -166,6 +168,8 @@ int runRender(const RenderArgs& args) {
         for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
         std::fprintf(stderr, "gdpt: warning: %s: not rendered: %s\n", args.scene.c_str(), list.c_str());
     }
+    if (const auto black = blackImageWarning(scene, options.scene.envRadiance); black && !args.quiet)
+        std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
     vk::ContextOptions ctxOptions;
     ctxOptions.device = args.device;
     ctxOptions.validation = args.validate;
@@ -260,7 +264,7 @@ Subcommand addRenderCommand(CLI::App& app) {
     auto args = std::make_shared<RenderArgs>();
     RenderArgs& a = *args;
     CLI::App* r = app.add_subcommand("render", "Render a glTF 2.0 scene to OpenEXR (every layer) + a PNG preview");
-    r->add_option("scene", a.scene, "glTF 2.0 scene (.gltf or .glb)")->required()->check(CLI::ExistingFile);
+    r->add_option("scene", a.scene, "glTF 2.0 scene (.gltf or .glb)")->required()->check(InputFile);
 
     const char* image = "Scene and image";
     r->add_option("-o,--output", a.output, "Output EXR; the PNG preview is written beside it")
@@ -352,7 +356,7 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->needs(checkpoint)
         ->group(budget);
     r->add_option("--resume", a.resume, "Continue a checkpoint of the same render; --spp counts the total")
-        ->check(CLI::ExistingFile)
+        ->check(InputFile)
         ->group(budget);
 
     const char* diagnostics = "Device and diagnostics";

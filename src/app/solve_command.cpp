@@ -139,7 +139,7 @@ Subcommand addSolveCommand(CLI::App& app) {
         app.add_subcommand("solve", "Screened Poisson reconstruction of a gradient-domain EXR (GPU)");
     sub->add_option("input", a->input,
                     "gdpt EXR with layers primal, dx, dy [, direct, var_primal, var_dx, var_dy]")
-        ->check(CLI::ExistingFile);
+        ->check(InputFile);
     sub->add_option("-o,--output", a->output, "Output EXR (final image + 'recon' layer)")
         ->capture_default_str();
     sub->add_option("--recon", a->recon,
@@ -173,9 +173,9 @@ Subcommand addSolveCommand(CLI::App& app) {
                     "IRLS: relative residual of the inner solves before the last round (the last uses --tolerance)")
         ->check(CLI::Range(1e-12, 0.5))
         ->capture_default_str();
-    sub->add_option("--primal", a->primal, "Primal EXR (instead of INPUT)")->check(CLI::ExistingFile);
-    sub->add_option("--dx", a->dx, "Horizontal-gradient EXR (instead of INPUT)")->check(CLI::ExistingFile);
-    sub->add_option("--dy", a->dy, "Vertical-gradient EXR (instead of INPUT)")->check(CLI::ExistingFile);
+    sub->add_option("--primal", a->primal, "Primal EXR (instead of INPUT)")->check(InputFile);
+    sub->add_option("--dx", a->dx, "Horizontal-gradient EXR (instead of INPUT)")->check(InputFile);
+    sub->add_option("--dy", a->dy, "Vertical-gradient EXR (instead of INPUT)")->check(InputFile);
     sub->add_option("--device", a->device, "Vulkan device index or name substring");
     sub->add_flag("--quiet", a->quiet, "No summary on stderr");
     return {sub, [a] { return runSolve(*a); }};

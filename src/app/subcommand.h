@@ -7,6 +7,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/input_file.h"
+
 namespace gdpt {
 
 struct Subcommand {

@@ -1,4 +1,4 @@
-// atomic_write.h — "write to name.tmp, rename() on success" (GUIDE §5), so that an
+// atomic_write.h — "write to name.tmp, rename() on success", so that an
 // interrupted or failed write never leaves a half-written output under the final name.
 #pragma once
 

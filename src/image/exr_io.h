@@ -18,7 +18,8 @@ struct NamedLayer {
     Image image;
 };
 
-// Writes all layers into one EXR at `path` (via path.tmp + rename, GUIDE §5). All layers
+// Writes all layers into one EXR at `path` (via path.tmp + rename, so that a failed
+// write never leaves a half-written file under `path`). All layers
 // must have the same non-zero size and distinct names. Throws gdpt::Error naming the file.
 void writeExr(const std::string& path, const std::vector<NamedLayer>& layers);
 

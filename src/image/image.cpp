@@ -25,11 +25,6 @@ std::array<double, 3> Image::meanRgb() const {
     return mean;
 }
 
-double Image::grayMean() const {
-    const auto m = meanRgb();
-    return (m[0] + m[1] + m[2]) / 3.0;
-}
-
 Image addImages(Image a, const Image& b) {
     if (!a.sameSize(b))
         throw Error("cannot add a " + std::to_string(b.width()) + "x" + std::to_string(b.height()) +

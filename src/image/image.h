@@ -42,8 +42,6 @@ public:
 
     // Mean of each channel over all pixels (double accumulation).
     [[nodiscard]] std::array<double, 3> meanRgb() const;
-    // Mean of the per-pixel gray value (R+G+B)/3, i.e. the mean of meanRgb().
-    [[nodiscard]] double grayMean() const;
 
 private:
     int width_ = 0;

@@ -1,7 +1,8 @@
 // metrics.h — image error metrics against a reference.
 //
-// relMSE is computed exactly as Kettunen et al. 2015 computed it (their errata; the
-// calculateRelMSE.m used for the paper, GPT_REFERENCE §4):
+// relMSE is computed exactly as Kettunen et al. 2015 computed it (the errata on their project
+// page: Sec. 6 of the paper describes it differently; this is the computation behind its
+// numbers, their calculateRelMSE.m):
 //     relMSE = 3 · mean over pixels p and channels c of (I_pc − R_pc)² / (1e-3 + gray(R_p)²)
 //            = mean over pixels of Σ_c (I_pc − R_pc)² / (1e-3 + gray(R_p)²),
 // with gray(R_p) = (R_pr + R_pg + R_pb) / 3 taken from the reference pixel.

@@ -5,10 +5,11 @@
 // Layout (gdpt-checkpoint-1):
 //   - default channels R,G,B: SamplerState::preview (PT: the running mean; G-PT: primal +
 //     direct, not reconstructed), so any EXR viewer and `gdpt diff` can read the file;
-//   - layers state<k>.mean, state<k>.m2, state<k>.count for statistics buffer k (PT: k = 0;
-//     G-PT: 0..9 in binding order): the Welford running mean and M2 per channel and the
-//     sample count (the same integer in R, G and B). FLOAT channels hold the float32 values
-//     bit for bit, and counts are integers <= 2^24, exact in float32;
+//   - layers state<k>.mean, state<k>.m2, state<k>.count for statistics buffer k (PT: k = 0, 1;
+//     G-PT: 0..10, or 0..11 with demodulation; order in sampler_state.h): the Welford
+//     running mean and M2 per channel and the sample count (the same integer in R, G and
+//     B). FLOAT channels hold the float32 values bit for bit, and counts are integers
+//     <= 2^24, exact in float32;
 //   - string attributes gdpt.format, gdpt.spp, gdpt.next_batch, gdpt.batches, gdpt.buffers
 //     (the schedule position), gdpt.id.<key> (the identity of the render: a resume must match
 //     every one) and gdpt.info.<key> (informational, e.g. the device).

@@ -1,7 +1,11 @@
 // sampler_state.h — everything a render needs to continue where another stopped: the
-// per-pixel running statistics of every accumulation buffer (PT: 1, G-PT: 10, in binding
-// order) and the position in the batch schedule. Checkpoints (render/checkpoint.h) store it;
-// RenderOptions::resume restores it.
+// per-pixel running statistics of every accumulation buffer and the position in the batch
+// schedule. The buffers, in the order of the passes' downloadStats():
+//   PT:   2 = the path tracer's accumulation, then emitter supersampling's;
+//   G-PT: 11 = the ten per-pixel statistics of gpt.comp in binding order (central, four
+//         neighbours, four gradients, direct), then emitter supersampling's; 12 with
+//         demodulation, whose modulation statistics come last.
+// Checkpoints (render/checkpoint.h) store it; RenderOptions::resume restores it.
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,5 @@
 // poisson_cpu.h — double-precision CPU reference of every screened-Poisson operator and
-// solver (GUIDE §6): the oracle the GPU solver is tested against. Kept deliberately naive:
+// solver: the oracle the GPU solver is tested against. Kept deliberately naive:
 // one small function per operator, each documented with its maths.
 //
 // Notation (see poisson_problem.h): A = Pᵀ W P is the weighted 5-point Laplacian plus the
@@ -121,9 +121,9 @@ struct IterativeOptions {
     std::function<void(int, const Field&)> onIterate;
 };
 
-// Conjugate gradient (Hestenes & Stiefel 1952), warm-started from x, as in the published
-// solver (GPT_REFERENCE §2). Minimises ‖x − x*‖_A over growing Krylov spaces, so that error
-// norm never increases.
+// Conjugate gradient (Hestenes & Stiefel 1952), warm-started from x, the method of the
+// published G-PT solver (Kettunen et al. 2015, §4). Minimises ‖x − x*‖_A over growing
+// Krylov spaces, so that error norm never increases.
 SolveStats solveCg(const PoissonOperator& op, const Field& b, Field& x,
                    const IterativeOptions& options = {});
 

@@ -3,7 +3,7 @@
 //
 // Solves, per RGB channel, argmin_I ‖H_dx I − dx‖²_W + ‖H_dy I − dy‖²_W + α²‖I − primal‖²_W
 // (forward differences, gradient rows beyond the last column/row dropped; Kettunen et al.
-// 2015, §4; GPT_REFERENCE §2) with
+// 2015, §4) with
 //   L2   one weighted least-squares solve, by
 //          mg-pcg  CG preconditioned with one symmetric multigrid V-cycle (default),
 //          cg      plain CG (the published solver's method),
@@ -62,7 +62,7 @@ struct SolveOptions {
     // 0.4 end near the regulariser of eight with 0.5 (5.1e-4 against 7.8e-4) and measured
     // the same or lower relMSE on the Cornell box at 4-32 spp and the scene set at 8 spp,
     // with the same outlier rejection, in 15-20 % less solve time (bench/RESULTS.md,
-    // seventh session).
+    // IRLS schedule).
     int irlsIterations = 6;
     double irlsRegInit = 0.05;
     double irlsRegIter = 0.4;
@@ -70,12 +70,12 @@ struct SolveOptions {
     // (Cornell box 4-32 spp, relMSE within 2 % from 0.001 to 0.1), but outlier rejection
     // does (a test image with corrupted gradients: rmse 0.0015 at 0.001, 0.014 at 0.01,
     // 0.015 at 0.02, 0.050 at 0.05). 0.02 instead of 0.01 keeps that and takes 20-30 % fewer
-    // iterations on low-spp renders (bench/RESULTS.md, seventh session).
+    // iterations on low-spp renders (bench/RESULTS.md, IRLS schedule).
     double irlsInnerTolerance = 0.02;
     double varianceEpsilon = 1e-4;     // WL2, WL1: w = 1/(var + ε)
     // WL1: the variances are averaged over a (2r+1)² box first, so that a row's weight is
     // not an estimate from the same samples as its value (unfiltered, WL1 and WL2 trade
-    // variance for a bias of their own: bench/RESULTS.md, sixth session).
+    // variance for a bias of their own: bench/RESULTS.md, variance-weighted L1).
     int varianceFilterRadius = 3;
     VcycleParams vcycle{};             // smoother and sweeps of mg / mg-pcg
     bool keepHistory = false;          // fill SolveReport::history (test mode)

@@ -9,25 +9,6 @@ namespace gdpt {
 
 IrlsOptions irlsPresetL1D() { return IrlsOptions{}; }
 
-IrlsOptions irlsPresetL1Q() {
-    IrlsOptions o;
-    o.iterations = 64;
-    o.regInit = 1.0;
-    o.regIter = 0.7;
-    o.innerIterations = 1000;
-    return o;
-}
-
-IrlsOptions irlsPresetL1L() {
-    IrlsOptions o;
-    o.iterations = 7;
-    o.regInit = 1e-4;
-    o.regIter = 0.1;
-    o.innerIterations = 20000;
-    o.innerTolerance = 1e-20;
-    return o;
-}
-
 IrlsOptions irlsPresetL2D() {
     IrlsOptions o;
     o.iterations = 1;

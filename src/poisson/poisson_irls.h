@@ -1,6 +1,7 @@
 // poisson_irls.h — L1 screened Poisson reconstruction by iteratively reweighted least squares
 // (IRLS), as the published G-PT solver does it (Kettunen et al. 2015, §4 "L1 reconstruction";
-// GPT_REFERENCE §2):
+// the authors' public screened Poisson solver by T. Karras, poisson_solver/ in
+// gradientdomain-mitsuba):
 //   iteration k = 0: all weights 1 (an L2 solve);
 //   iteration k ≥ 1: every row j (primal, dx, dy) gets w_j = 1 / (‖e_j‖_RGB + reg_k) with
 //     e_j the row residual of the current RGB estimate (primal rows: α (x − t)),
@@ -39,10 +40,8 @@ struct IrlsOptions {
     InnerSolver inner = InnerSolver::Cg;
 };
 
-// Presets of the published solver (GPT_REFERENCE §2, Solver.cpp setConfigPreset).
+// Presets of the published solver (its Solver.cpp, setConfigPreset: L1D and L2D).
 IrlsOptions irlsPresetL1D();  // default: 20 x 50 CG, regInit 0.05, regIter 0.5
-IrlsOptions irlsPresetL1Q();  // 64 x 1000, regInit 1, regIter 0.7
-IrlsOptions irlsPresetL1L();  // legacy MATLAB reference: 7 x 20000, 1e-4, 0.1, tol 1e-20
 IrlsOptions irlsPresetL2D();  // 1 x 50 (L2)
 
 // Row weights shared by the three channels.

@@ -1,5 +1,5 @@
 // poisson_problem.h — the screened Poisson reconstruction problem of gradient-domain
-// rendering (Kettunen et al. 2015, §4; GPT_REFERENCE §2), one colour channel at a time.
+// rendering (Kettunen et al. 2015, §4), one colour channel at a time.
 //
 // For a W x H image with pixel i = y*W + x, the unknown image I minimises
 //     E(I) = Σ_i wdx_i (I_{i+1} − I_i − dx_i)²      (rows with x < W−1 only)

@@ -10,13 +10,16 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <sstream>
+#include <string_view>
 
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
+#include <nlohmann/json.hpp>
 
 #include "scene/gltf_internal.h"
 
@@ -37,11 +40,12 @@ namespace {
 
 constexpr std::uintmax_t kMaxFileBytes = 2ull << 30;
 
-// Extensions whose content we render; any other listed extension is reported.
+// Extensions whose content we render; any other listed extension is reported, and a file
+// that requires any other is refused (requiredExtensionsError).
 const std::set<std::string> kSupportedExtensions = {
     "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_materials_ior",
     "KHR_lights_punctual"};
-// Geometry we cannot decode at all: a required one makes the file unrenderable.
+// Geometry we cannot decode at all.
 const std::set<std::string> kCompressionExtensions = {
     "KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_meshopt_compression"};
 
@@ -65,6 +69,27 @@ std::string oneLine(std::string s) {
     while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
     std::replace(s.begin(), s.end(), '\n', ';');
     return s;
+}
+
+// Why a file whose extensionsRequired is `required` cannot be loaded (glTF 2.0 §3.12: a
+// loader must not load a file that requires an extension it does not support), or nothing.
+std::optional<std::string> requiredExtensionsError(const std::vector<std::string>& required) {
+    std::vector<std::string> missing;
+    bool compression = false;
+    for (const std::string& ext : required) {
+        if (kSupportedExtensions.count(ext) ||
+            std::find(missing.begin(), missing.end(), ext) != missing.end())
+            continue;
+        missing.push_back(ext);
+        compression = compression || kCompressionExtensions.count(ext) > 0;
+    }
+    if (missing.empty()) return std::nullopt;
+    std::string list;
+    for (const std::string& ext : missing) list += (list.empty() ? "" : ", ") + ext;
+    std::string message = (missing.size() == 1 ? "required extension " : "required extensions ") + list +
+                          (missing.size() == 1 ? " is" : " are") + " not supported by gdpt";
+    if (compression) message += " (compressed geometry: decompress the file first)";
+    return message;
 }
 
 void checkFinite(const std::vector<double>& v, const std::string& what) {
@@ -102,15 +127,39 @@ glm::dmat4 localMatrix(const tinygltf::Node& node) {
     return t * r * s;
 }
 
+// The JSON text of a .gltf file, or the JSON chunk of a .glb (a 12-byte header, then the
+// first chunk's length, its type "JSON" and its data); empty if the container is malformed,
+// which the parser reports.
+std::string_view jsonText(const std::vector<unsigned char>& bytes, bool binary) {
+    const char* data = reinterpret_cast<const char*>(bytes.data());
+    if (!binary) return {data, bytes.size()};
+    if (bytes.size() < 20) return {};
+    std::uint32_t length = 0, type = 0;
+    std::memcpy(&length, data + 12, 4);
+    std::memcpy(&type, data + 16, 4);
+    if (type != 0x4E4F534Au || length > bytes.size() - 20) return {};  // 'JSON', little endian
+    return {data + 20, length};
+}
+
+// The top-level "extensionsRequired" names of a glTF JSON text, without building the rest of
+// the document; empty when the text is not valid JSON (the parser reports that).
+std::vector<std::string> requiredExtensions(std::string_view text) {
+    using nlohmann::json;
+    const json::parser_callback_t onlyRequired = [](int depth, json::parse_event_t event, json& parsed) {
+        return !(depth == 1 && event == json::parse_event_t::key && parsed != "extensionsRequired");
+    };
+    const json doc = json::parse(text.begin(), text.end(), onlyRequired, /*allow_exceptions=*/false);
+    std::vector<std::string> out;
+    if (!doc.is_object()) return out;
+    const auto it = doc.find("extensionsRequired");
+    if (it == doc.end() || !it->is_array()) return out;
+    for (const json& name : *it)
+        if (name.is_string()) out.push_back(name.get<std::string>());
+    return out;
+}
+
 void checkExtensions(gltf::Context& ctx) {
     const tinygltf::Model& model = ctx.model;
-    for (const auto& ext : model.extensionsRequired) {
-        if (kCompressionExtensions.count(ext))
-            throw Error("required extension " + ext +
-                        " (compressed geometry) is not supported; decompress the file first");
-        if (!kSupportedExtensions.count(ext))
-            ctx.unsupported("required extension " + ext + " (rendering without it)");
-    }
     for (const auto& ext : model.extensionsUsed)
         if (!kSupportedExtensions.count(ext)) ctx.unsupported("extension " + ext);
     if (!model.skins.empty()) ctx.unsupported("skins (meshes rendered in their bind pose)");
@@ -267,6 +316,10 @@ Scene loadImpl(const std::string& path) {
     std::string baseDir = std::filesystem::path(path).parent_path().string();
     if (baseDir.empty()) baseDir = ".";
     const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+    // Before the parser: it would fail on what such an extension replaces (e.g. a Draco mesh's
+    // accessors have no bufferView) with a message that does not name the extension.
+    if (const auto message = requiredExtensionsError(requiredExtensions(jsonText(bytes, binary))))
+        throw Error(*message);
     const bool ok =
         binary ? parser.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
                                              static_cast<unsigned int>(bytes.size()), baseDir)

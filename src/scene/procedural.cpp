@@ -1,4 +1,8 @@
 // procedural.cpp — Cornell box, furnace sphere, emissive quad and the benchmark scene.
+//
+// cbox.gltf below names the glTF Cornell box (Bitterli's layout) whose independent
+// reference image the reference tests read from ../shared/scenes/cbox; makeCornellBox()
+// reproduces its geometry, materials and camera.
 #include "scene/procedural.h"
 
 #include <algorithm>

@@ -12,8 +12,12 @@
 
 namespace gdpt {
 
-// The Cornell box of /work/shared/scenes/cbox/cbox.gltf (Bitterli's layout): same vertices,
-// triangles (36), normals, materials (white, red, green, light = 0..3) and camera.
+// The Cornell box in Bitterli's layout: Lambertian red, green and white walls, two white
+// boxes and a ceiling light of radiance (17, 12, 4) emitting downwards; 36 triangles,
+// materials white, red, green, light = 0..3; camera at (0, 1, 6.8) looking at (0, 1, 0)
+// with a vertical field of view of 19.5 degrees. The same geometry, materials and camera as
+// the glTF Cornell box with an independent reference image that some tests read from
+// ../shared/scenes/cbox.
 [[nodiscard]] Scene makeCornellBox();
 
 // A closed unit sphere (icosphere, 20 * 4^subdivisions triangles, radius 1, centred at the

@@ -277,10 +277,7 @@ VkBool32 Context::messengerCallback(VkDebugUtilsMessageSeverityFlagBitsEXT sever
                                     const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
     auto* self = static_cast<Context*>(user);
     const bool error = severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-    if (error)
-        ++self->validationErrors_;
-    else
-        ++self->validationWarnings_;
+    if (error) ++self->validationErrors_;
     if (self->printValidation_)
         std::fprintf(stderr, "gdpt: validation %s: %s\n", error ? "error" : "warning",
                      data && data->pMessage ? data->pMessage : "(no message)");

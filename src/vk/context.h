@@ -72,8 +72,6 @@ public:
     [[nodiscard]] std::uint32_t queueFamily() const { return queueFamily_; }
     [[nodiscard]] const DeviceInfo& info() const { return info_; }
     [[nodiscard]] std::uint32_t validationErrors() const { return validationErrors_.load(); }
-    [[nodiscard]] std::uint32_t validationWarnings() const { return validationWarnings_.load(); }
-    [[nodiscard]] bool validationEnabled() const { return validation_; }
 
     // Memory type with all `required` flags among `typeBits`; throws if none.
     [[nodiscard]] std::uint32_t findMemoryType(std::uint32_t typeBits,
@@ -101,7 +99,6 @@ private:
     bool validation_ = false;
     bool printValidation_ = true;
     std::atomic<std::uint32_t> validationErrors_{0};
-    std::atomic<std::uint32_t> validationWarnings_{0};
     Handle<VkInstance> instance_;
     Handle<VkDebugUtilsMessengerEXT> messenger_;
     VkPhysicalDevice physical_ = VK_NULL_HANDLE;

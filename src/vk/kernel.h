@@ -28,15 +28,16 @@ struct KernelDesc {
     std::size_t spirvBytes = 0;
     // The same kernel through spirv-opt (cmake/GdptSpirvEmbed.cmake), if not null: lavapipe
     // before Mesa 23 creates its pipeline in about half the time and runs it as fast; Mesa 25
-    // runs it ~12 % slower, so every other device gets `spirv` (bench/RESULTS.md, ninth
-    // session). GDPT_SPIRV=raw|opt in the environment overrides the choice.
+    // runs it ~12 % slower, so every other device gets `spirv` (bench/RESULTS.md,
+    // spirv-opt). GDPT_SPIRV=raw|opt in the environment overrides the choice.
     const std::uint32_t* spirvOptimized = nullptr;
     std::size_t spirvOptimizedBytes = 0;
     std::vector<std::uint32_t> bindings;  // binding numbers of set 0 (storage buffers unless below)
     // Bindings of `bindings` that the shader reads as uniform texel buffers (GLSL
     // textureBuffer / utextureBuffer + texelFetch), with the format of their view. Lavapipe
     // before Mesa 23 loads a storage buffer lane by lane with a branch per lane and
-    // component, but fetches texels with vector gathers (bench/RESULTS.md, eighth session).
+    // component, but fetches texels with vector gathers (bench/RESULTS.md,
+    // texel buffers).
     std::vector<std::pair<std::uint32_t, VkFormat>> texelBindings;
     std::uint32_t pushConstantBytes = 0;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> specConstants;  // (id, 32-bit value)

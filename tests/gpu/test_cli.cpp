@@ -47,7 +47,27 @@ TEST_F(Cli, UsageErrorsExitWithTwo) {
     EXPECT_EQ(run("render " + kScene + " --env 1,2").code, 2);
     EXPECT_EQ(run("render").code, 2);
     EXPECT_EQ(run("frobnicate").code, 2);
-    EXPECT_EQ(run("render " + path("missing.gltf")).code, 2);
+}
+
+// A missing or unreadable input is an input error (1), not a usage error: one line naming the
+// file and the reason, whichever command and option names it.
+TEST_F(Cli, MissingInputFilesAreErrorsNamingTheFile) {
+    const std::string missing = path("missing.gltf");
+    const std::string exr = path("missing.exr");
+    for (const std::string& args :
+         {"render " + missing, "info " + missing, "converge " + missing,
+          "render " + kScene + " --resume " + exr, "converge " + kScene + " --reference " + exr,
+          "diff " + exr + " " + exr, "solve " + exr,
+          "clone --source " + exr + " --target " + exr + " --mask " + exr, "render " + dir_.string()}) {
+        const RunResult r = run(args);
+        EXPECT_EQ(r.code, 1) << args << ": " << r.output;
+        EXPECT_EQ(r.output.rfind("gdpt: error: ", 0), 0u) << args << ": " << r.output;
+        EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << "one line: " << r.output;
+    }
+    const RunResult r = run("render " + missing + " -o " + path("out.exr"));
+    EXPECT_EQ(r.output, "gdpt: error: " + missing + ": no such file or directory\n");
+    EXPECT_NE(run("render " + dir_.string()).output.find("is a directory"), std::string::npos);
+    EXPECT_FALSE(fs::exists(path("out.exr")));
 }
 
 TEST_F(Cli, MalformedSceneIsAnErrorNamingTheFileAndWritesNothing) {
@@ -61,6 +81,35 @@ TEST_F(Cli, MalformedSceneIsAnErrorNamingTheFileAndWritesNothing) {
     EXPECT_FALSE(fs::exists(out));
     EXPECT_FALSE(fs::exists(path("out.png")));
     EXPECT_FALSE(fs::exists(out + ".tmp"));
+}
+
+// A scene with nothing that emits light renders black: render and info say so (and what to
+// try), a render with --env does not.
+TEST_F(Cli, SceneWithoutLightWarnsThatTheImageWillBeBlack) {
+    const std::string dark = path("dark.gltf");
+    // One triangle (0,0,0), (1,0,0), (0,1,0), default material; the buffer as a data URI.
+    std::ofstream(dark) << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [0, 0, 0], "max": [1, 1, 0]}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}],
+        "buffers": [{"byteLength": 36,
+                     "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]})";
+    const std::string warning =
+        dark +
+        ": no light source (no emissive surface, no punctual light, no --env): the image will be black; "
+        "try --env 1,1,1";
+    const std::string small = " --width 8 --height 8 --spp 1 -o " + path("out.exr");
+    const RunResult r = run("render " + dark + small);
+    EXPECT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("gdpt: warning: " + warning + "\n"), std::string::npos) << r.output;
+    const RunResult lit = run("render " + dark + small + " --env 1,1,1");
+    EXPECT_EQ(lit.code, 0) << lit.output;
+    EXPECT_EQ(lit.output.find("no light source"), std::string::npos) << lit.output;
+    const RunResult info = run("info " + dark);
+    EXPECT_EQ(info.code, 0) << info.output;
+    EXPECT_NE(info.output.find(warning), std::string::npos) << info.output;
+    EXPECT_EQ(run("info " + kScene).output.find("no light source"), std::string::npos);
 }
 
 TEST_F(Cli, SmallValidatedRenderWritesExrPngAndJson) {

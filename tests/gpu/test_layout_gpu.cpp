@@ -1,4 +1,5 @@
-// Host/shader layout, check 2 of GUIDE §2: a kernel writes a sentinel into every field of
+// Host/shader layout, device side (the host side is tests/unit/util/test_shared_layout.cpp):
+// a kernel writes a sentinel into every field of
 // the shared structs and the host reads them back through the C++ definitions. A field
 // whose offset differs between C++ and GLSL reads the wrong sentinel.
 #include <gtest/gtest.h>

@@ -176,9 +176,4 @@ void SceneGpu::bindTo(vk::Kernel& kernel) const {
     kernel.bind(gpu::kBindSceneConst, sceneConst_);
 }
 
-std::uint64_t SceneGpu::deviceBytes() const {
-    return triGeom_.size() + triShading_.size() + bvh_.size() + materials_.size() + texInfo_.size() +
-           texels_.size() + lightTris_.size() + punctual_.size() + sceneConst_.size();
-}
-
 }  // namespace gdpt

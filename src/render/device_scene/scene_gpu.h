@@ -49,7 +49,6 @@ public:
     [[nodiscard]] const SceneFeatures& features() const { return spec_.features(); }
     [[nodiscard]] const gpu::SceneConstants& constants() const { return constants_; }
     [[nodiscard]] const BvhBuildInfo& bvhInfo() const { return bvhInfo_; }
-    [[nodiscard]] std::uint64_t deviceBytes() const;
 
 private:
     SceneSpec spec_;

@@ -64,7 +64,7 @@ std::vector<std::uint32_t> demodulationMask(const std::vector<std::uint32_t>& ed
 // Whether the split bounce loop pays on this device: lavapipe with Mesa before 23, which runs
 // every branch under lane masks (15-25 % faster samples there); elsewhere the single loop,
 // as on Mesa 25's lavapipe, where the split measured no faster and only costs pipeline
-// creation time (bench/RESULTS.md, fourth session).
+// creation time (bench/RESULTS.md, split bounce loop).
 bool splitBounceDefault(const vk::DeviceInfo& device);
 
 // The resolved images (see gpt_resolve.comp for the estimators). With demodulation, primal,

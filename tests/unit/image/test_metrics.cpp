@@ -3,11 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
 #include <limits>
 
 #include "image/exr_io.h"
 #include "image/metrics.h"
+#include "shared_data.h"
 #include "util/error.h"
 
 namespace gdpt {
@@ -85,8 +85,8 @@ TEST(Image, AddImagesSumsEveryChannelAndRefusesOtherSizes) {
 }
 
 TEST(Metrics, CboxReferenceAgainstItselfAndReadmeMean) {
-    const std::string file = std::string(GDPT_SHARED_DIR) + "/scenes/cbox/reference.exr";
-    if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " not present";
+    const std::string file = test::sharedDataPath("scenes/cbox/reference.exr");
+    GDPT_REQUIRE_SHARED_DATA(file);
     const Image reference = readExrLayer(file);
     EXPECT_EQ(reference.width(), 256);
     EXPECT_EQ(reference.height(), 256);
@@ -94,7 +94,7 @@ TEST(Metrics, CboxReferenceAgainstItselfAndReadmeMean) {
     EXPECT_EQ(s.relMse, 0.0);
     EXPECT_EQ(s.mse, 0.0);
     EXPECT_EQ(s.nonFinitePixels, 0u);
-    // Values from /work/shared/scenes/README.md (given to 5 decimals).
+    // The mean RGB published with the reference image (rounded to 5 decimals).
     const auto mean = reference.meanRgb();
     EXPECT_NEAR(mean[0], 0.19617, 1e-4);
     EXPECT_NEAR(mean[1], 0.12765, 1e-4);

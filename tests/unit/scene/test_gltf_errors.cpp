@@ -1,5 +1,5 @@
 // test_gltf_errors.cpp — every malformed input gives gdpt::Error naming the file and the
-// element (GUIDE §5); no input crashes the loader. Each case starts from a valid file
+// element; no input crashes the loader. Each case starts from a valid file
 // (oneTriangle) and breaks exactly one thing, so a loader that ignored the defect would load
 // successfully and fail the test.
 #include <cmath>
@@ -257,6 +257,58 @@ TEST(GltfErrors, RequiredCompressionIsAnError) {
     g.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
     g.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
     expectError(g.writeGltf(test::testDir(), "draco"), {"KHR_draco_mesh_compression"});
+}
+
+// As a Draco encoder writes it: the primitive's accessors have no bufferView (the data is in
+// the extension's compressed buffer view). The file is refused naming the extension, before
+// anything reads those accessors.
+TEST(GltfErrors, RequiredDracoIsRefusedNamingItBeforeTheAccessors) {
+    const std::string dir = test::testDir();
+    auto g = test::oneTriangle();
+    g.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+    g.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+    for (auto& accessor : g.doc["accessors"]) accessor.erase("bufferView");
+    auto& primitive = g.doc["meshes"][0]["primitives"][0];
+    primitive["extensions"]["KHR_draco_mesh_compression"] = {
+        {"bufferView", 0}, {"attributes", {{"POSITION", 0}, {"NORMAL", 1}}}};
+    const std::vector<std::string> expected = {
+        "required extension KHR_draco_mesh_compression is not supported", "decompress"};
+    expectError(g.writeGltf(dir, "draco"), expected);
+    expectError(g.writeGlb(dir, "draco"), expected);
+}
+
+// glTF 2.0 §3.12: a file that requires an extension the loader does not support must not be
+// loaded; every such extension is named, the supported ones are not.
+TEST(GltfErrors, RequiredUnsupportedExtensionsAreRefused) {
+    const std::string dir = test::testDir();
+    auto g = test::oneTriangle();
+    const std::vector<std::string> unsupported = {"KHR_texture_transform", "KHR_materials_transmission",
+                                                  "EXT_made_up_by_a_test"};
+    g.doc["extensionsUsed"] = unsupported;
+    g.doc["extensionsUsed"].push_back("KHR_lights_punctual");
+    g.doc["extensionsRequired"] = {"KHR_lights_punctual", "KHR_texture_transform",
+                                   "KHR_materials_transmission", "EXT_made_up_by_a_test"};
+    for (const std::string& path : {g.writeGltf(dir, "req"), g.writeGlb(dir, "req")}) {
+        expectError(path, {"required extensions KHR_texture_transform, KHR_materials_transmission, "
+                           "EXT_made_up_by_a_test are not supported"});
+        try {
+            (void)loadGltf(path);
+        } catch (const Error& e) {
+            EXPECT_EQ(std::string(e.what()).find("KHR_lights_punctual"), std::string::npos) << e.what();
+        }
+    }
+    g.doc["extensionsRequired"] = {"KHR_texture_transform"};
+    expectError(g.writeGltf(dir, "one"), {"required extension KHR_texture_transform is not supported"});
+}
+
+// The extensions gdpt renders may be required.
+TEST(GltfErrors, RequiredSupportedExtensionsLoad) {
+    auto g = test::oneTriangle();
+    const std::vector<std::string> supported = {"KHR_materials_emissive_strength", "KHR_materials_specular",
+                                                "KHR_materials_ior", "KHR_lights_punctual"};
+    g.doc["extensionsUsed"] = supported;
+    g.doc["extensionsRequired"] = supported;
+    EXPECT_EQ(loadGltf(g.writeGltf(test::testDir(), "ok")).triangles.size(), 1u);
 }
 
 TEST(GltfErrors, TruncatedGlb) {

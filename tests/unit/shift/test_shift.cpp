@@ -139,7 +139,8 @@ TEST(ShiftHalfVector, JacobianEqualsFiniteDifferenceDeterminant) {
 }
 
 // Applying the shift from the offset back to the base returns the base direction and the
-// reverse Jacobian is the reciprocal (GPT_REFERENCE §7.5).
+// reverse Jacobian is the reciprocal: without both, the MIS weights of a pixel pair would not
+// sum to one.
 TEST(ShiftHalfVector, ReverseShiftIsIdentityAndJacobiansMultiplyToOne) {
     Source src(22);
     for (int i = 0; i < 500; ++i) {
@@ -379,7 +380,8 @@ TEST(ShiftMis, FourStrategyWeightsOfForwardAndReverseSumToOne) {
         const float rL = gptMisWeight(float(pLo), float(pBo), jRev * float(pL) / prefixRatio, jRev * float(pB) / prefixRatio);
         EXPECT_NEAR(fB + fL + rB + rL, 1.0f, 2e-5f) << "config " << i;
         // The light pdf in the base's measure is the same for both (same light point):
-        // pL' J = pL (GPT_REFERENCE §1.5, the identity gpt.comp relies on).
+        // pL' J = pL (the offset reconnects to the base's light point; the identity gpt.comp
+        // relies on).
         EXPECT_NEAR(float(pLo) * j / float(pL), 1.0f, 1e-4f) << "config " << i;
     }
 }

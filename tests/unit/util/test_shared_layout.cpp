@@ -1,4 +1,4 @@
-// Host/shader layout, check 1 of GUIDE §2: sizes and offsets of every shared struct are
+// Host/shader layout, host side: sizes and offsets of every shared struct are
 // pinned here. GLSL's scalar layout packs members at their natural 4-byte alignment, so the
 // C++ offsets below must equal the sums of the member sizes (the GPU sentinel test
 // tests/gpu/test_layout_gpu.cpp checks the GLSL side).
