@@ -25,7 +25,7 @@ packages=(
   libglm-dev libtinygltf-dev libopenexr-dev libimath-dev libstb-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libeigen3-dev
-  gnuplot-nox python3 clang libclang-rt-dev
+  gnuplot-nox python3 clang libclang-rt-dev clang-format-14
 )
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"

@@ -39,15 +39,15 @@ using uint = std::uint32_t;
 // Limits and sentinels
 // ---------------------------------------------------------------------------------------------
 GDPT_CONST uint kInvalidIndex = 0xFFFFFFFFu;
-GDPT_CONST uint kBvhStackSize = 64u;      // traversal stack entries (max BVH depth is capped below)
-GDPT_CONST uint kBvhMaxDepth = 60u;       // builder never exceeds this depth
+GDPT_CONST uint kBvhStackSize = 64u;  // traversal stack entries (max BVH depth is capped below)
+GDPT_CONST uint kBvhMaxDepth = 60u;   // builder never exceeds this depth
 // Traversal stack of the wide tree: nodes waiting to be visited (collapseToWide checks that
 // its tree never needs more).
 GDPT_CONST uint kBvhWideStackSize = 128u;
 // The register traversal stack (kSpecBvhRegisterStack = its entries, 8 or 16): trees whose
 // maxStack is at most that traverse with the stack in vector variables instead of an array.
 GDPT_CONST uint kBvhRegisterStackMax = 16u;
-GDPT_CONST uint kMaxLeafTriangles = 255u; // leaf primitive count must fit in this
+GDPT_CONST uint kMaxLeafTriangles = 255u;  // leaf primitive count must fit in this
 
 // ---------------------------------------------------------------------------------------------
 // Geometry (world space, metres as given by the glTF file)
@@ -55,11 +55,11 @@ GDPT_CONST uint kMaxLeafTriangles = 255u; // leaf primitive count must fit in th
 
 // Intersection data of one triangle, in BVH leaf order. 48 bytes.
 struct TriangleGeom {
-    vec3 v0;   // world-space position of vertex 0
+    vec3 v0;  // world-space position of vertex 0
     float pad0;
-    vec3 e1;   // v1 - v0 (world space)
+    vec3 e1;  // v1 - v0 (world space)
     float pad1;
-    vec3 e2;   // v2 - v0 (world space)
+    vec3 e2;  // v2 - v0 (world space)
     float pad2;
 };
 GDPT_CONST uint kTriangleGeomTexels = 3u;  // 16-byte texels per TriangleGeom (scene_geometry.glsl)
@@ -75,11 +75,12 @@ struct TriangleShading {
     vec2 uv0;       // texture coordinates (TEXCOORD_0) at vertex 0
     vec2 uv1;
     vec2 uv2;
-    uint lightIndex; // index into LightTriangle table, kInvalidIndex if not emissive
+    uint lightIndex;  // index into LightTriangle table, kInvalidIndex if not emissive
     uint pad3;
 };
 GDPT_CONST uint kTriangleShadingTexels = 5u;  // 16-byte texels per TriangleShading (scene_buffers.glsl)
-GDPT_CONST uint kTriFlagHasNormals = 1u;  // n0..n2 valid and not all the face normal; otherwise use the geometric normal
+GDPT_CONST uint kTriFlagHasNormals =
+    1u;  // n0..n2 valid and not all the face normal; otherwise use the geometric normal
 
 // Two-wide BVH node, what the builder writes (builder.h): stores both children's boxes. The
 // kernels traverse its four-wide collapse, BvhWideNode. 64 bytes.
@@ -87,11 +88,11 @@ GDPT_CONST uint kTriFlagHasNormals = 1u;  // n0..n2 valid and not all the face n
 // it is a leaf covering triangles [first, first + count) in TriangleGeom order. An absent
 // child has count == 0, index kInvalidIndex and an empty box (min > max).
 struct BvhNode {
-    vec3 lmin;        // left child bounds, world space
-    uint left;        // node index (count==0) or first triangle (count>0)
+    vec3 lmin;  // left child bounds, world space
+    uint left;  // node index (count==0) or first triangle (count>0)
     vec3 lmax;
-    uint leftCount;   // 0 = inner node, else triangle count (<= kMaxLeafTriangles)
-    vec3 rmin;        // right child bounds
+    uint leftCount;  // 0 = inner node, else triangle count (<= kMaxLeafTriangles)
+    vec3 rmin;       // right child bounds
     uint right;
     vec3 rmax;
     uint rightCount;
@@ -125,19 +126,19 @@ GDPT_CONST uint kBvhWideNodeTexels = 4u;  // 16-byte texels per BvhWideNode (sce
 
 // glTF metallic-roughness material (+KHR_materials_specular, emissive_strength). 80 bytes.
 struct Material {
-    vec4 baseColor;       // linear RGBA factor (alpha used for cutout only)
-    vec3 emissive;        // emitted radiance factor, W/(m^2 sr): emissiveFactor * strength
-    float metallic;       // [0,1]
-    vec3 specularColor;   // KHR_materials_specular specularColorFactor (linear)
-    float roughness;      // perceptual roughness [0,1]; GGX alpha = roughness^2
-    float specular;       // KHR_materials_specular specularFactor; 0 = pure Lambertian
-    float ior;            // index of refraction for dielectric F0 (default 1.5)
-    float alphaCutoff;    // cutout threshold, used when flags & kMatFlagAlphaMask
-    uint flags;           // kMatFlag*
-    int baseColorTex;     // texture index or -1
-    int metallicRoughnessTex; // texture index or -1 (G = roughness, B = metallic)
-    int emissiveTex;      // texture index or -1
-    int normalTex;        // texture index or -1 (currently unused by kernels; warned)
+    vec4 baseColor;            // linear RGBA factor (alpha used for cutout only)
+    vec3 emissive;             // emitted radiance factor, W/(m^2 sr): emissiveFactor * strength
+    float metallic;            // [0,1]
+    vec3 specularColor;        // KHR_materials_specular specularColorFactor (linear)
+    float roughness;           // perceptual roughness [0,1]; GGX alpha = roughness^2
+    float specular;            // KHR_materials_specular specularFactor; 0 = pure Lambertian
+    float ior;                 // index of refraction for dielectric F0 (default 1.5)
+    float alphaCutoff;         // cutout threshold, used when flags & kMatFlagAlphaMask
+    uint flags;                // kMatFlag*
+    int baseColorTex;          // texture index or -1
+    int metallicRoughnessTex;  // texture index or -1 (G = roughness, B = metallic)
+    int emissiveTex;           // texture index or -1
+    int normalTex;             // texture index or -1 (currently unused by kernels; warned)
 };
 GDPT_CONST uint kMaterialTexels = 5u;  // 16-byte texels per Material (scene_buffers.glsl)
 GDPT_CONST uint kMatFlagDoubleSided = 1u;
@@ -166,19 +167,17 @@ struct LightTriangle {
 };
 
 GDPT_ENUM_BEGIN(PunctualType)
-    kPunctualPoint = 0u,
-    kPunctualSpot = 1u
-GDPT_ENUM_END();
+kPunctualPoint = 0u, kPunctualSpot = 1u GDPT_ENUM_END();
 
 // KHR_lights_punctual point/spot light. Intensity in W/sr (glTF candela treated as
 // radiometric). Sampled uniformly among punctual lights.
 struct PunctualLight {
-    vec3 position;    // world space
-    uint type;        // PunctualType
-    vec3 intensity;   // colour * intensity, W/sr
-    float cosInner;   // spot: cos(innerConeAngle)
-    vec3 direction;   // spot: world-space unit direction the light points to
-    float cosOuter;   // spot: cos(outerConeAngle)
+    vec3 position;   // world space
+    uint type;       // PunctualType
+    vec3 intensity;  // colour * intensity, W/sr
+    float cosInner;  // spot: cos(innerConeAngle)
+    vec3 direction;  // spot: world-space unit direction the light points to
+    float cosOuter;  // spot: cos(outerConeAngle)
 };
 GDPT_CONST uint kPunctualLightTexels = 3u;  // 16-byte texels per PunctualLight (scene_buffers.glsl)
 
@@ -186,22 +185,22 @@ GDPT_CONST uint kPunctualLightTexels = 3u;  // 16-byte texels per PunctualLight 
 // Per-scene constants (one storage buffer, read-only)
 // ---------------------------------------------------------------------------------------------
 struct SceneConstants {
-    vec3 camPosition;     // world space
-    float tanHalfFovY;    // tan(yfov / 2)
-    vec3 camRight;        // unit, world space (+x on the image)
-    float aspect;         // width / height
-    vec3 camUp;           // unit, world space (+y on the image, i.e. towards row 0)
-    uint width;           // image width in pixels
-    vec3 camForward;      // unit view direction
-    uint height;          // image height in pixels
-    vec3 envRadiance;     // constant environment radiance, W/(m^2 sr)
+    vec3 camPosition;   // world space
+    float tanHalfFovY;  // tan(yfov / 2)
+    vec3 camRight;      // unit, world space (+x on the image)
+    float aspect;       // width / height
+    vec3 camUp;         // unit, world space (+y on the image, i.e. towards row 0)
+    uint width;         // image width in pixels
+    vec3 camForward;    // unit view direction
+    uint height;        // image height in pixels
+    vec3 envRadiance;   // constant environment radiance, W/(m^2 sr)
     uint numLightTriangles;
     uint numPunctualLights;
     float lightTrianglePower;  // total power of emissive triangles (selection weight)
     float punctualPower;       // total selection weight of punctual lights
-    uint maxDepth;        // maximum number of path segments (>= 1)
-    float sceneRadius;    // bounding-sphere radius, metres (for ray offsets / env)
-    uint rrDepth;         // Russian roulette starts after this many segments
+    uint maxDepth;             // maximum number of path segments (>= 1)
+    float sceneRadius;         // bounding-sphere radius, metres (for ray offsets / env)
+    uint rrDepth;              // Russian roulette starts after this many segments
     uint numTriangles;
     uint pad;
 };
@@ -210,11 +209,11 @@ struct SceneConstants {
 // Per-batch push constants (<= 128 bytes)
 // ---------------------------------------------------------------------------------------------
 struct FrameParams {
-    uint sampleBase;     // index of the first sample of this batch (per pixel)
-    uint samplesPerPixel;// samples taken per pixel in this batch
-    uint seed;           // user seed
-    uint rowOffset;      // first image row handled by this dispatch (dispatch tiling)
-    uint rowCount;       // rows handled by this dispatch
+    uint sampleBase;       // index of the first sample of this batch (per pixel)
+    uint samplesPerPixel;  // samples taken per pixel in this batch
+    uint seed;             // user seed
+    uint rowOffset;        // first image row handled by this dispatch (dispatch tiling)
+    uint rowCount;         // rows handled by this dispatch
     uint pad0;
     uint pad1;
     uint pad2;
@@ -222,12 +221,12 @@ struct FrameParams {
 
 // Push constants of emitter_supersampling.comp (emitter supersampling).
 struct VisibleParams {
-    uint phase;           // kVisiblePhase*
-    uint sampleBase;      // refine: first camera sample of this batch (per pixel)
-    uint samplesPerPixel; // refine: camera samples of this batch; each gets samplesPerSpp rays
-    uint seed;            // user seed
-    uint samplesPerSpp;   // supersampling factor requested (rays per camera sample, >= 1)
-    uint rayBudget;       // cap on refine rays per camera sample over the whole image
+    uint phase;            // kVisiblePhase*
+    uint sampleBase;       // refine: first camera sample of this batch (per pixel)
+    uint samplesPerPixel;  // refine: camera samples of this batch; each gets samplesPerSpp rays
+    uint seed;             // user seed
+    uint samplesPerSpp;    // supersampling factor requested (rays per camera sample, >= 1)
+    uint rayBudget;        // cap on refine rays per camera sample over the whole image
     uint pad0;
     uint pad1;
 };
@@ -237,8 +236,8 @@ GDPT_CONST uint kVisiblePhaseRefine = 2u;  // supersample them (one batch)
 
 // Written by emitter_supersampling.comp's count phase. 16 bytes.
 struct VisibleCounter {
-    uint refinedPixels;   // pixels whose neighbourhood sees an emission edge
-    uint raysPerSample;   // refine rays per camera sample in them (after the ray budget)
+    uint refinedPixels;  // pixels whose neighbourhood sees an emission edge
+    uint raysPerSample;  // refine rays per camera sample in them (after the ray budget)
     uint pad1;
     uint pad2;
 };
@@ -247,95 +246,77 @@ struct VisibleCounter {
 // mean and m2 stay bounded as samples grow, so float32 is accurate over 10^5 samples
 // (each merge adds a correction of relative size 1/n to a bounded value).
 struct PixelStats {
-    vec3 mean;    // running mean radiance
-    uint count;   // number of samples merged
-    vec3 m2;      // sum of squared deviations from the mean (per channel)
+    vec3 mean;   // running mean radiance
+    uint count;  // number of samples merged
+    vec3 m2;     // sum of squared deviations from the mean (per channel)
     uint pad;
 };
 
 // Device-side counters, reduced per batch (uints; no float atomics anywhere).
 struct Counters {
-    uint raysTraced;      // low 32 bits; host accumulates into 64-bit per batch
+    uint raysTraced;  // low 32 bits; host accumulates into 64-bit per batch
     uint pathsCompleted;
-    uint nanSamples;      // samples dropped because they were NaN/Inf
-    uint pad;             // unused (keeps the struct's layout)
-    uint shiftPairs;      // G-PT: offsets inside the image whose base's primary ray hit
-    uint shiftFailures;   // G-PT: of those, offsets whose shift failed (pair fell back to the base)
+    uint nanSamples;     // samples dropped because they were NaN/Inf
+    uint pad;            // unused (keeps the struct's layout)
+    uint shiftPairs;     // G-PT: offsets inside the image whose base's primary ray hit
+    uint shiftFailures;  // G-PT: of those, offsets whose shift failed (pair fell back to the base)
 };
 
 // ---------------------------------------------------------------------------------------------
 // Descriptor bindings of the path-tracing pipelines (set 0)
 // ---------------------------------------------------------------------------------------------
 GDPT_ENUM_BEGIN(SceneBinding)
-    kBindTriGeom = 0u,
-    kBindTriShading = 1u,
-    kBindBvh = 2u,
-    kBindMaterials = 3u,
-    kBindTexInfo = 4u,
-    kBindTexels = 5u,
-    kBindLightTris = 6u,
-    kBindPunctual = 7u,
-    kBindSceneConst = 8u,
-    kBindAccum = 9u,
-    kBindCounters = 10u,
+kBindTriGeom = 0u,
+    kBindTriShading = 1u, kBindBvh = 2u, kBindMaterials = 3u, kBindTexInfo = 4u, kBindTexels = 5u,
+    kBindLightTris = 6u, kBindPunctual = 7u, kBindSceneConst = 8u, kBindAccum = 9u, kBindCounters = 10u,
     kBindCount = 11u,
     // emitter supersampling (emitter_supersampling.comp, render/passes/emitter_supersampling_pass.h): the
     // supersampled estimate of the emission seen at the camera's first hit (PixelStats; a
     // count > 0 tells the path kernels to leave that term to it), the probe signature
     // per pixel (uint) and the pass's counter (VisibleCounter).
-    kBindVisibleStats = 14u,
-    kBindVisibleProbe = 15u,
-    kBindVisibleCounter = 16u
-GDPT_ENUM_END();
+    kBindVisibleStats = 14u, kBindVisibleProbe = 15u, kBindVisibleCounter = 16u GDPT_ENUM_END();
 
 // Bindings used only by test kernels (tests/gpu/kernels), kept here so no number repeats.
 GDPT_ENUM_BEGIN(TestBinding)
-    kBindTestInput = 32u,
-    kBindTestOutput = 33u,
-    kBindTestOutput2 = 34u
-GDPT_ENUM_END();
+kBindTestInput = 32u, kBindTestOutput = 33u, kBindTestOutput2 = 34u GDPT_ENUM_END();
 
 // Specialisation-constant ids (scene features compiled in or out per scene).
 GDPT_ENUM_BEGIN(SpecId)
-    kSpecWorkgroupX = 0u,
-    kSpecWorkgroupY = 1u,
-    kSpecHasTextures = 2u,
-    kSpecHasPunctual = 3u,
-    kSpecHasLightTris = 4u,
-    kSpecHasEnv = 5u,
-    kSpecHasGlossy = 6u,
-    kSpecHasAlphaMask = 7u,
-    kSpecMaxDepth = 8u,
-    kSpecPoissonFlags = 9u,  // poisson_*.comp: the kPoissonFlag* bits of this pipeline variant
-    kSpecVisibleEmission = 10u,  // path kernels: emitter supersampling is on (visible_emission.glsl)
+kSpecWorkgroupX = 0u,
+    kSpecWorkgroupY = 1u, kSpecHasTextures = 2u, kSpecHasPunctual = 3u, kSpecHasLightTris = 4u,
+    kSpecHasEnv = 5u, kSpecHasGlossy = 6u, kSpecHasAlphaMask = 7u, kSpecMaxDepth = 8u,
+    kSpecPoissonFlags = 9u,        // poisson_*.comp: the kPoissonFlag* bits of this pipeline variant
+    kSpecVisibleEmission = 10u,    // path kernels: emitter supersampling is on (visible_emission.glsl)
     kSpecHasShadingNormals = 11u,  // some triangle carries kTriFlagHasNormals (features.h)
-    kSpecHasSpecularLobe = 12u,  // some material has a metal/dielectric lobe (features.h hasSpecularLayer)
-    kSpecBvhRegisterStack = 13u,  // entries of the register traversal stack (8, 16), 0 = in memory (bvh_traverse.glsl)
-    kSpecGptDemodulate = 14u  // gpt.comp: first-hit texture demodulation is on (gpt_shared.h kBindGptDemodMask)
-GDPT_ENUM_END();
+    kSpecHasSpecularLobe = 12u,    // some material has a metal/dielectric lobe (features.h hasSpecularLayer)
+    kSpecBvhRegisterStack =
+        13u,  // entries of the register traversal stack (8, 16), 0 = in memory (bvh_traverse.glsl)
+    kSpecGptDemodulate =
+        14u  // gpt.comp: first-hit texture demodulation is on (gpt_shared.h kBindGptDemodMask)
+    GDPT_ENUM_END();
 
 // A ray of the BVH tests (tests/gpu/test_bvh_gpu.cpp). 32 bytes.
 struct TestRay {
     vec3 origin;  // world space
     float tMin;
-    vec3 dir;     // world space, not necessarily unit
+    vec3 dir;  // world space, not necessarily unit
     float tMax;
 };
 
 // State of one path between bounces of pt.comp (pt_core.glsl), kept in registers. 80 bytes.
 struct PathState {
-    vec3 origin;     // world-space origin of the next segment
-    uint pixel;      // y * width + x
-    vec3 dir;        // unit direction of the next segment
-    float prevPdf;   // solid-angle pdf of the BSDF sample that chose dir
-    vec3 beta;       // path throughput f/p so far
-    uint flags;      // kPathFlag*
-    vec3 radiance;   // radiance gathered so far
-    uint rng;        // Rng state
-    vec3 prevP;      // position of the vertex that spawned the segment (for MIS)
-    uint depth;      // index of the vertex the next hit will be (0 = first hit)
-    uint rays;       // rays traced by this path so far
-    uint ldSeed;     // the pixel's LdSample seed (sampler.glsl)
+    vec3 origin;       // world-space origin of the next segment
+    uint pixel;        // y * width + x
+    vec3 dir;          // unit direction of the next segment
+    float prevPdf;     // solid-angle pdf of the BSDF sample that chose dir
+    vec3 beta;         // path throughput f/p so far
+    uint flags;        // kPathFlag*
+    vec3 radiance;     // radiance gathered so far
+    uint rng;          // Rng state
+    vec3 prevP;        // position of the vertex that spawned the segment (for MIS)
+    uint depth;        // index of the vertex the next hit will be (0 = first hit)
+    uint rays;         // rays traced by this path so far
+    uint ldSeed;       // the pixel's LdSample seed (sampler.glsl)
     uint sampleIndex;  // this camera sample's index in its pixel
     uint pad0;
 };

@@ -39,14 +39,14 @@ struct GptFrameParams {
 // Resolved per-pixel output of gpt_resolve.comp (linear RGB radiance, W/(m^2 sr)). 96 bytes;
 // 88 MB for 1280x720, below lavapipe's 128 MiB maxStorageBufferRange.
 struct GptResolved {
-    vec3 primal;      // indirect ("throughput") estimate of I(p): average of the pair estimators
-    vec3 dx;          // forward difference I(x+1,y) - I(x,y); 0 in the last column
-    vec3 dy;          // forward difference I(x,y+1) - I(x,y); 0 in the last row
-    vec3 direct;      // emission seen directly by the camera ("very direct")
-    vec3 varPrimal;   // variance of the primal estimate (of the mean, not per sample)
-    vec3 varDx;       // variance of the dx estimate
-    vec3 varDy;       // variance of the dy estimate
-    vec3 varDirect;   // variance of the direct estimate
+    vec3 primal;     // indirect ("throughput") estimate of I(p): average of the pair estimators
+    vec3 dx;         // forward difference I(x+1,y) - I(x,y); 0 in the last column
+    vec3 dy;         // forward difference I(x,y+1) - I(x,y); 0 in the last row
+    vec3 direct;     // emission seen directly by the camera ("very direct")
+    vec3 varPrimal;  // variance of the primal estimate (of the mean, not per sample)
+    vec3 varDx;      // variance of the dx estimate
+    vec3 varDy;      // variance of the dy estimate
+    vec3 varDirect;  // variance of the direct estimate
 };
 
 // Where edge.comp sees an edge between two probe points (and the host between two pixels'
@@ -70,29 +70,25 @@ struct EdgeProbe {
 // (PixelStats each, one buffer per quantity so none exceeds 128 MiB) follow here, above
 // every number gdpt_shared.h uses (its scene list grows from 12 up, tests use 32..34).
 GDPT_ENUM_BEGIN(GptBinding)
-    kBindGptCentral = 40u,    // base's MIS-weighted radiance summed over the pairs of pixel p
+kBindGptCentral = 40u,        // base's MIS-weighted radiance summed over the pairs of pixel p
     kBindGptNeighbor0 = 41u,  // offset i's MIS-weighted radiance (belongs to pixel p + δ_i), i = 0..3
-    kBindGptNeighbor1 = 42u,
-    kBindGptNeighbor2 = 43u,
-    kBindGptNeighbor3 = 44u,
+    kBindGptNeighbor1 = 42u, kBindGptNeighbor2 = 43u, kBindGptNeighbor3 = 44u,
     kBindGptGradient0 = 45u,  // MIS-weighted f_offset − f_base of direction i, i = 0..3
-    kBindGptGradient1 = 46u,
-    kBindGptGradient2 = 47u,
-    kBindGptGradient3 = 48u,
-    kBindGptDirect = 49u,     // very-direct emission (first hit seen from the camera)
-    kBindGptResolved = 50u,   // GptResolved[] written by gpt_resolve.comp
-    kBindGptEdgeMask = 51u,   // uint per pixel written by edge.comp: 1 = a geometric edge
-                              // crosses the pixel, else 0
-    kBindGptEdgeList = 52u,   // uint pixel indices (y·width + x) of the edge pixels, ascending
+    kBindGptGradient1 = 46u, kBindGptGradient2 = 47u, kBindGptGradient3 = 48u,
+    kBindGptDirect = 49u,    // very-direct emission (first hit seen from the camera)
+    kBindGptResolved = 50u,  // GptResolved[] written by gpt_resolve.comp
+    kBindGptEdgeMask = 51u,  // uint per pixel written by edge.comp: 1 = a geometric edge
+                             // crosses the pixel, else 0
+    kBindGptEdgeList = 52u,  // uint pixel indices (y·width + x) of the edge pixels, ascending
     // First-hit texture demodulation (kSpecGptDemodulate; gpt_pass.h): a path whose camera
     // sample lies in a pixel with kBindGptDemodMask 1 divides its contributions by the
     // modulation m = the base-colour texture at its first hit (Lambertian-only materials;
     // else 1), so that pixel's statistics estimate J = I / m̄ (m̄ = the pixel mean of m).
-    kBindGptDemodMask = 53u,  // uint per pixel: 1 = demodulate the paths that start in it
-    kBindGptModulation = 54u, // PixelStats per pixel: m at the base paths' first hits (1 where
-                              // not demodulated, also on a miss)
-    kBindGptEdgeProbe = 55u   // EdgeProbe per pixel written by edge.comp
-GDPT_ENUM_END();
+    kBindGptDemodMask = 53u,   // uint per pixel: 1 = demodulate the paths that start in it
+    kBindGptModulation = 54u,  // PixelStats per pixel: m at the base paths' first hits (1 where
+                               // not demodulated, also on a miss)
+    kBindGptEdgeProbe = 55u    // EdgeProbe per pixel written by edge.comp
+    GDPT_ENUM_END();
 
 #ifdef __cplusplus
 static_assert(sizeof(GptFrameParams) == 36, "GptFrameParams layout");

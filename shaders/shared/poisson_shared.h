@@ -27,43 +27,40 @@ namespace gdpt::gpu {
 // 4096x4096 solve has 200-270 MB fields, lavapipe allows 128 MiB); it is only used then,
 // because lavapipe 22.3 runs the address-based loads about 1.2x slower.
 GDPT_ENUM_BEGIN(PoissonField)
-    kPoissonFieldCoef = 0u,      // float: per level cx, cy, cp planes
-    kPoissonFieldX = 1u,         // float: per level x (V-cycle unknown; 3 planes)
-    kPoissonFieldB = 2u,         // float: per level right-hand side (level 0: CG residual r)
-    kPoissonFieldR = 3u,         // float: per level scratch (residual, Jacobi ping-pong)
-    kPoissonFieldP = 4u,         // float: two fine RGB slots, CG search direction p (ping-pong)
-    kPoissonFieldAp = 5u,        // float: fine RGB, A p
-    kPoissonFieldSol = 6u,       // float: fine RGB, the solution image being reconstructed
-    kPoissonFieldRhs = 7u,       // float: fine RGB, b = Pᵀ W target
-    kPoissonFieldPrimal = 8u,    // float: fine RGB primal t (radiance)
-    kPoissonFieldDx = 9u,        // float: fine RGB target of I(x+1,y) − I(x,y)
-    kPoissonFieldDy = 10u,       // float: fine RGB target of I(x,y+1) − I(x,y)
-    kPoissonFieldWeights = 11u,  // float: fine planes wp, wdx, wdy (input weights, ≥ 0)
-    kPoissonFieldIrls = 12u,     // float: fine planes of IRLS row weights (primal, dx, dy)
-    kPoissonFieldPartials = 13u, // float: per-subgroup partial sums, see kPoissonSlot*
-    kPoissonFieldCount = 14u
-GDPT_ENUM_END();
+kPoissonFieldCoef = 0u,           // float: per level cx, cy, cp planes
+    kPoissonFieldX = 1u,          // float: per level x (V-cycle unknown; 3 planes)
+    kPoissonFieldB = 2u,          // float: per level right-hand side (level 0: CG residual r)
+    kPoissonFieldR = 3u,          // float: per level scratch (residual, Jacobi ping-pong)
+    kPoissonFieldP = 4u,          // float: two fine RGB slots, CG search direction p (ping-pong)
+    kPoissonFieldAp = 5u,         // float: fine RGB, A p
+    kPoissonFieldSol = 6u,        // float: fine RGB, the solution image being reconstructed
+    kPoissonFieldRhs = 7u,        // float: fine RGB, b = Pᵀ W target
+    kPoissonFieldPrimal = 8u,     // float: fine RGB primal t (radiance)
+    kPoissonFieldDx = 9u,         // float: fine RGB target of I(x+1,y) − I(x,y)
+    kPoissonFieldDy = 10u,        // float: fine RGB target of I(x,y+1) − I(x,y)
+    kPoissonFieldWeights = 11u,   // float: fine planes wp, wdx, wdy (input weights, ≥ 0)
+    kPoissonFieldIrls = 12u,      // float: fine planes of IRLS row weights (primal, dx, dy)
+    kPoissonFieldPartials = 13u,  // float: per-subgroup partial sums, see kPoissonSlot*
+    kPoissonFieldCount = 14u GDPT_ENUM_END();
 
 // Descriptor bindings of the poisson_* kernels (set 0).
 GDPT_ENUM_BEGIN(PoissonBinding)
-    kPoissonBindFields = 0u,     // device-address variant: uint64 address per kPoissonField*
+kPoissonBindFields = 0u,         // device-address variant: uint64 address per kPoissonField*
     kPoissonBindScalars = 1u,    // PoissonScalars followed by the residual history
     kPoissonBindFieldBase = 2u,  // descriptor variant: field f at binding 2 + f
     kPoissonBindGate = 16u,      // uint: indirect group counts (x, y, z) of gated dispatches
-    kPoissonBindCount = 17u
-GDPT_ENUM_END();
+    kPoissonBindCount = 17u GDPT_ENUM_END();
 
 // Partial-sum slots: a reduction kernel writes partials[(slot·3 + c)·G + g] for workgroup g
 // of G and channel c; poisson_scalars sums them in a fixed order (deterministic).
 GDPT_ENUM_BEGIN(PoissonSlot)
-    kPoissonSlotBB = 0u,      // ‖b‖²
+kPoissonSlotBB = 0u,          // ‖b‖²
     kPoissonSlotRR = 1u,      // ‖r‖²
     kPoissonSlotRZ = 2u,      // r·z (preconditioned)
     kPoissonSlotPAP = 3u,     // p·Ap
     kPoissonSlotWeight = 4u,  // Σ IRLS weights (channel 0 only meaningful)
     kPoissonSlotSum = 5u,     // Σ b (mean removal for singular systems)
-    kPoissonSlotCount = 6u
-GDPT_ENUM_END();
+    kPoissonSlotCount = 6u GDPT_ENUM_END();
 
 // Flag bits of a poisson_* pipeline variant. They are the specialisation constant
 // kSpecPoissonFlags, not a push constant: lavapipe executes both sides of every branch under
@@ -84,20 +81,20 @@ GDPT_CONST uint kPoissonFlagProject = 2048u;  // residual kernel: use b − mean
 
 // poisson_scalars modes.
 GDPT_ENUM_BEGIN(PoissonScalarMode)
-    kPoissonModeInit = 0u,    // bb, rr, rz from partials; β = 0; history[0]
+kPoissonModeInit = 0u,        // bb, rr, rz from partials; β = 0; history[0]
     kPoissonModeAlpha = 1u,   // α = rz / pAp
     kPoissonModeBeta = 2u,    // history[k] = rr; convergence; β = rz_new / rz
     kPoissonModeRecord = 3u,  // stationary solvers: history[k] = rr; convergence
     kPoissonModeFinal = 4u,   // finalRr = rr (true residual)
     kPoissonModeIrls = 5u,    // irlsScale = value / Σ weights
     kPoissonModeMean = 6u     // bMean = Σ b / value (value = pixel count)
-GDPT_ENUM_END();
+    GDPT_ENUM_END();
 
-GDPT_CONST uint kPoissonMaxHistory = 4096u;   // residual history entries (per channel)
-GDPT_CONST uint kPoissonSumUnroll = 16u;      // partials per loop iteration in poisson_scalars
-GDPT_CONST uint kPoissonMaxGroupSize = 256u;  // reductions assume ≤ 256, a power of two
-GDPT_CONST uint kPoissonCoarsestMax = 8u;     // coarsest level: width, height ≤ 8
-GDPT_CONST uint kPoissonCoarsestSweeps = 48u; // symmetric RB-GS sweep pairs on the coarsest
+GDPT_CONST uint kPoissonMaxHistory = 4096u;    // residual history entries (per channel)
+GDPT_CONST uint kPoissonSumUnroll = 16u;       // partials per loop iteration in poisson_scalars
+GDPT_CONST uint kPoissonMaxGroupSize = 256u;   // reductions assume ≤ 256, a power of two
+GDPT_CONST uint kPoissonCoarsestMax = 8u;      // coarsest level: width, height ≤ 8
+GDPT_CONST uint kPoissonCoarsestSweeps = 48u;  // symmetric RB-GS sweep pairs on the coarsest
 
 // Push constants of every poisson_* kernel. 92 bytes (≤ 128 on lavapipe).
 struct PoissonPush {
@@ -109,21 +106,21 @@ struct PoissonPush {
     uint cOff;         // float offset of this level's cx plane in Coef (cy, cp follow)
     uint coarseWidth;  // next-coarser level's size (restriction, prolongation, coarsening)
     uint coarseHeight;
-    uint coarseXOff;   // float offset of the coarser level's x in X
-    uint coarseBOff;   // ... its b in B
-    uint coarseCOff;   // ... its coefficients in Coef
-    uint flags;        // copy of the variant's kPoissonFlag* (the kernels read kFlags)
-    uint colour;       // RB-GS colour updated by this half-sweep: (x + y) mod 2
-    uint mode;         // poisson_scalars: kPoissonMode*
-    uint iteration;    // iteration number recorded by poisson_scalars
-    uint groups;       // number of workgroups G that wrote partial sums
-    uint pOld;         // float offset in P of the previous search direction
-    uint pNew;         // float offset in P of the new search direction
-    float omega;       // Jacobi damping
-    float alpha2;      // α², energy weight of the primal rows
-    float reg;         // IRLS regulariser ε_k (radiance units)
-    float tolerance;   // relative residual tolerance
-    float value;       // mode-specific scalar (IRLS: number of kept rows)
+    uint coarseXOff;  // float offset of the coarser level's x in X
+    uint coarseBOff;  // ... its b in B
+    uint coarseCOff;  // ... its coefficients in Coef
+    uint flags;       // copy of the variant's kPoissonFlag* (the kernels read kFlags)
+    uint colour;      // RB-GS colour updated by this half-sweep: (x + y) mod 2
+    uint mode;        // poisson_scalars: kPoissonMode*
+    uint iteration;   // iteration number recorded by poisson_scalars
+    uint groups;      // number of workgroups G that wrote partial sums
+    uint pOld;        // float offset in P of the previous search direction
+    uint pNew;        // float offset in P of the new search direction
+    float omega;      // Jacobi damping
+    float alpha2;     // α², energy weight of the primal rows
+    float reg;        // IRLS regulariser ε_k (radiance units)
+    float tolerance;  // relative residual tolerance
+    float value;      // mode-specific scalar (IRLS: number of kept rows)
 };
 
 // Device-side solver state (binding kPoissonBindScalars), followed by the residual history

@@ -6,15 +6,14 @@
 #include <algorithm>
 #include <cstdio>
 #include <memory>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "app/bench_util.h"
 #include "app/subcommand.h"
 #include "bvh/builder.h"
-#include "render/passes/bench_pass.h"
 #include "integrator/pt_sampler.h"
+#include "render/passes/bench_pass.h"
 #include "scene/procedural.h"
 #include "util/error.h"
 #include "util/timer.h"
@@ -71,7 +70,8 @@ int runBench(const BenchArgs& a) {
         std::fprintf(stderr, "gdpt bench: %s\n", name.c_str());
         const Scene scene = benchScene(name);
         std::vector<double> buildMs;
-        for (int r = 0; r < a.repeats; ++r) buildMs.push_back(buildBvh(scene.positions, scene.triangles).stats.buildMs);
+        for (int r = 0; r < a.repeats; ++r)
+            buildMs.push_back(buildBvh(scene.positions, scene.triangles).stats.buildMs);
 
         SceneGpuOptions so;
         so.width = a.width;
@@ -111,7 +111,9 @@ int runBench(const BenchArgs& a) {
             ptMs.push_back(res.stats.samplingMs);
             ptRaysCpu.push_back(static_cast<double>(res.stats.raysTraced) / cpu);
             for (const auto& [k, t] : res.stats.kernels)
-                kernels[k] = {{"count", t.count}, {"total_ms", t.totalMs}, {"ms_per_call", t.totalMs / double(t.count)}};
+                kernels[k] = {{"count", t.count},
+                              {"total_ms", t.totalMs},
+                              {"ms_per_call", t.totalMs / double(t.count)}};
         }
         out["scenes"].push_back({{"scene", name},
                                  {"triangles", scene.triangles.size()},
@@ -136,11 +138,18 @@ int runBench(const BenchArgs& a) {
 Subcommand addBenchCommand(CLI::App& app) {
     auto args = std::make_shared<BenchArgs>();
     CLI::App* b = app.add_subcommand("bench", "Throughput benchmark: BVH build, rays/s, PT samples/s (JSON)");
-    b->add_option("--scenes", args->scenes, "Comma-separated scenes: cbox, 10k, 100k, 1m")->capture_default_str();
+    b->add_option("--scenes", args->scenes, "Comma-separated scenes: cbox, 10k, 100k, 1m")
+        ->capture_default_str();
     b->add_option("--width", args->width, "Image width")->capture_default_str()->check(CLI::Range(1, 8192));
-    b->add_option("--height", args->height, "Image height")->capture_default_str()->check(CLI::Range(1, 8192));
-    b->add_option("--spp", args->spp, "Samples per pixel per measurement")->capture_default_str()->check(CLI::Range(1u, 4096u));
-    b->add_option("--repeats", args->repeats, "Repeats (the median is reported)")->capture_default_str()->check(CLI::Range(1, 100));
+    b->add_option("--height", args->height, "Image height")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 8192));
+    b->add_option("--spp", args->spp, "Samples per pixel per measurement")
+        ->capture_default_str()
+        ->check(CLI::Range(1u, 4096u));
+    b->add_option("--repeats", args->repeats, "Repeats (the median is reported)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 100));
     b->add_option("--workgroup", args->workgroup, "Compute workgroup size WxH")->capture_default_str();
     b->add_option("--device", args->device, "Vulkan device index or name substring");
     b->add_option("-o,--output", args->output, "Write the JSON here ('-' = stdout)")->capture_default_str();

@@ -15,8 +15,8 @@
 #include "app/bench_util.h"
 #include "app/subcommand.h"
 #include "image/metrics.h"
-#include "render/device_scene/features.h"
 #include "integrator/integrator.h"
+#include "render/device_scene/features.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
 #include "vk/context.h"
@@ -53,8 +53,10 @@ const Feature kFeatures[] = {
     {"env", gpu::kSpecHasEnv, [](const SceneFeatures& f, bool) { return f.hasEnv; }},
     {"glossy", gpu::kSpecHasGlossy, [](const SceneFeatures& f, bool gpt) { return f.hasGlossy || !gpt; }},
     {"alpha_mask", gpu::kSpecHasAlphaMask, [](const SceneFeatures& f, bool) { return f.hasAlphaMask; }},
-    {"shading_normals", gpu::kSpecHasShadingNormals, [](const SceneFeatures& f, bool) { return f.hasShadingNormals; }},
-    {"specular_lobe", gpu::kSpecHasSpecularLobe, [](const SceneFeatures& f, bool) { return f.hasSpecularLayer; }},
+    {"shading_normals", gpu::kSpecHasShadingNormals,
+     [](const SceneFeatures& f, bool) { return f.hasShadingNormals; }},
+    {"specular_lobe", gpu::kSpecHasSpecularLobe,
+     [](const SceneFeatures& f, bool) { return f.hasSpecularLayer; }},
     {"max_depth", gpu::kSpecMaxDepth, [](const SceneFeatures&, bool) { return false; }},
     {"memory_stack", gpu::kSpecBvhRegisterStack, [](const SceneFeatures&, bool) { return false; }},
 };
@@ -68,8 +70,8 @@ struct Variant {
 
 // One render of `method` with the variant's generic features; returns samples/s and the
 // image (G-PT without reconstruction: primal + direct, the estimator the kernels compute).
-double renderOnce(const vk::Context& ctx, const Scene& scene, const BenchFeaturesArgs& a, const std::string& method,
-                  std::uint32_t generic, std::uint32_t seed, Image* image) {
+double renderOnce(const vk::Context& ctx, const Scene& scene, const BenchFeaturesArgs& a,
+                  const std::string& method, std::uint32_t generic, std::uint32_t seed, Image* image) {
     RenderOptions ro;
     ro.scene.width = a.width;
     ro.scene.height = a.height;

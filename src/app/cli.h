@@ -3,9 +3,8 @@
 #pragma once
 
 #include <cstdint>
-#include <string>
-
 #include <glm/glm.hpp>
+#include <string>
 
 #include "render/passes/edge_options.h"
 #include "render/passes/emitter_supersampling_options.h"
@@ -32,9 +31,10 @@ struct RenderArgs {
     std::string workgroup = "8x8";
     float shiftThreshold = 0.001f;
     std::string splitBounce = "auto";  // G-PT: auto, on, off (GptPassOptions::SplitBounce)
-    std::uint32_t emitterSupersampling = kDefaultEmitterSupersampling;  // render/passes/emitter_supersampling_pass.h
-    std::uint32_t edgeSamples = kDefaultEdgeSamples;                    // G-PT: render/edge_pass.h
-    std::string demodulate = "auto";  // G-PT: auto, on, off (Demodulation, render/gpt_pass.h)
+    std::uint32_t emitterSupersampling =
+        kDefaultEmitterSupersampling;                 // render/passes/emitter_supersampling_pass.h
+    std::uint32_t edgeSamples = kDefaultEdgeSamples;  // G-PT: render/edge_pass.h
+    std::string demodulate = "auto";                  // G-PT: auto, on, off (Demodulation, render/gpt_pass.h)
     std::string recon = "l1";
     double alpha = 0.2;
     double tolerance = 1e-4;

@@ -72,15 +72,9 @@ Subcommand addCloneCommand(CLI::App& app) {
     auto a = std::make_shared<CloneArgs>();
     CLI::App* sub =
         app.add_subcommand("clone", "Seamless cloning (Perez et al. 2003) of a masked source into a target");
-    sub->add_option("--source", a->source, "Source image (PNG/JPEG/EXR)")
-        ->required()
-        ->check(InputFile);
-    sub->add_option("--target", a->target, "Target image (PNG/JPEG/EXR)")
-        ->required()
-        ->check(InputFile);
-    sub->add_option("--mask", a->mask, "Mask, source-sized; red > 0.5 selects")
-        ->required()
-        ->check(InputFile);
+    sub->add_option("--source", a->source, "Source image (PNG/JPEG/EXR)")->required()->check(InputFile);
+    sub->add_option("--target", a->target, "Target image (PNG/JPEG/EXR)")->required()->check(InputFile);
+    sub->add_option("--mask", a->mask, "Mask, source-sized; red > 0.5 selects")->required()->check(InputFile);
     sub->add_option("--offset", a->offset, "Target position X,Y of the source's top-left pixel")
         ->capture_default_str();
     sub->add_flag("--mixed", a->mixed, "Mixed gradients: keep the stronger of source and target gradient");

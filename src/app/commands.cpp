@@ -3,9 +3,8 @@
 
 #include <cstdio>
 #include <memory>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "app/bench_util.h"
 #include "app/subcommand.h"
@@ -58,8 +57,8 @@ int runDiff(const DiffArgs& args) {
               {"nonfinite_pixels", e.nonFinitePixels}};
     if (!args.json.empty()) writeTextOutput(args.json, j.dump(2) + "\n");
     if (args.json != "-")
-        std::printf("relMSE %.6g  MSE %.6g  MAE %.6g  max %.6g  bias %.3g  (%zu pixels, %zu non-finite)\n", e.relMse,
-                    e.mse, e.mae, e.maxAbsError, e.meanBias, e.finitePixels, e.nonFinitePixels);
+        std::printf("relMSE %.6g  MSE %.6g  MAE %.6g  max %.6g  bias %.3g  (%zu pixels, %zu non-finite)\n",
+                    e.relMse, e.mse, e.mae, e.maxAbsError, e.meanBias, e.finitePixels, e.nonFinitePixels);
     return 0;
 }
 
@@ -78,18 +77,19 @@ int runInfo(const InfoArgs& args) {
     // the pipelines (small scenes) and its traversals hold at most kBvhRegisterStackMax
     // (bvh_traverse.glsl); 0 = the stack in memory.
     if (spec && spec->bvh())
-        std::printf("  %-26s %u (register stack up to %u)\n", "bvh traversal stack", spec->bvh()->wide.maxStack,
-                    gpu::kBvhRegisterStackMax);
+        std::printf("  %-26s %u (register stack up to %u)\n", "bvh traversal stack",
+                    spec->bvh()->wide.maxStack, gpu::kBvhRegisterStackMax);
     else
         std::printf("  %-26s built with the scene upload (more than %zu triangles)\n", "bvh traversal stack",
                     kSpecBvhTriangles);
     // visibleEmission: emitter supersampling (render/passes/emitter_supersampling_pass.h) at the default
     // factor, which needs something the camera can see emit.
-    std::printf("kernel variant: pt[textures=%d punctual=%d lightTris=%d env=%d glossy=%d alphaMask=%d "
-                "shadingNormals=%d specularLobe=%d emitterSupersampling=%d bvhRegisterStack=%u]\n",
-                f.hasTextures, f.hasPunctual, f.hasLightTris, f.hasEnv, f.hasGlossy, f.hasAlphaMask,
-                f.hasShadingNormals, f.hasSpecularLayer, emitterSupersamplingPossible(f),
-                spec ? spec->bvhRegisterStack() : 0u);
+    std::printf(
+        "kernel variant: pt[textures=%d punctual=%d lightTris=%d env=%d glossy=%d alphaMask=%d "
+        "shadingNormals=%d specularLobe=%d emitterSupersampling=%d bvhRegisterStack=%u]\n",
+        f.hasTextures, f.hasPunctual, f.hasLightTris, f.hasEnv, f.hasGlossy, f.hasAlphaMask,
+        f.hasShadingNormals, f.hasSpecularLayer, emitterSupersamplingPossible(f),
+        spec ? spec->bvhRegisterStack() : 0u);
     // G-PT's first-hit texture demodulation as --demodulate auto chooses it (gpt_pass.h).
     std::printf("gpt variant: demodulate=%d\n", demodulationApplies(scene) ? 1 : 0);
     for (const auto& u : scene.unsupported) std::printf("  unsupported: %s\n", u.c_str());
@@ -127,19 +127,22 @@ int runDevices(const DevicesArgs& args) {
         return 0;
     }
     for (const auto& d : list)
-        std::printf("[%u] %s (%s, %s %s)\n    Vulkan %s, maxStorageBufferRange %llu MiB, maxTexelBufferElements %llu Mi, maxMemoryAllocationSize %llu MiB, push constants %u B, "
-                    "workgroup %u, shared %u KiB, subgroup %u, timestamps %s, heap %llu MiB%s\n",
-                    d["index"].get<unsigned>(), d["name"].get<std::string>().c_str(), d["type"].get<std::string>().c_str(),
-                    d["driver"].get<std::string>().c_str(), d["driver_info"].get<std::string>().c_str(),
-                    d["api"].get<std::string>().c_str(),
-                    static_cast<unsigned long long>(d["max_storage_buffer_range"].get<std::uint64_t>() >> 20),
-                    static_cast<unsigned long long>(d["max_texel_buffer_elements"].get<std::uint64_t>() >> 20),
-                    static_cast<unsigned long long>(d["max_memory_allocation"].get<std::uint64_t>() >> 20),
-                    d["max_push_constants"].get<unsigned>(), d["max_workgroup_invocations"].get<unsigned>(),
-                    d["shared_memory"].get<unsigned>() / 1024, d["subgroup_size"].get<unsigned>(),
-                    d["timestamps"].get<bool>() ? "yes" : "no",
-                    static_cast<unsigned long long>(d["device_local_heap"].get<std::uint64_t>() >> 20),
-                    d["usable"].get<bool>() ? "" : (" — unusable: " + d["unsuitable_reason"].get<std::string>()).c_str());
+        std::printf(
+            "[%u] %s (%s, %s %s)\n    Vulkan %s, maxStorageBufferRange %llu MiB, maxTexelBufferElements %llu "
+            "Mi, maxMemoryAllocationSize %llu MiB, push constants %u B, "
+            "workgroup %u, shared %u KiB, subgroup %u, timestamps %s, heap %llu MiB%s\n",
+            d["index"].get<unsigned>(), d["name"].get<std::string>().c_str(),
+            d["type"].get<std::string>().c_str(), d["driver"].get<std::string>().c_str(),
+            d["driver_info"].get<std::string>().c_str(), d["api"].get<std::string>().c_str(),
+            static_cast<unsigned long long>(d["max_storage_buffer_range"].get<std::uint64_t>() >> 20),
+            static_cast<unsigned long long>(d["max_texel_buffer_elements"].get<std::uint64_t>() >> 20),
+            static_cast<unsigned long long>(d["max_memory_allocation"].get<std::uint64_t>() >> 20),
+            d["max_push_constants"].get<unsigned>(), d["max_workgroup_invocations"].get<unsigned>(),
+            d["shared_memory"].get<unsigned>() / 1024, d["subgroup_size"].get<unsigned>(),
+            d["timestamps"].get<bool>() ? "yes" : "no",
+            static_cast<unsigned long long>(d["device_local_heap"].get<std::uint64_t>() >> 20),
+            d["usable"].get<bool>() ? ""
+                                    : (" — unusable: " + d["unsuitable_reason"].get<std::string>()).c_str());
     return 0;
 }
 
@@ -148,7 +151,8 @@ int runDevices(const DevicesArgs& args) {
 Subcommand addDiffCommand(CLI::App& app) {
     auto args = std::make_shared<DiffArgs>();
     auto& diff = *args;
-    CLI::App* d = app.add_subcommand("diff", "Compare two EXR images: relMSE (Kettunen et al. 2015), MSE, MAE, max error");
+    CLI::App* d = app.add_subcommand(
+        "diff", "Compare two EXR images: relMSE (Kettunen et al. 2015), MSE, MAE, max error");
     d->add_option("test", diff.test, "Image to evaluate")->required()->check(InputFile);
     d->add_option("reference", diff.reference, "Reference image")->required()->check(InputFile);
     d->add_option("--json", diff.json, "Write the metrics as JSON to this file ('-' = stdout)");

@@ -12,9 +12,8 @@
 #include <fstream>
 #include <map>
 #include <memory>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "app/bench_util.h"
 #include "app/subcommand.h"
@@ -82,7 +81,8 @@ struct Run {
 // like scene parsing).
 class Converger {
 public:
-    Converger(const vk::Context& ctx, const Scene& scene, const ConvergeArgs& a) : ctx_(ctx), scene_(scene), a_(a) {}
+    Converger(const vk::Context& ctx, const Scene& scene, const ConvergeArgs& a)
+        : ctx_(ctx), scene_(scene), a_(a) {}
 
     // Renders `method` within `budget` seconds with seed `seed`.
     Run run(const std::string& method, double budget, std::uint32_t seed, const Image& reference) {
@@ -210,12 +210,13 @@ int runConverge(const ConvergeArgs& a) {
     if (!a.reference.empty()) {
         reference = readExrLayer(a.reference);
     } else if (a.makeReference > 0) {
-        const fs::path cached = dir / ("reference_" + referenceKey(a.scene, a.width, a.height, a.makeReference) + ".exr");
+        const fs::path cached =
+            dir / ("reference_" + referenceKey(a.scene, a.width, a.height, a.makeReference) + ".exr");
         if (fs::exists(cached)) {
             reference = readExrLayer(cached.string());
         } else {
-            std::fprintf(stderr, "gdpt converge: rendering a %u spp PT reference (cached as %s)\n", a.makeReference,
-                         cached.c_str());
+            std::fprintf(stderr, "gdpt converge: rendering a %u spp PT reference (cached as %s)\n",
+                         a.makeReference, cached.c_str());
             RenderOptions o;
             o.scene.width = a.width;
             o.scene.height = a.height;
@@ -292,7 +293,8 @@ int runConverge(const ConvergeArgs& a) {
             if (s["budget_s"] == t) {
                 row[s["method"].get<std::string>()] = s["relmse_median"];
                 if (ptErr > 0.0 && s["method"] != "pt")
-                    row[s["method"].get<std::string>() + "_gain_vs_pt"] = ptErr / s["relmse_median"].get<double>();
+                    row[s["method"].get<std::string>() + "_gain_vs_pt"] =
+                        ptErr / s["relmse_median"].get<double>();
             }
         equalTime.push_back(row);
     }
@@ -305,12 +307,20 @@ int runConverge(const ConvergeArgs& a) {
     for (std::size_t i = 0; i < runs.size(); ++i) {
         const Run& r = runs[i];
         const int repeat = static_cast<int>(i % static_cast<std::size_t>(a.repeats));
-        runsJson.push_back({{"method", r.method}, {"budget_s", r.budget}, {"repeat", repeat}, {"seconds", r.seconds},
-                            {"recon_seconds", r.reconSeconds}, {"spp", r.spp}, {"partial_pass_rows", r.partialPassRows}, {"relmse", r.error.relMse},
-                            {"mse", r.error.mse}, {"mae", r.error.mae}, {"mean_bias", r.error.meanBias}});
-        csv << r.method << "," << r.budget << "," << repeat << "," << r.seconds << "," << r.reconSeconds << ","
-            << r.spp << "," << r.partialPassRows << "," << r.error.relMse << "," << r.error.mse << "," << r.error.mae << "," << r.error.meanBias
-            << "\n";
+        runsJson.push_back({{"method", r.method},
+                            {"budget_s", r.budget},
+                            {"repeat", repeat},
+                            {"seconds", r.seconds},
+                            {"recon_seconds", r.reconSeconds},
+                            {"spp", r.spp},
+                            {"partial_pass_rows", r.partialPassRows},
+                            {"relmse", r.error.relMse},
+                            {"mse", r.error.mse},
+                            {"mae", r.error.mae},
+                            {"mean_bias", r.error.meanBias}});
+        csv << r.method << "," << r.budget << "," << repeat << "," << r.seconds << "," << r.reconSeconds
+            << "," << r.spp << "," << r.partialPassRows << "," << r.error.relMse << "," << r.error.mse << ","
+            << r.error.mae << "," << r.error.meanBias << "\n";
     }
     const json results = {{"schema", "gdpt-converge-1"},
                           {"scene", a.scene},
@@ -353,11 +363,15 @@ int runConverge(const ConvergeArgs& a) {
 
 Subcommand addConvergeCommand(CLI::App& app) {
     auto a = std::make_shared<ConvergeArgs>();
-    CLI::App* c = app.add_subcommand("converge", "Error against time: each method at each time budget vs a reference");
+    CLI::App* c =
+        app.add_subcommand("converge", "Error against time: each method at each time budget vs a reference");
     c->add_option("scene", a->scene, "glTF 2.0 scene")->required()->check(InputFile);
-    c->add_option("--reference", a->reference, "Converged reference EXR (same size and camera)")->check(InputFile);
-    c->add_option("--make-reference", a->makeReference, "Render a PT reference with this many spp (cached by scene hash)");
-    c->add_option("--methods", a->methods, "Methods: pt, gpt (= gpt-l1), gpt-l1, gpt-l2, gpt-wl2, gpt-wl1")->capture_default_str();
+    c->add_option("--reference", a->reference, "Converged reference EXR (same size and camera)")
+        ->check(InputFile);
+    c->add_option("--make-reference", a->makeReference,
+                  "Render a PT reference with this many spp (cached by scene hash)");
+    c->add_option("--methods", a->methods, "Methods: pt, gpt (= gpt-l1), gpt-l1, gpt-l2, gpt-wl2, gpt-wl1")
+        ->capture_default_str();
     c->add_option("--times", a->times, "Time budgets in seconds (comma-separated)")->capture_default_str();
     c->add_option("--repeats", a->repeats, "Independent repeats per budget (median reported)")
         ->capture_default_str()
@@ -378,8 +392,9 @@ Subcommand addConvergeCommand(CLI::App& app) {
         ->check(CLI::IsMember({"auto", "on", "off"}));
     c->add_option("--width", a->width, "Image width")->capture_default_str()->check(CLI::Range(1, 16384));
     c->add_option("--height", a->height, "Image height")->capture_default_str()->check(CLI::Range(1, 16384));
-    c->add_option("--target", a->target, "relMSE for the time-to-reach figure (default: the first method's error at "
-                                         "the largest budget)");
+    c->add_option("--target", a->target,
+                  "relMSE for the time-to-reach figure (default: the first method's error at "
+                  "the largest budget)");
     c->add_option("-o,--output", a->output, "Output directory")->capture_default_str();
     c->add_option("--device", a->device, "Vulkan device index or name substring");
     c->add_flag("--validate", a->validate, "Enable Vulkan validation layers (errors make the run fail)");

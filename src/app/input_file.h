@@ -7,12 +7,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <string>
-
-#include <CLI/CLI.hpp>
 
 #include "util/error.h"
 

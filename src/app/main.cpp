@@ -1,11 +1,10 @@
 // main.cpp — gdpt entry point: parses the command line (CLI11) and runs the chosen
 // subcommand. Exit codes: 0 success, 1 runtime or input error (one clear line on stderr),
 // 2 usage error.
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 #include <vector>
-
-#include <CLI/CLI.hpp>
 
 #include "app/subcommand.h"
 #include "util/error.h"
@@ -17,15 +16,9 @@ int main(int argc, char** argv) {
     app.set_help_all_flag("--help-all", "Print help for all subcommands");
 
     const std::vector<Subcommand> commands = {
-        addRenderCommand(app),
-        addDiffCommand(app),
-        addInfoCommand(app),
-        addDevicesCommand(app),
-        addBenchCommand(app),
-        addConvergeCommand(app),
-        addSolveCommand(app),
-        addCloneCommand(app),
-        addBenchPoissonCommand(app),
+        addRenderCommand(app),        addDiffCommand(app),  addInfoCommand(app),
+        addDevicesCommand(app),       addBenchCommand(app), addConvergeCommand(app),
+        addSolveCommand(app),         addCloneCommand(app), addBenchPoissonCommand(app),
         addBenchFeaturesCommand(app),
     };
 

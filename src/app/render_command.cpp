@@ -6,13 +6,13 @@
 #include <csignal>
 #include <cstdio>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 
-#include <nlohmann/json.hpp>
-
 #include "app/bench_util.h"
 #include "app/commands.h"
+#include "app/input_file.h"
 #include "app/subcommand.h"
 #include "image/exr_io.h"
 #include "image/png_preview.h"
@@ -22,7 +22,6 @@
 #include "integrator/render_identity.h"
 #include "scene/gltf_loader.h"
 #include "scene/light_sources.h"
-#include "app/input_file.h"
 #include "util/error.h"
 #include "util/timer.h"
 #include "vk/context.h"
@@ -35,7 +34,9 @@ using nlohmann::json;
 // Set by SIGINT/SIGTERM; the sampling loop stops at the next batch boundary.
 std::atomic<bool> gInterrupted{false};
 
-extern "C" void onInterrupt(int) { gInterrupted.store(true); }
+extern "C" void onInterrupt(int) {
+    gInterrupted.store(true);
+}
 
 WorkgroupSize parseWorkgroup(const std::string& text) {
     unsigned x = 0, y = 0;
@@ -70,7 +71,8 @@ void printProfile(const std::map<std::string, vk::KernelTime>& kernels) {
     for (const auto& [name, t] : kernels)
         std::fprintf(stderr, "%-24s %8llu %12.3f %12.3f %6.1f%%\n", name.c_str(),
                      static_cast<unsigned long long>(t.count), t.totalMs,
-                     t.count ? t.totalMs / double(t.count) : 0.0, total > 0 ? 100.0 * t.totalMs / total : 0.0);
+                     t.count ? t.totalMs / double(t.count) : 0.0,
+                     total > 0 ? 100.0 * t.totalMs / total : 0.0);
 }
 
 // The integrator of args.method with the method options from the command line.
@@ -113,7 +115,8 @@ RenderOptions renderOptionsFor(const RenderArgs& args) {
 }
 
 json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrator& integrator,
-                 const RenderStats& s, double seconds, double reserved, double finishReserved, double writeMs) {
+                 const RenderStats& s, double seconds, double reserved, double finishReserved,
+                 double writeMs) {
     json j = {{"scene", args.scene},
               {"output", args.output},
               {"method", args.method},
@@ -183,8 +186,9 @@ int runRender(const RenderArgs& args) {
     // method, size and settings (readback, output layers, EXR + PNG; nothing the first time).
     const bool timed = args.time > 0.0;
     const double reserved = timed ? integrator->reserveAfterSampling(ctx, args.width, args.height) : 0.0;
-    const std::string finishKey = "finish|" + reservationKey(ctx, args.width, args.height) + "|" + args.method +
-                                  (args.method == "gpt" ? "|" + std::to_string(args.allRecon ? 4 : 1) + " solves" : "");
+    const std::string finishKey =
+        "finish|" + reservationKey(ctx, args.width, args.height) + "|" + args.method +
+        (args.method == "gpt" ? "|" + std::to_string(args.allRecon ? 4 : 1) + " solves" : "");
     const double finishReserved = timed ? cache.get(finishKey).value_or(0.0) : 0.0;
     if (timed) options.timeBudget = std::max(0.05 * args.time, args.time - reserved - finishReserved);
     options.elapsedBefore = total.seconds();
@@ -223,9 +227,10 @@ int runRender(const RenderArgs& args) {
         if (args.checkpoint.empty())
             std::fprintf(stderr, "gdpt: interrupted after %u spp; no output written\n", s.spp);
         else
-            std::fprintf(stderr,
-                         "gdpt: interrupted after %u spp; checkpoint written to %s (continue with --resume %s)\n",
-                         s.spp, args.checkpoint.c_str(), args.checkpoint.c_str());
+            std::fprintf(
+                stderr,
+                "gdpt: interrupted after %u spp; checkpoint written to %s (continue with --resume %s)\n",
+                s.spp, args.checkpoint.c_str(), args.checkpoint.c_str());
         return 130;
     }
     Timer writeTimer;
@@ -246,9 +251,10 @@ int runRender(const RenderArgs& args) {
                      double(s.pathsCompleted) / (s.samplingMs * 1e-3) * 1e-6);
     }
     if (!args.json.empty())
-        writeTextOutput(args.json,
-                        summaryJson(args, ctx, *integrator, s, seconds, reserved, finishReserved, writeMs).dump(2) +
-                            "\n");
+        writeTextOutput(
+            args.json,
+            summaryJson(args, ctx, *integrator, s, seconds, reserved, finishReserved, writeMs).dump(2) +
+                "\n");
     if (ctx.validationErrors() > 0) {
         std::fprintf(stderr, "gdpt: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
         return 1;
@@ -263,7 +269,8 @@ namespace gdpt {
 Subcommand addRenderCommand(CLI::App& app) {
     auto args = std::make_shared<RenderArgs>();
     RenderArgs& a = *args;
-    CLI::App* r = app.add_subcommand("render", "Render a glTF 2.0 scene to OpenEXR (every layer) + a PNG preview");
+    CLI::App* r =
+        app.add_subcommand("render", "Render a glTF 2.0 scene to OpenEXR (every layer) + a PNG preview");
     r->add_option("scene", a.scene, "glTF 2.0 scene (.gltf or .glb)")->required()->check(InputFile);
 
     const char* image = "Scene and image";
@@ -278,7 +285,8 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(1, 16384))
         ->group(image);
-    r->add_option("--camera", a.camera, "Camera index in the glTF (default: the first, else a framing camera)")
+    r->add_option("--camera", a.camera,
+                  "Camera index in the glTF (default: the first, else a framing camera)")
         ->check(CLI::NonNegativeNumber)
         ->group(image);
     r->add_option("--env", a.env, "Constant environment radiance R,G,B (or one value for grey)")
@@ -308,11 +316,13 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->group(sampling);
 
     const char* gpt = "G-PT";
-    r->add_option("--recon", a.recon, "Reconstruction of the final image: l1, l2, wl2 or wl1 (docs/reconstruction.md)")
+    r->add_option("--recon", a.recon,
+                  "Reconstruction of the final image: l1, l2, wl2 or wl1 (docs/reconstruction.md)")
         ->capture_default_str()
         ->check(CLI::IsMember({"l1", "l2", "wl2", "wl1"}))
         ->group(gpt);
-    r->add_flag("--all-recon", a.allRecon, "Also write the other reconstructions as layers recon_*")->group(gpt);
+    r->add_flag("--all-recon", a.allRecon, "Also write the other reconstructions as layers recon_*")
+        ->group(gpt);
     r->add_option("--alpha", a.alpha, "Weight of the primal term of the screened Poisson energy")
         ->capture_default_str()
         ->check(CLI::Range(0.0, 1e3))
@@ -362,12 +372,15 @@ Subcommand addRenderCommand(CLI::App& app) {
     const char* diagnostics = "Device and diagnostics";
     r->add_option("--device", a.device, "Vulkan device index or name substring (default: lavapipe)")
         ->group(diagnostics);
-    r->add_option("--workgroup", a.workgroup, "Compute workgroup size WxH")->capture_default_str()->group(diagnostics);
+    r->add_option("--workgroup", a.workgroup, "Compute workgroup size WxH")
+        ->capture_default_str()
+        ->group(diagnostics);
     r->add_flag("--profile", a.profile, "Print GPU time per kernel (timestamp queries)")->group(diagnostics);
     r->add_option("--json", a.json, "Write the render's statistics as JSON to this file ('-' = stdout)")
         ->group(diagnostics);
     r->add_flag("--quiet", a.quiet, "No progress or summary output")->group(diagnostics);
-    r->add_flag("--validate", a.validate, "Enable Vulkan validation layers (errors fail the run)")->group(diagnostics);
+    r->add_flag("--validate", a.validate, "Enable Vulkan validation layers (errors fail the run)")
+        ->group(diagnostics);
 
     return {r, [args] { return runRender(*args); }};
 }

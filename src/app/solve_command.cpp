@@ -8,8 +8,8 @@
 
 #include "app/subcommand.h"
 #include "image/exr_io.h"
-#include "poisson/poisson_gpu.h"
 #include "integrator/gpt_sampler.h"
+#include "poisson/poisson_gpu.h"
 #include "util/error.h"
 #include "util/progress.h"
 #include "util/timer.h"
@@ -103,11 +103,11 @@ int runSolve(const SolveArgs& a) {
     o.progress = [&](int roundsDone, int rounds, int iterations) {
         if (started.seconds() < 2.0) return;
         shown = true;
-        progress.update(double(roundsDone) / rounds, (isIrls(o.method)
-                                                          ? "IRLS round " + std::to_string(roundsDone) + "/" +
-                                                                std::to_string(rounds) + ", "
-                                                          : std::string()) +
-                                                         std::to_string(iterations) + " iterations");
+        progress.update(double(roundsDone) / rounds,
+                        (isIrls(o.method) ? "IRLS round " + std::to_string(roundsDone) + "/" +
+                                                std::to_string(rounds) + ", "
+                                          : std::string()) +
+                            std::to_string(iterations) + " iterations");
     };
     const Image recon = reconstruct(ctx, primal, dx, dy, varP, varX, varY, o, &report);
     if (shown) {
@@ -142,9 +142,10 @@ Subcommand addSolveCommand(CLI::App& app) {
         ->check(InputFile);
     sub->add_option("-o,--output", a->output, "Output EXR (final image + 'recon' layer)")
         ->capture_default_str();
-    sub->add_option("--recon", a->recon,
-                    "Reconstruction: l1, l2, wl2 (inverse-variance weighted L2) or wl1 (L1 with inverse-variance "
-                    "weights from a 7x7 box of the variance)")
+    sub->add_option(
+           "--recon", a->recon,
+           "Reconstruction: l1, l2, wl2 (inverse-variance weighted L2) or wl1 (L1 with inverse-variance "
+           "weights from a 7x7 box of the variance)")
         ->check(CLI::IsMember({"l1", "l2", "wl2", "wl1"}))
         ->capture_default_str();
     sub->add_option("--solver", a->solver, "Linear solver: mg-pcg, cg, jacobi or mg")
@@ -166,11 +167,13 @@ Subcommand addSolveCommand(CLI::App& app) {
                     "IRLS: regulariser of the second round's weights 1/(|e| + reg), in radiance units")
         ->check(CLI::Range(1e-12, 1e6))
         ->capture_default_str();
-    sub->add_option("--irls-reg-iter", a->irlsRegIter, "IRLS: factor applied to the regulariser every later round")
+    sub->add_option("--irls-reg-iter", a->irlsRegIter,
+                    "IRLS: factor applied to the regulariser every later round")
         ->check(CLI::Range(1e-6, 1.0))
         ->capture_default_str();
-    sub->add_option("--irls-inner-tolerance", a->irlsInnerTolerance,
-                    "IRLS: relative residual of the inner solves before the last round (the last uses --tolerance)")
+    sub->add_option(
+           "--irls-inner-tolerance", a->irlsInnerTolerance,
+           "IRLS: relative residual of the inner solves before the last round (the last uses --tolerance)")
         ->check(CLI::Range(1e-12, 0.5))
         ->capture_default_str();
     sub->add_option("--primal", a->primal, "Primal EXR (instead of INPUT)")->check(InputFile);

@@ -3,9 +3,8 @@
 // subcommand lives in its own file; main.cpp lists the factories.
 #pragma once
 
-#include <functional>
-
 #include <CLI/CLI.hpp>
+#include <functional>
 
 #include "app/input_file.h"
 

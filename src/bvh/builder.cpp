@@ -264,10 +264,8 @@ ChildRef SubtreeBuilder::build(const Range& r, uint32_t depth) {
         glm::vec3 e = r.centroids.hi - r.centroids.lo;
         int a = (e.x >= e.y && e.x >= e.z) ? 0 : (e.y >= e.z ? 1 : 2);
         mid = r.begin + n / 2;
-        std::nth_element(in_.order.begin() + r.begin, in_.order.begin() + mid,
-                         in_.order.begin() + r.end, [&](uint32_t x, uint32_t y) {
-                             return in_.centroids[x][a] < in_.centroids[y][a];
-                         });
+        std::nth_element(in_.order.begin() + r.begin, in_.order.begin() + mid, in_.order.begin() + r.end,
+                         [&](uint32_t x, uint32_t y) { return in_.centroids[x][a] < in_.centroids[y][a]; });
     }
     const Range left = makeRange(in_, r.begin, mid);
     const Range right = makeRange(in_, mid, r.end);
@@ -346,19 +344,17 @@ Bvh buildBvh(const std::vector<glm::vec3>& positions, const std::vector<glm::uve
              const BvhBuildOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     if (triangles.size() >= gpu::kInvalidIndex) {
-        throw std::invalid_argument("buildBvh: too many triangles (" +
-                                    std::to_string(triangles.size()) + ")");
+        throw std::invalid_argument("buildBvh: too many triangles (" + std::to_string(triangles.size()) +
+                                    ")");
     }
     const auto count = static_cast<uint32_t>(triangles.size());
     std::vector<Aabb> primBoxes(count);
     std::vector<glm::vec3> centroids(count);
     for (uint32_t t = 0; t < count; ++t) {
         const glm::uvec3 tri = triangles[t];
-        if (tri.x >= positions.size() || tri.y >= positions.size() ||
-            tri.z >= positions.size()) {
+        if (tri.x >= positions.size() || tri.y >= positions.size() || tri.z >= positions.size()) {
             throw std::invalid_argument("buildBvh: triangle " + std::to_string(t) +
-                                        " has a vertex index >= " +
-                                        std::to_string(positions.size()));
+                                        " has a vertex index >= " + std::to_string(positions.size()));
         }
         Aabb& b = primBoxes[t];
         triangleBounds(positions[tri.x], positions[tri.y], positions[tri.z], b.lo, b.hi);
@@ -428,8 +424,7 @@ Bvh buildBvh(const std::vector<glm::vec3>& positions, const std::vector<glm::uve
     const double rootArea = sceneBox.halfArea();
     bvh.stats.sahCost = float(rootArea > 0.0 ? builder.sahSum_ / rootArea : builder.sahSum_);
     bvh.stats.buildMs =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-            .count();
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return bvh;
 }
 

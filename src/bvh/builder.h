@@ -4,9 +4,8 @@
 #pragma once
 
 #include <cstdint>
-#include <vector>
-
 #include <glm/glm.hpp>
+#include <vector>
 
 #include "gdpt_shared.h"
 
@@ -15,10 +14,10 @@ namespace gdpt {
 // Build parameters. Defaults were chosen with gdpt_bvh_bench (see bench/bvh_bench_notes.md):
 // the CPU traversal is used as a proxy for the GPU one.
 struct BvhBuildOptions {
-    uint32_t maxLeafSize = 4;   // leaf triangle limit (clamped to [1, kMaxLeafTriangles])
-    uint32_t binCount = 16;     // centroid bins per axis (Wald 2007), clamped to [2, 256]
-    float traversalCost = 1.0f; // SAH cost of visiting one node (testing its two boxes)
-    float intersectCost = 1.0f; // SAH cost of one ray/triangle test
+    uint32_t maxLeafSize = 4;    // leaf triangle limit (clamped to [1, kMaxLeafTriangles])
+    uint32_t binCount = 16;      // centroid bins per axis (Wald 2007), clamped to [2, 256]
+    float traversalCost = 1.0f;  // SAH cost of visiting one node (testing its two boxes)
+    float intersectCost = 1.0f;  // SAH cost of one ray/triangle test
     // Depth limit (leaf depth; children of the root have depth 1). Clamped to
     // kBvhMaxDepth, and raised if the mesh cannot fit in a tree that shallow. Lower values
     // only serve tests of the depth cap.
@@ -29,11 +28,11 @@ struct BvhBuildOptions {
 };
 
 struct BvhStats {
-    uint32_t nodeCount = 0;    // number of gpu::BvhNode (inner nodes, including the root)
-    uint32_t leafCount = 0;    // number of leaf children
-    uint32_t maxDepth = 0;     // deepest leaf; children of the root have depth 1
-    float sahCost = 0.0f;      // SAH cost of the tree, relative to the root box (Wald 2007)
-    double buildMs = 0.0;      // wall-clock build time in milliseconds
+    uint32_t nodeCount = 0;  // number of gpu::BvhNode (inner nodes, including the root)
+    uint32_t leafCount = 0;  // number of leaf children
+    uint32_t maxDepth = 0;   // deepest leaf; children of the root have depth 1
+    float sahCost = 0.0f;    // SAH cost of the tree, relative to the root box (Wald 2007)
+    double buildMs = 0.0;    // wall-clock build time in milliseconds
 };
 
 struct Bvh {

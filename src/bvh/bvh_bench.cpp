@@ -54,8 +54,8 @@ Scene terrain(uint32_t count) {
         for (uint32_t i = 0; i <= n; ++i) {
             float x = -1.0f + 2.0f * float(i) / float(n);
             float z = -1.0f + 2.0f * float(j) / float(n);
-            float y = 0.3f * std::sin(5.0f * x) * std::cos(4.0f * z) +
-                      0.05f * std::sin(37.0f * x + 11.0f * z);
+            float y =
+                0.3f * std::sin(5.0f * x) * std::cos(4.0f * z) + 0.05f * std::sin(37.0f * x + 11.0f * z);
             s.positions.emplace_back(x, y, z);
         }
     }
@@ -103,28 +103,27 @@ int main(int argc, char** argv) {
                     opt.traversalCost = traversalCost;
                     opt.intersectCost = intersectCost;
                     const gdpt::Bvh bvh = gdpt::buildBvh(scene.positions, scene.triangles, opt);
-                    const auto geoms = gdpt::makeTriangleGeoms(scene.positions, scene.triangles,
-                                                               bvh.triangleOrder);
+                    const auto geoms =
+                        gdpt::makeTriangleGeoms(scene.positions, scene.triangles, bvh.triangleOrder);
                     uint64_t visits = 0;
                     uint32_t hits = 0;
                     const auto t0 = std::chrono::steady_clock::now();
                     for (uint32_t i = 0; i < rayCount; ++i) {
-                        gdpt::Hit h = gdpt::traceClosestCpu(bvh.nodes, geoms, origins[i],
-                                                            dirs[i], 0.0f, 1e30f);
+                        gdpt::Hit h =
+                            gdpt::traceClosestCpu(bvh.nodes, geoms, origins[i], dirs[i], 0.0f, 1e30f);
                         hits += h.triangle != gdpt::gpu::kInvalidIndex ? 1u : 0u;
                         visits += gdpt::lastTraversalNodeVisits();
                     }
                     const double sec =
-                        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
-                            .count();
+                        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
                     std::printf(
                         "{\"scene\":\"%s\",\"triangles\":%zu,\"maxLeafSize\":%u,\"binCount\":%u,\"ct\":%.2f,"
                         "\"buildMs\":%.1f,\"sahCost\":%.2f,\"nodes\":%u,\"maxDepth\":%u,"
                         "\"mraysPerS\":%.3f,\"nodesPerRay\":%.1f,\"hitFraction\":%.3f}\n",
                         scene.name.c_str(), scene.triangles.size(), leaf, bins, double(traversalCost),
-                        bvh.stats.buildMs, double(bvh.stats.sahCost), bvh.stats.nodeCount,
-                        bvh.stats.maxDepth, double(rayCount) / sec * 1e-6,
-                        double(visits) / double(rayCount), double(hits) / double(rayCount));
+                        bvh.stats.buildMs, double(bvh.stats.sahCost), bvh.stats.nodeCount, bvh.stats.maxDepth,
+                        double(rayCount) / sec * 1e-6, double(visits) / double(rayCount),
+                        double(hits) / double(rayCount));
                     std::fflush(stdout);
                 }
             }

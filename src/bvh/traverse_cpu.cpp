@@ -17,8 +17,8 @@ inline bool anyHitFilter(uint32_t /*tri*/, float /*u*/, float /*v*/) {
 
 }  // namespace
 
-bool intersectTriangleCpu(const gpu::TriangleGeom& g, glm::vec3 orig, glm::vec3 dir,
-                          float tMin, float& tMax, float& u, float& v) {
+bool intersectTriangleCpu(const gpu::TriangleGeom& g, glm::vec3 orig, glm::vec3 dir, float tMin, float& tMax,
+                          float& u, float& v) {
     return gpu::intersectTriangleGeom(orig, dir, g.v0, g.e1, g.e2, tMin, tMax, u, v);
 }
 
@@ -26,8 +26,8 @@ namespace {
 
 // Triangle i against the ray: shrinks `hit` to it if it is accepted and closer (the body of
 // the GLSL traceClosest's triangle loop).
-void closerHit(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir, uint32_t i, float tMin,
-               Hit& hit) {
+void closerHit(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir, uint32_t i,
+               float tMin, Hit& hit) {
     float tCand = hit.t;
     float u;
     float v;
@@ -40,8 +40,8 @@ void closerHit(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm:
 }
 
 // Triangle i is hit and accepted in (tMin, tMax) (the body of traceAny's triangle loop).
-bool anyHitAt(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir, uint32_t i, float tMin,
-              float tMax) {
+bool anyHitAt(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir, uint32_t i,
+              float tMin, float tMax) {
     float tCand = tMax;
     float u;
     float v;
@@ -63,9 +63,8 @@ bool intersectLeafAny(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 ori
 
 }  // namespace
 
-Hit traceClosestCpu(const std::vector<gpu::BvhNode>& nodes,
-                    const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
-                    float tMin, float tMax) {
+Hit traceClosestCpu(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu::TriangleGeom>& geoms,
+                    glm::vec3 orig, glm::vec3 dir, float tMin, float tMax) {
     Hit hit = gpu::missHit(tMax);
     const glm::vec3 invDir = gpu::bvhSafeInverse(dir);
     uint32_t stack[gpu::kBvhStackSize];
@@ -77,10 +76,10 @@ Hit traceClosestCpu(const std::vector<gpu::BvhNode>& nodes,
         ++visits;
         float dL = 0.0f;
         float dR = 0.0f;
-        bool hitL = n.left != gpu::kInvalidIndex &&
-                    gpu::intersectBox(orig, invDir, n.lmin, n.lmax, tMin, hit.t, dL);
-        bool hitR = n.right != gpu::kInvalidIndex &&
-                    gpu::intersectBox(orig, invDir, n.rmin, n.rmax, tMin, hit.t, dR);
+        bool hitL =
+            n.left != gpu::kInvalidIndex && gpu::intersectBox(orig, invDir, n.lmin, n.lmax, tMin, hit.t, dL);
+        bool hitR =
+            n.right != gpu::kInvalidIndex && gpu::intersectBox(orig, invDir, n.rmin, n.rmax, tMin, hit.t, dR);
         // Visit order: the child with the nearer entry distance first.
         bool swapLR = hitR && (!hitL || dR < dL);
         uint32_t c0 = swapLR ? n.right : n.left;
@@ -120,9 +119,8 @@ Hit traceClosestCpu(const std::vector<gpu::BvhNode>& nodes,
     return hit;
 }
 
-bool traceAnyCpu(const std::vector<gpu::BvhNode>& nodes,
-                 const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
-                 float tMin, float tMax) {
+bool traceAnyCpu(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu::TriangleGeom>& geoms,
+                 glm::vec3 orig, glm::vec3 dir, float tMin, float tMax) {
     const glm::vec3 invDir = gpu::bvhSafeInverse(dir);
     uint32_t stack[gpu::kBvhStackSize];
     uint32_t stackSize = 0;
@@ -133,10 +131,10 @@ bool traceAnyCpu(const std::vector<gpu::BvhNode>& nodes,
         ++tlsNodeVisits;
         float dL = 0.0f;
         float dR = 0.0f;
-        bool hitL = n.left != gpu::kInvalidIndex &&
-                    gpu::intersectBox(orig, invDir, n.lmin, n.lmax, tMin, tMax, dL);
-        bool hitR = n.right != gpu::kInvalidIndex &&
-                    gpu::intersectBox(orig, invDir, n.rmin, n.rmax, tMin, tMax, dR);
+        bool hitL =
+            n.left != gpu::kInvalidIndex && gpu::intersectBox(orig, invDir, n.lmin, n.lmax, tMin, tMax, dL);
+        bool hitR =
+            n.right != gpu::kInvalidIndex && gpu::intersectBox(orig, invDir, n.rmin, n.rmax, tMin, tMax, dR);
         uint32_t next = gpu::kInvalidIndex;
         if (hitL) {
             if (n.leftCount > 0u) {
@@ -167,8 +165,9 @@ bool traceAnyCpu(const std::vector<gpu::BvhNode>& nodes,
     return false;
 }
 
-Hit traceClosestWideCpu(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<gpu::TriangleGeom>& geoms,
-                        glm::vec3 orig, glm::vec3 dir, float tMin, float tMax) {
+Hit traceClosestWideCpu(const std::vector<gpu::BvhWideNode>& nodes,
+                        const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
+                        float tMin, float tMax) {
     Hit hit = gpu::missHit(tMax);
     const glm::vec3 invDir = gpu::bvhSafeInverse(dir);
     uint32_t stackNode[gpu::kBvhWideStackSize];
@@ -251,15 +250,16 @@ bool traceAnyWideCpu(const std::vector<gpu::BvhWideNode>& nodes, const std::vect
     return false;
 }
 
-Hit traceClosestBruteForce(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig,
-                           glm::vec3 dir, float tMin, float tMax) {
+Hit traceClosestBruteForce(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
+                           float tMin, float tMax) {
     Hit hit = gpu::missHit(tMax);
-    for (size_t i = 0; i < geoms.size(); ++i) closerHit(geoms, orig, dir, static_cast<uint32_t>(i), tMin, hit);
+    for (size_t i = 0; i < geoms.size(); ++i)
+        closerHit(geoms, orig, dir, static_cast<uint32_t>(i), tMin, hit);
     return hit;
 }
 
-bool traceAnyBruteForce(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig,
-                        glm::vec3 dir, float tMin, float tMax) {
+bool traceAnyBruteForce(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
+                        float tMin, float tMax) {
     for (size_t i = 0; i < geoms.size(); ++i)
         if (anyHitAt(geoms, orig, dir, static_cast<uint32_t>(i), tMin, tMax)) return true;
     return false;

@@ -16,32 +16,31 @@ namespace gdpt {
 using gpu::Hit;
 
 // Ray (orig, dir) against one TriangleGeom; see gpu::intersectTriangleGeom.
-bool intersectTriangleCpu(const gpu::TriangleGeom& g, glm::vec3 orig, glm::vec3 dir,
-                          float tMin, float& tMax, float& u, float& v);
+bool intersectTriangleCpu(const gpu::TriangleGeom& g, glm::vec3 orig, glm::vec3 dir, float tMin, float& tMax,
+                          float& u, float& v);
 
 // Closest hit with tMin < t < tMax; Hit::triangle indexes `geoms` (leaf order), or is
 // kInvalidIndex on a miss. `nodes` must contain at least the root.
-Hit traceClosestCpu(const std::vector<gpu::BvhNode>& nodes,
-                    const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
-                    float tMin, float tMax);
+Hit traceClosestCpu(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu::TriangleGeom>& geoms,
+                    glm::vec3 orig, glm::vec3 dir, float tMin, float tMax);
 
 // True if any triangle is hit with tMin < t < tMax.
-bool traceAnyCpu(const std::vector<gpu::BvhNode>& nodes,
-                 const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
-                 float tMin, float tMax);
+bool traceAnyCpu(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu::TriangleGeom>& geoms,
+                 glm::vec3 orig, glm::vec3 dir, float tMin, float tMax);
 
 // The same queries on the four-wide tree the kernels traverse (wide_bvh.h): a
 // statement-for-statement mirror of traceClosest / traceAny in bvh_traverse.glsl.
-Hit traceClosestWideCpu(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<gpu::TriangleGeom>& geoms,
-                        glm::vec3 orig, glm::vec3 dir, float tMin, float tMax);
+Hit traceClosestWideCpu(const std::vector<gpu::BvhWideNode>& nodes,
+                        const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
+                        float tMin, float tMax);
 bool traceAnyWideCpu(const std::vector<gpu::BvhWideNode>& nodes, const std::vector<gpu::TriangleGeom>& geoms,
                      glm::vec3 orig, glm::vec3 dir, float tMin, float tMax);
 
 // Brute force over every triangle in index order; among equal t the lowest index wins.
-Hit traceClosestBruteForce(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig,
-                           glm::vec3 dir, float tMin, float tMax);
-bool traceAnyBruteForce(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig,
-                        glm::vec3 dir, float tMin, float tMax);
+Hit traceClosestBruteForce(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
+                           float tMin, float tMax);
+bool traceAnyBruteForce(const std::vector<gpu::TriangleGeom>& geoms, glm::vec3 orig, glm::vec3 dir,
+                        float tMin, float tMax);
 
 // Number of nodes visited by the last traversal call (binary or wide) on this thread
 // (diagnostics for the benchmark).

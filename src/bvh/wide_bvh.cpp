@@ -154,8 +154,8 @@ WideBvh collapseToWide(const std::vector<gpu::BvhNode>& binary) {
     c.emit(0, 1, 0);
     WideBvh w = c.take();
     if (w.maxStack > gpu::kBvhWideStackSize)
-        throw std::invalid_argument("collapseToWide: a traversal of this tree could need " + std::to_string(w.maxStack) +
-                                    " stack entries, more than the kernels' " +
+        throw std::invalid_argument("collapseToWide: a traversal of this tree could need " +
+                                    std::to_string(w.maxStack) + " stack entries, more than the kernels' " +
                                     std::to_string(gpu::kBvhWideStackSize));
     return w;
 }

@@ -5,9 +5,8 @@
 #pragma once
 
 #include <cstdint>
-#include <vector>
-
 #include <glm/glm.hpp>
+#include <vector>
 
 #include "gdpt_shared.h"
 
@@ -15,8 +14,8 @@ namespace gdpt {
 
 struct WideBvh {
     std::vector<gpu::BvhWideNode> nodes;  // node 0 is the root
-    uint32_t maxStack = 0;  // most stack entries a traversal of this tree can hold
-    uint32_t maxDepth = 0;  // deepest leaf; children of the root have depth 1
+    uint32_t maxStack = 0;                // most stack entries a traversal of this tree can hold
+    uint32_t maxDepth = 0;                // deepest leaf; children of the root have depth 1
 };
 
 // Collapse of `binary` (a builder.h tree, root = node 0): a wide node starts from its binary

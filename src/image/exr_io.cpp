@@ -27,7 +27,9 @@ namespace {
 // not a multi-gigabyte allocation. 2^27 pixels = 1.5 GiB per RGB float layer.
 constexpr std::int64_t kMaxPixels = std::int64_t{1} << 27;
 
-std::string channelPrefix(const std::string& layer) { return layer.empty() ? "" : layer + "."; }
+std::string channelPrefix(const std::string& layer) {
+    return layer.empty() ? "" : layer + ".";
+}
 
 // Channels of one layer found in the file, keyed by their suffix (R, G, B, Y).
 struct LayerChannels {
@@ -88,12 +90,11 @@ void validateLayers(const std::vector<NamedLayer>& layers) {
     for (const NamedLayer& layer : layers) {
         if (layer.image.empty()) throw Error("layer '" + layer.name + "' is empty");
         if (!layer.image.sameSize(layers.front().image))
-            throw Error("layer '" + layer.name + "' is " + std::to_string(layer.image.width()) +
-                        "x" + std::to_string(layer.image.height()) + ", expected " +
+            throw Error("layer '" + layer.name + "' is " + std::to_string(layer.image.width()) + "x" +
+                        std::to_string(layer.image.height()) + ", expected " +
                         std::to_string(layers.front().image.width()) + "x" +
                         std::to_string(layers.front().image.height()));
-        if (!names.insert(layer.name).second)
-            throw Error("duplicate layer name '" + layer.name + "'");
+        if (!names.insert(layer.name).second) throw Error("duplicate layer name '" + layer.name + "'");
     }
 }
 
@@ -121,8 +122,8 @@ std::vector<NamedLayer> readLayers(const std::string& path) {
     const std::int64_t height = std::int64_t{dataWindow.max.y} - dataWindow.min.y + 1;
     if (width <= 0 || height <= 0) throw Error(path + ": empty data window");
     if (width * height > kMaxPixels)
-        throw Error(path + ": data window " + std::to_string(width) + "x" +
-                    std::to_string(height) + " is too large");
+        throw Error(path + ": data window " + std::to_string(width) + "x" + std::to_string(height) +
+                    " is too large");
 
     std::vector<NamedLayer> layers;
     Imf::FrameBuffer frameBuffer;
@@ -144,9 +145,9 @@ std::vector<NamedLayer> readLayers(const std::string& path) {
             const std::string suffix = hasRgb ? kSuffix[c] : "Y";
             if (!hasRgb && c > 0) break;  // Y goes into plane 0, copied below
             // A channel missing from the file is filled with 0 by OpenEXR (fillValue).
-            frameBuffer.insert(channelPrefix(name) + suffix,
-                               Imf::Slice::Make(Imf::FLOAT, image.plane(c).data(), dataWindow,
-                                                xStride, yStride));
+            frameBuffer.insert(
+                channelPrefix(name) + suffix,
+                Imf::Slice::Make(Imf::FLOAT, image.plane(c).data(), dataWindow, xStride, yStride));
         }
     }
     if (layers.empty()) throw Error(path + ": no R, G, B or Y channels");

@@ -9,8 +9,7 @@ namespace gdpt {
 
 Image::Image(int width, int height, float fill) : width_(width), height_(height) {
     if (width < 0 || height < 0)
-        throw Error("invalid image size " + std::to_string(width) + "x" +
-                    std::to_string(height));
+        throw Error("invalid image size " + std::to_string(width) + "x" + std::to_string(height));
     for (auto& p : planes_) p.assign(pixelCount(), fill);
 }
 

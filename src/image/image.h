@@ -29,8 +29,7 @@ public:
     }
 
     [[nodiscard]] std::size_t index(int x, int y) const {
-        return static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
-               static_cast<std::size_t>(x);
+        return static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x);
     }
     // Unchecked element access (c = 0 red, 1 green, 2 blue).
     [[nodiscard]] float& at(int x, int y, int c) { return planes_[c][index(x, y)]; }

@@ -16,9 +16,8 @@ constexpr double kRelMseEpsilon = 1e-3;
 
 ImageErrorStats compareImages(const Image& test, const Image& reference) {
     if (!test.sameSize(reference))
-        throw Error("cannot compare a " + std::to_string(test.width()) + "x" +
-                    std::to_string(test.height()) + " image with a " +
-                    std::to_string(reference.width()) + "x" +
+        throw Error("cannot compare a " + std::to_string(test.width()) + "x" + std::to_string(test.height()) +
+                    " image with a " + std::to_string(reference.width()) + "x" +
                     std::to_string(reference.height()) + " reference");
     ImageErrorStats s;
     double relSum = 0.0, sqSum = 0.0, absSum = 0.0, biasSum = 0.0;

@@ -21,11 +21,11 @@
 namespace gdpt {
 
 struct ImageErrorStats {
-    double relMse = 0.0;       // Kettunen et al. 2015 relMSE (see above)
-    double mse = 0.0;          // mean over pixel-channels of (I − R)²
-    double mae = 0.0;          // mean over pixel-channels of |I − R|
-    double maxAbsError = 0.0;  // max over pixel-channels of |I − R|
-    double meanBias = 0.0;     // mean over pixel-channels of (I − R)
+    double relMse = 0.0;                    // Kettunen et al. 2015 relMSE (see above)
+    double mse = 0.0;                       // mean over pixel-channels of (I − R)²
+    double mae = 0.0;                       // mean over pixel-channels of |I − R|
+    double maxAbsError = 0.0;               // max over pixel-channels of |I − R|
+    double meanBias = 0.0;                  // mean over pixel-channels of (I − R)
     std::array<double, 3> meanTest{};       // per-channel mean of I (finite pixels)
     std::array<double, 3> meanReference{};  // per-channel mean of R (finite pixels)
     std::size_t finitePixels = 0;           // pixels used

@@ -36,8 +36,7 @@ std::uint8_t previewCode(float linear, const PreviewOptions& options) {
     return static_cast<std::uint8_t>(std::lround(255.0 * linearToSrgb(v)));
 }
 
-void writePngPreview(const std::string& path, const Image& image,
-                     const PreviewOptions& options) {
+void writePngPreview(const std::string& path, const Image& image, const PreviewOptions& options) {
     if (image.empty()) throw Error(path + ": cannot write an empty image");
     const int w = image.width();
     const int h = image.height();
@@ -69,9 +68,8 @@ Image readPng(const std::string& path) {
     // Precomputing a table would be faster for 8 bit; readImage is not on a hot path.
     for (std::size_t i = 0; i < image.pixelCount(); ++i)
         for (int c = 0; c < 3; ++c) {
-            const double code =
-                sixteen ? static_cast<const std::uint16_t*>(pixels.get())[i * 3 + c]
-                        : static_cast<const std::uint8_t*>(pixels.get())[i * 3 + c];
+            const double code = sixteen ? static_cast<const std::uint16_t*>(pixels.get())[i * 3 + c]
+                                        : static_cast<const std::uint8_t*>(pixels.get())[i * 3 + c];
             image.plane(c)[i] = static_cast<float>(srgbToLinear(code / maxCode));
         }
     return image;

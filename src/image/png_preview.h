@@ -29,8 +29,7 @@ struct PreviewOptions {
 [[nodiscard]] std::uint8_t previewCode(float linear, const PreviewOptions& options = {});
 
 // Writes an RGB8 PNG preview of `image` (via path.tmp + rename). Throws gdpt::Error.
-void writePngPreview(const std::string& path, const Image& image,
-                     const PreviewOptions& options = {});
+void writePngPreview(const std::string& path, const Image& image, const PreviewOptions& options = {});
 
 // Reads an 8- or 16-bit PNG (gray, gray+alpha, RGB or RGBA; alpha dropped) and converts it
 // to linear float with the exact inverse sRGB OETF. Throws gdpt::Error naming the file.

@@ -2,9 +2,8 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <utility>
-
 #include <nlohmann/json.hpp>
+#include <utility>
 
 #include "integrator/render_identity.h"
 #include "util/timer.h"
@@ -62,7 +61,8 @@ double GptIntegrator::reserveAfterSampling(const vk::Context& ctx, int width, in
     }
     if (calibratedSeconds_ < 0.0) {
         calibratedSeconds_ = 0.0;
-        for (const SolveOptions& so : s) calibratedSeconds_ += calibrateReconSeconds(solverGpu, so, /*warmUp=*/true);
+        for (const SolveOptions& so : s)
+            calibratedSeconds_ += calibrateReconSeconds(solverGpu, so, /*warmUp=*/true);
     }
     return std::max(calibratedSeconds_, longestSeconds_);
 }
@@ -100,7 +100,8 @@ RenderOutput GptIntegrator::render(const vk::Context& ctx, const Scene& scene, c
         const SolveReport report = solver_->solve(input, so, recon);
         if (!options.quiet)
             std::fprintf(stderr, "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g, %.1f ms\n",
-                         toString(so.method), report.iterations, report.irlsIterations, report.residual, report.ms);
+                         toString(so.method), report.iterations, report.irlsIterations, report.residual,
+                         report.ms);
         out.stats.reconstructionMs += report.ms;
         recons.push_back({std::string("recon_") + toString(so.method), std::move(recon)});
     }
@@ -115,12 +116,15 @@ RenderOutput GptIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     out.layers.push_back({"", gptFinal(g, recons.empty() ? g.primal : recons.front().image)});
     for (NamedLayer& r : recons) out.layers.push_back(std::move(r));
     Image primalPlusDirect = gptFinal(g, g.primal);
-    const std::vector<NamedLayer> buffers = {
-        {"primal", std::move(g.primal)},         {"dx", std::move(g.dx)},
-        {"dy", std::move(g.dy)},                 {"direct", std::move(g.direct)},
-        {"var_primal", std::move(g.varPrimal)},  {"var_dx", std::move(g.varDx)},
-        {"var_dy", std::move(g.varDy)},          {"var_direct", std::move(g.varDirect)},
-        {"primal_plus_direct", std::move(primalPlusDirect)}};
+    const std::vector<NamedLayer> buffers = {{"primal", std::move(g.primal)},
+                                             {"dx", std::move(g.dx)},
+                                             {"dy", std::move(g.dy)},
+                                             {"direct", std::move(g.direct)},
+                                             {"var_primal", std::move(g.varPrimal)},
+                                             {"var_dx", std::move(g.varDx)},
+                                             {"var_dy", std::move(g.varDy)},
+                                             {"var_direct", std::move(g.varDirect)},
+                                             {"primal_plus_direct", std::move(primalPlusDirect)}};
     out.layers.insert(out.layers.end(), buffers.begin(), buffers.end());
     if (g.stats.demodulated) out.layers.push_back({"modulation", std::move(g.modulation)});
     return out;
@@ -135,7 +139,8 @@ void GptIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
 std::string GptIntegrator::summary(const RenderStats& s) const {
     std::string text;
     if (s.edgePixels)
-        text += ", x" + std::to_string(1 + s.edgeSamples) + " in " + std::to_string(s.edgePixels) + " edge pixels";
+        text += ", x" + std::to_string(1 + s.edgeSamples) + " in " + std::to_string(s.edgePixels) +
+                " edge pixels";
     if (s.demodulated) text += ", demodulated in " + std::to_string(s.demodulatedPixels) + " pixels";
     return text;
 }

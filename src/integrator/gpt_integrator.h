@@ -49,7 +49,7 @@ private:
     std::unique_ptr<PoissonSolverGpu> solver_;
     const vk::Context* solverCtx_ = nullptr;
     int solverWidth_ = 0, solverHeight_ = 0;
-    std::string reserveKey_;          // the cache key of the last reservation (with a cache)
+    std::string reserveKey_;           // the cache key of the last reservation (with a cache)
     double calibratedSeconds_ = -1.0;  // without a cache: the warm calibration (< 0: not yet)
     double longestSeconds_ = 0.0;      // without a cache: the longest reconstruction so far
 };

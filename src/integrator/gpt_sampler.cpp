@@ -55,12 +55,14 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     // Gathers the neighbours' terms into the resolved buffer (resolve only writes that
     // buffer, so sampling can continue after a checkpoint's snapshot).
     const auto resolveNow = [&] {
-        sampling.submitAndWait("gpt resolve", [&](VkCommandBuffer cmd) { pass->resolve(cmd, sampling.timer()); });
+        sampling.submitAndWait("gpt resolve",
+                               [&](VkCommandBuffer cmd) { pass->resolve(cmd, sampling.timer()); });
     };
     sampling.run([&] {
         resolveNow();
         const GptImages images = pass->readback();
-        return gptFinal(images.primal, images.modulation.empty() ? nullptr : &images.modulation, &images.direct);
+        return gptFinal(images.primal, images.modulation.empty() ? nullptr : &images.modulation,
+                        &images.direct);
     });
 
     // The gather after the last batch (a separate submission so its time is its own).

@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <string>
 
-#include "render/passes/gpt_pass.h"
 #include "integrator/render_options.h"
+#include "render/passes/gpt_pass.h"
 
 namespace gdpt {
 
@@ -47,7 +47,7 @@ struct RenderResultGpt {
     // reconstruction + direct (gptFinal). Empty without.
     Image modulation;
     Image varModulation;  // its variance (of the mean); empty without demodulation
-    RenderStats stats;  // spp = camera samples per pixel (each = 1 base + 4 offset paths)
+    RenderStats stats;    // spp = camera samples per pixel (each = 1 base + 4 offset paths)
 };
 
 // Renders with options exactly as renderPt interprets them (maxBatchSpp 0: the default for

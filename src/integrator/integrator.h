@@ -8,10 +8,9 @@
 
 #include <cstdint>
 #include <memory>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json_fwd.hpp>
 
 #include "image/exr_io.h"
 #include "integrator/gpt_sampler.h"
@@ -75,8 +74,8 @@ struct GptOptions {
     // image; each is written as layer recon_<name>. Empty: none; the final image is then the
     // primal (× modulation) + direct, the estimate before reconstruction.
     std::vector<Reconstruction> reconstructions = {Reconstruction::L1};
-    double alpha = 0.2;        // weight of the primal term
-    double tolerance = 1e-4;   // relative residual at which each solve stops
+    double alpha = 0.2;       // weight of the primal term
+    double tolerance = 1e-4;  // relative residual at which each solve stops
     // Timed renders: the reconstruction time remembered per configuration (recon_reserve.h);
     // null: measured once per integrator and raised to its longest real reconstruction.
     const ReconTimeCache* reconCache = nullptr;

@@ -61,20 +61,21 @@ void PixelSampling::run(const std::function<Image()>& preview) {
         state.preview = preview();
     };
     const std::string label = kind_ == "pt" ? "render" : "render " + kind_;
-    runBatchLoop(options_, label.c_str(), total_, stats_,
-                 [&](std::uint32_t first, std::uint32_t n, std::uint32_t rows, const std::function<void()>& onWait) {
-                     VkCommandBuffer cmd = stream_.begin();
-                     if (options_.profile) timer_.reset(cmd);
-                     pass_->record(cmd, first, n, options_.seed, timer(), rows);
-                     stream_.setWhat(kind_ + " batch " + std::to_string(stats_.batches) + " (samples " +
-                                     std::to_string(first) + ".." + std::to_string(first + n - 1) + ", seed " +
-                                     std::to_string(options_.seed) + ")");
-                     stream_.submit();
-                     stream_.waitAll(onWait);
-                     if (options_.profile) timer_.collect();
-                     return pass_->takeCounters();
-                 },
-                 snapshot);
+    runBatchLoop(
+        options_, label.c_str(), total_, stats_,
+        [&](std::uint32_t first, std::uint32_t n, std::uint32_t rows, const std::function<void()>& onWait) {
+            VkCommandBuffer cmd = stream_.begin();
+            if (options_.profile) timer_.reset(cmd);
+            pass_->record(cmd, first, n, options_.seed, timer(), rows);
+            stream_.setWhat(kind_ + " batch " + std::to_string(stats_.batches) + " (samples " +
+                            std::to_string(first) + ".." + std::to_string(first + n - 1) + ", seed " +
+                            std::to_string(options_.seed) + ")");
+            stream_.submit();
+            stream_.waitAll(onWait);
+            if (options_.profile) timer_.collect();
+            return pass_->takeCounters();
+        },
+        snapshot);
 }
 
 void PixelSampling::finish() {

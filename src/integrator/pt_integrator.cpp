@@ -10,7 +10,9 @@ std::uint32_t PtIntegrator::maxBatchSpp(int width, int height) const {
     return maxBatchSppFor(width, height, kPtBatchPixelSamples);
 }
 
-ExrAttributes PtIntegrator::identity(const Scene&, const RenderOptions&) const { return {}; }
+ExrAttributes PtIntegrator::identity(const Scene&, const RenderOptions&) const {
+    return {};
+}
 
 RenderOutput PtIntegrator::render(const vk::Context& ctx, const Scene& scene, const RenderOptions& options) {
     RenderResult r = renderPt(ctx, scene, options);

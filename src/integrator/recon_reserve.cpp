@@ -68,7 +68,8 @@ void ReconTimeCache::put(const std::string& key, double seconds) const {
 }
 
 std::string reservationKey(const vk::Context& ctx, std::uint32_t width, std::uint32_t height) {
-    return ctx.info().name + "|" + ctx.info().driverInfo + "|" + std::to_string(width) + "x" + std::to_string(height);
+    return ctx.info().name + "|" + ctx.info().driverInfo + "|" + std::to_string(width) + "x" +
+           std::to_string(height);
 }
 
 ReconReservation reserveReconstruction(const vk::Context& ctx, PoissonSolverGpu& solver,

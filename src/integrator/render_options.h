@@ -28,9 +28,9 @@ std::uint32_t maxBatchSppFor(int width, int height, std::uint64_t pixelSamplesPe
 
 struct RenderOptions {
     SceneGpuOptions scene;
-    std::uint32_t spp = 16;        // samples per pixel (ignored when timeBudget > 0)
-    double timeBudget = 0.0;       // seconds for the whole render (0 = use spp)
-    double elapsedBefore = 0.0;    // seconds already spent (e.g. loading) counted in the budget
+    std::uint32_t spp = 16;      // samples per pixel (ignored when timeBudget > 0)
+    double timeBudget = 0.0;     // seconds for the whole render (0 = use spp)
+    double elapsedBefore = 0.0;  // seconds already spent (e.g. loading) counted in the budget
     std::uint32_t seed = 0;
     bool profile = false;
     bool quiet = false;
@@ -63,28 +63,27 @@ struct RenderStats {
     std::uint32_t batches = 0;
     double bvhBuildMs = 0.0;
     std::uint32_t bvhRegisterStack = 0;  // entries of the kernels' register traversal stack (0: in memory)
-    double uploadMs = 0.0;       // scene upload + pipeline creation (the part not overlapped)
-    double pipelineWaitMs = 0.0; // of which: waiting for the pipelines after the scene upload
-    double samplingMs = 0.0;     // wall time of the batch loop
+    double uploadMs = 0.0;               // scene upload + pipeline creation (the part not overlapped)
+    double pipelineWaitMs = 0.0;         // of which: waiting for the pipelines after the scene upload
+    double samplingMs = 0.0;             // wall time of the batch loop
     double readbackMs = 0.0;
     double reconstructionMs = 0.0;  // G-PT: screened Poisson solve(s)
     std::uint64_t raysTraced = 0;
     std::uint64_t pathsCompleted = 0;
     std::uint64_t nanSamples = 0;
-    std::uint64_t shiftPairs = 0;     // G-PT: shifts attempted (offsets in the image, base hit)
-    std::uint64_t shiftFailures = 0;  // G-PT: shifts that failed (pair fell back to the base)
-    bool gptSplitBounce = false;      // G-PT: the kernel ran the split bounce loop
-    std::uint32_t emitterSupersampling = 0;  // emitter supersampling factor (0 = off)
-    std::uint32_t emitterRaysPerSample = 0;  // rays per camera sample it took (after its ray budget)
+    std::uint64_t shiftPairs = 0;                 // G-PT: shifts attempted (offsets in the image, base hit)
+    std::uint64_t shiftFailures = 0;              // G-PT: shifts that failed (pair fell back to the base)
+    bool gptSplitBounce = false;                  // G-PT: the kernel ran the split bounce loop
+    std::uint32_t emitterSupersampling = 0;       // emitter supersampling factor (0 = off)
+    std::uint32_t emitterRaysPerSample = 0;       // rays per camera sample it took (after its ray budget)
     std::uint32_t emitterSupersampledPixels = 0;  // pixels it covered
-    std::uint32_t edgeSamples = 0;  // G-PT: extra samples per camera sample in edge pixels (0 = off)
-    std::uint32_t edgePixels = 0;   // G-PT: pixels a geometric edge crosses
+    std::uint32_t edgeSamples = 0;        // G-PT: extra samples per camera sample in edge pixels (0 = off)
+    std::uint32_t edgePixels = 0;         // G-PT: pixels a geometric edge crosses
     bool demodulated = false;             // G-PT: first-hit texture demodulation was on
     std::uint32_t demodulatedPixels = 0;  // G-PT: pixels it acted in (away from the edges)
     bool cancelled = false;
     std::map<std::string, vk::KernelTime> kernels;
     SceneFeatures features;
 };
-
 
 }  // namespace gdpt

@@ -82,7 +82,8 @@ void runBatchLoop(const RenderOptions& options, const char* label, const Timer& 
         }
         done += n;
         secondsPerSpp = batchTimer.seconds() / n;
-        const double mraysPerS = static_cast<double>(stats.raysTraced) / std::max(1e-9, phase.seconds()) * 1e-6;
+        const double mraysPerS =
+            static_cast<double>(stats.raysTraced) / std::max(1e-9, phase.seconds()) * 1e-6;
         char rate[64];
         std::snprintf(rate, sizeof rate, "%u spp, %.2f Mrays/s", done, mraysPerS);
         progress.update(timed ? total.seconds() : static_cast<double>(done), rate);

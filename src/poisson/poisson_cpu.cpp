@@ -14,15 +14,17 @@ void checkField(const std::vector<double>& v, std::size_t n, const char* name, b
                 bool nonNegative) {
     if (optional && v.empty()) return;
     if (v.size() != n)
-        throw Error(std::string("Poisson problem: ") + name + " has " +
-                    std::to_string(v.size()) + " values, expected " + std::to_string(n));
+        throw Error(std::string("Poisson problem: ") + name + " has " + std::to_string(v.size()) +
+                    " values, expected " + std::to_string(n));
     for (double value : v)
         if (!std::isfinite(value) || (nonNegative && value < 0.0))
             throw Error(std::string("Poisson problem: ") + name + " has an invalid value " +
                         std::to_string(value));
 }
 
-double weightAt(const std::vector<double>& w, std::size_t i) { return w.empty() ? 1.0 : w[i]; }
+double weightAt(const std::vector<double>& w, std::size_t i) {
+    return w.empty() ? 1.0 : w[i];
+}
 
 }  // namespace
 
@@ -31,8 +33,7 @@ void validateProblem(const PoissonProblem& p) {
         throw Error("Poisson problem: invalid size " + std::to_string(p.width) + "x" +
                     std::to_string(p.height));
     if (!std::isfinite(p.alpha) || p.alpha < 0.0)
-        throw Error("Poisson problem: alpha must be finite and >= 0, got " +
-                    std::to_string(p.alpha));
+        throw Error("Poisson problem: alpha must be finite and >= 0, got " + std::to_string(p.alpha));
     const std::size_t n = p.size();
     checkField(p.primal, n, "primal", false, false);
     checkField(p.dx, n, "dx", false, false);
@@ -129,7 +130,9 @@ double dot(const Field& a, const Field& b) {
     return s;
 }
 
-double norm2(const Field& a) { return std::sqrt(dot(a, a)); }
+double norm2(const Field& a) {
+    return std::sqrt(dot(a, a));
+}
 
 void jacobiSweep(const PoissonOperator& op, const Field& b, Field& x, double omega) {
     Field r;
@@ -139,8 +142,7 @@ void jacobiSweep(const PoissonOperator& op, const Field& b, Field& x, double ome
         if (d[i] > 0.0) x[i] += omega * r[i] / d[i];
 }
 
-void gaussSeidelRedBlackSweep(const PoissonOperator& op, const Field& b, Field& x,
-                              bool redFirst) {
+void gaussSeidelRedBlackSweep(const PoissonOperator& op, const Field& b, Field& x, bool redFirst) {
     const std::size_t w = static_cast<std::size_t>(op.width);
     for (int pass = 0; pass < 2; ++pass) {
         // Colour (x+y) mod 2: 0 = red, 1 = black. Pixels of one colour only couple to the
@@ -151,10 +153,22 @@ void gaussSeidelRedBlackSweep(const PoissonOperator& op, const Field& b, Field& 
                 const std::size_t i = py * w + px;
                 double diag = op.cp[i];
                 double sum = b[i];
-                if (px + 1 < op.width) { diag += op.cx[i]; sum += op.cx[i] * x[i + 1]; }
-                if (px > 0) { diag += op.cx[i - 1]; sum += op.cx[i - 1] * x[i - 1]; }
-                if (py + 1 < op.height) { diag += op.cy[i]; sum += op.cy[i] * x[i + w]; }
-                if (py > 0) { diag += op.cy[i - w]; sum += op.cy[i - w] * x[i - w]; }
+                if (px + 1 < op.width) {
+                    diag += op.cx[i];
+                    sum += op.cx[i] * x[i + 1];
+                }
+                if (px > 0) {
+                    diag += op.cx[i - 1];
+                    sum += op.cx[i - 1] * x[i - 1];
+                }
+                if (py + 1 < op.height) {
+                    diag += op.cy[i];
+                    sum += op.cy[i] * x[i + w];
+                }
+                if (py > 0) {
+                    diag += op.cy[i - w];
+                    sum += op.cy[i - w] * x[i - w];
+                }
                 if (diag > 0.0) x[i] = sum / diag;
             }
     }

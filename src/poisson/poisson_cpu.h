@@ -61,8 +61,7 @@ void jacobiSweep(const PoissonOperator& op, const Field& b, Field& x, double ome
 // One red-black Gauss-Seidel sweep: for colour k in order (red = (x+y) even first if
 // redFirst, else black first), x_i ← (b_i + Σ_j c_ij x_j) / D_i. A red-first sweep followed by
 // a black-first sweep is symmetric, which keeps a V-cycle usable as a CG preconditioner.
-void gaussSeidelRedBlackSweep(const PoissonOperator& op, const Field& b, Field& x,
-                              bool redFirst = true);
+void gaussSeidelRedBlackSweep(const PoissonOperator& op, const Field& b, Field& x, bool redFirst = true);
 
 // ---- multigrid (cell-centred, poisson_multigrid.cpp) -------------------------------------
 //
@@ -83,9 +82,9 @@ enum class Smoother { RedBlackGaussSeidel, Jacobi };
 
 struct MultigridOptions {
     Smoother smoother = Smoother::RedBlackGaussSeidel;
-    int preSmooth = 2;           // sweeps before the coarse-grid correction
-    int postSmooth = 2;          // sweeps after it (use preSmooth == postSmooth for PCG)
-    double jacobiOmega = 0.8;    // damping for Smoother::Jacobi
+    int preSmooth = 2;         // sweeps before the coarse-grid correction
+    int postSmooth = 2;        // sweeps after it (use preSmooth == postSmooth for PCG)
+    double jacobiOmega = 0.8;  // damping for Smoother::Jacobi
 };
 
 struct MultigridHierarchy {
@@ -124,13 +123,11 @@ struct IterativeOptions {
 // Conjugate gradient (Hestenes & Stiefel 1952), warm-started from x, the method of the
 // published G-PT solver (Kettunen et al. 2015, §4). Minimises ‖x − x*‖_A over growing
 // Krylov spaces, so that error norm never increases.
-SolveStats solveCg(const PoissonOperator& op, const Field& b, Field& x,
-                   const IterativeOptions& options = {});
+SolveStats solveCg(const PoissonOperator& op, const Field& b, Field& x, const IterativeOptions& options = {});
 
 // CG preconditioned with one symmetric V-cycle (zero initial guess) per iteration.
 SolveStats solvePcgMultigrid(const PoissonOperator& op, const Field& b, Field& x,
-                             const IterativeOptions& options = {},
-                             const MultigridOptions& mg = {});
+                             const IterativeOptions& options = {}, const MultigridOptions& mg = {});
 
 // Stand-alone multigrid: repeated V-cycles.
 SolveStats solveMultigrid(const PoissonOperator& op, const Field& b, Field& x,
@@ -148,7 +145,7 @@ enum class L2Method { Exact, Cg, PcgMultigrid, Multigrid, Jacobi };
 
 // Whole L2 reconstruction of one channel: operator, rhs, warm start from the primal, solve,
 // and the mean fix for singular systems (see the top of this header).
-Field solvePoissonL2(const PoissonProblem& problem, L2Method method,
-                     const IterativeOptions& options = {}, SolveStats* stats = nullptr);
+Field solvePoissonL2(const PoissonProblem& problem, L2Method method, const IterativeOptions& options = {},
+                     SolveStats* stats = nullptr);
 
 }  // namespace gdpt

@@ -98,8 +98,10 @@ std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t
         const int len = alongX ? w : h, lines = alongX ? h : w;
         for (int line = 0; line < lines; ++line) {
             const auto at = [&](int k) {
-                return alongX ? static_cast<std::size_t>(line) * static_cast<std::size_t>(w) + static_cast<std::size_t>(k)
-                              : static_cast<std::size_t>(k) * static_cast<std::size_t>(w) + static_cast<std::size_t>(line);
+                return alongX ? static_cast<std::size_t>(line) * static_cast<std::size_t>(w) +
+                                    static_cast<std::size_t>(k)
+                              : static_cast<std::size_t>(k) * static_cast<std::size_t>(w) +
+                                    static_cast<std::size_t>(line);
             };
             double runA = 0.0, runC = 0.0;
             for (int k = 0; k < std::min(radius, len); ++k) {
@@ -125,7 +127,8 @@ std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t
     pass(value, count, true);
     pass(value, count, false);
     std::vector<float> out(n);
-    for (std::size_t i = 0; i < n; ++i) out[i] = count[i] > 0.5 ? static_cast<float>(value[i] / count[i]) : -1.0f;
+    for (std::size_t i = 0; i < n; ++i)
+        out[i] = count[i] > 0.5 ? static_cast<float>(value[i] / count[i]) : -1.0f;
     return out;
 }
 
@@ -188,7 +191,8 @@ void PoissonSolverGpu::readHistory(int count, SolveReport& report) {
 }
 
 PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o, double tolerance, bool irls,
-                                                           bool singular, bool trueResidual, SolveReport& report) {
+                                                           bool singular, bool trueResidual,
+                                                           SolveReport& report) {
     // irls: the IRLS weights and their scale have been recorded/computed already by the caller
     // into this batch's command buffer (see solve()).
     PoissonGpuEngine& e = engine_;

@@ -72,15 +72,15 @@ struct SolveOptions {
     // 0.015 at 0.02, 0.050 at 0.05). 0.02 instead of 0.01 keeps that and takes 20-30 % fewer
     // iterations on low-spp renders (bench/RESULTS.md, IRLS schedule).
     double irlsInnerTolerance = 0.02;
-    double varianceEpsilon = 1e-4;     // WL2, WL1: w = 1/(var + ε)
+    double varianceEpsilon = 1e-4;  // WL2, WL1: w = 1/(var + ε)
     // WL1: the variances are averaged over a (2r+1)² box first, so that a row's weight is
     // not an estimate from the same samples as its value (unfiltered, WL1 and WL2 trade
     // variance for a bias of their own: bench/RESULTS.md, variance-weighted L1).
     int varianceFilterRadius = 3;
-    VcycleParams vcycle{};             // smoother and sweeps of mg / mg-pcg
-    bool keepHistory = false;          // fill SolveReport::history (test mode)
-    bool warmStart = true;             // start from the primal (else from 0)
-    vk::GpuTimer* timer = nullptr;     // per-kernel GPU times (capacity: scopes per batch)
+    VcycleParams vcycle{};          // smoother and sweeps of mg / mg-pcg
+    bool keepHistory = false;       // fill SolveReport::history (test mode)
+    bool warmStart = true;          // start from the primal (else from 0)
+    vk::GpuTimer* timer = nullptr;  // per-kernel GPU times (capacity: scopes per batch)
     // Called after every submitted batch: IRLS rounds finished (L2: 0, then 1), rounds in
     // all, inner iterations recorded so far. For progress reports on long solves.
     std::function<void(int roundsDone, int rounds, int iterations)> progress;
@@ -125,8 +125,8 @@ bool needsVariance(Reconstruction r);
 
 // Mean over RGB of `var`, averaged over the (2·radius+1)² box around each pixel (clipped at
 // the borders; separable, linear in the pixels). A pixel whose variance is not finite or
-// whose RGB mean is negative counts as missing: they are left out of the averages and counted in `bad`; a box with no valid
-// value gives -1 (the caller's weight 0).
+// whose RGB mean is negative counts as missing: they are left out of the averages and counted in `bad`; a box
+// with no valid value gives -1 (the caller's weight 0).
 std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& bad);
 
 class PoissonSolverGpu {
@@ -152,8 +152,8 @@ private:
         bool converged = false;
     };
     // trueResidual: finish with b − A x recomputed (else the recursive residual is reported).
-    InnerResult innerSolve(const SolveOptions& o, double tolerance, bool irls, bool singular, bool trueResidual,
-                           SolveReport& report);
+    InnerResult innerSolve(const SolveOptions& o, double tolerance, bool irls, bool singular,
+                           bool trueResidual, SolveReport& report);
     void readHistory(int count, SolveReport& report);
 
     PoissonGpuEngine engine_;

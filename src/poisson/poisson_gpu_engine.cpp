@@ -42,7 +42,8 @@ vk::KernelDesc describe(vk::KernelDesc d, std::uint32_t gx, std::uint32_t gy, bo
     if (addressed)
         d.bindings.push_back(gpu::kPoissonBindFields);
     else
-        for (std::uint32_t f = 0; f < gpu::kPoissonFieldCount; ++f) d.bindings.push_back(gpu::kPoissonBindFieldBase + f);
+        for (std::uint32_t f = 0; f < gpu::kPoissonFieldCount; ++f)
+            d.bindings.push_back(gpu::kPoissonBindFieldBase + f);
     d.pushConstantBytes = sizeof(PoissonPush);
     if (grid) {
         d.specConstants = {{gpu::kSpecWorkgroupX, gx}, {gpu::kSpecWorkgroupY, gy}};
@@ -80,8 +81,9 @@ PoissonKernels::PoissonKernels(const vk::Context& ctx, std::uint32_t gx, std::ui
         descs_[0][static_cast<std::size_t>(op)] = describe(std::move(d), gx, gy, grid, false);
         descs_[1][static_cast<std::size_t>(op)] = describe(std::move(addressed), gx, gy, grid, true);
     };
-#define GDPT_POISSON_KERNEL(op, name, grid) \
-    set(PoissonOp::op, vk::kernelDesc(#name, GDPT_KERNEL_SPIRV(name)), vk::kernelDesc(#name, GDPT_KERNEL_SPIRV(name##_addr)), grid)
+#define GDPT_POISSON_KERNEL(op, name, grid)                            \
+    set(PoissonOp::op, vk::kernelDesc(#name, GDPT_KERNEL_SPIRV(name)), \
+        vk::kernelDesc(#name, GDPT_KERNEL_SPIRV(name##_addr)), grid)
     GDPT_POISSON_KERNEL(Setup, poisson_setup, true);
     GDPT_POISSON_KERNEL(Coarsen, poisson_coarsen, true);
     GDPT_POISSON_KERNEL(Residual, poisson_residual, true);
@@ -168,10 +170,12 @@ PoissonGpuEngine::PoissonGpuEngine(const vk::Context& ctx, int width, int height
     const std::uint64_t sumIterations =
         9ull * ((groups() + 256ull * gpu::kPoissonSumUnroll - 1) / (256ull * gpu::kPoissonSumUnroll) + 8);
     if (ctx.info().isCpu && sumIterations > 65535)
-        throw Error(what + ": its reductions would exceed llvmpipe's 65535-iteration loop limit; use a smaller image");
-    addressing_ = addressing.value_or(largest <= ctx.info().maxStorageBufferRange
-                                          ? PoissonAddressing::Descriptors
-                                          : PoissonAddressing::DeviceAddress);
+        throw Error(
+            what +
+            ": its reductions would exceed llvmpipe's 65535-iteration loop limit; use a smaller image");
+    addressing_ =
+        addressing.value_or(largest <= ctx.info().maxStorageBufferRange ? PoissonAddressing::Descriptors
+                                                                        : PoissonAddressing::DeviceAddress);
     coef = vk::Buffer(ctx, all, "poissonCoef");
     x = vk::Buffer(ctx, all, "poissonX");
     b = vk::Buffer(ctx, all, "poissonB");
@@ -235,7 +239,8 @@ void PoissonGpuEngine::bind() {
         buffers[gpu::kPoissonBindFields] = &fieldTable;
     } else {
         const auto fields = fieldBuffers();
-        for (std::uint32_t f = 0; f < gpu::kPoissonFieldCount; ++f) buffers[gpu::kPoissonBindFieldBase + f] = fields[f];
+        for (std::uint32_t f = 0; f < gpu::kPoissonFieldCount; ++f)
+            buffers[gpu::kPoissonBindFieldBase + f] = fields[f];
     }
     kernels_->bindAll(buffers, addressing_);
 }
@@ -251,7 +256,8 @@ void PoissonGpuEngine::dispatchGroups(VkCommandBuffer cmd, const vk::Kernel& ker
     if (gated_) {
         const auto it = gateEntry_.find({gx, gy});
         GDPT_CHECK(it != gateEntry_.end());
-        kernel.dispatchIndirect(cmd, gate, std::uint64_t{it->second} * 3 * sizeof(std::uint32_t), push, timer);
+        kernel.dispatchIndirect(cmd, gate, std::uint64_t{it->second} * 3 * sizeof(std::uint32_t), push,
+                                timer);
     } else {
         kernel.dispatch(cmd, gx, gy, 1, push, timer);
     }
@@ -263,7 +269,9 @@ void PoissonGpuEngine::addGateShape(std::pair<std::uint32_t, std::uint32_t> grou
         gateArgs_.insert(gateArgs_.end(), {groups.first, groups.second, 1u});
 }
 
-void PoissonGpuEngine::armGate() { gate.upload(gateArgs_.data(), gateArgs_.size() * sizeof(std::uint32_t)); }
+void PoissonGpuEngine::armGate() {
+    gate.upload(gateArgs_.data(), gateArgs_.size() * sizeof(std::uint32_t));
+}
 
 void PoissonGpuEngine::recordSetup(VkCommandBuffer cmd, float alpha2, bool irlsWeights, vk::GpuTimer* timer) {
     PoissonPush push = levelPush(levels_[0], groups());
@@ -276,8 +284,8 @@ void PoissonGpuEngine::recordCoarsenAll(VkCommandBuffer cmd, vk::GpuTimer* timer
     for (std::size_t l = 0; l + 1 < levels_.size(); ++l) {
         PoissonPush push = levelPush(levels_[l], groups());
         withCoarse(push, levels_[l + 1]);
-        dispatch(cmd, kernel(PoissonOp::Coarsen, 0u), levels_[l + 1].width, levels_[l + 1].height,
-                 &push, timer);
+        dispatch(cmd, kernel(PoissonOp::Coarsen, 0u), levels_[l + 1].width, levels_[l + 1].height, &push,
+                 timer);
     }
 }
 
@@ -297,8 +305,7 @@ void PoissonGpuEngine::recordSmooth(VkCommandBuffer cmd, int level, std::uint32_
     push.colour = colour;
     push.omega = omega;
     // One invocation per horizontal pixel pair (see poisson_smooth.comp).
-    dispatch(cmd, kernel(PoissonOp::Smooth, flags), (levels_[l].width + 1) / 2, push.height, &push,
-             timer);
+    dispatch(cmd, kernel(PoissonOp::Smooth, flags), (levels_[l].width + 1) / 2, push.height, &push, timer);
 }
 
 void PoissonGpuEngine::recordRestrict(VkCommandBuffer cmd, int level, std::uint32_t flags,
@@ -307,8 +314,7 @@ void PoissonGpuEngine::recordRestrict(VkCommandBuffer cmd, int level, std::uint3
     PoissonPush push = levelPush(levels_.at(l), groups());
     withCoarse(push, levels_.at(l + 1));
     push.flags = flags;
-    dispatch(cmd, kernel(PoissonOp::Restrict, flags), push.coarseWidth, push.coarseHeight, &push,
-             timer);
+    dispatch(cmd, kernel(PoissonOp::Restrict, flags), push.coarseWidth, push.coarseHeight, &push, timer);
 }
 
 void PoissonGpuEngine::recordProlong(VkCommandBuffer cmd, int level, vk::GpuTimer* timer) {

@@ -189,7 +189,7 @@ private:
     std::vector<PoissonLevel> levels_;
     PoissonAddressing addressing_ = PoissonAddressing::Descriptors;
     bool gated_ = false;
-    std::vector<std::uint32_t> gateArgs_;                                      // 3 per shape
+    std::vector<std::uint32_t> gateArgs_;                                         // 3 per shape
     std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> gateEntry_;  // shape -> entry
 };
 

@@ -7,7 +7,9 @@
 
 namespace gdpt {
 
-IrlsOptions irlsPresetL1D() { return IrlsOptions{}; }
+IrlsOptions irlsPresetL1D() {
+    return IrlsOptions{};
+}
 
 IrlsOptions irlsPresetL2D() {
     IrlsOptions o;
@@ -30,8 +32,7 @@ PoissonProblem channelProblem(const RgbPoissonProblem& p, int c) {
 
 }  // namespace
 
-IrlsWeights computeIrlsWeights(const RgbPoissonProblem& p, const std::array<Field, 3>& x,
-                               double reg) {
+IrlsWeights computeIrlsWeights(const RgbPoissonProblem& p, const std::array<Field, 3>& x, double reg) {
     const std::size_t n = static_cast<std::size_t>(p.width) * static_cast<std::size_t>(p.height);
     const std::size_t w = static_cast<std::size_t>(p.width);
     IrlsWeights weights{Field(n, 0.0), Field(n, 0.0), Field(n, 0.0)};
@@ -99,9 +100,8 @@ std::array<Field, 3> solveL1Irls(const RgbPoissonProblem& problem, const IrlsOpt
         const PoissonOperator op = makeOperator(channels[0]);
         for (int c = 0; c < 3; ++c) {
             const Field b = computeRhs(channels[c]);
-            const SolveStats cs = options.inner == InnerSolver::Cg
-                                      ? solveCg(op, b, x[c], inner)
-                                      : solvePcgMultigrid(op, b, x[c], inner);
+            const SolveStats cs = options.inner == InnerSolver::Cg ? solveCg(op, b, x[c], inner)
+                                                                   : solvePcgMultigrid(op, b, x[c], inner);
             s.innerIterations += cs.iterations;
         }
         ++s.irlsIterations;

@@ -29,14 +29,14 @@ struct RgbPoissonProblem {
 enum class InnerSolver { Cg, PcgMultigrid };
 
 struct IrlsOptions {
-    int iterations = 20;         // IRLS iterations (1 = plain L2)
-    double regInit = 0.05;       // reg_1
-    double regIter = 0.5;        // reg_k = regInit · regIter^(k−1)
+    int iterations = 20;    // IRLS iterations (1 = plain L2)
+    double regInit = 0.05;  // reg_1
+    double regIter = 0.5;   // reg_k = regInit · regIter^(k−1)
     // reg is in the units of the input (radiance for G-PT). For data in other units, scale
     // it here (e.g. the image's typical value) instead of rescaling the data.
     double regScale = 1.0;
-    int innerIterations = 50;    // CG iterations per IRLS iteration
-    double innerTolerance = 0.0; // relative residual; 0 = always run innerIterations
+    int innerIterations = 50;     // CG iterations per IRLS iteration
+    double innerTolerance = 0.0;  // relative residual; 0 = always run innerIterations
     InnerSolver inner = InnerSolver::Cg;
 };
 
@@ -50,8 +50,7 @@ struct IrlsWeights {
 };
 
 // w_j = 1 / (‖e_j‖_RGB + reg) for every kept row, then scaled to mean 1 over kept rows.
-IrlsWeights computeIrlsWeights(const RgbPoissonProblem& problem, const std::array<Field, 3>& x,
-                               double reg);
+IrlsWeights computeIrlsWeights(const RgbPoissonProblem& problem, const std::array<Field, 3>& x, double reg);
 
 struct IrlsStats {
     int irlsIterations = 0;
@@ -60,7 +59,6 @@ struct IrlsStats {
 
 // L1 reconstruction; returns the three channels. Throws gdpt::Error on invalid input.
 std::array<Field, 3> solveL1Irls(const RgbPoissonProblem& problem,
-                                 const IrlsOptions& options = irlsPresetL1D(),
-                                 IrlsStats* stats = nullptr);
+                                 const IrlsOptions& options = irlsPresetL1D(), IrlsStats* stats = nullptr);
 
 }  // namespace gdpt

@@ -11,7 +11,9 @@
 namespace gdpt {
 namespace {
 
-int coarseSize(int n) { return (n + 1) / 2; }
+int coarseSize(int n) {
+    return (n + 1) / 2;
+}
 
 }  // namespace
 
@@ -84,8 +86,8 @@ MultigridHierarchy buildHierarchy(const PoissonOperator& op) {
 
 namespace {
 
-void smooth(const PoissonOperator& op, const Field& b, Field& x, const MultigridOptions& o,
-            int sweeps, bool pre) {
+void smooth(const PoissonOperator& op, const Field& b, Field& x, const MultigridOptions& o, int sweeps,
+            bool pre) {
     for (int s = 0; s < sweeps; ++s) {
         if (o.smoother == Smoother::Jacobi)
             jacobiSweep(op, b, x, o.jacobiOmega);

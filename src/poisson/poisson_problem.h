@@ -63,10 +63,10 @@ struct PoissonOperator {
 
 // Result of an iterative solve.
 struct SolveStats {
-    int iterations = 0;            // iterations (CG steps, sweeps or V-cycles) performed
-    double residualNorm = 0.0;     // ‖b − A x‖₂ at exit
-    double rhsNorm = 0.0;          // ‖b‖₂
-    bool converged = false;        // residualNorm ≤ tolerance · rhsNorm
+    int iterations = 0;         // iterations (CG steps, sweeps or V-cycles) performed
+    double residualNorm = 0.0;  // ‖b − A x‖₂ at exit
+    double rhsNorm = 0.0;       // ‖b‖₂
+    bool converged = false;     // residualNorm ≤ tolerance · rhsNorm
 };
 
 }  // namespace gdpt

@@ -2,7 +2,6 @@
 // the exact sparse LDLᵀ solve, and the whole-channel L2 reconstruction.
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
-
 #include <cmath>
 #include <string>
 
@@ -99,8 +98,7 @@ SolveStats conjugateGradient(const PoissonOperator& op, const Field& b, Field& x
 
 }  // namespace
 
-SolveStats solveCg(const PoissonOperator& op, const Field& b, Field& x,
-                   const IterativeOptions& options) {
+SolveStats solveCg(const PoissonOperator& op, const Field& b, Field& x, const IterativeOptions& options) {
     return conjugateGradient(op, b, x, options, [](const Field& r, Field& z) { z = r; });
 }
 
@@ -120,11 +118,10 @@ SolveStats solveMultigrid(const PoissonOperator& op, const Field& b, Field& x,
                              [&](const Field& rhs, Field& v) { vcycle(hierarchy, 0, rhs, v, mg); });
 }
 
-SolveStats solveJacobi(const PoissonOperator& op, const Field& b, Field& x,
-                       const IterativeOptions& options, double omega) {
-    return iterateStationary(op, b, x, options, [&](const Field& rhs, Field& v) {
-        jacobiSweep(op, rhs, v, omega);
-    });
+SolveStats solveJacobi(const PoissonOperator& op, const Field& b, Field& x, const IterativeOptions& options,
+                       double omega) {
+    return iterateStationary(op, b, x, options,
+                             [&](const Field& rhs, Field& v) { jacobiSweep(op, rhs, v, omega); });
 }
 
 Field solveExact(const PoissonOperator& op, const Field& b) {
@@ -144,8 +141,14 @@ Field solveExact(const PoissonOperator& op, const Field& b) {
     };
     for (int i = 0; i < n; ++i) {
         add(i, i, d[i]);
-        if (i % w + 1 < w && op.cx[i] != 0.0) { add(i, i + 1, -op.cx[i]); add(i + 1, i, -op.cx[i]); }
-        if (i + w < n && op.cy[i] != 0.0) { add(i, i + w, -op.cy[i]); add(i + w, i, -op.cy[i]); }
+        if (i % w + 1 < w && op.cx[i] != 0.0) {
+            add(i, i + 1, -op.cx[i]);
+            add(i + 1, i, -op.cx[i]);
+        }
+        if (i + w < n && op.cy[i] != 0.0) {
+            add(i, i + w, -op.cy[i]);
+            add(i + w, i, -op.cy[i]);
+        }
     }
     if (singular) triplets.emplace_back(0, 0, 1.0);
     Eigen::SparseMatrix<double> a(n, n);
@@ -163,18 +166,29 @@ Field solveExact(const PoissonOperator& op, const Field& b) {
     return x;
 }
 
-Field solvePoissonL2(const PoissonProblem& problem, L2Method method,
-                     const IterativeOptions& options, SolveStats* stats) {
+Field solvePoissonL2(const PoissonProblem& problem, L2Method method, const IterativeOptions& options,
+                     SolveStats* stats) {
     const PoissonOperator op = makeOperator(problem);
     const Field b = computeRhs(problem);
     Field x = problem.primal;  // warm start from the primal, as the published solver does
     SolveStats s;
     switch (method) {
-        case L2Method::Exact: x = solveExact(op, b); s.converged = true; break;
-        case L2Method::Cg: s = solveCg(op, b, x, options); break;
-        case L2Method::PcgMultigrid: s = solvePcgMultigrid(op, b, x, options); break;
-        case L2Method::Multigrid: s = solveMultigrid(op, b, x, options); break;
-        case L2Method::Jacobi: s = solveJacobi(op, b, x, options); break;
+        case L2Method::Exact:
+            x = solveExact(op, b);
+            s.converged = true;
+            break;
+        case L2Method::Cg:
+            s = solveCg(op, b, x, options);
+            break;
+        case L2Method::PcgMultigrid:
+            s = solvePcgMultigrid(op, b, x, options);
+            break;
+        case L2Method::Multigrid:
+            s = solveMultigrid(op, b, x, options);
+            break;
+        case L2Method::Jacobi:
+            s = solveJacobi(op, b, x, options);
+            break;
     }
     if (op.singular()) {
         // Solvers returned a solution up to a constant: choose the constant so that the

@@ -16,48 +16,72 @@ namespace {
 
 const char* typeName(int type) {
     switch (type) {
-    case TINYGLTF_TYPE_SCALAR: return "SCALAR";
-    case TINYGLTF_TYPE_VEC2: return "VEC2";
-    case TINYGLTF_TYPE_VEC3: return "VEC3";
-    case TINYGLTF_TYPE_VEC4: return "VEC4";
-    case TINYGLTF_TYPE_MAT2: return "MAT2";
-    case TINYGLTF_TYPE_MAT3: return "MAT3";
-    case TINYGLTF_TYPE_MAT4: return "MAT4";
-    default: return "unknown";
+        case TINYGLTF_TYPE_SCALAR:
+            return "SCALAR";
+        case TINYGLTF_TYPE_VEC2:
+            return "VEC2";
+        case TINYGLTF_TYPE_VEC3:
+            return "VEC3";
+        case TINYGLTF_TYPE_VEC4:
+            return "VEC4";
+        case TINYGLTF_TYPE_MAT2:
+            return "MAT2";
+        case TINYGLTF_TYPE_MAT3:
+            return "MAT3";
+        case TINYGLTF_TYPE_MAT4:
+            return "MAT4";
+        default:
+            return "unknown";
     }
 }
 
 const char* componentTypeName(int componentType) {
     switch (componentType) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE: return "BYTE";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return "UNSIGNED_BYTE";
-    case TINYGLTF_COMPONENT_TYPE_SHORT: return "SHORT";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return "UNSIGNED_SHORT";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return "UNSIGNED_INT";
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return "FLOAT";
-    default: return "unknown";
+        case TINYGLTF_COMPONENT_TYPE_BYTE:
+            return "BYTE";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+            return "UNSIGNED_BYTE";
+        case TINYGLTF_COMPONENT_TYPE_SHORT:
+            return "SHORT";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+            return "UNSIGNED_SHORT";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+            return "UNSIGNED_INT";
+        case TINYGLTF_COMPONENT_TYPE_FLOAT:
+            return "FLOAT";
+        default:
+            return "unknown";
     }
 }
 
 int componentSize(int componentType) {
     switch (componentType) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
-    case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
-    default: return 0;
+        case TINYGLTF_COMPONENT_TYPE_BYTE:
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+            return 1;
+        case TINYGLTF_COMPONENT_TYPE_SHORT:
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+            return 2;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+        case TINYGLTF_COMPONENT_TYPE_FLOAT:
+            return 4;
+        default:
+            return 0;
     }
 }
 
 int componentCount(int type) {
     switch (type) {
-    case TINYGLTF_TYPE_SCALAR: return 1;
-    case TINYGLTF_TYPE_VEC2: return 2;
-    case TINYGLTF_TYPE_VEC3: return 3;
-    case TINYGLTF_TYPE_VEC4: return 4;
-    default: return 0;  // matrices are never vertex attributes we read
+        case TINYGLTF_TYPE_SCALAR:
+            return 1;
+        case TINYGLTF_TYPE_VEC2:
+            return 2;
+        case TINYGLTF_TYPE_VEC3:
+            return 3;
+        case TINYGLTF_TYPE_VEC4:
+            return 4;
+        default:
+            return 0;  // matrices are never vertex attributes we read
     }
 }
 
@@ -69,32 +93,34 @@ std::string accessorLabel(int accessor, const char* role) {
 // glTF 2.0 §3.11 (table "normalized integer to float": c/255, max(c/127,-1), ...).
 double readComponent(const unsigned char* p, int componentType, bool normalized) {
     switch (componentType) {
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: {
-        float v;
-        std::memcpy(&v, p, 4);
-        return v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
-        std::uint32_t v;
-        std::memcpy(&v, p, 4);
-        return v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-        std::uint16_t v;
-        std::memcpy(&v, p, 2);
-        return normalized ? v / 65535.0 : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_SHORT: {
-        std::int16_t v;
-        std::memcpy(&v, p, 2);
-        return normalized ? std::max(v / 32767.0, -1.0) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? *p / 255.0 : *p;
-    case TINYGLTF_COMPONENT_TYPE_BYTE: {
-        const auto v = static_cast<std::int8_t>(*p);
-        return normalized ? std::max(v / 127.0, -1.0) : v;
-    }
-    default: return 0.0;
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+            float v;
+            std::memcpy(&v, p, 4);
+            return v;
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+            std::uint32_t v;
+            std::memcpy(&v, p, 4);
+            return v;
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+            std::uint16_t v;
+            std::memcpy(&v, p, 2);
+            return normalized ? v / 65535.0 : v;
+        }
+        case TINYGLTF_COMPONENT_TYPE_SHORT: {
+            std::int16_t v;
+            std::memcpy(&v, p, 2);
+            return normalized ? std::max(v / 32767.0, -1.0) : v;
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+            return normalized ? *p / 255.0 : *p;
+        case TINYGLTF_COMPONENT_TYPE_BYTE: {
+            const auto v = static_cast<std::int8_t>(*p);
+            return normalized ? std::max(v / 127.0, -1.0) : v;
+        }
+        default:
+            return 0.0;
     }
 }
 
@@ -102,8 +128,8 @@ double readComponent(const unsigned char* p, int componentType, bool normalized)
 // `byteOffset` inside bufferView `view`, after checking that all of them lie inside the
 // view and the view inside its buffer.
 const unsigned char* checkedRange(const tinygltf::Model& model, int view, std::uint64_t byteOffset,
-                                  std::uint64_t count, std::uint64_t elemSize,
-                                  std::uint64_t stride, const std::string& label) {
+                                  std::uint64_t count, std::uint64_t elemSize, std::uint64_t stride,
+                                  const std::string& label) {
     if (view < 0 || static_cast<std::size_t>(view) >= model.bufferViews.size())
         throw Error(label + ": bufferView " + std::to_string(view) + " out of range (file has " +
                     std::to_string(model.bufferViews.size()) + " bufferViews)");
@@ -116,40 +142,36 @@ const unsigned char* checkedRange(const tinygltf::Model& model, int view, std::u
     const std::uint64_t viewEnd = std::uint64_t(bv.byteOffset) + std::uint64_t(bv.byteLength);
     if (viewEnd > bufferSize || viewEnd < bv.byteOffset)
         throw Error(bvLabel + " spans bytes [" + std::to_string(bv.byteOffset) + ", " +
-                    std::to_string(viewEnd) + ") but buffer " + std::to_string(bv.buffer) +
-                    " has only " + std::to_string(bufferSize) + " bytes (missing or short buffer)");
+                    std::to_string(viewEnd) + ") but buffer " + std::to_string(bv.buffer) + " has only " +
+                    std::to_string(bufferSize) + " bytes (missing or short buffer)");
     if (count == 0) return nullptr;
     if (byteOffset > bv.byteLength || stride > (1ull << 32) || elemSize > stride)
         throw Error(label + ": byteOffset " + std::to_string(byteOffset) + " / stride " +
-                    std::to_string(stride) + " do not fit bufferView " + std::to_string(view) +
-                    " of " + std::to_string(bv.byteLength) + " bytes");
+                    std::to_string(stride) + " do not fit bufferView " + std::to_string(view) + " of " +
+                    std::to_string(bv.byteLength) + " bytes");
     // count <= kMaxAccessorCount and stride <= 2^32, so this cannot overflow 64 bits.
     const std::uint64_t needEnd = byteOffset + (count - 1) * stride + elemSize;
     if (needEnd > bv.byteLength)
-        throw Error(label + " needs bytes [" + std::to_string(byteOffset) + ", " +
-                    std::to_string(needEnd) + ") of bufferView " + std::to_string(view) +
-                    ", which has only " + std::to_string(bv.byteLength) + " bytes");
-    return model.buffers[static_cast<std::size_t>(bv.buffer)].data.data() + bv.byteOffset +
-           byteOffset;
+        throw Error(label + " needs bytes [" + std::to_string(byteOffset) + ", " + std::to_string(needEnd) +
+                    ") of bufferView " + std::to_string(view) + ", which has only " +
+                    std::to_string(bv.byteLength) + " bytes");
+    return model.buffers[static_cast<std::size_t>(bv.buffer)].data.data() + bv.byteOffset + byteOffset;
 }
 
 // Reads accessor `index` as count x components doubles after checking its type against
 // `expectedType` and its componentType against `allowedComponentTypes`. Handles strided
 // views, accessors without bufferView (all zeros) and sparse substitution (§3.6.2.3).
-std::vector<double> readAccessor(const tinygltf::Model& model, int index, const char* role,
-                                 int expectedType,
-                                 std::initializer_list<int> allowedComponentTypes,
-                                 std::size_t* countOut) {
+std::vector<double> readAccessor(const tinygltf::Model& model, int index, const char* role, int expectedType,
+                                 std::initializer_list<int> allowedComponentTypes, std::size_t* countOut) {
     const std::string label = accessorLabel(index, role);
     if (index < 0 || static_cast<std::size_t>(index) >= model.accessors.size())
         throw Error(label + " out of range (file has " + std::to_string(model.accessors.size()) +
                     " accessors)");
     const tinygltf::Accessor& acc = model.accessors[static_cast<std::size_t>(index)];
     if (acc.type != expectedType)
-        throw Error(label + " has type " + typeName(acc.type) + ", expected " +
-                    typeName(expectedType));
-    if (std::find(allowedComponentTypes.begin(), allowedComponentTypes.end(),
-                  acc.componentType) == allowedComponentTypes.end()) {
+        throw Error(label + " has type " + typeName(acc.type) + ", expected " + typeName(expectedType));
+    if (std::find(allowedComponentTypes.begin(), allowedComponentTypes.end(), acc.componentType) ==
+        allowedComponentTypes.end()) {
         std::string allowed;
         for (int ct : allowedComponentTypes)
             allowed += std::string(allowed.empty() ? "" : " or ") + componentTypeName(ct);
@@ -173,13 +195,13 @@ std::vector<double> readAccessor(const tinygltf::Model& model, int index, const 
             throw Error(label + ": bufferView " + std::to_string(acc.bufferView) + " byteStride " +
                         std::to_string(stride) + " is smaller than the element size " +
                         std::to_string(elemSize));
-        const unsigned char* base = checkedRange(model, acc.bufferView, acc.byteOffset, acc.count,
-                                                 elemSize, stride, label);
+        const unsigned char* base =
+            checkedRange(model, acc.bufferView, acc.byteOffset, acc.count, elemSize, stride, label);
         for (std::size_t i = 0; i < acc.count; ++i)
             for (int c = 0; c < nComp; ++c)
-                out[i * static_cast<std::size_t>(nComp) + static_cast<std::size_t>(c)] =
-                    readComponent(base + i * stride + static_cast<std::size_t>(c * componentSize(acc.componentType)),
-                                  acc.componentType, acc.normalized);
+                out[i * static_cast<std::size_t>(nComp) + static_cast<std::size_t>(c)] = readComponent(
+                    base + i * stride + static_cast<std::size_t>(c * componentSize(acc.componentType)),
+                    acc.componentType, acc.normalized);
     }
 
     if (acc.sparse.isSparse) {
@@ -196,21 +218,21 @@ std::vector<double> readAccessor(const tinygltf::Model& model, int index, const 
                         std::to_string(acc.count) + "]");
         const auto n = static_cast<std::uint64_t>(sp.count);
         const std::uint64_t idxSize = std::uint64_t(componentSize(idxType));
-        const unsigned char* idx = checkedRange(model, sp.indices.bufferView,
-                                                std::uint64_t(std::max(sp.indices.byteOffset, 0)),
-                                                n, idxSize, idxSize, spLabel + " indices");
-        const unsigned char* val = checkedRange(model, sp.values.bufferView,
-                                                std::uint64_t(std::max(sp.values.byteOffset, 0)),
-                                                n, elemSize, elemSize, spLabel + " values");
+        const unsigned char* idx =
+            checkedRange(model, sp.indices.bufferView, std::uint64_t(std::max(sp.indices.byteOffset, 0)), n,
+                         idxSize, idxSize, spLabel + " indices");
+        const unsigned char* val =
+            checkedRange(model, sp.values.bufferView, std::uint64_t(std::max(sp.values.byteOffset, 0)), n,
+                         elemSize, elemSize, spLabel + " values");
         for (std::uint64_t k = 0; k < n; ++k) {
             const auto target = static_cast<std::uint64_t>(readComponent(idx + k * idxSize, idxType, false));
             if (target >= acc.count)
                 throw Error(spLabel + " index " + std::to_string(target) + " is out of range of " +
                             std::to_string(acc.count) + " elements");
             for (int c = 0; c < nComp; ++c)
-                out[target * std::uint64_t(nComp) + std::uint64_t(c)] = readComponent(
-                    val + k * elemSize + std::uint64_t(c * componentSize(acc.componentType)),
-                    acc.componentType, acc.normalized);
+                out[target * std::uint64_t(nComp) + std::uint64_t(c)] =
+                    readComponent(val + k * elemSize + std::uint64_t(c * componentSize(acc.componentType)),
+                                  acc.componentType, acc.normalized);
         }
     }
     return out;
@@ -218,11 +240,16 @@ std::vector<double> readAccessor(const tinygltf::Model& model, int index, const 
 
 const char* modeName(int mode) {
     switch (mode) {
-    case TINYGLTF_MODE_POINTS: return "POINTS";
-    case TINYGLTF_MODE_LINE: return "LINES";
-    case TINYGLTF_MODE_LINE_LOOP: return "LINE_LOOP";
-    case TINYGLTF_MODE_LINE_STRIP: return "LINE_STRIP";
-    default: return "unknown";
+        case TINYGLTF_MODE_POINTS:
+            return "POINTS";
+        case TINYGLTF_MODE_LINE:
+            return "LINES";
+        case TINYGLTF_MODE_LINE_LOOP:
+            return "LINE_LOOP";
+        case TINYGLTF_MODE_LINE_STRIP:
+            return "LINE_STRIP";
+        default:
+            return "unknown";
     }
 }
 
@@ -276,45 +303,41 @@ void noteIgnoredAttributes(Context& ctx, const tinygltf::Primitive& prim) {
 
 std::vector<glm::vec3> readVec3(const tinygltf::Model& model, int accessor, const char* role) {
     std::size_t count = 0;
-    const auto raw = readAccessor(model, accessor, role, TINYGLTF_TYPE_VEC3,
-                                  {TINYGLTF_COMPONENT_TYPE_FLOAT}, &count);
+    const auto raw =
+        readAccessor(model, accessor, role, TINYGLTF_TYPE_VEC3, {TINYGLTF_COMPONENT_TYPE_FLOAT}, &count);
     std::vector<glm::vec3> out(count);
     for (std::size_t i = 0; i < count; ++i) {
         const glm::dvec3 v(raw[3 * i], raw[3 * i + 1], raw[3 * i + 2]);
         if (!allFinite(v))
-            throw Error(accessorLabel(accessor, role) + " element " + std::to_string(i) +
-                        " is not finite");
+            throw Error(accessorLabel(accessor, role) + " element " + std::to_string(i) + " is not finite");
         out[i] = glm::vec3(v);
     }
     return out;
 }
 
-std::vector<glm::vec2> readTexcoords(const tinygltf::Model& model, int accessor,
-                                     const char* role) {
+std::vector<glm::vec2> readTexcoords(const tinygltf::Model& model, int accessor, const char* role) {
     std::size_t count = 0;
     // §3.7.2.1: TEXCOORD_n is float, or normalized unsigned byte/short.
     const auto raw = readAccessor(model, accessor, role, TINYGLTF_TYPE_VEC2,
-                                  {TINYGLTF_COMPONENT_TYPE_FLOAT,
-                                   TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                                  {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
                                    TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
                                   &count);
     std::vector<glm::vec2> out(count);
     for (std::size_t i = 0; i < count; ++i) {
         out[i] = glm::vec2(static_cast<float>(raw[2 * i]), static_cast<float>(raw[2 * i + 1]));
         if (!std::isfinite(out[i].x) || !std::isfinite(out[i].y))
-            throw Error(accessorLabel(accessor, role) + " element " + std::to_string(i) +
-                        " is not finite");
+            throw Error(accessorLabel(accessor, role) + " element " + std::to_string(i) + " is not finite");
     }
     return out;
 }
 
 std::vector<std::uint32_t> readIndices(const tinygltf::Model& model, int accessor) {
     std::size_t count = 0;
-    const auto raw = readAccessor(model, accessor, "indices", TINYGLTF_TYPE_SCALAR,
-                                  {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
-                                   TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
-                                   TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT},
-                                  &count);
+    const auto raw =
+        readAccessor(model, accessor, "indices", TINYGLTF_TYPE_SCALAR,
+                     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+                      TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT},
+                     &count);
     if (model.accessors[static_cast<std::size_t>(accessor)].normalized)
         throw Error(accessorLabel(accessor, "indices") + " must not be normalized");
     std::vector<std::uint32_t> out(count);
@@ -322,8 +345,7 @@ std::vector<std::uint32_t> readIndices(const tinygltf::Model& model, int accesso
     return out;
 }
 
-void addMeshInstance(Context& ctx, const MeshInstance& inst, bool sceneHasNormals,
-                     bool sceneHasUvs) {
+void addMeshInstance(Context& ctx, const MeshInstance& inst, bool sceneHasNormals, bool sceneHasUvs) {
     const tinygltf::Model& model = ctx.model;
     Scene& scene = ctx.scene;
     const tinygltf::Mesh& mesh = model.meshes[static_cast<std::size_t>(inst.mesh)];
@@ -349,8 +371,8 @@ void addMeshInstance(Context& ctx, const MeshInstance& inst, bool sceneHasNormal
             const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
             if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
                 mode != TINYGLTF_MODE_TRIANGLE_FAN) {
-                ctx.unsupported(primLabel + ": mode " + std::to_string(mode) + " (" +
-                                modeName(mode) + "); only triangles are rendered");
+                ctx.unsupported(primLabel + ": mode " + std::to_string(mode) + " (" + modeName(mode) +
+                                "); only triangles are rendered");
                 continue;
             }
             if (!prim.targets.empty()) ctx.unsupported("morph targets (" + meshLabel + ")");
@@ -364,16 +386,14 @@ void addMeshInstance(Context& ctx, const MeshInstance& inst, bool sceneHasNormal
                 nrm = readVec3(model, it->second, "NORMAL");
                 if (nrm.size() != pos.size())
                     throw Error(accessorLabel(it->second, "NORMAL") + " has count " +
-                                std::to_string(nrm.size()) + ", POSITION has " +
-                                std::to_string(pos.size()));
+                                std::to_string(nrm.size()) + ", POSITION has " + std::to_string(pos.size()));
             }
             std::vector<glm::vec2> uv;
             if (auto it = prim.attributes.find("TEXCOORD_0"); it != prim.attributes.end()) {
                 uv = readTexcoords(model, it->second, "TEXCOORD_0");
                 if (uv.size() != pos.size())
                     throw Error(accessorLabel(it->second, "TEXCOORD_0") + " has count " +
-                                std::to_string(uv.size()) + ", POSITION has " +
-                                std::to_string(pos.size()));
+                                std::to_string(uv.size()) + ", POSITION has " + std::to_string(pos.size()));
             }
 
             std::vector<std::uint32_t> idx;
@@ -381,10 +401,9 @@ void addMeshInstance(Context& ctx, const MeshInstance& inst, bool sceneHasNormal
                 idx = readIndices(model, prim.indices);
                 for (std::size_t i = 0; i < idx.size(); ++i)
                     if (idx[i] >= pos.size())
-                        throw Error(accessorLabel(prim.indices, "indices") + " element " +
-                                    std::to_string(i) + " is " + std::to_string(idx[i]) +
-                                    ", out of range of the " + std::to_string(pos.size()) +
-                                    " vertices");
+                        throw Error(accessorLabel(prim.indices, "indices") + " element " + std::to_string(i) +
+                                    " is " + std::to_string(idx[i]) + ", out of range of the " +
+                                    std::to_string(pos.size()) + " vertices");
             } else {
                 idx.resize(pos.size());
                 std::iota(idx.begin(), idx.end(), 0u);
@@ -397,8 +416,7 @@ void addMeshInstance(Context& ctx, const MeshInstance& inst, bool sceneHasNormal
             for (std::size_t i = 0; i < pos.size(); ++i) {
                 const glm::dvec3 p = glm::dvec3(inst.world * glm::dvec4(glm::dvec3(pos[i]), 1.0));
                 if (!allFinite(p) || glm::any(glm::greaterThan(glm::abs(p), glm::dvec3(1e30))))
-                    throw Error("vertex " + std::to_string(i) +
-                                " is not finite after the node transform");
+                    throw Error("vertex " + std::to_string(i) + " is not finite after the node transform");
                 wPos[i] = glm::vec3(p);
             }
             if (flip)

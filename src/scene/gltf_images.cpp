@@ -5,12 +5,12 @@
 // loader instead so that (a) the decoder and its failure messages are ours (the message
 // names the image), (b) 16-bit PNGs keep their precision, and (c) absurd image sizes are
 // refused before allocation. stb_image comes from libstb (<stb/stb_image.h>).
+#include <stb/stb_image.h>
+
 #include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
-
-#include <stb/stb_image.h>
 
 #include "scene/gltf_internal.h"
 
@@ -26,8 +26,7 @@ float srgbToLinear(float c) {
 }  // namespace
 
 bool decodeImage(tinygltf::Image* image, int imageIndex, std::string* err, std::string* /*warn*/,
-                 int /*reqWidth*/, int /*reqHeight*/, const unsigned char* bytes, int size,
-                 void* userData) {
+                 int /*reqWidth*/, int /*reqHeight*/, const unsigned char* bytes, int size, void* userData) {
     const std::string label = "image " + std::to_string(imageIndex) +
                               (image->name.empty() ? std::string() : " '" + image->name + "'");
     auto fail = [&](const std::string& why) {
@@ -61,16 +60,15 @@ bool decodeImage(tinygltf::Image* image, int imageIndex, std::string* err, std::
     const bool sixteen = stbi_is_16_bit_from_memory(bytes, size) != 0;
     void* pixels = sixteen ? static_cast<void*>(stbi_load_16_from_memory(bytes, size, &w, &h, &comp, 4))
                            : static_cast<void*>(stbi_load_from_memory(bytes, size, &w, &h, &comp, 4));
-    if (pixels == nullptr)
-        return fail(std::string("cannot decode (") + stbi_failure_reason() + ")");
+    if (pixels == nullptr) return fail(std::string("cannot decode (") + stbi_failure_reason() + ")");
     const std::size_t bytesPerChannel = sixteen ? 2 : 1;
     const std::size_t total = std::size_t(w) * std::size_t(h) * 4 * bytesPerChannel;
     image->width = w;
     image->height = h;
     image->component = 4;  // always expanded to RGBA
     image->bits = sixteen ? 16 : 8;
-    image->pixel_type = sixteen ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT
-                                : TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+    image->pixel_type =
+        sixteen ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
     image->image.resize(total);
     std::memcpy(image->image.data(), pixels, total);
     stbi_image_free(pixels);

@@ -10,16 +10,15 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <optional>
-#include <set>
-#include <sstream>
-#include <string_view>
-
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string_view>
 
 #include "scene/gltf_internal.h"
 
@@ -43,11 +42,10 @@ constexpr std::uintmax_t kMaxFileBytes = 2ull << 30;
 // Extensions whose content we render; any other listed extension is reported, and a file
 // that requires any other is refused (requiredExtensionsError).
 const std::set<std::string> kSupportedExtensions = {
-    "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_materials_ior",
-    "KHR_lights_punctual"};
+    "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_materials_ior", "KHR_lights_punctual"};
 // Geometry we cannot decode at all.
-const std::set<std::string> kCompressionExtensions = {
-    "KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_meshopt_compression"};
+const std::set<std::string> kCompressionExtensions = {"KHR_draco_mesh_compression", "EXT_meshopt_compression",
+                                                      "KHR_meshopt_compression"};
 
 std::vector<unsigned char> readFile(const std::string& path) {
     std::error_code ec;
@@ -262,7 +260,8 @@ void addCamera(gltf::Context& ctx, const tinygltf::Node& node, const glm::dmat4&
     out.forward = glm::vec3(f);
     out.up = glm::vec3(u / ul);
     out.yfov = static_cast<float>(yfov);
-    out.aspectRatio = cam.perspective.aspectRatio > 0.0 ? static_cast<float>(cam.perspective.aspectRatio) : 0.0f;
+    out.aspectRatio =
+        cam.perspective.aspectRatio > 0.0 ? static_cast<float>(cam.perspective.aspectRatio) : 0.0f;
     ctx.scene.cameras.push_back(out);
 }
 
@@ -323,8 +322,7 @@ Scene loadImpl(const std::string& path) {
     const bool ok =
         binary ? parser.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
                                              static_cast<unsigned int>(bytes.size()), baseDir)
-               : parser.LoadASCIIFromString(&model, &err, &warn,
-                                            reinterpret_cast<const char*>(bytes.data()),
+               : parser.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
                                             static_cast<unsigned int>(bytes.size()), baseDir);
     if (!ok) throw Error("glTF parse error: " + oneLine(err.empty() ? "unknown error" : err));
 
@@ -358,8 +356,10 @@ Scene loadImpl(const std::string& path) {
             if (node.skin >= 0) ctx.unsupported("skins (meshes rendered in their bind pose)");
             if (!node.weights.empty()) ctx.unsupported("morph target weights");
             for (const auto& [name, value] : node.extensions) {
-                if (name == "KHR_lights_punctual") addLight(ctx, value, world);
-                else ctx.unsupported("node extension " + name);
+                if (name == "KHR_lights_punctual")
+                    addLight(ctx, value, world);
+                else
+                    ctx.unsupported("node extension " + name);
             }
             for (auto c = node.children.rbegin(); c != node.children.rend(); ++c)
                 stack.emplace_back(*c, world);
@@ -413,14 +413,13 @@ Camera defaultCamera(const Scene& scene) {
 std::string describeScene(const Scene& scene) {
     std::ostringstream os;
     const Bounds b = scene.bounds();
-    os << (scene.sourcePath.empty() ? "(generated)" : scene.sourcePath) << ": "
-       << scene.triangles.size() << " triangles, " << scene.positions.size() << " vertices, "
-       << scene.materials.size() << " materials, " << scene.textures.size() << " textures, "
-       << scene.punctualLights.size() << " punctual lights, " << scene.cameras.size()
-       << " cameras";
+    os << (scene.sourcePath.empty() ? "(generated)" : scene.sourcePath) << ": " << scene.triangles.size()
+       << " triangles, " << scene.positions.size() << " vertices, " << scene.materials.size()
+       << " materials, " << scene.textures.size() << " textures, " << scene.punctualLights.size()
+       << " punctual lights, " << scene.cameras.size() << " cameras";
     if (!b.empty())
-        os << "\n  bounds (" << b.min.x << ", " << b.min.y << ", " << b.min.z << ") - (" << b.max.x
-           << ", " << b.max.y << ", " << b.max.z << ")";
+        os << "\n  bounds (" << b.min.x << ", " << b.min.y << ", " << b.min.z << ") - (" << b.max.x << ", "
+           << b.max.y << ", " << b.max.z << ")";
     for (const auto& u : scene.unsupported) os << "\n  unsupported: " << u;
     return os.str();
 }

@@ -36,12 +36,14 @@ glm::vec3 vec3Or(const tinygltf::Value& obj, const char* key, glm::vec3 fallback
     return out;
 }
 
-float clamp01(double v) { return static_cast<float>(std::clamp(v, 0.0, 1.0)); }
+float clamp01(double v) {
+    return static_cast<float>(std::clamp(v, 0.0, 1.0));
+}
 
 // Resolves a texture reference to an index into scene.textures, decoding the image on
 // first use in the requested colour space. Returns -1 when the texture cannot be used.
-int resolveTexture(Context& ctx, int textureIndex, int texCoord,
-                   const tinygltf::ExtensionMap& infoExtensions, bool srgb, const std::string& slot) {
+int resolveTexture(Context& ctx, int textureIndex, int texCoord, const tinygltf::ExtensionMap& infoExtensions,
+                   bool srgb, const std::string& slot) {
     if (textureIndex < 0) return -1;
     const tinygltf::Model& model = ctx.model;
     if (static_cast<std::size_t>(textureIndex) >= model.textures.size())
@@ -72,8 +74,9 @@ int resolveTexture(Context& ctx, int textureIndex, int texCoord,
                             ": wrap modes other than REPEAT (REPEAT used)");
     }
     if (tex.source < 0) {
-        ctx.unsupported(texLabel + " has no PNG/JPEG source (e.g. KHR_texture_basisu, "
-                                   "EXT_texture_webp); texture ignored");
+        ctx.unsupported(texLabel +
+                        " has no PNG/JPEG source (e.g. KHR_texture_basisu, "
+                        "EXT_texture_webp); texture ignored");
         return -1;
     }
     if (static_cast<std::size_t>(tex.source) >= model.images.size())
@@ -88,8 +91,8 @@ int resolveTexture(Context& ctx, int textureIndex, int texCoord,
     if (img.image.empty() || img.width <= 0 || img.height <= 0)
         throw Error(imgLabel + " could not be loaded or decoded");
     Texture out = imageToTexture(img, srgb);
-    out.name = (printable ? imgName : "image " + std::to_string(tex.source)) +
-               (srgb ? " (sRGB)" : " (linear)");
+    out.name =
+        (printable ? imgName : "image " + std::to_string(tex.source)) + (srgb ? " (sRGB)" : " (linear)");
     ctx.scene.textures.push_back(std::move(out));
     const int index = static_cast<int>(ctx.scene.textures.size() - 1);
     ctx.textureCache[key] = index;
@@ -100,17 +103,16 @@ gpu::Material convertMaterial(Context& ctx, const tinygltf::Material& m) {
     gpu::Material out{};
     const auto& pbr = m.pbrMetallicRoughness;
     if (pbr.baseColorFactor.size() != 4) throw Error("baseColorFactor must have 4 numbers");
-    out.baseColor = glm::vec4(static_cast<float>(pbr.baseColorFactor[0]),
-                              static_cast<float>(pbr.baseColorFactor[1]),
-                              static_cast<float>(pbr.baseColorFactor[2]),
-                              static_cast<float>(pbr.baseColorFactor[3]));
+    out.baseColor =
+        glm::vec4(static_cast<float>(pbr.baseColorFactor[0]), static_cast<float>(pbr.baseColorFactor[1]),
+                  static_cast<float>(pbr.baseColorFactor[2]), static_cast<float>(pbr.baseColorFactor[3]));
     out.metallic = clamp01(pbr.metallicFactor);
     out.roughness = clamp01(pbr.roughnessFactor);
     out.baseColorTex = resolveTexture(ctx, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
                                       pbr.baseColorTexture.extensions, true, "baseColorTexture");
-    out.metallicRoughnessTex = resolveTexture(
-        ctx, pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
-        pbr.metallicRoughnessTexture.extensions, false, "metallicRoughnessTexture");
+    out.metallicRoughnessTex =
+        resolveTexture(ctx, pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+                       pbr.metallicRoughnessTexture.extensions, false, "metallicRoughnessTexture");
 
     // Emission: emissiveFactor × KHR_materials_emissive_strength = radiance.
     if (m.emissiveFactor.size() != 3) throw Error("emissiveFactor must have 3 numbers");

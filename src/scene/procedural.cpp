@@ -61,14 +61,14 @@ void addRoomAndLight(Scene& s, bool withBoxes) {
     if (withBoxes) {
         // Corner coordinates copied from cbox.bin (float32 values printed to 9 digits).
         const glm::vec3 shortBox[8] = {
-            {0.704602957f, 0.0f, 0.170820087f},       {0.704602957f, 0.600000024f, 0.170820087f},
-            {0.529179931f, 0.600000024f, 0.744602919f}, {0.529179931f, 0.0f, 0.744602919f},
-            {0.130820081f, 0.0f, -0.00460293842f},    {-0.044602938f, 0.0f, 0.569179893f},
+            {0.704602957f, 0.0f, 0.170820087f},          {0.704602957f, 0.600000024f, 0.170820087f},
+            {0.529179931f, 0.600000024f, 0.744602919f},  {0.529179931f, 0.0f, 0.744602919f},
+            {0.130820081f, 0.0f, -0.00460293842f},       {-0.044602938f, 0.0f, 0.569179893f},
             {-0.044602938f, 0.600000024f, 0.569179893f}, {0.130820081f, 0.600000024f, -0.00460293842f}};
         const glm::vec3 tallBox[8] = {
-            {-0.135820091f, 0.0f, -0.664602935f},      {-0.135820091f, 1.20000005f, -0.664602935f},
+            {-0.135820091f, 0.0f, -0.664602935f},        {-0.135820091f, 1.20000005f, -0.664602935f},
             {0.039602939f, 1.20000005f, -0.0908200815f}, {0.039602939f, 0.0f, -0.0908200815f},
-            {-0.709602952f, 0.0f, -0.489179909f},      {-0.534179926f, 0.0f, 0.0846029371f},
+            {-0.709602952f, 0.0f, -0.489179909f},        {-0.534179926f, 0.0f, 0.0846029371f},
             {-0.534179926f, 1.20000005f, 0.0846029371f}, {-0.709602952f, 1.20000005f, -0.489179909f}};
         addBox(s, shortBox, 0);
         addBox(s, tallBox, 0);
@@ -78,9 +78,9 @@ void addRoomAndLight(Scene& s, bool withBoxes) {
 }
 
 void addCornellMaterials(Scene& s) {
-    s.materials.push_back(lambertian({0.725f, 0.71f, 0.68f}));   // white
-    s.materials.push_back(lambertian({0.63f, 0.065f, 0.05f}));   // red
-    s.materials.push_back(lambertian({0.14f, 0.45f, 0.091f}));   // green
+    s.materials.push_back(lambertian({0.725f, 0.71f, 0.68f}));                    // white
+    s.materials.push_back(lambertian({0.63f, 0.065f, 0.05f}));                    // red
+    s.materials.push_back(lambertian({0.14f, 0.45f, 0.091f}));                    // green
     s.materials.push_back(lambertian({0.0f, 0.0f, 0.0f}, {17.0f, 12.0f, 4.0f}));  // light
 }
 
@@ -99,12 +99,12 @@ Camera cornellCamera() {
 // outside. Shared vertices (edge midpoints are cached) make the mesh closed.
 void icosphere(int subdivisions, std::vector<glm::vec3>& verts, std::vector<glm::uvec3>& tris) {
     const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
-    verts = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-             {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    verts = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+             {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
     for (auto& v : verts) v = glm::normalize(v);
-    tris = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+    tris = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
             {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-            {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+            {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
     for (int level = 0; level < subdivisions; ++level) {
         std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> midpoint;
         auto mid = [&](std::uint32_t a, std::uint32_t b) {
@@ -188,8 +188,8 @@ Scene makeTriangleScene(std::uint32_t targetTriangles, std::uint32_t seed) {
     SplitMix rng{0x5EED0000ull ^ (std::uint64_t(seed) << 20) ^ targetTriangles};
     // A few diffuse colours for the spheres (materials 4..7).
     for (int i = 0; i < 4; ++i)
-        s.materials.push_back(lambertian({rng.range(0.2f, 0.8f), rng.range(0.2f, 0.8f),
-                                          rng.range(0.2f, 0.8f)}));
+        s.materials.push_back(
+            lambertian({rng.range(0.2f, 0.8f), rng.range(0.2f, 0.8f), rng.range(0.2f, 0.8f)}));
     addRoomAndLight(s, false);
 
     // Pick the finest sphere level that still gives >= 16 spheres, so the total lands within
@@ -208,12 +208,11 @@ Scene makeTriangleScene(std::uint32_t targetTriangles, std::uint32_t seed) {
     const float radius =
         count > 0 ? std::min(0.3f, std::cbrt(0.2f * 8.0f / (4.18879f * float(count)))) : 0.0f;
     for (std::uint64_t k = 0; k < count; ++k) {
-        const glm::vec3 centre(rng.range(-1.0f + radius, 1.0f - radius),
-                               rng.range(radius, 1.9f - radius),
+        const glm::vec3 centre(rng.range(-1.0f + radius, 1.0f - radius), rng.range(radius, 1.9f - radius),
                                rng.range(-1.0f + radius, 1.0f - radius));
         // Squash each sphere into an ellipsoid ("blob"); normals use the inverse scale.
-        const glm::vec3 scale = radius * glm::vec3(rng.range(0.7f, 1.2f), rng.range(0.7f, 1.2f),
-                                                   rng.range(0.7f, 1.2f));
+        const glm::vec3 scale =
+            radius * glm::vec3(rng.range(0.7f, 1.2f), rng.range(0.7f, 1.2f), rng.range(0.7f, 1.2f));
         const auto mat = static_cast<std::uint32_t>(4 + (rng.next() % 4));
         const auto base = static_cast<std::uint32_t>(s.positions.size());
         for (const auto& v : unitVerts) {

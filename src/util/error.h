@@ -27,20 +27,19 @@ public:
 
 // GDPT_CHECK: a cheap invariant, checked in every build. Throws gdpt::Error with the
 // expression, file and line (the message is for developers; it means a bug in gdpt).
-#define GDPT_CHECK(cond)                                                                     \
-    do {                                                                                     \
-        if (!(cond))                                                                         \
-            throw ::gdpt::Error(std::string("internal check failed: ") + #cond + " at " +   \
-                                __FILE__ + ":" + std::to_string(__LINE__));                  \
+#define GDPT_CHECK(cond)                                                                                   \
+    do {                                                                                                   \
+        if (!(cond))                                                                                       \
+            throw ::gdpt::Error(std::string("internal check failed: ") + #cond + " at " + __FILE__ + ":" + \
+                                std::to_string(__LINE__));                                                 \
     } while (0)
 
-#define GDPT_CHECK_OP(a, op, b)                                                              \
-    do {                                                                                     \
-        const auto gdptA_ = (a);                                                             \
-        const auto gdptB_ = (b);                                                             \
-        if (!(gdptA_ op gdptB_))                                                             \
-            throw ::gdpt::Error(std::string("internal check failed: ") + #a " " #op " " #b + \
-                                " (" + std::to_string(gdptA_) + " vs " +                     \
-                                std::to_string(gdptB_) + ") at " + __FILE__ + ":" +          \
-                                std::to_string(__LINE__));                                   \
+#define GDPT_CHECK_OP(a, op, b)                                                                      \
+    do {                                                                                             \
+        const auto gdptA_ = (a);                                                                     \
+        const auto gdptB_ = (b);                                                                     \
+        if (!(gdptA_ op gdptB_))                                                                     \
+            throw ::gdpt::Error(std::string("internal check failed: ") + #a " " #op " " #b + " (" +  \
+                                std::to_string(gdptA_) + " vs " + std::to_string(gdptB_) + ") at " + \
+                                __FILE__ + ":" + std::to_string(__LINE__));                          \
     } while (0)

@@ -35,9 +35,10 @@ void Progress::print(double done, const std::string& extra, bool final) {
     const double elapsed = timer_.seconds();
     const double eta = frac > 0.0 ? elapsed * (1.0 - frac) / frac : 0.0;
     char line[256];
-    std::snprintf(line, sizeof line, "%s: %5.1f%%  %6.1fs elapsed%s%s", label_.c_str(), frac * 100.0, elapsed,
-                  final ? "" : (std::string(", ~") + std::to_string(static_cast<int>(eta + 0.5)) + "s left").c_str(),
-                  extra.empty() ? "" : ("  " + extra).c_str());
+    std::snprintf(
+        line, sizeof line, "%s: %5.1f%%  %6.1fs elapsed%s%s", label_.c_str(), frac * 100.0, elapsed,
+        final ? "" : (std::string(", ~") + std::to_string(static_cast<int>(eta + 0.5)) + "s left").c_str(),
+        extra.empty() ? "" : ("  " + extra).c_str());
     if (tty_)
         std::fprintf(stderr, "\r\033[K%s%s", line, final ? "\n" : "");
     else

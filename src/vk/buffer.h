@@ -4,11 +4,11 @@
 // the buffer is device-local and uploads/downloads go through a staging copy.
 #pragma once
 
+#include <vulkan/vulkan.h>
+
 #include <cstdint>
 #include <string>
 #include <vector>
-
-#include <vulkan/vulkan.h>
 
 #include "vk/handle.h"
 

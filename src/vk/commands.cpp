@@ -12,7 +12,8 @@ CommandStream::CommandStream(const Context& ctx, std::string what) : ctx_(ctx), 
     poolInfo.queueFamilyIndex = ctx.queueFamily();
     VkCommandPool pool = VK_NULL_HANDLE;
     VK_CHECK(vkCreateCommandPool(device, &poolInfo, nullptr, &pool));
-    pool_ = Handle<VkCommandPool>(pool, [device](VkCommandPool p) { vkDestroyCommandPool(device, p, nullptr); });
+    pool_ =
+        Handle<VkCommandPool>(pool, [device](VkCommandPool p) { vkDestroyCommandPool(device, p, nullptr); });
     VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
     alloc.commandPool = pool;
     alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;

@@ -3,11 +3,11 @@
 // ("pt batch 12 (samples 48..51)") so a device-lost report says how to reproduce it.
 #pragma once
 
+#include <vulkan/vulkan.h>
+
 #include <cstdint>
 #include <functional>
 #include <string>
-
-#include <vulkan/vulkan.h>
 
 #include "vk/handle.h"
 

@@ -66,11 +66,16 @@ VkInstance createInstance(bool validation, bool debugUtils) {
 
 const char* deviceTypeName(VkPhysicalDeviceType t) {
     switch (t) {
-        case VK_PHYSICAL_DEVICE_TYPE_CPU: return "cpu";
-        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete-gpu";
-        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated-gpu";
-        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual-gpu";
-        default: return "other";
+        case VK_PHYSICAL_DEVICE_TYPE_CPU:
+            return "cpu";
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+            return "discrete-gpu";
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+            return "integrated-gpu";
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+            return "virtual-gpu";
+        default:
+            return "other";
     }
 }
 
@@ -92,7 +97,8 @@ DeviceInfo queryDevice(VkPhysicalDevice pd, std::uint32_t index) {
     d.driverName = driver.driverName;
     d.driverInfo = driver.driverInfo;
     d.driverVersion = p.driverVersion;
-    d.lavapipeBeforeMesa23 = d.driverName == "llvmpipe" && mesaMajorVersion(d.driverInfo, p.driverVersion) < 23;
+    d.lavapipeBeforeMesa23 =
+        d.driverName == "llvmpipe" && mesaMajorVersion(d.driverInfo, p.driverVersion) < 23;
     d.apiVersion = p.apiVersion;
     d.maxStorageBufferRange = p.limits.maxStorageBufferRange;
     d.maxTexelBufferElements = p.limits.maxTexelBufferElements;
@@ -158,8 +164,8 @@ std::uint32_t chooseDevice(const std::vector<DeviceInfo>& infos, const std::stri
     if (!wanted.empty()) {
         const bool numeric = std::all_of(wanted.begin(), wanted.end(), ::isdigit);
         for (const auto& d : infos) {
-            const bool match = numeric ? std::to_string(d.index) == wanted
-                                       : d.name.find(wanted) != std::string::npos;
+            const bool match =
+                numeric ? std::to_string(d.index) == wanted : d.name.find(wanted) != std::string::npos;
             if (!match) continue;
             if (!d.unsuitable.empty())
                 throw Error("device " + std::to_string(d.index) + " '" + d.name +
@@ -177,8 +183,7 @@ std::uint32_t chooseDevice(const std::vector<DeviceInfo>& infos, const std::stri
     };
     const auto best = std::max_element(infos.begin(), infos.end(),
                                        [&](const auto& a, const auto& b) { return rank(a) < rank(b); });
-    if (rank(*best) == 0)
-        throw Error("no usable Vulkan device: '" + best->name + "': " + best->unsuitable);
+    if (rank(*best) == 0) throw Error("no usable Vulkan device: '" + best->name + "': " + best->unsuitable);
     return best->index;
 }
 
@@ -196,8 +201,9 @@ std::vector<DeviceInfo> Context::listDevices() {
 Context::Context(const ContextOptions& options)
     : validation_(options.validation), printValidation_(options.printValidation) {
     if (validation_ && !layerAvailable(kValidationLayer))
-        throw Error("validation requested but VK_LAYER_KHRONOS_validation is not installed "
-                    "(apt-get install vulkan-validationlayers)");
+        throw Error(
+            "validation requested but VK_LAYER_KHRONOS_validation is not installed "
+            "(apt-get install vulkan-validationlayers)");
     const bool debugUtils = instanceExtensionAvailable(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     instance_ = Handle<VkInstance>(createInstance(validation_, debugUtils),
                                    [](VkInstance i) { vkDestroyInstance(i, nullptr); });
@@ -213,8 +219,8 @@ Context::Context(const ContextOptions& options)
         auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
             vkGetInstanceProcAddr(inst, "vkDestroyDebugUtilsMessengerEXT"));
         VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-        info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
-                               VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+        info.messageSeverity =
+            VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
         info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
                            VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                            VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
@@ -293,10 +299,8 @@ bool Context::hasMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags requir
 
 std::uint32_t Context::findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required) const {
     for (std::uint32_t i = 0; i < memory_.memoryTypeCount; ++i)
-        if ((typeBits & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & required) == required)
-            return i;
-    throw Error("no Vulkan memory type with flags " + std::to_string(required) + " on '" +
-                info_.name + "'");
+        if ((typeBits & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & required) == required) return i;
+    throw Error("no Vulkan memory type with flags " + std::to_string(required) + " on '" + info_.name + "'");
 }
 
 void Context::setName(VkObjectType type, std::uint64_t handle, const std::string& name) const {
@@ -325,8 +329,8 @@ void Context::checkAllocationSize(std::uint64_t bytes, const std::string& what) 
 }
 
 void Context::checkStorageBufferSize(std::uint64_t bytes, const std::string& what) const {
-    checkLimit(bytes, info_.maxStorageBufferRange, "a storage buffer", "maxStorageBufferRange", info_.name, what,
-               "use a smaller scene or image");
+    checkLimit(bytes, info_.maxStorageBufferRange, "a storage buffer", "maxStorageBufferRange", info_.name,
+               what, "use a smaller scene or image");
 }
 
 void Context::checkTexelBufferSize(std::uint64_t texels, const std::string& what) const {

@@ -4,20 +4,20 @@
 // messenger counts validation errors (tests fail on any).
 #pragma once
 
+#include <vulkan/vulkan.h>
+
 #include <atomic>
 #include <cstdint>
 #include <string>
 #include <vector>
-
-#include <vulkan/vulkan.h>
 
 #include "vk/handle.h"
 
 namespace gdpt::vk {
 
 struct ContextOptions {
-    std::string device;       // "" = default choice; else a device index or name substring
-    bool validation = false;  // enable VK_LAYER_KHRONOS_validation + error-counting messenger
+    std::string device;           // "" = default choice; else a device index or name substring
+    bool validation = false;      // enable VK_LAYER_KHRONOS_validation + error-counting messenger
     bool printValidation = true;  // print validation messages to stderr
 };
 
@@ -25,9 +25,9 @@ struct ContextOptions {
 struct DeviceInfo {
     std::uint32_t index = 0;
     std::string name;
-    std::string type;        // "cpu", "discrete-gpu", ...
-    std::string driverName;  // e.g. "llvmpipe"
-    std::string driverInfo;  // e.g. "Mesa 22.3.6 (LLVM 15.0.6)"
+    std::string type;                 // "cpu", "discrete-gpu", ...
+    std::string driverName;           // e.g. "llvmpipe"
+    std::string driverInfo;           // e.g. "Mesa 22.3.6 (LLVM 15.0.6)"
     std::uint32_t driverVersion = 0;  // VkPhysicalDeviceProperties::driverVersion (vendor encoding)
     std::uint32_t apiVersion = 0;
     bool isCpu = false;
@@ -74,8 +74,7 @@ public:
     [[nodiscard]] std::uint32_t validationErrors() const { return validationErrors_.load(); }
 
     // Memory type with all `required` flags among `typeBits`; throws if none.
-    [[nodiscard]] std::uint32_t findMemoryType(std::uint32_t typeBits,
-                                               VkMemoryPropertyFlags required) const;
+    [[nodiscard]] std::uint32_t findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required) const;
     [[nodiscard]] bool hasMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required) const;
     // Debug name shown by validation messages and tools (no-op without debug utils).
     void setName(VkObjectType type, std::uint64_t handle, const std::string& name) const;
@@ -93,8 +92,7 @@ public:
 private:
     static VkBool32 VKAPI_PTR messengerCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                 VkDebugUtilsMessageTypeFlagsEXT types,
-                                                const VkDebugUtilsMessengerCallbackDataEXT* data,
-                                                void* user);
+                                                const VkDebugUtilsMessengerCallbackDataEXT* data, void* user);
 
     bool validation_ = false;
     bool printValidation_ = true;

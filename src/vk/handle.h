@@ -11,8 +11,7 @@ template <typename T>
 class Handle {
 public:
     Handle() = default;
-    Handle(T handle, std::function<void(T)> deleter)
-        : handle_(handle), deleter_(std::move(deleter)) {}
+    Handle(T handle, std::function<void(T)> deleter) : handle_(handle), deleter_(std::move(deleter)) {}
     ~Handle() { reset(); }
     Handle(const Handle&) = delete;
     Handle& operator=(const Handle&) = delete;

@@ -52,13 +52,17 @@ VkPipeline createPipeline(const PipelineJob& job) {
 std::uint64_t texelBytes(VkFormat format) {
     switch (format) {
         case VK_FORMAT_R32G32B32A32_UINT:
-        case VK_FORMAT_R32G32B32A32_SFLOAT: return 16;
-        case VK_FORMAT_R32G32_UINT: return 8;
-        default: throw Error("unsupported texel-buffer format " + std::to_string(static_cast<int>(format)));
+        case VK_FORMAT_R32G32B32A32_SFLOAT:
+            return 16;
+        case VK_FORMAT_R32G32_UINT:
+            return 8;
+        default:
+            throw Error("unsupported texel-buffer format " + std::to_string(static_cast<int>(format)));
     }
 }
 
-VkFormat texelFormat(const std::vector<std::pair<std::uint32_t, VkFormat>>& texelBindings, std::uint32_t binding) {
+VkFormat texelFormat(const std::vector<std::pair<std::uint32_t, VkFormat>>& texelBindings,
+                     std::uint32_t binding) {
     for (const auto& [b, format] : texelBindings)
         if (b == binding) return format;
     return VK_FORMAT_UNDEFINED;
@@ -73,7 +77,8 @@ bool useOptimizedSpirv(const DeviceInfo& device) {
     throw Error("GDPT_SPIRV='" + v + "': expected auto, raw or opt");
 }
 
-Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation creation) : ctx_(ctx), desc_(desc) {
+Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation creation)
+    : ctx_(ctx), desc_(desc) {
     VkDevice device = ctx.device();
     GDPT_CHECK(desc.spirv != nullptr && desc.spirvBytes > 0);
     if (desc.pushConstantBytes > ctx.info().maxPushConstantsSize)
@@ -87,7 +92,8 @@ Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation crea
     moduleInfo.pCode = optimized ? desc.spirvOptimized : desc.spirv;
     VkShaderModule module = VK_NULL_HANDLE;
     VK_CHECK(vkCreateShaderModule(device, &moduleInfo, nullptr, &module));
-    module_ = Handle<VkShaderModule>(module, [device](VkShaderModule m) { vkDestroyShaderModule(device, m, nullptr); });
+    module_ = Handle<VkShaderModule>(
+        module, [device](VkShaderModule m) { vkDestroyShaderModule(device, m, nullptr); });
     ctx.setName(VK_OBJECT_TYPE_SHADER_MODULE, reinterpret_cast<std::uint64_t>(module), desc.name);
 
     std::vector<VkDescriptorSetLayoutBinding> bindings;
@@ -98,7 +104,8 @@ Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation crea
         VkDescriptorSetLayoutBinding lb{};
         lb.binding = b;
         const bool texel = texelFormat(desc.texelBindings, b) != VK_FORMAT_UNDEFINED;
-        lb.descriptorType = texel ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        lb.descriptorType =
+            texel ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
         texelCount += texel ? 1u : 0u;
         lb.descriptorCount = 1;
         lb.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -147,7 +154,8 @@ Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation crea
         poolInfo.pPoolSizes = sizes.data();
         VkDescriptorPool pool = VK_NULL_HANDLE;
         VK_CHECK(vkCreateDescriptorPool(device, &poolInfo, nullptr, &pool));
-        pool_ = Handle<VkDescriptorPool>(pool, [device](VkDescriptorPool p) { vkDestroyDescriptorPool(device, p, nullptr); });
+        pool_ = Handle<VkDescriptorPool>(
+            pool, [device](VkDescriptorPool p) { vkDestroyDescriptorPool(device, p, nullptr); });
         VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
         alloc.descriptorPool = pool;
         alloc.descriptorSetCount = 1;
@@ -176,7 +184,8 @@ Kernel::~Kernel() {
 
 void Kernel::adopt(VkPipeline pipeline) const {
     const VkDevice device = ctx_.device();
-    pipeline_ = Handle<VkPipeline>(pipeline, [device](VkPipeline p) { vkDestroyPipeline(device, p, nullptr); });
+    pipeline_ =
+        Handle<VkPipeline>(pipeline, [device](VkPipeline p) { vkDestroyPipeline(device, p, nullptr); });
     ctx_.setName(VK_OBJECT_TYPE_PIPELINE, reinterpret_cast<std::uint64_t>(pipeline), desc_.name);
 }
 
@@ -225,11 +234,13 @@ VkBufferView Kernel::createTexelView(const Buffer& buffer, VkFormat format) cons
 }
 
 VkBufferView Kernel::texelView(std::uint32_t binding, const Buffer& buffer, VkFormat format) {
-    Handle<VkBufferView> view(createTexelView(buffer, format),
-                              [device = ctx_.device()](VkBufferView v) { vkDestroyBufferView(device, v, nullptr); });
+    Handle<VkBufferView> view(createTexelView(buffer, format), [device = ctx_.device()](VkBufferView v) {
+        vkDestroyBufferView(device, v, nullptr);
+    });
     const VkBufferView raw = view.get();
     // A rebinding replaces the earlier view (bind() is never called while work is pending).
-    auto it = std::find_if(views_.begin(), views_.end(), [binding](const auto& e) { return e.first == binding; });
+    auto it =
+        std::find_if(views_.begin(), views_.end(), [binding](const auto& e) { return e.first == binding; });
     if (it != views_.end())
         it->second = std::move(view);
     else
@@ -241,8 +252,8 @@ void Kernel::bindState(VkCommandBuffer cmd, const void* push) const {
     (void)wait();
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.get());
     if (set_ != VK_NULL_HANDLE)
-        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelineLayout_.get(), 0, 1,
-                                &set_, 0, nullptr);
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelineLayout_.get(), 0, 1, &set_, 0,
+                                nullptr);
     if (push && desc_.pushConstantBytes)
         vkCmdPushConstants(cmd, pipelineLayout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0,
                            desc_.pushConstantBytes, push);
@@ -265,8 +276,8 @@ void Kernel::dispatchIndirect(VkCommandBuffer cmd, const Buffer& args, std::uint
     if (timer) timer->end(cmd);
 }
 
-void Kernel::dispatchItems(VkCommandBuffer cmd, std::uint32_t itemsX, std::uint32_t itemsY,
-                           const void* push, GpuTimer* timer) const {
+void Kernel::dispatchItems(VkCommandBuffer cmd, std::uint32_t itemsX, std::uint32_t itemsY, const void* push,
+                           GpuTimer* timer) const {
     const std::uint32_t gx = (itemsX + desc_.localSizeX - 1) / desc_.localSizeX;
     const std::uint32_t gy = (itemsY + desc_.localSizeY - 1) / desc_.localSizeY;
     dispatch(cmd, gx, gy, 1, push, timer);

@@ -4,14 +4,14 @@
 // are bound to by binding number.
 #pragma once
 
+#include <vulkan/vulkan.h>
+
 #include <cstddef>
 #include <cstdint>
 #include <future>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <vulkan/vulkan.h>
 
 #include "vk/handle.h"
 
@@ -23,7 +23,7 @@ struct DeviceInfo;
 class GpuTimer;
 
 struct KernelDesc {
-    std::string name;                    // shown in --profile and error messages
+    std::string name;  // shown in --profile and error messages
     const std::uint32_t* spirv = nullptr;
     std::size_t spirvBytes = 0;
     // The same kernel through spirv-opt (cmake/GdptSpirvEmbed.cmake), if not null: lavapipe
@@ -51,12 +51,14 @@ std::uint64_t texelBytes(VkFormat format);
 
 // The view format that `texelBindings` (KernelDesc::texelBindings) gives `binding`;
 // VK_FORMAT_UNDEFINED if it lists no such binding (a storage buffer).
-VkFormat texelFormat(const std::vector<std::pair<std::uint32_t, VkFormat>>& texelBindings, std::uint32_t binding);
+VkFormat texelFormat(const std::vector<std::pair<std::uint32_t, VkFormat>>& texelBindings,
+                     std::uint32_t binding);
 
 // KernelDesc with the SPIR-V of the embedded arrays kSpv_<name> and kSpv_<name>_opt from the
 // build (GDPT_KERNEL_SPIRV(name) names both).
 template <std::size_t N, std::size_t M>
-KernelDesc kernelDesc(std::string name, const std::uint32_t (&spirv)[N], const std::uint32_t (&optimized)[M]) {
+KernelDesc kernelDesc(std::string name, const std::uint32_t (&spirv)[N],
+                      const std::uint32_t (&optimized)[M]) {
     KernelDesc d;
     d.name = std::move(name);
     d.spirv = spirv;
@@ -107,7 +109,7 @@ public:
 
 private:
     void bindState(VkCommandBuffer cmd, const void* push) const;  // pipeline, set, push constants
-    void adopt(VkPipeline pipeline) const;  // owns and names a created pipeline
+    void adopt(VkPipeline pipeline) const;                        // owns and names a created pipeline
     [[nodiscard]] VkBufferView createTexelView(const Buffer& buffer, VkFormat format) const;
     // A `format` view of `buffer` for texel binding `binding`, kept in views_ (replacing an
     // older one).

@@ -45,9 +45,9 @@ void GpuTimer::end(VkCommandBuffer cmd) {
 void GpuTimer::collect() {
     if (!enabled_ || used_ == 0) return;
     std::vector<std::uint64_t> stamps(used_);
-    VK_CHECK(vkGetQueryPoolResults(ctx_.device(), pool_.get(), 0, used_, stamps.size() * sizeof(std::uint64_t),
-                                   stamps.data(), sizeof(std::uint64_t),
-                                   VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+    VK_CHECK(vkGetQueryPoolResults(ctx_.device(), pool_.get(), 0, used_,
+                                   stamps.size() * sizeof(std::uint64_t), stamps.data(),
+                                   sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
     for (std::size_t i = 0; i + 1 < stamps.size(); i += 2) {
         const std::uint64_t t0 = stamps[i] & validMask_;
         const std::uint64_t t1 = stamps[i + 1] & validMask_;

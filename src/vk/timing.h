@@ -3,12 +3,12 @@
 // each dispatch, collect() after the fence has signalled. Totals accumulate per name.
 #pragma once
 
+#include <vulkan/vulkan.h>
+
 #include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
-
-#include <vulkan/vulkan.h>
 
 #include "vk/handle.h"
 

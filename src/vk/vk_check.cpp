@@ -37,8 +37,8 @@ const char* vkResultName(VkResult result) {
 }
 
 void throwVulkanError(VkResult result, const char* expr, const char* file, int line) {
-    std::string msg = std::string("Vulkan call failed with ") + vkResultName(result) + ": " +
-                      expr + " (" + file + ":" + std::to_string(line) + ")";
+    std::string msg = std::string("Vulkan call failed with ") + vkResultName(result) + ": " + expr + " (" +
+                      file + ":" + std::to_string(line) + ")";
     if (result == VK_ERROR_OUT_OF_DEVICE_MEMORY || result == VK_ERROR_OUT_OF_HOST_MEMORY)
         msg += "; the device ran out of memory (try a smaller image or scene)";
     throw VulkanError(result, msg);

@@ -3,9 +3,9 @@
 // never assert-only, so release builds report Vulkan failures too.
 #pragma once
 
-#include <string>
-
 #include <vulkan/vulkan.h>
+
+#include <string>
 
 #include "util/error.h"
 
@@ -27,9 +27,8 @@ private:
 
 }  // namespace gdpt
 
-#define VK_CHECK(expr)                                                          \
-    do {                                                                        \
-        const VkResult gdptResult_ = (expr);                                    \
-        if (gdptResult_ != VK_SUCCESS)                                          \
-            ::gdpt::throwVulkanError(gdptResult_, #expr, __FILE__, __LINE__);   \
+#define VK_CHECK(expr)                                                                                   \
+    do {                                                                                                 \
+        const VkResult gdptResult_ = (expr);                                                             \
+        if (gdptResult_ != VK_SUCCESS) ::gdpt::throwVulkanError(gdptResult_, #expr, __FILE__, __LINE__); \
     } while (0)

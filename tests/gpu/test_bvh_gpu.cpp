@@ -4,11 +4,11 @@
 // Closest hit: the same triangle, or (for coplanar/duplicate ties) the same t; t within a
 // few ulps. Any hit: identical answers. The same with the stack in registers
 // (kSpecBvhRegisterStack, 8 and 16 entries) on trees that need exactly that many.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstring>
 #include <random>
-
-#include <gtest/gtest.h>
 
 #include "bvh/builder.h"
 #include "bvh/traverse_cpu.h"
@@ -51,7 +51,8 @@ Soup coplanarGrid() {
     Soup s;
     for (int y = 0; y < 20; ++y)
         for (int x = 0; x < 20; ++x) {
-            const float x0 = -1.0f + float(x) * 0.1f, y0 = -1.0f + float(y) * 0.1f, x1 = x0 + 0.1f, y1 = y0 + 0.1f;
+            const float x0 = -1.0f + float(x) * 0.1f, y0 = -1.0f + float(y) * 0.1f, x1 = x0 + 0.1f,
+                        y1 = y0 + 0.1f;
             for (int copy = 0; copy < 2; ++copy) {
                 s.add({x0, y0, 0}, {x1, y0, 0}, {x1, y1, 0});
                 s.add({x0, y0, 0}, {x1, y1, 0}, {x0, y1, 0});
@@ -68,9 +69,15 @@ Soup degenerate(std::uint32_t seed) {
     for (int i = 0; i < 800; ++i) {
         const glm::vec3 a(pos(rng), pos(rng), pos(rng)), b(pos(rng), pos(rng), pos(rng));
         switch (i % 3) {
-            case 0: s.add(a, a, a); break;                        // a point
-            case 1: s.add(a, b, 0.5f * (a + b)); break;           // collinear
-            default: s.add(a, b, b + glm::vec3(1e-6f, 0, 0)); break;  // sliver
+            case 0:
+                s.add(a, a, a);
+                break;  // a point
+            case 1:
+                s.add(a, b, 0.5f * (a + b));
+                break;  // collinear
+            default:
+                s.add(a, b, b + glm::vec3(1e-6f, 0, 0));
+                break;  // sliver
         }
     }
     return s;
@@ -96,7 +103,8 @@ std::vector<gpu::TestRay> randomRays(std::uint32_t count, std::uint32_t seed) {
 bool withinUlps(float a, float b, int ulps) {
     if (a == b) return true;
     if (!std::isfinite(a) || !std::isfinite(b)) return false;
-    return std::abs(a - b) <= float(ulps) * std::numeric_limits<float>::epsilon() * std::max(std::abs(a), std::abs(b));
+    return std::abs(a - b) <=
+           float(ulps) * std::numeric_limits<float>::epsilon() * std::max(std::abs(a), std::abs(b));
 }
 
 class BvhGpu : public test::GpuTest {
@@ -166,8 +174,12 @@ protected:
     }
 };
 
-TEST_F(BvhGpu, RandomSoupMatchesBruteForce) { check(randomSoup(1000, 7), 11); }
-TEST_F(BvhGpu, CoplanarDuplicatedGridMatchesBruteForce) { check(coplanarGrid(), 12); }
+TEST_F(BvhGpu, RandomSoupMatchesBruteForce) {
+    check(randomSoup(1000, 7), 11);
+}
+TEST_F(BvhGpu, CoplanarDuplicatedGridMatchesBruteForce) {
+    check(coplanarGrid(), 12);
+}
 // The same kernel with its pipeline created on a worker thread while the buffers are made,
 // uploaded and bound (how the renderers create theirs): the first dispatch waits for it.
 TEST_F(BvhGpu, BackgroundPipelineMatchesBruteForce) {
@@ -187,7 +199,9 @@ TEST_F(BvhGpu, UnusedBackgroundPipelineIsDestroyed) {
     EXPECT_GE(waited.wait(), 0.0);
     EXPECT_EQ(waited.wait(), 0.0);  // already there: no second wait
 }
-TEST_F(BvhGpu, DegenerateTrianglesMatchBruteForce) { check(degenerate(9), 13); }
+TEST_F(BvhGpu, DegenerateTrianglesMatchBruteForce) {
+    check(degenerate(9), 13);
+}
 
 // The register stacks at their capacity: a soup whose tree needs exactly 8 (16) entries,
 // the most each holds, so the deepest entries are pushed and popped too (larger triangles

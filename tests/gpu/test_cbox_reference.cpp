@@ -21,9 +21,9 @@
 // proportional to gdpt's (both are unbiased path tracers of the same scene) and scaled so
 // that its relMSE equals the stated floor. Šidák correction over 8x8x3 tests, family
 // alpha = 0.01.
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "gpu_fixture.h"
 #include "image/exr_io.h"
@@ -88,8 +88,8 @@ TEST_F(CboxReference, PathTracerMatchesIndependentRenderer) {
                 const double m = static_cast<double>(rw * rh);
                 const double sigma = std::sqrt(va * (1.0 + k)) / m;
                 EXPECT_LE(std::abs(sa - sb) / m, z * sigma + 1e-7)
-                    << "region " << rx << "," << ry << " channel " << c << ": gdpt " << sa / m << " reference "
-                    << sb / m;
+                    << "region " << rx << "," << ry << " channel " << c << ": gdpt " << sa / m
+                    << " reference " << sb / m;
             }
 }
 

@@ -67,7 +67,8 @@ std::uint64_t pathsPerSample(const std::string& jsonPath, std::uint64_t pixels) 
     std::ifstream in(jsonPath);
     const auto j = nlohmann::json::parse(in);
     if (j.contains("edge_samples"))
-        pixels += j["edge_samples"]["factor"].get<std::uint64_t>() * j["edge_samples"]["pixels"].get<std::uint64_t>();
+        pixels += j["edge_samples"]["factor"].get<std::uint64_t>() *
+                  j["edge_samples"]["pixels"].get<std::uint64_t>();
     return pixels;
 }
 
@@ -135,10 +136,12 @@ protected:
     // Resuming with `flags` (default: the checkpoint's own settings) fails with exit 1, one
     // line naming `file` and containing `why`, and no output file.
     // A 2-spp G-PT checkpoint written with `written` must not continue with `resumed`.
-    void expectGptOptionRefused(const std::string& written, const std::string& resumed, const std::string& why) {
+    void expectGptOptionRefused(const std::string& written, const std::string& resumed,
+                                const std::string& why) {
         const std::string c = path("g.exr");
-        const RunResult r = test::runGdpt("render " + kScene + kSize + "--spp 2 --seed 7 --method gpt " + written +
-                                          " --quiet --checkpoint " + c + " -o " + path("g_out.exr"));
+        const RunResult r =
+            test::runGdpt("render " + kScene + kSize + "--spp 2 --seed 7 --method gpt " + written +
+                          " --quiet --checkpoint " + c + " -o " + path("g_out.exr"));
         ASSERT_EQ(r.code, 0) << r.output;
         expectRefused(c, kSize + "--spp 4 --seed 7 --method gpt " + resumed, why);
     }

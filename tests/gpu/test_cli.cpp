@@ -1,14 +1,14 @@
 // The gdpt program as a user meets it: exit codes (0 ok, 1 input/runtime error, 2 usage),
 // one clear error line naming the file, no output file left behind on failure, complete
 // --help, and a small validated render that writes EXR + PNG + JSON.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <string>
-
-#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "cli_runner.h"
 #include "image/exr_io.h"
@@ -21,7 +21,9 @@ namespace fs = std::filesystem;
 
 using test::RunResult;
 
-RunResult run(const std::string& args) { return test::runGdpt(args); }
+RunResult run(const std::string& args) {
+    return test::runGdpt(args);
+}
 
 // gdpt with environment assignments ("NAME=value ") before it, through the shell.
 RunResult runWithEnv(const std::string& env, const std::string& args) {
@@ -35,8 +37,9 @@ const std::string kScene = std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.g
 TEST_F(Cli, HelpDocumentsEveryRenderFlag) {
     const RunResult r = run("render --help");
     EXPECT_EQ(r.code, 0);
-    for (const char* flag : {"--output", "--spp", "--time", "--width", "--height", "--max-depth", "--seed", "--env",
-                             "--device", "--camera", "--method", "--profile", "--json", "--quiet", "--validate"})
+    for (const char* flag :
+         {"--output", "--spp", "--time", "--width", "--height", "--max-depth", "--seed", "--env", "--device",
+          "--camera", "--method", "--profile", "--json", "--quiet", "--validate"})
         EXPECT_NE(r.output.find(flag), std::string::npos) << flag;
     EXPECT_EQ(run("--help").code, 0);
 }
@@ -115,8 +118,10 @@ TEST_F(Cli, SceneWithoutLightWarnsThatTheImageWillBeBlack) {
 TEST_F(Cli, SmallValidatedRenderWritesExrPngAndJson) {
     const std::string out = path("cb.exr");
     const std::string json = path("cb.json");
-    const RunResult r = run("render " + kScene + " -o " + out + " --width 24 --height 16 --spp 4 --validate --quiet "
-                            "--profile --json " + json);
+    const RunResult r = run("render " + kScene + " -o " + out +
+                            " --width 24 --height 16 --spp 4 --validate --quiet "
+                            "--profile --json " +
+                            json);
     ASSERT_EQ(r.code, 0) << r.output;
     ASSERT_TRUE(fs::exists(out));
     EXPECT_TRUE(fs::exists(path("cb.png")));
@@ -136,7 +141,8 @@ TEST_F(Cli, SmallValidatedRenderWritesExrPngAndJson) {
     // The wait for the background-created pipelines is part of the set-up it reports.
     const auto& t = j["time_s"];
     EXPECT_GE(t["pipeline_wait"].get<double>(), 0.0);
-    EXPECT_LE(t["pipeline_wait"].get<double>(), t["upload"].get<double>() + t["bvh_build"].get<double>() + 1e-6);
+    EXPECT_LE(t["pipeline_wait"].get<double>(),
+              t["upload"].get<double>() + t["bvh_build"].get<double>() + 1e-6);
     EXPECT_LE(t["upload"].get<double>() + t["sampling"].get<double>(), t["total"].get<double>());
 }
 
@@ -199,7 +205,8 @@ TEST_F(Cli, GptRenderReportsItsEdgeSamples) {
     const int pixels = j["edge_samples"]["pixels"].get<int>();
     EXPECT_GT(pixels, 0) << "the Cornell box's walls and boxes have edges";
     EXPECT_LT(pixels, 32 * 32 / 2);
-    EXPECT_EQ(j["paths_completed"].get<long>(), 2L * (32 * 32 + 3 * pixels)) << "2 spp, 3 more per edge pixel";
+    EXPECT_EQ(j["paths_completed"].get<long>(), 2L * (32 * 32 + 3 * pixels))
+        << "2 spp, 3 more per edge pixel";
     r = render(" --edge-samples 0");
     ASSERT_EQ(r.code, 0) << r.output;
     j = readJson();
@@ -269,7 +276,8 @@ TEST_F(Cli, InfoPrintsTheFeaturesAndTheKernelVariant) {
 // leaves no file behind; on a device that can, it renders a finite image.
 TEST_F(Cli, HugeImageRendersOrIsRefusedNamingTheDeviceLimit) {
     const std::string out = path("huge.exr");
-    const RunResult r = run("render " + kScene + " --width 4096 --height 4096 --spp 1 --max-depth 1 --quiet -o " + out);
+    const RunResult r =
+        run("render " + kScene + " --width 4096 --height 4096 --spp 1 --max-depth 1 --quiet -o " + out);
     if (r.code == 0) {
         const auto layers = readExr(out);
         ASSERT_FALSE(layers.empty());
@@ -309,16 +317,19 @@ TEST_F(Cli, DevicesListsAtLeastOneUsableDevice) {
     ASSERT_EQ(text.code, 0) << text.output;
     EXPECT_NE(text.output.find(j[0]["name"].get<std::string>()), std::string::npos) << text.output;
     EXPECT_NE(text.output.find("maxStorageBufferRange " +
-                               std::to_string(j[0]["max_storage_buffer_range"].get<std::uint64_t>() >> 20) + " MiB"),
+                               std::to_string(j[0]["max_storage_buffer_range"].get<std::uint64_t>() >> 20) +
+                               " MiB"),
               std::string::npos)
         << text.output;
     EXPECT_NE(text.output.find("maxTexelBufferElements " +
-                               std::to_string(j[0]["max_texel_buffer_elements"].get<std::uint64_t>() >> 20) + " Mi"),
+                               std::to_string(j[0]["max_texel_buffer_elements"].get<std::uint64_t>() >> 20) +
+                               " Mi"),
               std::string::npos)
         << text.output;
-    EXPECT_NE(text.output.find("maxMemoryAllocationSize " +
-                               std::to_string(j[0]["max_memory_allocation"].get<std::uint64_t>() >> 20) + " MiB"),
-              std::string::npos)
+    EXPECT_NE(
+        text.output.find("maxMemoryAllocationSize " +
+                         std::to_string(j[0]["max_memory_allocation"].get<std::uint64_t>() >> 20) + " MiB"),
+        std::string::npos)
         << text.output;
 }
 

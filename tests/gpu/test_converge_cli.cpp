@@ -87,7 +87,8 @@ void checkResults(const fs::path& dir, const std::vector<std::string>& methods,
         ASSERT_TRUE(r.contains("repeat") && r["repeat"].is_number_integer()) << r.dump();
         ASSERT_TRUE(r.contains("spp") && r["spp"].is_number_unsigned()) << r.dump();
         // Rows of the partial last pass (one sample more): fewer than the image's rows.
-        ASSERT_TRUE(r.contains("partial_pass_rows") && r["partial_pass_rows"].is_number_unsigned()) << r.dump();
+        ASSERT_TRUE(r.contains("partial_pass_rows") && r["partial_pass_rows"].is_number_unsigned())
+            << r.dump();
         EXPECT_LT(r["partial_pass_rows"].get<unsigned>(), static_cast<unsigned>(height)) << r.dump();
         for (const char* key : {"budget_s", "seconds", "recon_seconds", "relmse", "mse", "mae", "mean_bias"})
             ASSERT_TRUE(r.contains(key) && r[key].is_number()) << key << " in " << r.dump();
@@ -130,9 +131,9 @@ void checkResults(const fs::path& dir, const std::vector<std::string>& methods,
     // CSV: the header, then the JSON runs in the same order with the same values.
     const auto rows = readCsv((dir / "results.csv").string());
     ASSERT_EQ(rows.size(), runs.size() + 1);
-    const std::vector<std::string> header = {"method", "budget_s", "repeat",            "seconds",
-                                             "recon_seconds", "spp", "partial_pass_rows", "relmse",
-                                             "mse",    "mae",      "mean_bias"};
+    const std::vector<std::string> header = {
+        "method", "budget_s", "repeat", "seconds",  "recon_seconds", "spp", "partial_pass_rows",
+        "relmse", "mse",      "mae",    "mean_bias"};
     ASSERT_EQ(rows[0], header);
     for (std::size_t i = 0; i < runs.size(); ++i) {
         const auto& row = rows[i + 1];
@@ -193,11 +194,12 @@ TEST_F(ConvergeCli, ErrorFallsWithTimeForEveryMethod) {
     std::map<std::pair<std::string, double>, json> byRun;
     for (int attempt = 0; attempt < 2; ++attempt) {
         const std::string out = path("out" + std::to_string(attempt));
-        const test::RunResult r = test::runGdpt("converge " + kScene +
-                                                " --make-reference 1024 --width 32 --height 32 "
-                                                "--methods pt,gpt-l1,gpt-l2,gpt-wl2,gpt-wl1 --times 0.25,2 --repeats 1 "
-                                                "--validate -o " +
-                                                out);
+        const test::RunResult r =
+            test::runGdpt("converge " + kScene +
+                          " --make-reference 1024 --width 32 --height 32 "
+                          "--methods pt,gpt-l1,gpt-l2,gpt-wl2,gpt-wl1 --times 0.25,2 --repeats 1 "
+                          "--validate -o " +
+                          out);
         ASSERT_EQ(r.code, 0) << r.output;
         checkResults(fs::path(out), methods, {0.25, 2.0}, 1, 32, 32);
         if (HasFatalFailure()) return;
@@ -208,7 +210,8 @@ TEST_F(ConvergeCli, ErrorFallsWithTimeForEveryMethod) {
             byRun[{run["method"].get<std::string>(), run["budget_s"].get<double>()}] = run;
         bool valid = true;
         for (const auto& m : methods)
-            valid = valid && byRun.at({m, 2.0})["spp"].get<unsigned>() >= 2 * byRun.at({m, 0.25})["spp"].get<unsigned>();
+            valid = valid && byRun.at({m, 2.0})["spp"].get<unsigned>() >=
+                                 2 * byRun.at({m, 0.25})["spp"].get<unsigned>();
         if (valid) break;
     }
     for (const auto& m : methods) {

@@ -22,10 +22,10 @@
 #include <vector>
 
 #include "gpu_fixture.h"
-#include "render/passes/gpt_pass.h"
 #include "integrator/gpt_sampler.h"
 #include "integrator/pt_sampler.h"
 #include "integrator/render_options.h"
+#include "render/passes/gpt_pass.h"
 #include "scene/procedural.h"
 #include "scene_builders.h"
 #include "stats_normal.h"

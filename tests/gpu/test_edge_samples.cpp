@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "gpu_fixture.h"
-#include "render/passes/gpt_pass.h"
 #include "render/device_scene/scene_gpu.h"
+#include "render/passes/gpt_pass.h"
 #include "scene/procedural.h"
 #include "scene_builders.h"
 #include "vk/commands.h"

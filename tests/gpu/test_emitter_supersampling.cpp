@@ -1,16 +1,15 @@
-// emitter supersampling (emitter_supersampling.comp, render/passes/emitter_supersampling_pass.h) against the closed
-// form: a black-backed emissive square parallel to the image plane projects to an
-// axis-aligned rectangle, so each pixel's expected value is L × (the fraction of the pixel
-// square it covers), and with one ray per camera sample the estimate's variance is
-// c(1 − c)L²/N (less with the stratified samples of sampler.glsl). Checked for PT and for
-// G-PT's very-direct layer, with the pass on (unbiased, far below that variance and below
-// the path kernels' own estimate) and off (the kernels' own estimate, unbiased), plus the
+// emitter supersampling (emitter_supersampling.comp, render/passes/emitter_supersampling_pass.h) against the
+// closed form: a black-backed emissive square parallel to the image plane projects to an axis-aligned
+// rectangle, so each pixel's expected value is L × (the fraction of the pixel square it covers), and with one
+// ray per camera sample the estimate's variance is c(1 − c)L²/N (less with the stratified samples of
+// sampler.glsl). Checked for PT and for G-PT's very-direct layer, with the pass on (unbiased, far below that
+// variance and below the path kernels' own estimate) and off (the kernels' own estimate, unbiased), plus the
 // scenes where the pass must switch itself off.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "gpu_fixture.h"
 #include "integrator/gpt_sampler.h"
@@ -68,7 +67,8 @@ RimErrors rimErrors(const Image& image, std::uint32_t spp, const std::string& wh
             const double c = coverage(x, y);
             if (c == 0.0 || c == 1.0) {
                 for (int ch = 0; ch < 3; ++ch)
-                    EXPECT_EQ(image.at(x, y, ch), float(c * kRadiance[ch])) << what << " pixel " << x << "," << y;
+                    EXPECT_EQ(image.at(x, y, ch), float(c * kRadiance[ch]))
+                        << what << " pixel " << x << "," << y;
                 continue;
             }
             const double d = image.at(x, y, 0) - c * kRadiance[0];
@@ -88,7 +88,8 @@ protected:
         return o;
     }
     // The very-direct image of `method`: PT's image, or G-PT's direct layer.
-    static Image render(const std::string& method, const Scene& s, const RenderOptions& o, RenderStats* stats) {
+    static Image render(const std::string& method, const Scene& s, const RenderOptions& o,
+                        RenderStats* stats) {
         if (method == "pt") {
             RenderResult r = renderPt(ctx(), s, o);
             *stats = r.stats;
@@ -123,7 +124,8 @@ TEST_F(VisibleEmission, RimPixelsAreUnbiasedAndFarBelowTheKernelsOwnEstimate) {
         EXPECT_GE(stats.emitterSupersampledPixels, std::uint32_t(r.rimPixels)) << method;
         EXPECT_LE(stats.emitterSupersampledPixels, std::uint32_t(3 * r.rimPixels)) << method;
         const std::uint32_t k = stats.emitterRaysPerSample;
-        EXPECT_EQ(k, std::min(factor, std::uint32_t(kSize * kSize / 4) / stats.emitterSupersampledPixels)) << method;
+        EXPECT_EQ(k, std::min(factor, std::uint32_t(kSize * kSize / 4) / stats.emitterSupersampledPixels))
+            << method;
         ASSERT_GE(k, 8u) << method;
         expectUnbiased(r, k, method + " on");
         // Far below one ray per camera sample: the squared errors sum to under a quarter of

@@ -19,12 +19,12 @@
 // least 4. Each test also checks its own power: the same statistic against a wrong
 // expectation (the gradient of the mirrored sign, or the PT image of the neighbour) must be
 // rejected somewhere, so a test that could not fail would fail.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <functional>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "gpu_fixture.h"
 #include "integrator/gpt_sampler.h"
@@ -77,15 +77,17 @@ double checkGradients(const RenderResultGpt& g, const RenderResult& pt, int axis
                         const double ptDiff = pt.image.at(x1, y1, c) - pt.image.at(x, y, c);
                         // PT includes the very-direct light that G-PT keeps out of the
                         // gradients: add G-PT's direct difference back.
-                        const double estimate = grad.at(x, y, c) + g.direct.at(x1, y1, c) - g.direct.at(x, y, c);
-                        const double v = gvar.at(x, y, c) + g.varDirect.at(x, y, c) + g.varDirect.at(x1, y1, c) +
-                                         pt.varianceOfMean.at(x, y, c) + pt.varianceOfMean.at(x1, y1, c);
+                        const double estimate =
+                            grad.at(x, y, c) + g.direct.at(x1, y1, c) - g.direct.at(x, y, c);
+                        const double v = gvar.at(x, y, c) + g.varDirect.at(x, y, c) +
+                                         g.varDirect.at(x1, y1, c) + pt.varianceOfMean.at(x, y, c) +
+                                         pt.varianceOfMean.at(x1, y1, c);
                         right.add(estimate, ptDiff, v);
                         wrong.add(estimate, -ptDiff, v);
                     }
-                EXPECT_LE(right.zScore(), z) << name << (axis == 0 ? " dx" : " dy") << " region " << rx << ","
-                                             << ry << " channel " << c << ": sum diff " << right.diff
-                                             << " se " << std::sqrt(right.var);
+                EXPECT_LE(right.zScore(), z)
+                    << name << (axis == 0 ? " dx" : " dy") << " region " << rx << "," << ry << " channel "
+                    << c << ": sum diff " << right.diff << " se " << std::sqrt(right.var);
                 maxWrongZ = std::max(maxWrongZ, wrong.zScore());
             }
     return maxWrongZ;
@@ -93,7 +95,8 @@ double checkGradients(const RenderResultGpt& g, const RenderResult& pt, int axis
 
 // Tests the primal against PT on the step-3 lattice. Returns the largest |z| against the
 // PT image shifted by one pixel (power check).
-double checkPrimal(const RenderResultGpt& g, const RenderResult& pt, int region, double z, const std::string& name) {
+double checkPrimal(const RenderResultGpt& g, const RenderResult& pt, int region, double z,
+                   const std::string& name) {
     const int w = pt.image.width(), h = pt.image.height();
     double maxWrongZ = 0.0;
     for (int ry = 0; ry < h / region; ++ry)
@@ -110,8 +113,9 @@ double checkPrimal(const RenderResultGpt& g, const RenderResult& pt, int region,
                         const int xs = std::min(x + 1, w - 1);
                         wrong.add(estimate, pt.image.at(xs, y, c), gv + pt.varianceOfMean.at(xs, y, c));
                     }
-                EXPECT_LE(right.zScore(), z) << name << " primal region " << rx << "," << ry << " channel " << c
-                                             << ": sum diff " << right.diff << " se " << std::sqrt(right.var);
+                EXPECT_LE(right.zScore(), z)
+                    << name << " primal region " << rx << "," << ry << " channel " << c << ": sum diff "
+                    << right.diff << " se " << std::sqrt(right.var);
                 maxWrongZ = std::max(maxWrongZ, wrong.zScore());
             }
     return maxWrongZ;
@@ -140,7 +144,8 @@ void checkPixels(const RenderResultGpt& g, const RenderResult& pt, const std::st
                                       << ": G-PT " << estimate << " PT " << expected << " z " << zs;
                 };
                 test(g.primal.at(x, y, c) + g.direct.at(x, y, c), pt.image.at(x, y, c),
-                     g.varPrimal.at(x, y, c) + g.varDirect.at(x, y, c) + pt.varianceOfMean.at(x, y, c), "primal");
+                     g.varPrimal.at(x, y, c) + g.varDirect.at(x, y, c) + pt.varianceOfMean.at(x, y, c),
+                     "primal");
                 if (x + 1 < w)
                     test(g.dx.at(x, y, c) + g.direct.at(x + 1, y, c) - g.direct.at(x, y, c),
                          pt.image.at(x + 1, y, c) - pt.image.at(x, y, c),
@@ -307,7 +312,7 @@ TEST_F(GptRender, SplitBounceLoopGivesTheSameBitsAsTheSingleLoop) {
         EXPECT_EQ(a.stats.raysTraced, b.stats.raysTraced);
         EXPECT_EQ(a.stats.shiftFailures, b.stats.shiftFailures);
         const std::pair<const Image*, const Image*> images[] = {
-            {&a.primal, &b.primal}, {&a.dx, &b.dx}, {&a.dy, &b.dy}, {&a.direct, &b.direct},
+            {&a.primal, &b.primal},       {&a.dx, &b.dx},       {&a.dy, &b.dy},      {&a.direct, &b.direct},
             {&a.varPrimal, &b.varPrimal}, {&a.varDx, &b.varDx}, {&a.varDy, &b.varDy}};
         for (const auto& [x, y] : images)
             for (int ch = 0; ch < 3; ++ch) ASSERT_EQ(x->plane(ch), y->plane(ch));

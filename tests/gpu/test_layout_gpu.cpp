@@ -5,9 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
-#include <vector>
-
 #include <glm/gtc/packing.hpp>
+#include <vector>
 
 #include "gdpt_shared.h"
 #include "gpu_fixture.h"
@@ -182,7 +181,7 @@ TEST_F(LayoutGpu, TexelAccessorsReturnTheUploadedStructs) {
                          tableBuffer(ctx(), shading, "shading"),  tableBuffer(ctx(), materials, "materials"),
                          tableBuffer(ctx(), texInfo, "tex info"), tableBuffer(ctx(), texels, "texels"),
                          tableBuffer(ctx(), lights, "lights"),    tableBuffer(ctx(), punctual, "punctual")};
-    const std::uint32_t bindings[] = {gpu::kBindTriGeom,   gpu::kBindBvh,    gpu::kBindTriShading,
+    const std::uint32_t bindings[] = {gpu::kBindTriGeom,   gpu::kBindBvh,     gpu::kBindTriShading,
                                       gpu::kBindMaterials, gpu::kBindTexInfo, gpu::kBindTexels,
                                       gpu::kBindLightTris, gpu::kBindPunctual};
     for (std::size_t i = 0; i < std::size(bindings); ++i) kernel.bind(bindings[i], bufs[i]);

@@ -548,9 +548,12 @@ struct VarianceProblem {
 };
 VarianceProblem varianceProblem(int w, int h, unsigned seed, std::array<double, 2> vxRange,
                                 std::array<double, 2> vyRange) {
-    return {randomImage(w, h, seed, 0.0, 1.0),           randomImage(w, h, seed + 1, -0.3, 0.3),
-            randomImage(w, h, seed + 2, -0.3, 0.3),      randomImage(w, h, seed + 3, 0.01, 1.0),
-            randomImage(w, h, seed + 4, vxRange[0], vxRange[1]), randomImage(w, h, seed + 5, vyRange[0], vyRange[1])};
+    return {randomImage(w, h, seed, 0.0, 1.0),
+            randomImage(w, h, seed + 1, -0.3, 0.3),
+            randomImage(w, h, seed + 2, -0.3, 0.3),
+            randomImage(w, h, seed + 3, 0.01, 1.0),
+            randomImage(w, h, seed + 4, vxRange[0], vxRange[1]),
+            randomImage(w, h, seed + 5, vyRange[0], vyRange[1])};
 }
 
 // Inverse-variance weights equal the CPU solve with the same row weights.
@@ -699,8 +702,8 @@ TEST_F(PoissonGpu, PreparedPipelinesCoverALaterSolve) {
     const Image primal = randomImage(57, 43, 71, 0.0, 1.0);
     const Image dx = randomImage(57, 43, 72, -0.3, 0.3), dy = randomImage(57, 43, 73, -0.3, 0.3);
     const Image var = randomImage(57, 43, 74, 0.001, 0.01);
-    for (Reconstruction m : {Reconstruction::L2, Reconstruction::L1, Reconstruction::WeightedL2,
-                             Reconstruction::WeightedL1}) {
+    for (Reconstruction m :
+         {Reconstruction::L2, Reconstruction::L1, Reconstruction::WeightedL2, Reconstruction::WeightedL1}) {
         PoissonKernels kernels(ctx());
         PoissonSolverGpu solver(ctx(), primal.width(), primal.height(), &kernels);
         SolveOptions o;
@@ -780,9 +783,9 @@ TEST_F(PoissonGpu, DeviceAddressKernelsGiveTheSameBitsAsDescriptorKernels) {
     PoissonSolverGpu byAddress(ctx(), w, h, &sharedKernels(), PoissonAddressing::DeviceAddress);
     ASSERT_EQ(byAddress.engine().addressing(), PoissonAddressing::DeviceAddress);
     const std::vector<std::pair<Reconstruction, GpuSolver>> cases = {
-        {Reconstruction::L2, GpuSolver::MgPcg}, {Reconstruction::L2, GpuSolver::Cg},
+        {Reconstruction::L2, GpuSolver::MgPcg},  {Reconstruction::L2, GpuSolver::Cg},
         {Reconstruction::L2, GpuSolver::Jacobi}, {Reconstruction::L2, GpuSolver::Mg},
-        {Reconstruction::L1, GpuSolver::MgPcg}, {Reconstruction::WeightedL2, GpuSolver::MgPcg}};
+        {Reconstruction::L1, GpuSolver::MgPcg},  {Reconstruction::WeightedL2, GpuSolver::MgPcg}};
     for (const auto& [method, solverKind] : cases) {
         SolveOptions o;
         o.method = method;

@@ -2,13 +2,13 @@
 // Lambertian plane (L = rho/pi * I cos(theta) / r^2), a spot light's cone, a constant
 // environment over a Lambertian plane (L = rho * L_env exactly, every sample) and alpha
 // cutouts (a masked-out occluder lets an emitter through, an opaque one does not).
-#include <cmath>
-
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "gpu_fixture.h"
-#include "scene_builders.h"
 #include "integrator/pt_sampler.h"
+#include "scene_builders.h"
 
 namespace gdpt {
 namespace {
@@ -16,7 +16,6 @@ namespace {
 using test::addQuadZ;
 using test::lambert;
 using test::lookDown;
-
 
 class RenderLights : public test::GpuTest {
 protected:
@@ -89,7 +88,8 @@ TEST_F(RenderLights, ConstantEnvironmentOverLambertianPlaneIsExact) {
     // Every sample: cosine-sampled bounce (weight = albedo) escapes to the environment.
     const glm::vec3 albedo(0.5f, 0.25f, 0.125f);
     for (int c = 0; c < 3; ++c)
-        for (std::size_t i = 0; i < r.image.pixelCount(); ++i) ASSERT_FLOAT_EQ(r.image.plane(c)[i], env[c] * albedo[c]);
+        for (std::size_t i = 0; i < r.image.pixelCount(); ++i)
+            ASSERT_FLOAT_EQ(r.image.plane(c)[i], env[c] * albedo[c]);
 }
 
 TEST_F(RenderLights, AlphaCutoutLetsTheEmitterThroughOnlyBelowTheCutoff) {

@@ -2,18 +2,18 @@
 // L = Le / (1 - a)), an emitter seen directly (exactly its radiance), and determinism.
 // Every tolerance is a number of standard errors estimated from the per-pixel sample
 // variance the renderer accumulates, with fixed seeds.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstring>
 
-#include <gtest/gtest.h>
-
 #include "gpu_fixture.h"
+#include "integrator/pt_sampler.h"
 #include "integrator/sampling_loop.h"
 #include "render/passes/pt_pass.h"
-#include "integrator/pt_sampler.h"
-#include "vk/commands.h"
 #include "scene/procedural.h"
 #include "stats_normal.h"
+#include "vk/commands.h"
 
 namespace gdpt {
 namespace {
@@ -147,7 +147,8 @@ TEST_F(RenderPt, TimedRenderCountsWholeAndPartialPasses) {
     const RenderResult r = renderPt(ctx(), makeCornellBox(), o);
     EXPECT_GE(r.stats.spp, 1u);
     EXPECT_LT(r.stats.partialPassRows, 24u);
-    EXPECT_EQ(r.stats.pathsCompleted, std::uint64_t{r.stats.spp} * 32u * 24u + std::uint64_t{r.stats.partialPassRows} * 32u);
+    EXPECT_EQ(r.stats.pathsCompleted,
+              std::uint64_t{r.stats.spp} * 32u * 24u + std::uint64_t{r.stats.partialPassRows} * 32u);
 }
 
 }  // namespace

@@ -7,12 +7,12 @@
 #include <gtest/gtest.h>
 
 #include "gpu_fixture.h"
-#include "same_bits.h"
-#include "render/device_scene/features.h"
 #include "integrator/gpt_sampler.h"
 #include "integrator/pt_sampler.h"
 #include "integrator/render_options.h"
+#include "render/device_scene/features.h"
 #include "render/device_scene/scene_spec.h"
+#include "same_bits.h"
 #include "scene/gltf_loader.h"
 #include "scene/procedural.h"
 
@@ -36,7 +36,8 @@ TEST(SceneFeatures, FlatNormalsOfEitherSignAreNotShadingNormals) {
     EXPECT_FALSE(triangleHasShadingNormals(oneTriangle(2.0f * z, z, 0.5f * z), 0)) << "lengths do not matter";
     const glm::vec3 tilted = glm::normalize(glm::vec3(0.01f, 0, 1));
     EXPECT_TRUE(triangleHasShadingNormals(oneTriangle(z, z, tilted), 0));
-    EXPECT_TRUE(triangleHasShadingNormals(oneTriangle(z, -z, z), 0)) << "mixed signs interpolate through zero";
+    EXPECT_TRUE(triangleHasShadingNormals(oneTriangle(z, -z, z), 0))
+        << "mixed signs interpolate through zero";
     EXPECT_TRUE(triangleHasShadingNormals(oneTriangle(z, glm::vec3(0), z), 0)) << "a zero normal";
     Scene none = oneTriangle(z, z, z);
     none.normals.clear();
@@ -48,8 +49,10 @@ TEST(SceneFeatures, FlatNormalsOfEitherSignAreNotShadingNormals) {
 // The repository's scenes: the box is flat-shaded and Lambertian, the glossy spheres have
 // shading normals and a metal/dielectric lobe.
 TEST(SceneFeatures, ShippedScenesClassifyTheirNormalsAndSpecularLobes) {
-    const SceneFeatures box = analyzeScene(loadGltf(GDPT_SOURCE_DIR "/scenes/cornell_box.gltf"), glm::vec3(0));
-    const SceneFeatures glossy = analyzeScene(loadGltf(GDPT_SOURCE_DIR "/scenes/glossy_cornell.gltf"), glm::vec3(0));
+    const SceneFeatures box =
+        analyzeScene(loadGltf(GDPT_SOURCE_DIR "/scenes/cornell_box.gltf"), glm::vec3(0));
+    const SceneFeatures glossy =
+        analyzeScene(loadGltf(GDPT_SOURCE_DIR "/scenes/glossy_cornell.gltf"), glm::vec3(0));
     EXPECT_FALSE(box.hasShadingNormals);
     EXPECT_TRUE(glossy.hasShadingNormals);
     EXPECT_FALSE(box.hasSpecularLayer);

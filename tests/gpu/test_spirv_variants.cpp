@@ -1,18 +1,18 @@
 // test_spirv_variants.cpp — the two embedded SPIR-V forms of every kernel (glslang's, and
 // spirv-opt's: cmake/GdptSpirvEmbed.cmake) render the same image, and which one a device
 // gets (vk::useOptimizedSpirv: lavapipe before Mesa 23, read from the driver string).
-#include <cstdlib>
-
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include "gpu_fixture.h"
-#include "same_bits.h"
 #include "integrator/gpt_sampler.h"
 #include "integrator/pt_sampler.h"
 #include "integrator/render_options.h"
+#include "same_bits.h"
 #include "scene/gltf_loader.h"
-#include "vk/kernel.h"
 #include "util/error.h"
+#include "vk/kernel.h"
 
 namespace gdpt {
 namespace {

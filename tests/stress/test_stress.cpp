@@ -2,26 +2,28 @@
 // thin images, long accumulation. Each case asserts finite output, the expected energy
 // where it is known (in standard errors estimated from the per-pixel variance), and
 // reports the NaN/Inf sample count. GDPT_STRESS_LONG=1 runs the long variants locally.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
-#include <utility>
 #include <cstdlib>
-
-#include <gtest/gtest.h>
+#include <utility>
 
 #include "gpu_fixture.h"
 #include "image/metrics.h"
-#include "render/device_scene/features.h"
 #include "integrator/gpt_sampler.h"
 #include "integrator/pt_sampler.h"
 #include "integrator/render_options.h"
+#include "render/device_scene/features.h"
 #include "scene/gltf_loader.h"
 #include "scene/procedural.h"
 
 namespace gdpt {
 namespace {
 
-bool longMode() { return std::getenv("GDPT_STRESS_LONG") != nullptr; }
+bool longMode() {
+    return std::getenv("GDPT_STRESS_LONG") != nullptr;
+}
 
 class Stress : public test::GpuTest {
 protected:

@@ -2,13 +2,12 @@
 // and capture its exit code and output; a fixture with a private temporary directory.
 #pragma once
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <string>
-
-#include <gtest/gtest.h>
 
 namespace gdpt::test {
 
@@ -19,7 +18,8 @@ struct RunResult {
 
 // Runs `gdpt <args>` through the shell; `env` ("NAME=value ..."), if given, is set for it.
 inline RunResult runGdpt(const std::string& args, const std::string& env = "") {
-    const std::string cmd = (env.empty() ? "" : "env " + env + " ") + std::string(GDPT_BINARY) + " " + args + " 2>&1";
+    const std::string cmd =
+        (env.empty() ? "" : "env " + env + " ") + std::string(GDPT_BINARY) + " " + args + " 2>&1";
     RunResult r;
     FILE* pipe = popen(cmd.c_str(), "r");
     if (!pipe) return r;

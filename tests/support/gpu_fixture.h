@@ -3,10 +3,10 @@
 // reported any error while it ran.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <memory>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "integrator/render_options.h"
 #include "vk/commands.h"

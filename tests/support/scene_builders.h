@@ -3,7 +3,6 @@
 #pragma once
 
 #include <cstdint>
-
 #include <glm/glm.hpp>
 
 #include "gdpt_shared.h"
@@ -27,7 +26,8 @@ inline gpu::Material lambert(glm::vec3 albedo, glm::vec3 emission = glm::vec3(0.
 // Quad in the plane z = zPlane, half-size h, front face towards +z (or -z).
 inline void addQuadZ(Scene& s, float zPlane, float h, std::uint32_t mat, bool facePlusZ = true) {
     const auto base = static_cast<std::uint32_t>(s.positions.size());
-    s.positions.insert(s.positions.end(), {{-h, -h, zPlane}, {h, -h, zPlane}, {h, h, zPlane}, {-h, h, zPlane}});
+    s.positions.insert(s.positions.end(),
+                       {{-h, -h, zPlane}, {h, -h, zPlane}, {h, h, zPlane}, {-h, h, zPlane}});
     if (facePlusZ) {
         s.triangles.emplace_back(base, base + 1, base + 2);
         s.triangles.emplace_back(base, base + 2, base + 3);

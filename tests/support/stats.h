@@ -102,9 +102,8 @@ inline Chi2Result chi2Test(const std::vector<double>& observed, const std::vecto
     std::vector<double> cellExp;
     for (std::size_t i : order) {
         if (expected[i] <= 0.0 && observed[i] > 0.0) {
-            res.error = "observed " + std::to_string(observed[i]) + " samples in cell " +
-                        std::to_string(i) + " whose expected count is " +
-                        std::to_string(expected[i]);
+            res.error = "observed " + std::to_string(observed[i]) + " samples in cell " + std::to_string(i) +
+                        " whose expected count is " + std::to_string(expected[i]);
             res.pValue = 0.0;
             return res;
         }

@@ -11,13 +11,18 @@ inline double twoSidedZ(double alpha) {
     double lo = 0.0, hi = 40.0;
     for (int i = 0; i < 200; ++i) {
         const double mid = 0.5 * (lo + hi);
-        if (std::erfc(mid / std::sqrt(2.0)) > alpha) lo = mid; else hi = mid;
+        if (std::erfc(mid / std::sqrt(2.0)) > alpha)
+            lo = mid;
+        else
+            hi = mid;
     }
     return 0.5 * (lo + hi);
 }
 
 // Per-test significance such that a family of m independent tests has overall level alpha
 // (Šidák 1967): 1 - (1 - alpha)^(1/m).
-inline double sidakAlpha(double alpha, int m) { return 1.0 - std::pow(1.0 - alpha, 1.0 / m); }
+inline double sidakAlpha(double alpha, int m) {
+    return 1.0 - std::pow(1.0 - alpha, 1.0 / m);
+}
 
 }  // namespace gdpt::test

@@ -8,9 +8,11 @@ namespace gdpt {
 bool triangleHasShadingNormals(const Scene& scene, std::size_t tri) {
     if (scene.normals.empty()) return false;
     const glm::uvec3 t = scene.triangles[tri];
-    const glm::vec3 face = glm::cross(scene.positions[t.y] - scene.positions[t.x], scene.positions[t.z] - scene.positions[t.x]);
+    const glm::vec3 face =
+        glm::cross(scene.positions[t.y] - scene.positions[t.x], scene.positions[t.z] - scene.positions[t.x]);
     const float faceLength = glm::length(face);
-    if (!(faceLength > 0.0f) || !std::isfinite(faceLength)) return true;  // degenerate: leave it to the kernels
+    if (!(faceLength > 0.0f) || !std::isfinite(faceLength))
+        return true;  // degenerate: leave it to the kernels
     float lo = 1.0f, hi = -1.0f;
     for (int k = 0; k < 3; ++k) {
         const glm::vec3 n = scene.normals[t[k]];
@@ -56,7 +58,8 @@ SceneFeatures analyzeScene(const Scene& scene, glm::vec3 envRadiance, float shif
     for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
         const std::uint32_t m = scene.triangleMaterial[t];
         if (m < used.size()) used[m] = true;
-        if (m < scene.materials.size() && (scene.materials[m].flags & gpu::kMatFlagEmissive)) ++f.emissiveTriangles;
+        if (m < scene.materials.size() && (scene.materials[m].flags & gpu::kMatFlagEmissive))
+            ++f.emissiveTriangles;
     }
     f.hasLightTris = f.emissiveTriangles > 0;
     for (std::size_t t = 0; t < scene.triangles.size() && !f.hasShadingNormals; ++t)

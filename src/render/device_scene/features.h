@@ -5,11 +5,10 @@
 #pragma once
 
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "scene/scene.h"
 
@@ -20,15 +19,15 @@ struct SceneFeatures {
     std::uint32_t emissiveTriangles = 0;
     std::uint32_t punctualLights = 0;
     std::uint32_t textures = 0;
-    bool hasTextures = false;    // some material samples a texture
+    bool hasTextures = false;  // some material samples a texture
     bool hasPunctual = false;
     bool hasLightTris = false;
     bool hasEnv = false;
-    bool hasGlossy = false;      // some vertex can be classified glossy (roughness <= threshold)
+    bool hasGlossy = false;         // some vertex can be classified glossy (roughness <= threshold)
     bool hasSpecularLayer = false;  // some material has a non-Lambertian (metal/dielectric) lobe
     bool hasAlphaMask = false;
     bool hasShadingNormals = false;  // some triangle's vertex normals differ from its face normal
-    float minRoughness = 1.0f;   // over materials with a specular lobe
+    float minRoughness = 1.0f;       // over materials with a specular lobe
     float maxRoughness = 0.0f;
 };
 

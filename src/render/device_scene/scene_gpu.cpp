@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <glm/gtc/packing.hpp>
 
 #include "bvh/builder.h"
@@ -17,7 +16,9 @@ namespace {
 
 constexpr float kPi = 3.14159265358979f;
 
-float luminance(glm::vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+float luminance(glm::vec3 c) {
+    return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
+}
 
 // The buffer of scene binding `binding`, checked against the limit of how the kernels read
 // it: a texel buffer of its SceneSpec::sceneTexelBindings format, else a storage buffer.
@@ -91,7 +92,8 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     bvhInfo_.buildMs = built->buildMs;
     bvhInfo_.nodes = static_cast<std::uint32_t>(bvh.nodes.size());
     bvhInfo_.maxDepth = bvh.stats.maxDepth;
-    std::vector<gpu::TriangleGeom> geoms = makeTriangleGeoms(scene.positions, scene.triangles, bvh.triangleOrder);
+    std::vector<gpu::TriangleGeom> geoms =
+        makeTriangleGeoms(scene.positions, scene.triangles, bvh.triangleOrder);
     std::vector<gpu::TriangleShading> shading = makeShading(scene, bvh.triangleOrder);
 
     // Emissive triangles, with a CDF proportional to power = area * luminance(Le) * pi
@@ -117,7 +119,8 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     GDPT_CHECK(lights.size() == spec_.features().emissiveTriangles);
 
     double punctualPower = 0.0;
-    for (const auto& l : scene.punctualLights) punctualPower += 4.0 * kPi * std::max(1e-12, double(luminance(l.intensity)));
+    for (const auto& l : scene.punctualLights)
+        punctualPower += 4.0 * kPi * std::max(1e-12, double(luminance(l.intensity)));
 
     // Textures: linear RGBA as packed halves.
     std::vector<gpu::TextureInfo> texInfo;
@@ -128,7 +131,8 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
         info.width = static_cast<std::uint32_t>(t.width);
         info.height = static_cast<std::uint32_t>(t.height);
         for (const glm::vec4& c : t.texels)
-            texels.emplace_back(glm::packHalf2x16(glm::vec2(c.x, c.y)), glm::packHalf2x16(glm::vec2(c.z, c.w)));
+            texels.emplace_back(glm::packHalf2x16(glm::vec2(c.x, c.y)),
+                                glm::packHalf2x16(glm::vec2(c.z, c.w)));
         texInfo.push_back(info);
     }
 
@@ -161,7 +165,8 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     texels_ = makeBuffer(ctx, texels, "texels", gpu::kBindTexels);
     lightTris_ = makeBuffer(ctx, lights, "light triangles", gpu::kBindLightTris);
     punctual_ = makeBuffer(ctx, scene.punctualLights, "punctual lights", gpu::kBindPunctual);
-    sceneConst_ = makeBuffer(ctx, std::vector<gpu::SceneConstants>{constants_}, "scene constants", gpu::kBindSceneConst);
+    sceneConst_ = makeBuffer(ctx, std::vector<gpu::SceneConstants>{constants_}, "scene constants",
+                             gpu::kBindSceneConst);
 }
 
 void SceneGpu::bindTo(vk::Kernel& kernel) const {

@@ -54,8 +54,7 @@ private:
     SceneSpec spec_;
     gpu::SceneConstants constants_{};
     BvhBuildInfo bvhInfo_;
-    vk::Buffer triGeom_, triShading_, bvh_, materials_, texInfo_, texels_, lightTris_, punctual_,
-        sceneConst_;
+    vk::Buffer triGeom_, triShading_, bvh_, materials_, texInfo_, texels_, lightTris_, punctual_, sceneConst_;
 };
 
 // Builds the camera constants for an image of width × height (shared with tests).

@@ -33,7 +33,8 @@ SceneSpec::SceneSpec(const Scene& scene, const SceneGpuOptions& options)
         if (emitterPower(scene, t, triangleArea(scene, t)) > 0.0) ++lights;
     features_.emissiveTriangles = lights;
     features_.hasLightTris = lights > 0;
-    if (scene.triangles.size() <= kSpecBvhTriangles) bvh_ = std::make_shared<const SceneBvh>(buildSceneBvh(scene));
+    if (scene.triangles.size() <= kSpecBvhTriangles)
+        bvh_ = std::make_shared<const SceneBvh>(buildSceneBvh(scene));
 }
 
 std::uint32_t SceneSpec::bvhRegisterStack() const {

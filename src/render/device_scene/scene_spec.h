@@ -8,11 +8,10 @@
 #pragma once
 
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <memory>
 #include <utility>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "bvh/builder.h"
 #include "bvh/wide_bvh.h"

@@ -7,14 +7,14 @@
 #include "vk/context.h"
 
 namespace gdpt {
-namespace {
-}  // namespace
+namespace {}  // namespace
 
 BenchRaysPass::BenchRaysPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg)
     : ctx_(ctx),
       width_(scene.constants().width),
       height_(scene.constants().height),
-      kernel_(ctx, scene.kernelDesc(vk::kernelDesc("bench_rays", GDPT_KERNEL_SPIRV(bench_rays)), wg, {gpu::kBindCounters})),
+      kernel_(ctx, scene.kernelDesc(vk::kernelDesc("bench_rays", GDPT_KERNEL_SPIRV(bench_rays)), wg,
+                                    {gpu::kBindCounters})),
       counters_(ctx, sizeof(gpu::Counters), "bench counters") {
     scene.bindTo(kernel_);
     kernel_.bind(gpu::kBindCounters, counters_);

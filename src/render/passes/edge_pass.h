@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "gpt_shared.h"
-#include "render/passes/edge_options.h"
 #include "render/device_scene/scene_gpu.h"
+#include "render/passes/edge_options.h"
 #include "vk/buffer.h"
 #include "vk/kernel.h"
 

@@ -19,6 +19,8 @@ constexpr std::uint32_t kMaxEmitterSupersampling = 64;
 
 // The pass has work only where the camera can see emission: an emissive triangle or the
 // environment.
-inline bool emitterSupersamplingPossible(const SceneFeatures& f) { return f.hasLightTris || f.hasEnv; }
+inline bool emitterSupersamplingPossible(const SceneFeatures& f) {
+    return f.hasLightTris || f.hasEnv;
+}
 
 }  // namespace gdpt

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <string>
 
-#include "util/error.h"
 #include "emitter_supersampling.spv.h"
+#include "util/error.h"
 #include "vk/commands.h"
 #include "vk/context.h"
 
@@ -28,29 +28,33 @@ std::uint32_t activeFactor(std::uint32_t samplesPerSpp, const SceneSpec& scene) 
 }
 }  // namespace
 
-EmitterSupersamplingPass::EmitterSupersamplingPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg,
-                         std::uint32_t samplesPerSpp, const vk::Buffer& counters)
+EmitterSupersamplingPass::EmitterSupersamplingPass(const vk::Context& ctx, const SceneGpu& scene,
+                                                   WorkgroupSize wg, std::uint32_t samplesPerSpp,
+                                                   const vk::Buffer& counters)
     : EmitterSupersamplingPass(ctx, scene.spec(), wg, samplesPerSpp, counters, vk::PipelineCreation::Now) {
     attach(scene);
 }
 
-EmitterSupersamplingPass::EmitterSupersamplingPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize wg,
-                         std::uint32_t samplesPerSpp, const vk::Buffer& counters, vk::PipelineCreation creation)
+EmitterSupersamplingPass::EmitterSupersamplingPass(const vk::Context& ctx, const SceneSpec& scene,
+                                                   WorkgroupSize wg, std::uint32_t samplesPerSpp,
+                                                   const vk::Buffer& counters, vk::PipelineCreation creation)
     : width_(scene.width()),
       height_(scene.height()),
       samplesPerSpp_(activeFactor(samplesPerSpp, scene)),
       // Disabled: 16-byte placeholders (the path kernels compile the read out).
       stats_(ctx, enabled() ? std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats) : 0,
              "emitter-supersampling statistics"),
-      probe_(ctx, enabled() ? std::uint64_t{width_} * height_ * sizeof(std::uint32_t) : 0, "emitter-supersampling probe"),
+      probe_(ctx, enabled() ? std::uint64_t{width_} * height_ * sizeof(std::uint32_t) : 0,
+             "emitter-supersampling probe"),
       counter_(ctx, sizeof(gpu::VisibleCounter), "emitter-supersampling counter") {
     if (!enabled()) return;
-    ctx.checkStorageBufferSize(stats_.size(), "the emitter-supersampling statistics of a " + std::to_string(width_) +
-                                                  "x" + std::to_string(height_) + " image");
-    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("emitter_supersampling", GDPT_KERNEL_SPIRV(emitter_supersampling)), wg,
-                                        {gpu::kBindCounters, gpu::kBindVisibleStats, gpu::kBindVisibleProbe,
-                                         gpu::kBindVisibleCounter},
-                                        sizeof(gpu::VisibleParams));
+    ctx.checkStorageBufferSize(stats_.size(), "the emitter-supersampling statistics of a " +
+                                                  std::to_string(width_) + "x" + std::to_string(height_) +
+                                                  " image");
+    vk::KernelDesc d = scene.kernelDesc(
+        vk::kernelDesc("emitter_supersampling", GDPT_KERNEL_SPIRV(emitter_supersampling)), wg,
+        {gpu::kBindCounters, gpu::kBindVisibleStats, gpu::kBindVisibleProbe, gpu::kBindVisibleCounter},
+        sizeof(gpu::VisibleParams));
     kernel_.emplace(ctx, d, creation);
     kernel_->bind(gpu::kBindCounters, counters);
     kernel_->bind(gpu::kBindVisibleStats, stats_);
@@ -68,7 +72,9 @@ void EmitterSupersamplingPass::configure(vk::KernelDesc& desc) const {
     desc.specConstants.push_back({gpu::kSpecVisibleEmission, enabled() ? 1u : 0u});
 }
 
-void EmitterSupersamplingPass::bindTo(vk::Kernel& kernel) const { kernel.bind(gpu::kBindVisibleStats, stats_); }
+void EmitterSupersamplingPass::bindTo(vk::Kernel& kernel) const {
+    kernel.bind(gpu::kBindVisibleStats, stats_);
+}
 
 void EmitterSupersamplingPass::reset() {
     stats_.zero();
@@ -76,8 +82,8 @@ void EmitterSupersamplingPass::reset() {
     probed_ = false;
 }
 
-void EmitterSupersamplingPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
-                         vk::GpuTimer* timer) {
+void EmitterSupersamplingPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp,
+                                      std::uint32_t seed, vk::GpuTimer* timer) {
     if (!enabled() || spp == 0) return;
     gpu::VisibleParams p{};
     p.sampleBase = sampleBase;
@@ -113,8 +119,10 @@ void EmitterSupersamplingPass::uploadStats(const std::vector<gpu::PixelStats>& s
         throw Error("emitter-supersampling statistics: " + std::to_string(stats.size()) + " entries for a " +
                     std::to_string(width_) + "x" + std::to_string(height_) + " image");
     if (!enabled()) {
-        const bool empty = std::all_of(stats.begin(), stats.end(), [](const gpu::PixelStats& s) { return s.count == 0; });
-        if (!empty) throw Error("emitter-supersampling statistics have samples, but emitter supersampling is off");
+        const bool empty =
+            std::all_of(stats.begin(), stats.end(), [](const gpu::PixelStats& s) { return s.count == 0; });
+        if (!empty)
+            throw Error("emitter-supersampling statistics have samples, but emitter supersampling is off");
         return;
     }
     stats_.uploadVector(stats);

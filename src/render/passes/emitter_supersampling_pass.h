@@ -30,12 +30,13 @@ class GpuTimer;
 class EmitterSupersamplingPass {
 public:
     // samplesPerSpp in [0, kMaxEmitterSupersampling]; 0 disables the pass.
-    EmitterSupersamplingPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg, std::uint32_t samplesPerSpp,
-                const vk::Buffer& counters);
+    EmitterSupersamplingPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg,
+                             std::uint32_t samplesPerSpp, const vk::Buffer& counters);
     // The same before the scene is on the device: the pipeline is created as `creation`
     // says, and attach() binds the scene's buffers once they exist (before record()).
-    EmitterSupersamplingPass(const vk::Context& ctx, const SceneSpec& spec, WorkgroupSize wg, std::uint32_t samplesPerSpp,
-                const vk::Buffer& counters, vk::PipelineCreation creation);
+    EmitterSupersamplingPass(const vk::Context& ctx, const SceneSpec& spec, WorkgroupSize wg,
+                             std::uint32_t samplesPerSpp, const vk::Buffer& counters,
+                             vk::PipelineCreation creation);
     void attach(const SceneGpu& scene);
     // Waits for a pipeline created in the background; the seconds waited.
     double waitForPipeline() const { return kernel_ ? kernel_->wait() : 0.0; }

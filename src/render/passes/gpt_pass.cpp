@@ -4,8 +4,8 @@
 #include <string>
 
 #include "gpt.spv.h"
-#include "gpt_split.spv.h"
 #include "gpt_resolve.spv.h"
+#include "gpt_split.spv.h"
 #include "lib/surface_rules.glsl"
 #include "render/device_scene/scene_gpu.h"
 #include "util/error.h"
@@ -20,10 +20,9 @@ namespace {
 constexpr std::uint64_t kMaxPixelSamplesPerDispatch = 1u << 19;
 constexpr std::uint32_t kNumStats = 10;  // bindings kBindGptCentral .. kBindGptDirect
 
-const char* const kStatNames[kNumStats] = {"gpt central",    "gpt neighbor right", "gpt neighbor down",
-                                           "gpt neighbor left", "gpt neighbor up",  "gpt gradient right",
-                                           "gpt gradient down", "gpt gradient left", "gpt gradient up",
-                                           "gpt direct"};
+const char* const kStatNames[kNumStats] = {
+    "gpt central",        "gpt neighbor right", "gpt neighbor down", "gpt neighbor left", "gpt neighbor up",
+    "gpt gradient right", "gpt gradient down",  "gpt gradient left", "gpt gradient up",   "gpt direct"};
 
 // Whether some vertex can be classified glossy: a specular layer at or below the threshold,
 // or one below bsdf.glsl's Dirac cutoff (perceptual roughness 0.01), which
@@ -69,7 +68,9 @@ vk::KernelDesc resolveDesc(WorkgroupSize wg, const EmitterSupersamplingPass& vis
 }
 
 std::array<vk::Buffer, kNumStats> makeStats(const vk::Context& ctx, std::uint64_t pixels) {
-    auto make = [&](std::uint32_t i) { return vk::Buffer(ctx, pixels * sizeof(gpu::PixelStats), kStatNames[i]); };
+    auto make = [&](std::uint32_t i) {
+        return vk::Buffer(ctx, pixels * sizeof(gpu::PixelStats), kStatNames[i]);
+    };
     return {make(0), make(1), make(2), make(3), make(4), make(5), make(6), make(7), make(8), make(9)};
 }
 }  // namespace
@@ -86,7 +87,8 @@ namespace {
 // edge.comp's test between two probe points, applied to two pixels' first probes.
 bool sameSurface(const gpu::EdgeProbe& a, const gpu::EdgeProbe& b) {
     if (a.hit != b.hit) return false;
-    return a.hit == 0 || gpu::probeHitsAgree(a.material, a.position, a.normal, b.material, b.position, b.normal);
+    return a.hit == 0 ||
+           gpu::probeHitsAgree(a.material, a.position, a.normal, b.material, b.position, b.normal);
 }
 }  // namespace
 
@@ -127,7 +129,8 @@ GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize w
       counters_(ctx, sizeof(gpu::Counters), "gpt counters"),
       emitterSupersampling_(ctx, scene, wg, options.emitterSupersampling, counters_, creation),
       edges_(ctx, scene, wg, options.edgeSamples, creation, options.demodulate),
-      kernel_(ctx, gptDesc(scene, wg, halfVector_, splitBounce_, options.demodulate, emitterSupersampling_), creation),
+      kernel_(ctx, gptDesc(scene, wg, halfVector_, splitBounce_, options.demodulate, emitterSupersampling_),
+              creation),
       resolveKernel_(ctx, resolveDesc(wg, emitterSupersampling_), creation),
       stats_(makeStats(ctx, std::uint64_t{width_} * height_)),
       resolved_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::GptResolved), "gpt resolved"),
@@ -161,7 +164,8 @@ void GptPass::attach(const SceneGpu& scene) {
 }
 
 double GptPass::waitForPipelines() const {
-    return emitterSupersampling_.waitForPipeline() + edges_.waitForPipeline() + kernel_.wait() + resolveKernel_.wait();
+    return emitterSupersampling_.waitForPipeline() + edges_.waitForPipeline() + kernel_.wait() +
+           resolveKernel_.wait();
 }
 
 void GptPass::findEdges(vk::CommandStream& stream) {

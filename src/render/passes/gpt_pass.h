@@ -11,10 +11,10 @@
 
 #include "gpt_shared.h"
 #include "image/image.h"
-#include "render/passes/sampling_pass.h"
 #include "render/passes/edge_pass.h"
-#include "render/passes/pt_pass.h"
 #include "render/passes/emitter_supersampling_pass.h"
+#include "render/passes/pt_pass.h"
+#include "render/passes/sampling_pass.h"
 #include "scene/scene.h"
 #include "vk/buffer.h"
 #include "vk/context.h"
@@ -77,7 +77,8 @@ struct GptImages {
 
 class GptPass final : public SamplingPass {
 public:
-    GptPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg = {}, GptPassOptions options = {});
+    GptPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg = {},
+            GptPassOptions options = {});
     // The same before the scene is on the device: the pipelines are created as `creation`
     // says (Background: while the caller builds the SceneGpu), and attach() binds the
     // scene's buffers (before record()).
@@ -116,7 +117,9 @@ public:
     [[nodiscard]] bool demodulating() const { return options_.demodulate; }
     // Pixels marked for demodulation by the last findEdges() (0 before).
     [[nodiscard]] std::uint32_t demodulatedPixels() const { return demodulatedPixels_; }
-    [[nodiscard]] const EmitterSupersamplingPass& emitterSupersampling() const override { return emitterSupersampling_; }
+    [[nodiscard]] const EmitterSupersamplingPass& emitterSupersampling() const override {
+        return emitterSupersampling_;
+    }
     [[nodiscard]] const EdgePass& edges() const { return edges_; }
 
 private:

@@ -18,7 +18,8 @@ constexpr std::uint64_t kMaxPixelSamplesPerDispatch = 1u << 20;
 
 namespace {
 vk::KernelDesc ptDesc(const SceneSpec& scene, WorkgroupSize wg, const EmitterSupersamplingPass& visible) {
-    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("pt", GDPT_KERNEL_SPIRV(pt)), wg, {gpu::kBindAccum, gpu::kBindCounters});
+    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("pt", GDPT_KERNEL_SPIRV(pt)), wg,
+                                        {gpu::kBindAccum, gpu::kBindCounters});
     visible.configure(d);
     return d;
 }
@@ -33,22 +34,24 @@ void recordTiled(VkCommandBuffer cmd, const vk::DeviceInfo& device, std::uint32_
                  const std::function<void(const DispatchTile&)>& dispatch) {
     const std::uint32_t step = samplesPerDispatch(device, spp);
     const std::uint64_t perRow = std::uint64_t{width} * step;
-    const auto rowsPerDispatch =
-        static_cast<std::uint32_t>(std::max<std::uint64_t>(1, maxPixelSamples / std::max<std::uint64_t>(perRow, 1)));
+    const auto rowsPerDispatch = static_cast<std::uint32_t>(
+        std::max<std::uint64_t>(1, maxPixelSamples / std::max<std::uint64_t>(perRow, 1)));
     for (std::uint32_t first = 0; first < spp; first += step) {
         for (std::uint32_t row = 0; row < height; row += rowsPerDispatch)
-            dispatch({sampleBase + first, std::min(step, spp - first), row, std::min(rowsPerDispatch, height - row)});
+            dispatch({sampleBase + first, std::min(step, spp - first), row,
+                      std::min(rowsPerDispatch, height - row)});
         vk::computeBarrier(cmd);
     }
 }
 
-PtPass::PtPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg, std::uint32_t emitterSupersampling)
+PtPass::PtPass(const vk::Context& ctx, const SceneGpu& scene, WorkgroupSize wg,
+               std::uint32_t emitterSupersampling)
     : PtPass(ctx, scene.spec(), wg, emitterSupersampling, vk::PipelineCreation::Now) {
     attach(scene);
 }
 
-PtPass::PtPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize wg, std::uint32_t emitterSupersampling,
-               vk::PipelineCreation creation)
+PtPass::PtPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize wg,
+               std::uint32_t emitterSupersampling, vk::PipelineCreation creation)
     : ctx_(ctx),
       width_(scene.width()),
       height_(scene.height()),
@@ -56,8 +59,8 @@ PtPass::PtPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize wg,
       emitterSupersampling_(ctx, scene, wg, emitterSupersampling, counters_, creation),
       kernel_(ctx, ptDesc(scene, wg, emitterSupersampling_), creation),
       accum_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats), "pt pixel statistics") {
-    ctx.checkStorageBufferSize(accum_.size(), "the per-pixel statistics of a " + std::to_string(width_) + "x" +
-                                                  std::to_string(height_) + " image");
+    ctx.checkStorageBufferSize(accum_.size(), "the per-pixel statistics of a " + std::to_string(width_) +
+                                                  "x" + std::to_string(height_) + " image");
     kernel_.bind(gpu::kBindAccum, accum_);
     kernel_.bind(gpu::kBindCounters, counters_);
     emitterSupersampling_.bindTo(kernel_);
@@ -69,7 +72,9 @@ void PtPass::attach(const SceneGpu& scene) {
     emitterSupersampling_.attach(scene);
 }
 
-double PtPass::waitForPipelines() const { return emitterSupersampling_.waitForPipeline() + kernel_.wait(); }
+double PtPass::waitForPipelines() const {
+    return emitterSupersampling_.waitForPipeline() + kernel_.wait();
+}
 
 void PtPass::reset() {
     accum_.zero();
@@ -80,8 +85,8 @@ void PtPass::reset() {
 void PtPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
                     vk::GpuTimer* timer, std::uint32_t rows) {
     emitterSupersampling_.record(cmd, sampleBase, spp, seed, timer);
-    recordTiled(cmd, ctx_.info(), width_, std::min(rows, height_), sampleBase, spp, kMaxPixelSamplesPerDispatch,
-                [&](const DispatchTile& t) {
+    recordTiled(cmd, ctx_.info(), width_, std::min(rows, height_), sampleBase, spp,
+                kMaxPixelSamplesPerDispatch, [&](const DispatchTile& t) {
                     gpu::FrameParams p{};
                     setTileParams(p, t, seed);
                     kernel_.dispatchItems(cmd, width_, p.rowCount, &p, timer);
@@ -96,7 +101,8 @@ gpu::Counters PtPass::takeCounters() {
 }
 
 std::vector<std::vector<gpu::PixelStats>> PtPass::downloadStats() const {
-    return {accum_.downloadVector<gpu::PixelStats>(std::size_t{width_} * height_), emitterSupersampling_.downloadStats()};
+    return {accum_.downloadVector<gpu::PixelStats>(std::size_t{width_} * height_),
+            emitterSupersampling_.downloadStats()};
 }
 
 void PtPass::uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats) {

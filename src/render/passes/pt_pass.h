@@ -9,9 +9,9 @@
 
 #include "gdpt_shared.h"
 #include "image/image.h"
-#include "render/passes/sampling_pass.h"
 #include "render/device_scene/scene_gpu.h"
 #include "render/passes/emitter_supersampling_pass.h"
+#include "render/passes/sampling_pass.h"
 #include "vk/buffer.h"
 #include "vk/kernel.h"
 
@@ -67,8 +67,8 @@ public:
     // The same before the scene is on the device: the pipelines are created as `creation`
     // says (Background: while the caller builds the SceneGpu), and attach() binds the
     // scene's buffers (before record()).
-    PtPass(const vk::Context& ctx, const SceneSpec& spec, WorkgroupSize wg, std::uint32_t emitterSupersampling,
-           vk::PipelineCreation creation);
+    PtPass(const vk::Context& ctx, const SceneSpec& spec, WorkgroupSize wg,
+           std::uint32_t emitterSupersampling, vk::PipelineCreation creation);
     void attach(const SceneGpu& scene) override;
     // Waits for pipelines created in the background; the seconds waited.
     double waitForPipelines() const override;
@@ -93,7 +93,9 @@ public:
     [[nodiscard]] const vk::Buffer& accum() const { return accum_; }
     [[nodiscard]] const vk::Buffer& counters() const { return counters_; }
     [[nodiscard]] EmitterSupersamplingPass& emitterSupersampling() { return emitterSupersampling_; }
-    [[nodiscard]] const EmitterSupersamplingPass& emitterSupersampling() const override { return emitterSupersampling_; }
+    [[nodiscard]] const EmitterSupersamplingPass& emitterSupersampling() const override {
+        return emitterSupersampling_;
+    }
 
 private:
     const vk::Context& ctx_;

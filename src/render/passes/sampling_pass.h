@@ -5,10 +5,10 @@
 // back through its own interface.
 #pragma once
 
+#include <vulkan/vulkan.h>
+
 #include <cstdint>
 #include <vector>
-
-#include <vulkan/vulkan.h>
 
 #include "gdpt_shared.h"
 

@@ -3,12 +3,11 @@
 
 #include <cmath>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <map>
 #include <random>
 #include <utility>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 namespace gdpt::test {
 
@@ -79,16 +78,14 @@ inline Mesh terrain(uint32_t n, uint32_t seed) {
 inline Mesh icosphere(uint32_t levels) {
     const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
     Mesh m;
-    const float v[12][3] = {{-1, t, 0}, {1, t, 0},  {-1, -t, 0}, {1, -t, 0},
-                            {0, -1, t}, {0, 1, t},  {0, -1, -t}, {0, 1, -t},
-                            {t, 0, -1}, {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+    const float v[12][3] = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                            {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
     for (const auto& p : v) {
         m.addVertex(glm::normalize(glm::vec3(p[0], p[1], p[2])));
     }
-    m.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                   {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                   {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                   {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+    m.triangles = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                   {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+                   {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
     for (uint32_t l = 0; l < levels; ++l) {
         std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints;
         auto mid = [&](uint32_t a, uint32_t b) {

@@ -35,17 +35,14 @@ Mesh degenerateScene(uint32_t seed) {
     for (int i = 0; i < 60; ++i) {
         glm::vec3 a = test::uniformInBox(rng, glm::vec3(-1.0f), glm::vec3(1.0f));
         glm::vec3 b = test::uniformInBox(rng, glm::vec3(-1.0f), glm::vec3(1.0f));
-        m.addTriangle(a, a, b);                    // repeated vertex
-        m.addTriangle(a, 0.5f * (a + b), b);       // collinear
-        m.addTriangle(a, a, a);                    // a point
+        m.addTriangle(a, a, b);               // repeated vertex
+        m.addTriangle(a, 0.5f * (a + b), b);  // collinear
+        m.addTriangle(a, a, a);               // a point
     }
     for (int i = 0; i < 100; ++i) {  // overlapping coplanar triangles in the plane z = 0.25
-        glm::vec3 c = test::uniformInBox(rng, glm::vec3(-1.0f, -1.0f, 0.25f),
-                                         glm::vec3(1.0f, 1.0f, 0.25f));
-        glm::vec3 d1 = test::uniformInBox(rng, glm::vec3(-0.3f, -0.3f, 0.0f),
-                                          glm::vec3(0.3f, 0.3f, 0.0f));
-        glm::vec3 d2 = test::uniformInBox(rng, glm::vec3(-0.3f, -0.3f, 0.0f),
-                                          glm::vec3(0.3f, 0.3f, 0.0f));
+        glm::vec3 c = test::uniformInBox(rng, glm::vec3(-1.0f, -1.0f, 0.25f), glm::vec3(1.0f, 1.0f, 0.25f));
+        glm::vec3 d1 = test::uniformInBox(rng, glm::vec3(-0.3f, -0.3f, 0.0f), glm::vec3(0.3f, 0.3f, 0.0f));
+        glm::vec3 d2 = test::uniformInBox(rng, glm::vec3(-0.3f, -0.3f, 0.0f), glm::vec3(0.3f, 0.3f, 0.0f));
         m.addTriangle(c, c + d1, c + d2);
     }
     const size_t original = m.triangles.size();
@@ -152,7 +149,12 @@ void checkStructure(const Mesh& m, const Bvh& bvh, uint32_t leafLimit) {
     std::vector<int> leafRef(n, 0);
     uint32_t leaves = 0;
     uint32_t maxDepth = 0;
-    struct Item { uint32_t node; uint32_t depth; glm::vec3 lo; glm::vec3 hi; };
+    struct Item {
+        uint32_t node;
+        uint32_t depth;
+        glm::vec3 lo;
+        glm::vec3 hi;
+    };
     std::vector<Item> todo{{0, 0, glm::vec3(-1e38f), glm::vec3(1e38f)}};
     while (!todo.empty()) {
         Item it = todo.back();
@@ -190,8 +192,7 @@ void checkStructure(const Mesh& m, const Bvh& bvh, uint32_t leafLimit) {
                 glm::vec3 tlo;
                 glm::vec3 thi;
                 triangleBounds(m.positions[t.x], m.positions[t.y], m.positions[t.z], tlo, thi);
-                EXPECT_TRUE(glm::all(glm::lessThanEqual(lo, tlo)) &&
-                            glm::all(glm::greaterThanEqual(hi, thi)))
+                EXPECT_TRUE(glm::all(glm::lessThanEqual(lo, tlo)) && glm::all(glm::greaterThanEqual(hi, thi)))
                     << "leaf box does not contain triangle " << bvh.triangleOrder[i];
             }
         }
@@ -252,7 +253,8 @@ void checkWideStructure(const Mesh& m, const Bvh& bvh, const WideBvh& wide) {
         }
     }
     for (size_t i = 0; i < seen.size(); ++i) ASSERT_EQ(seen[i], 1) << "triangle " << i;
-    for (size_t i = 0; i < nodeSeen.size(); ++i) ASSERT_EQ(nodeSeen[i], 1) << "wide node " << i << " unreachable";
+    for (size_t i = 0; i < nodeSeen.size(); ++i)
+        ASSERT_EQ(nodeSeen[i], 1) << "wide node " << i << " unreachable";
     EXPECT_EQ(leaves, bvh.stats.leafCount);
     EXPECT_LE(wide.maxStack, gpu::kBvhWideStackSize);
     EXPECT_LE(wide.maxDepth, bvh.stats.maxDepth);
@@ -263,50 +265,48 @@ void checkWideStructure(const Mesh& m, const Bvh& bvh, const WideBvh& wide) {
 
 // Closest and any hit of the BVH against brute force over the triangles in ORIGINAL order
 // (so triangleOrder and makeTriangleGeoms are checked as well).
-void compareWithBruteForce(const Mesh& m, const BvhBuildOptions& opt, uint32_t rayCount,
-                           uint32_t seed) {
+void compareWithBruteForce(const Mesh& m, const BvhBuildOptions& opt, uint32_t rayCount, uint32_t seed) {
     const Bvh bvh = buildBvh(m.positions, m.triangles, opt);
     checkStructure(m, bvh, std::min(opt.maxLeafSize, gpu::kMaxLeafTriangles));
     const auto leafGeoms = makeTriangleGeoms(m.positions, m.triangles, bvh.triangleOrder);
-    const auto origGeoms =
-        makeTriangleGeoms(m.positions, m.triangles, identityOrder(m.triangles.size()));
+    const auto origGeoms = makeTriangleGeoms(m.positions, m.triangles, identityOrder(m.triangles.size()));
     const std::vector<Ray> rays = makeRays(m, rayCount, seed);
     const WideBvh wide = collapseToWide(bvh.nodes);
     checkWideStructure(m, bvh, wide);
     uint32_t hits = 0;
     uint32_t failures = 0;
     for (const Ray& r : rays) {
-      const Hit f = traceClosestBruteForce(origGeoms, r.orig, r.dir, 0.0f, r.tMax);
-      const bool anyF = traceAnyBruteForce(origGeoms, r.orig, r.dir, 0.0f, r.tMax);
-      // The binary tree, then the four-wide tree the kernels traverse: the same checks.
-      for (int tree = 0; tree < 2; ++tree) {
-        const Hit b = tree == 0 ? traceClosestCpu(bvh.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax)
-                                : traceClosestWideCpu(wide.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax);
-        const bool anyB = tree == 0 ? traceAnyCpu(bvh.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax)
-                                    : traceAnyWideCpu(wide.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax);
-        bool ok = (b.triangle == gpu::kInvalidIndex) == (f.triangle == gpu::kInvalidIndex) &&
-                  anyB == anyF && anyF == (f.triangle != gpu::kInvalidIndex);
-        if (ok && f.triangle != gpu::kInvalidIndex) {
-            ++hits;
-            ok = b.t == f.t;  // exact, see the file comment
-            if (ok && bvh.triangleOrder[b.triangle] != f.triangle) {
-                // A tie: the BVH's triangle alone must give the same t.
-                float t = r.tMax;
-                float u;
-                float v;
-                ok = intersectTriangleCpu(leafGeoms[b.triangle], r.orig, r.dir, 0.0f, t, u, v) &&
-                     t == f.t;
-            } else if (ok) {
-                ok = b.u == f.u && b.v == f.v;
+        const Hit f = traceClosestBruteForce(origGeoms, r.orig, r.dir, 0.0f, r.tMax);
+        const bool anyF = traceAnyBruteForce(origGeoms, r.orig, r.dir, 0.0f, r.tMax);
+        // The binary tree, then the four-wide tree the kernels traverse: the same checks.
+        for (int tree = 0; tree < 2; ++tree) {
+            const Hit b = tree == 0 ? traceClosestCpu(bvh.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax)
+                                    : traceClosestWideCpu(wide.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax);
+            const bool anyB = tree == 0 ? traceAnyCpu(bvh.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax)
+                                        : traceAnyWideCpu(wide.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax);
+            bool ok = (b.triangle == gpu::kInvalidIndex) == (f.triangle == gpu::kInvalidIndex) &&
+                      anyB == anyF && anyF == (f.triangle != gpu::kInvalidIndex);
+            if (ok && f.triangle != gpu::kInvalidIndex) {
+                ++hits;
+                ok = b.t == f.t;  // exact, see the file comment
+                if (ok && bvh.triangleOrder[b.triangle] != f.triangle) {
+                    // A tie: the BVH's triangle alone must give the same t.
+                    float t = r.tMax;
+                    float u;
+                    float v;
+                    ok =
+                        intersectTriangleCpu(leafGeoms[b.triangle], r.orig, r.dir, 0.0f, t, u, v) && t == f.t;
+                } else if (ok) {
+                    ok = b.u == f.u && b.v == f.v;
+                }
+            }
+            if (!ok && ++failures <= 5) {
+                ADD_FAILURE() << (tree == 0 ? "binary" : "wide") << " ray o=(" << r.orig.x << "," << r.orig.y
+                              << "," << r.orig.z << ") d=(" << r.dir.x << "," << r.dir.y << "," << r.dir.z
+                              << ") bvh tri " << b.triangle << " t " << b.t << " brute tri " << f.triangle
+                              << " t " << f.t << " any " << anyB << "/" << anyF;
             }
         }
-        if (!ok && ++failures <= 5) {
-            ADD_FAILURE() << (tree == 0 ? "binary" : "wide") << " ray o=(" << r.orig.x << "," << r.orig.y << ","
-                          << r.orig.z << ") d=(" << r.dir.x << "," << r.dir.y << "," << r.dir.z
-                          << ") bvh tri " << b.triangle << " t " << b.t << " brute tri "
-                          << f.triangle << " t " << f.t << " any " << anyB << "/" << anyF;
-        }
-      }
     }
     EXPECT_EQ(failures, 0u);
     // The test is only meaningful if a good share of rays hit something.
@@ -315,7 +315,8 @@ void compareWithBruteForce(const Mesh& m, const BvhBuildOptions& opt, uint32_t r
     }
 }
 
-const BvhBuildOptions kDeepOptions{1, 4, 1.0f, 1.0f, gpu::kBvhMaxDepth, 1};  // tiny leaves, few bins: deep tree
+const BvhBuildOptions kDeepOptions{1, 4, 1.0f, 1.0f, gpu::kBvhMaxDepth,
+                                   1};  // tiny leaves, few bins: deep tree
 
 TEST(BvhTraversal, RandomSoupMatchesBruteForce) {
     const Mesh m = test::randomSoup(400, 0.25f, 11);
@@ -370,8 +371,7 @@ TEST(BvhTraversal, SingleTriangle) {
     EXPECT_EQ(bvh.nodes[0].leftCount, 1u);
     EXPECT_EQ(bvh.nodes[0].right, gpu::kInvalidIndex);
     const auto geoms = makeTriangleGeoms(m.positions, m.triangles, bvh.triangleOrder);
-    const Hit h = traceClosestCpu(bvh.nodes, geoms, {0.25f, 0.5f, 1.0f}, {0.0f, 0.0f, -2.0f},
-                                  0.0f, 1e30f);
+    const Hit h = traceClosestCpu(bvh.nodes, geoms, {0.25f, 0.5f, 1.0f}, {0.0f, 0.0f, -2.0f}, 0.0f, 1e30f);
     EXPECT_EQ(h.triangle, 0u);
     EXPECT_EQ(h.t, 0.5f);
     EXPECT_EQ(h.u, 0.25f);
@@ -399,8 +399,7 @@ TEST(BvhBuilder, EmptyMeshHasAbsentRootChildren) {
     EXPECT_EQ(bvh.nodes[0].right, gpu::kInvalidIndex);
     EXPECT_GT(bvh.nodes[0].lmin.x, bvh.nodes[0].lmax.x);
     EXPECT_FALSE(traceAnyCpu(bvh.nodes, {}, glm::vec3(0.0f), {0.0f, 0.0f, 1.0f}, 0.0f, 1e30f));
-    EXPECT_EQ(traceClosestCpu(bvh.nodes, {}, glm::vec3(0.0f), {1.0f, 0.0f, 0.0f}, 0.0f, 1e30f)
-                  .triangle,
+    EXPECT_EQ(traceClosestCpu(bvh.nodes, {}, glm::vec3(0.0f), {1.0f, 0.0f, 0.0f}, 0.0f, 1e30f).triangle,
               gpu::kInvalidIndex);
 }
 
@@ -419,8 +418,7 @@ TEST(BvhBuilder, SameResultForAnyThreadCount) {
     const Bvh b = buildBvh(m.positions, m.triangles, parallel);
     checkStructure(m, b, serial.maxLeafSize);
     ASSERT_EQ(a.nodes.size(), b.nodes.size());
-    EXPECT_EQ(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(gpu::BvhNode)),
-              0);
+    EXPECT_EQ(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(gpu::BvhNode)), 0);
     EXPECT_EQ(a.triangleOrder, b.triangleOrder);
 }
 
@@ -445,8 +443,7 @@ TEST(BvhTraversal, WatertightThroughSharedEdges) {
         const Hit h = traceClosestCpu(bvh.nodes, geoms, orig, dir, 0.0f, 1e30f);
         const bool any = traceAnyCpu(bvh.nodes, geoms, orig, dir, 0.0f, 1e30f);
         if ((h.triangle == gpu::kInvalidIndex || !any) && ++misses <= 5) {
-            ADD_FAILURE() << "ray through a shared edge escaped the closed mesh (ray " << i
-                          << ")";
+            ADD_FAILURE() << "ray through a shared edge escaped the closed mesh (ray " << i << ")";
         }
     }
     EXPECT_EQ(misses, 0u);

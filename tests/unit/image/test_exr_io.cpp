@@ -1,10 +1,10 @@
 // test_exr_io.cpp — EXR round trips, foreign (HALF/UINT, offset window) files, corrupt files,
 // and the tmp+rename guarantee.
+#include <Imath/half.h>
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfOutputFile.h>
-#include <Imath/half.h>
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -36,8 +36,7 @@ Image randomImage(int w, int h, unsigned seed) {
 bool bitEqual(const Image& a, const Image& b) {
     if (!a.sameSize(b)) return false;
     for (int c = 0; c < 3; ++c)
-        if (std::memcmp(a.plane(c).data(), b.plane(c).data(), a.pixelCount() * sizeof(float)))
-            return false;
+        if (std::memcmp(a.plane(c).data(), b.plane(c).data(), a.pixelCount() * sizeof(float))) return false;
     return true;
 }
 
@@ -145,8 +144,8 @@ TEST_F(ExrIo, TruncatedFileThrowsErrorNamingTheFile) {
     const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     ASSERT_GT(bytes.size(), 400u);
     // Cut at several places: inside the header, inside the offset table, inside the data.
-    for (std::size_t keep : {std::size_t{0}, std::size_t{10}, std::size_t{200}, bytes.size() / 2,
-                             bytes.size() - 1}) {
+    for (std::size_t keep :
+         {std::size_t{0}, std::size_t{10}, std::size_t{200}, bytes.size() / 2, bytes.size() - 1}) {
         const std::string bad = path("truncated_" + std::to_string(keep) + ".exr");
         std::ofstream(bad, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(keep));
         try {
@@ -172,7 +171,8 @@ TEST_F(ExrIo, CorruptBytesThrowErrorNotCrash) {
         const std::size_t at = pos(rng);
         for (std::size_t k = 0; k < 16; ++k) copy[at + k] = static_cast<char>(rng());
         const std::string bad = path("corrupt.exr");
-        std::ofstream(bad, std::ios::binary | std::ios::trunc).write(copy.data(), static_cast<std::streamsize>(copy.size()));
+        std::ofstream(bad, std::ios::binary | std::ios::trunc)
+            .write(copy.data(), static_cast<std::streamsize>(copy.size()));
         try {
             readExr(bad);  // some corruptions are harmless (pixel data): fine either way
         } catch (const Error& e) {

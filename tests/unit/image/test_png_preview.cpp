@@ -21,18 +21,17 @@ TEST(PreviewCode, KnownValues) {
     EXPECT_EQ(previewCode(0.5f), 188);
     // Linear segment: 0.001 * 12.92 * 255 = 3.29 -> 3.
     EXPECT_EQ(previewCode(0.001f), 3);
-    EXPECT_EQ(previewCode(4.0f), 255);                                        // clamped
-    EXPECT_EQ(previewCode(-1.0f), 0);                                         // negative
-    EXPECT_EQ(previewCode(std::numeric_limits<float>::quiet_NaN()), 0);       // NaN
-    EXPECT_EQ(previewCode(std::numeric_limits<float>::infinity()), 255);      // +inf
-    EXPECT_EQ(previewCode(0.25f, {2.0f, ToneMap::Clamp}), 188);               // exposure
-    EXPECT_EQ(previewCode(1.0f, {1.0f, ToneMap::Reinhard}), 188);             // 1/(1+1)
+    EXPECT_EQ(previewCode(4.0f), 255);                                    // clamped
+    EXPECT_EQ(previewCode(-1.0f), 0);                                     // negative
+    EXPECT_EQ(previewCode(std::numeric_limits<float>::quiet_NaN()), 0);   // NaN
+    EXPECT_EQ(previewCode(std::numeric_limits<float>::infinity()), 255);  // +inf
+    EXPECT_EQ(previewCode(0.25f, {2.0f, ToneMap::Clamp}), 188);           // exposure
+    EXPECT_EQ(previewCode(1.0f, {1.0f, ToneMap::Reinhard}), 188);         // 1/(1+1)
     EXPECT_EQ(previewCode(std::numeric_limits<float>::infinity(), {1.0f, ToneMap::Reinhard}), 255);
 }
 
 TEST(Srgb, CurvesAreInverse) {
-    for (double v = 0.0; v <= 1.0; v += 1.0 / 64.0)
-        EXPECT_NEAR(srgbToLinear(linearToSrgb(v)), v, 1e-12);
+    for (double v = 0.0; v <= 1.0; v += 1.0 / 64.0) EXPECT_NEAR(srgbToLinear(linearToSrgb(v)), v, 1e-12);
     EXPECT_NEAR(linearToSrgb(0.0031308), 0.04045, 1e-6);  // continuity at the knee
 }
 

@@ -11,8 +11,7 @@
 
 namespace gdpt::test {
 
-inline std::vector<double> randomField(int w, int h, unsigned seed, double lo = 0.0,
-                                       double hi = 1.0) {
+inline std::vector<double> randomField(int w, int h, unsigned seed, double lo = 0.0, double hi = 1.0) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(lo, hi);
     std::vector<double> v(static_cast<std::size_t>(w) * h);
@@ -34,8 +33,7 @@ inline std::vector<double> structuredField(int w, int h) {
 }
 
 // Problem whose gradients and primal are those of `image` exactly.
-inline PoissonProblem exactProblem(const std::vector<double>& image, int w, int h,
-                                   double alpha) {
+inline PoissonProblem exactProblem(const std::vector<double>& image, int w, int h, double alpha) {
     PoissonProblem p;
     p.width = w;
     p.height = h;

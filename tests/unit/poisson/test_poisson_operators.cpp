@@ -78,8 +78,8 @@ TEST_P(OperatorSizes, GalerkinCoarseOperatorIsQuarterPtAP) {
     for (int j = 0; j < nc; ++j) {
         ec[j] = 1.0;
         fineVec.assign(static_cast<std::size_t>(w) * h, 0.0);
-        prolongate(w, h, ec, fineVec);                  // P e_j
-        applyA(fine, fineVec, aFine);                   // A P e_j
+        prolongate(w, h, ec, fineVec);                   // P e_j
+        applyA(fine, fineVec, aFine);                    // A P e_j
         restrictFullWeighting(w, h, aFine, restricted);  // ¼ Pᵀ A P e_j
         applyA(coarse, ec, aCoarse);
         for (int i = 0; i < nc; ++i) EXPECT_NEAR(aCoarse[i], restricted[i], 1e-12) << i << "," << j;
@@ -103,8 +103,8 @@ TEST_P(OperatorSizes, RestrictionIsQuarterTransposeOfProlongation) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sizes, OperatorSizes,
-                         ::testing::Values(std::pair{1, 1}, std::pair{1, 5}, std::pair{6, 1},
-                                           std::pair{4, 4}, std::pair{5, 3}, std::pair{7, 6}));
+                         ::testing::Values(std::pair{1, 1}, std::pair{1, 5}, std::pair{6, 1}, std::pair{4, 4},
+                                           std::pair{5, 3}, std::pair{7, 6}));
 
 TEST(Smoothers, JacobiSweepFollowsItsFormula) {
     const PoissonProblem p = weightedRandomProblem(5, 4, 31);

@@ -34,7 +34,11 @@ IterativeOptions tight(int maxIterations) {
 // Exact gradients + primal of an image: the energy is 0 at the image, so it is the unique
 // minimiser for any α > 0. Solved from x = 0 so that the solvers have real work to do.
 TEST(Reconstruction, ExactGradientsAndPrimalReturnTheImage) {
-    struct Case { const char* name; int w, h; Field image; };
+    struct Case {
+        const char* name;
+        int w, h;
+        Field image;
+    };
     const Case cases[] = {{"random", 13, 11, randomField(13, 11, 7)},
                           {"structured", 16, 9, structuredField(16, 9)},
                           {"hdr", 12, 12, hdrField(12, 12, 8)}};
@@ -62,7 +66,9 @@ TEST(Reconstruction, ExactGradientsAndPrimalReturnTheImage) {
         }
 }
 
-struct SizeCase { int w, h; };
+struct SizeCase {
+    int w, h;
+};
 
 class SolverAgreement : public ::testing::TestWithParam<SizeCase> {};
 
@@ -88,23 +94,20 @@ TEST_P(SolverAgreement, IterativeSolversMatchExact) {
             }
             const Field exact = solvePoissonL2(p, L2Method::Exact);
             EXPECT_LT(relativeError(solvePoissonL2(p, L2Method::Cg, tight(5000)), exact), 1e-6);
-            EXPECT_LT(relativeError(solvePoissonL2(p, L2Method::PcgMultigrid, tight(500)), exact),
-                      1e-6);
-            EXPECT_LT(relativeError(solvePoissonL2(p, L2Method::Multigrid, tight(3000)), exact),
-                      1e-6);
+            EXPECT_LT(relativeError(solvePoissonL2(p, L2Method::PcgMultigrid, tight(500)), exact), 1e-6);
+            EXPECT_LT(relativeError(solvePoissonL2(p, L2Method::Multigrid, tight(3000)), exact), 1e-6);
             // Jacobi's rate is 1 − O(α²/4) on smooth error: only test it where it converges
             // in a few thousand sweeps.
             if (alpha >= 0.2) {
-                EXPECT_LT(relativeError(solvePoissonL2(p, L2Method::Jacobi, tight(20000)), exact),
-                          1e-6);
+                EXPECT_LT(relativeError(solvePoissonL2(p, L2Method::Jacobi, tight(20000)), exact), 1e-6);
             }
         }
 }
 
 INSTANTIATE_TEST_SUITE_P(Sizes, SolverAgreement,
-                         ::testing::Values(SizeCase{1, 1}, SizeCase{1, 9}, SizeCase{8, 1},
-                                           SizeCase{2, 2}, SizeCase{5, 3}, SizeCase{16, 16},
-                                           SizeCase{17, 9}, SizeCase{31, 33}));
+                         ::testing::Values(SizeCase{1, 1}, SizeCase{1, 9}, SizeCase{8, 1}, SizeCase{2, 2},
+                                           SizeCase{5, 3}, SizeCase{16, 16}, SizeCase{17, 9},
+                                           SizeCase{31, 33}));
 
 // CG minimises the A-norm of the error over nested Krylov spaces, so ‖x_k − x*‖_A (= the
 // residual's A⁻¹-norm) never increases (the residual's 2-norm may).

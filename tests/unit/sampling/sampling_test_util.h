@@ -86,8 +86,8 @@ struct DirHistogram {
             for (int b = 0; b <= sub; ++b) {
                 double wb = (b == 0 || b == sub) ? 1.0 : (b % 2 ? 4.0 : 2.0);
                 double phi = (ip * sub + b) * hp;
-                gpu::vec3 w(static_cast<float>(st * std::cos(phi)),
-                            static_cast<float>(st * std::sin(phi)), static_cast<float>(ct));
+                gpu::vec3 w(static_cast<float>(st * std::cos(phi)), static_cast<float>(st * std::sin(phi)),
+                            static_cast<float>(ct));
                 sum += wa * wb * static_cast<double>(pdfSolidAngle(w)) * st;
             }
         }

@@ -42,11 +42,9 @@ std::vector<Config> chi2Configs() {
         {"metal_r0.7_75", makeBsdfParams(c, 1.0f, 0.7f, 1.0f, white, 1.5f), 75.0f},
         {"dielectric_r0.2_45", makeBsdfParams(c, 0.0f, 0.2f, 1.0f, white, 1.5f), 45.0f},
         {"dielectric_r0.2_85", makeBsdfParams(c, 0.0f, 0.2f, 1.0f, white, 1.5f), 85.0f},
-        {"mix_m0.5_r0.5_s0.5", makeBsdfParams(c, 0.5f, 0.5f, 0.5f, vec3(1.0f, 0.8f, 0.6f), 1.4f),
-         50.0f},
+        {"mix_m0.5_r0.5_s0.5", makeBsdfParams(c, 0.5f, 0.5f, 0.5f, vec3(1.0f, 0.8f, 0.6f), 1.4f), 50.0f},
         {"mirror_plus_diffuse", makeBsdfParams(c, 0.0f, 0.0f, 1.0f, white, 1.5f), 40.0f},
-        {"tinted_spec_r0.4", makeBsdfParams(c, 0.2f, 0.4f, 0.8f, vec3(0.2f, 1.0f, 2.0f), 2.0f),
-         60.0f},
+        {"tinted_spec_r0.4", makeBsdfParams(c, 0.2f, 0.4f, 0.8f, vec3(0.2f, 1.0f, 2.0f), 2.0f), 60.0f},
     };
 }
 
@@ -72,8 +70,7 @@ gdpt::stats::Chi2Result bsdfChi2(const Config& cfg, std::uint32_t seed) {
         }
     }
     std::vector<double> obs = hist.counts;
-    std::vector<double> expd =
-        hist.expected([&](vec3 wi) { return bsdfPdf(cfg.m, wo, wi); }, n);
+    std::vector<double> expd = hist.expected([&](vec3 wi) { return bsdfPdf(cfg.m, wo, wi); }, n);
     double sum = 0.0;
     for (double e : expd) {
         sum += e;
@@ -196,8 +193,8 @@ TEST(Bsdf, WhiteFurnaceAlbedoAtMostOne) {
                     // G2 = 2 cos_i / (1 + cos_i), so the albedo is 1 - ln 2 = 0.307; at 89 deg
                     // the Fresnel-coupled diffuse adds little (albedo ~0.15 for metallic 0).
                     if (thetaO <= 60.0f) {
-                        EXPECT_GT(st[c].mean, 0.28) << "energy lost: roughness " << r
-                                                   << " metallic " << mt << " theta_o " << thetaO;
+                        EXPECT_GT(st[c].mean, 0.28)
+                            << "energy lost: roughness " << r << " metallic " << mt << " theta_o " << thetaO;
                     }
                 }
             }
@@ -307,8 +304,7 @@ TEST(Bsdf, BelowSurfaceAndNaN) {
         for (float cosO : {1e-7f, 1e-4f, 1.0f}) {
             vec3 wo = vec3(safeSqrt(1.0f - cosO * cosO), 0.0f, cosO);
             for (int i = 0; i < 2000; ++i) {
-                vec3 u = i < 8 ? vec3(i & 1 ? kOneMinusEpsilon : 0.0f,
-                                      i & 2 ? kOneMinusEpsilon : 0.0f,
+                vec3 u = i < 8 ? vec3(i & 1 ? kOneMinusEpsilon : 0.0f, i & 2 ? kOneMinusEpsilon : 0.0f,
                                       i & 4 ? kOneMinusEpsilon : 0.0f)
                                : rnd.next3();
                 if (bsdfSample(g, wo, u, s)) {

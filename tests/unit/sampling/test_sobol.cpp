@@ -69,7 +69,8 @@ TEST(Sobol, EveryAlignedBlockIsANetForEveryScramble) {
         const uint sx = seed * 0x9E3779B9u + 7u, sy = seed * 0x85EBCA6Bu + 3u;
         for (uint m = 0; m <= 10; ++m)
             for (uint b = 0; b < 4; ++b)
-                ASSERT_TRUE(isNet(block(b << m, m, sx, sy), m)) << "seed " << seed << " m " << m << " block " << b;
+                ASSERT_TRUE(isNet(block(b << m, m, sx, sy), m))
+                    << "seed " << seed << " m " << m << " block " << b;
     }
     // The check can tell: with van der Corput in both coordinates (no second generator
     // matrix) the first four points lie on the diagonal, two in each of two 2x2 cells.

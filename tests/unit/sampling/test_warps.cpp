@@ -84,8 +84,7 @@ double integrateSphere(Pdf pdf, double thetaMax) {
         for (int j = 0; j < np; ++j) {
             double phi = (j + 0.5) * 2.0 * kPiD / np;
             vec3 w(static_cast<float>(std::sin(theta) * std::cos(phi)),
-                   static_cast<float>(std::sin(theta) * std::sin(phi)),
-                   static_cast<float>(std::cos(theta)));
+                   static_cast<float>(std::sin(theta) * std::sin(phi)), static_cast<float>(std::cos(theta)));
             sum += static_cast<double>(pdf(w)) * std::sin(theta);
         }
     }
@@ -93,11 +92,9 @@ double integrateSphere(Pdf pdf, double thetaMax) {
 }
 
 TEST(Warps, PdfsIntegrateToOne) {
-    EXPECT_NEAR(integrateSphere([](vec3 w) { return cosineHemispherePdf(w.z); }, kPiD), 1.0,
-                1e-4);
+    EXPECT_NEAR(integrateSphere([](vec3 w) { return cosineHemispherePdf(w.z); }, kPiD), 1.0, 1e-4);
     EXPECT_NEAR(integrateSphere([](vec3) { return uniformSpherePdf(); }, kPiD), 1.0, 1e-4);
-    EXPECT_NEAR(integrateSphere([](vec3) { return uniformHemispherePdf(); }, kPiD / 2), 1.0,
-                1e-4);
+    EXPECT_NEAR(integrateSphere([](vec3) { return uniformHemispherePdf(); }, kPiD / 2), 1.0, 1e-4);
 }
 
 // pdf = 1/|det J|: central differences (step 1e-3 in double-evaluated float maps give a
@@ -112,23 +109,23 @@ TEST(Warps, PdfMatchesJacobian) {
         float ox = 2.0f * u.x - 1.0f;
         float oy = 2.0f * u.y - 1.0f;
         if (std::fabs(std::fabs(ox) - std::fabs(oy)) > 4.0f * h) {
-            vec2 dx = (sampleConcentricDisk(u + vec2(h, 0.0f)) -
-                       sampleConcentricDisk(u - vec2(h, 0.0f))) / (2.0f * h);
-            vec2 dy = (sampleConcentricDisk(u + vec2(0.0f, h)) -
-                       sampleConcentricDisk(u - vec2(0.0f, h))) / (2.0f * h);
+            vec2 dx = (sampleConcentricDisk(u + vec2(h, 0.0f)) - sampleConcentricDisk(u - vec2(h, 0.0f))) /
+                      (2.0f * h);
+            vec2 dy = (sampleConcentricDisk(u + vec2(0.0f, h)) - sampleConcentricDisk(u - vec2(0.0f, h))) /
+                      (2.0f * h);
             EXPECT_NEAR(std::fabs(dx.x * dy.y - dx.y * dy.x), kPiD, 1e-2 * kPiD);
         }
         // Sphere: |dw/du0 x dw/du1| = 1/pdf = 4 pi.
-        vec3 sx = (sampleUniformSphere(u + vec2(h, 0.0f)) - sampleUniformSphere(u - vec2(h, 0.0f))) /
-                  (2.0f * h);
-        vec3 sy = (sampleUniformSphere(u + vec2(0.0f, h)) - sampleUniformSphere(u - vec2(0.0f, h))) /
-                  (2.0f * h);
+        vec3 sx =
+            (sampleUniformSphere(u + vec2(h, 0.0f)) - sampleUniformSphere(u - vec2(h, 0.0f))) / (2.0f * h);
+        vec3 sy =
+            (sampleUniformSphere(u + vec2(0.0f, h)) - sampleUniformSphere(u - vec2(0.0f, h))) / (2.0f * h);
         EXPECT_NEAR(length(cross(sx, sy)) * uniformSpherePdf(), 1.0f, 1e-2f);
         // Triangle: barycentric (b1, b2) area map, |det J| = 1/2 (area of the unit simplex).
-        vec3 tx = (sampleUniformTriangle(u + vec2(h, 0.0f)) -
-                   sampleUniformTriangle(u - vec2(h, 0.0f))) / (2.0f * h);
-        vec3 ty = (sampleUniformTriangle(u + vec2(0.0f, h)) -
-                   sampleUniformTriangle(u - vec2(0.0f, h))) / (2.0f * h);
+        vec3 tx = (sampleUniformTriangle(u + vec2(h, 0.0f)) - sampleUniformTriangle(u - vec2(h, 0.0f))) /
+                  (2.0f * h);
+        vec3 ty = (sampleUniformTriangle(u + vec2(0.0f, h)) - sampleUniformTriangle(u - vec2(0.0f, h))) /
+                  (2.0f * h);
         EXPECT_NEAR(std::fabs(tx.y * ty.z - tx.z * ty.y), 0.5f, 1e-2f);
     }
 }
@@ -154,8 +151,8 @@ TEST(Warps, CosineHemisphereChi2) {
 }
 
 TEST(Warps, UniformSphereChi2) {
-    auto r = warpChi2([](vec2 u) { return sampleUniformSphere(u); },
-                      [](vec3) { return uniformSpherePdf(); }, kPiD, 7u);
+    auto r = warpChi2([](vec2 u) { return sampleUniformSphere(u); }, [](vec3) { return uniformSpherePdf(); },
+                      kPiD, 7u);
     EXPECT_TRUE(r.error.empty()) << r.error;
     EXPECT_GT(r.pValue, gdpt::test::chi2Alpha()) << "chi2=" << r.statistic << " dof=" << r.dof;
 }
@@ -169,8 +166,7 @@ TEST(Warps, Chi2RejectsWrongPdf) {
 
 TEST(Basis, OrthonormalRightHanded) {
     Uniform rnd(9u);
-    vec3 special[4] = {vec3(0, 0, 1), vec3(0, 0, -1), normalize(vec3(1e-4f, 0, -1)),
-                       vec3(1, 0, 0)};
+    vec3 special[4] = {vec3(0, 0, 1), vec3(0, 0, -1), normalize(vec3(1e-4f, 0, -1)), vec3(1, 0, 0)};
     for (int i = 0; i < 20000; ++i) {
         vec3 n = i < 4 ? special[i] : sampleUniformSphere(rnd.next2());
         vec3 t;
@@ -194,8 +190,7 @@ TEST(Mis, PowerHeuristic) {
         for (float g : {0.2f, 1.0f, 7.0f}) {
             float ref = (f * f) / (f * f + 4.0f * g * g);
             EXPECT_NEAR(powerHeuristic(1.0f, f, 2.0f, g), ref, 1e-6f);
-            EXPECT_NEAR(powerHeuristic(1.0f, f, 2.0f, g) + powerHeuristic(2.0f, g, 1.0f, f),
-                        1.0f, 1e-6f);
+            EXPECT_NEAR(powerHeuristic(1.0f, f, 2.0f, g) + powerHeuristic(2.0f, g, 1.0f, f), 1.0f, 1e-6f);
             EXPECT_NEAR(powerHeuristicRatio(2.0f * g / f), ref, 1e-6f);
         }
     }

@@ -3,16 +3,16 @@
 // input next to its assertions.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 namespace gdpt::test {
 
@@ -22,8 +22,7 @@ constexpr int kFloat = 5126, kUInt = 5125, kUShort = 5123, kUByte = 5121;
 inline std::string testDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) /
-                                ("gdpt_scene_" + std::string(info->test_suite_name()) + "_" +
-                                 info->name());
+                                ("gdpt_scene_" + std::string(info->test_suite_name()) + "_" + info->name());
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     return dir.string();
@@ -51,8 +50,8 @@ public:
     }
     int addAccessor(int view, int componentType, std::size_t count, const std::string& type,
                     std::size_t byteOffset = 0) {
-        nlohmann::json a = {{"bufferView", view}, {"componentType", componentType},
-                            {"count", count}, {"type", type}};
+        nlohmann::json a = {
+            {"bufferView", view}, {"componentType", componentType}, {"count", count}, {"type", type}};
         if (byteOffset) a["byteOffset"] = byteOffset;
         doc["accessors"].push_back(a);
         return static_cast<int>(doc["accessors"].size() - 1);
@@ -145,8 +144,12 @@ public:
 };
 
 // One counter-clockwise triangle in the z = 0 plane facing +Z, with +Z normals.
-inline std::vector<glm::vec3> unitTriangle() { return {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}; }
-inline std::vector<glm::vec3> plusZNormals() { return {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}}; }
+inline std::vector<glm::vec3> unitTriangle() {
+    return {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+}
+inline std::vector<glm::vec3> plusZNormals() {
+    return {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
+}
 
 // A minimal valid file: one node with one triangle mesh named "Tri".
 inline TestGltf oneTriangle() {

@@ -2,11 +2,11 @@
 // element; no input crashes the loader. Each case starts from a valid file
 // (oneTriangle) and breaks exactly one thing, so a loader that ignored the defect would load
 // successfully and fail the test.
-#include <cmath>
-#include <limits>
-
 #include <gtest/gtest.h>
 #include <stb/stb_image_write.h>
+
+#include <cmath>
+#include <limits>
 
 #include "gltf_test_writer.h"
 #include "scene/gltf_loader.h"
@@ -25,7 +25,8 @@ void expectError(const std::string& path, const std::vector<std::string>& substr
     } catch (const Error& e) {
         const std::string msg = e.what();
         EXPECT_NE(msg.find(path), std::string::npos) << msg;
-        for (const auto& s : substrings) EXPECT_NE(msg.find(s), std::string::npos) << "'" << s << "' not in: " << msg;
+        for (const auto& s : substrings)
+            EXPECT_NE(msg.find(s), std::string::npos) << "'" << s << "' not in: " << msg;
     }
 }
 
@@ -39,7 +40,9 @@ TEST(GltfErrors, MissingFile) {
     expectError(test::testDir() + "/does_not_exist.gltf", {"cannot open"});
 }
 
-TEST(GltfErrors, DirectoryInsteadOfFile) { expectError(test::testDir(), {"not a regular file"}); }
+TEST(GltfErrors, DirectoryInsteadOfFile) {
+    expectError(test::testDir(), {"not a regular file"});
+}
 
 TEST(GltfErrors, BadJson) {
     const std::string path = test::testDir() + "/bad.gltf";
@@ -188,8 +191,8 @@ TEST(GltfErrors, ChildIndexOutOfRange) {
 
 TEST(GltfErrors, CameraIndexOutOfRange) {
     auto g = test::oneTriangle();
-    g.doc["cameras"] = nlohmann::json::array(
-        {{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}}}}});
+    g.doc["cameras"] =
+        nlohmann::json::array({{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}}}}});
     const int cam = g.addNode({{"name", "Cam"}, {"camera", 3}});
     g.setScene({0, cam});
     expectError(g.writeGltf(test::testDir(), "cam"),
@@ -205,8 +208,7 @@ TEST(GltfErrors, MeshIndexOutOfRange) {
 TEST(GltfErrors, MaterialIndexOutOfRange) {
     auto g = test::oneTriangle();
     g.doc["meshes"][0]["primitives"][0]["material"] = 3;
-    expectError(g.writeGltf(test::testDir(), "mat"),
-                {"mesh 'Tri' primitive 0: material 3 out of range"});
+    expectError(g.writeGltf(test::testDir(), "mat"), {"mesh 'Tri' primitive 0: material 3 out of range"});
 }
 
 TEST(GltfErrors, SceneIndexOutOfRange) {
@@ -230,8 +232,8 @@ TEST(GltfErrors, ImageBufferViewOutsideBuffer) {
     // tinygltf does not check this itself; it would hand the decoder a wild pointer.
     auto g = test::oneTriangle();
     g.doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 1 << 20}, {"byteLength", 64}});
-    g.doc["images"] = nlohmann::json::array(
-        {{{"bufferView", g.doc["bufferViews"].size() - 1}, {"mimeType", "image/png"}}});
+    g.doc["images"] =
+        nlohmann::json::array({{{"bufferView", g.doc["bufferViews"].size() - 1}, {"mimeType", "image/png"}}});
     expectError(g.writeGltf(test::testDir(), "imgbv"), {"image 0", "lies outside its buffer"});
 }
 
@@ -330,8 +332,8 @@ TEST(GltfErrors, BadRotation) {
 TEST(GltfErrors, MutatedFilesNeverCrash) {
     const std::string dir = test::testDir();
     auto g = test::oneTriangle();
-    g.doc["cameras"] = nlohmann::json::array(
-        {{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}}}}});
+    g.doc["cameras"] =
+        nlohmann::json::array({{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}}}}});
     g.addNode({{"camera", 0}, {"translation", {0, 0, 3}}});
     g.doc["scenes"][0]["nodes"].push_back(1);
     for (const std::string& src : {g.writeGlb(dir, "base"), g.writeGltf(dir, "base")}) {
@@ -376,8 +378,8 @@ TEST(GltfErrors, MutatedIndicesNeverCrash) {
             v->insert(v->end(), static_cast<unsigned char*>(data), static_cast<unsigned char*>(data) + size);
         },
         &png, 1, 1, 4, pixel, 4);
-    g.doc["cameras"] = nlohmann::json::array(
-        {{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}}}}});
+    g.doc["cameras"] =
+        nlohmann::json::array({{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}}}}});
     g.doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}}};
     g.addNode({{"camera", 0}, {"children", {}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
     g.doc["scenes"][0]["nodes"].push_back(1);

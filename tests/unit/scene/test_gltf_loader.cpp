@@ -2,12 +2,12 @@
 // transforms, .gltf/.glb equivalence, strips and fans, normals policy, materials, textures,
 // lights, cameras, scene selection and unsupported-feature reporting. Expected values are
 // worked out by hand in the comments, not computed with the code under test.
-#include <algorithm>
-#include <cmath>
-
-#include <glm/gtc/constants.hpp>
 #include <gtest/gtest.h>
 #include <stb/stb_image_write.h>
+
+#include <algorithm>
+#include <cmath>
+#include <glm/gtc/constants.hpp>
 
 #include "gltf_test_writer.h"
 #include "scene/gltf_loader.h"
@@ -33,8 +33,8 @@ bool hasUnsupported(const Scene& s, const std::string& needle) {
 
 glm::vec3 faceNormal(const Scene& s, std::size_t t) {
     const glm::uvec3 tri = s.triangles[t];
-    return glm::normalize(glm::cross(s.positions[tri.y] - s.positions[tri.x],
-                                     s.positions[tri.z] - s.positions[tri.x]));
+    return glm::normalize(
+        glm::cross(s.positions[tri.y] - s.positions[tri.x], s.positions[tri.z] - s.positions[tri.x]));
 }
 
 // Field-by-field equality of two scenes (normals within `normalTol`).
@@ -118,8 +118,8 @@ TEST(GltfLoader, SharedCornellBoxMatchesProcedural) {
 }
 
 TEST(GltfLoader, OwnCornellBoxMatchesProcedural) {
-    expectSameScene(loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.gltf"),
-                    makeCornellBox(), 2e-7f);
+    expectSameScene(loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.gltf"), makeCornellBox(),
+                    2e-7f);
 }
 
 TEST(GltfLoader, OwnGlossyAndFurnaceScenesLoadCleanly) {
@@ -148,11 +148,11 @@ TEST(GltfLoader, NestedTrsAndMatrixTransforms) {
     TestGltf g;
     // Triangle (0,0,0),(1,0,0),(0,1,0) with normal (1,1,0)/sqrt2 at every vertex.
     const float r = 1.0f / std::sqrt(2.0f);
-    const int mesh = g.addMesh({g.primitive(test::unitTriangle(), {0, 1, 2}, 4,
-                                            {{r, r, 0}, {r, r, 0}, {r, r, 0}})});
+    const int mesh =
+        g.addMesh({g.primitive(test::unitTriangle(), {0, 1, 2}, 4, {{r, r, 0}, {r, r, 0}, {r, r, 0}})});
     // Child: matrix = translation (0,0,1) (column-major, translation in elements 12..14).
-    const int child = g.addNode({{"mesh", mesh},
-                                 {"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 1, 1}}});
+    const int child =
+        g.addNode({{"mesh", mesh}, {"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 1, 1}}});
     // Parent: T (1,2,3) * R (90° about +Y: quaternion (0, sin45, 0, cos45)) * S (2,1,1).
     const int parent = g.addNode({{"children", {child}},
                                   {"translation", {1, 2, 3}},
@@ -214,10 +214,9 @@ TEST(GltfLoader, StripsAndFansBecomeTriangles) {
     const std::vector<glm::vec3> strip = {{0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {2, 0, 0}};
     // Fan around the origin: centre then 5 rim points counter-clockwise.
     std::vector<glm::vec3> fan = {{0, 0, 0}};
-    for (int i = 0; i < 5; ++i)
-        fan.emplace_back(std::cos(0.3f * float(i)), std::sin(0.3f * float(i)), 0.0f);
+    for (int i = 0; i < 5; ++i) fan.emplace_back(std::cos(0.3f * float(i)), std::sin(0.3f * float(i)), 0.0f);
     const int mesh = g.addMesh({g.primitive(strip, {0, 1, 2, 3, 4}, 5),  // indexed strip
-                                g.primitive(fan, {}, 6)});                // non-indexed fan
+                                g.primitive(fan, {}, 6)});               // non-indexed fan
     g.setScene({g.addNode({{"mesh", mesh}})});
     const Scene s = loadGltf(g.writeGltf(test::testDir(), "strip"));
     // Strip: n-2 = 3 triangles, §3.7.2.1: (0,1,2), (1,3,2), (2,3,4) — alternate ones reversed
@@ -235,10 +234,10 @@ TEST(GltfLoader, StripsAndFansBecomeTriangles) {
 
 TEST(GltfLoader, LinesArePointsAreReportedNotRendered) {
     TestGltf g;
-    const int mesh = g.addMesh({g.primitive(test::unitTriangle(), {}, 1),
-                                g.primitive(test::unitTriangle(), {}, 0),
-                                g.primitive(test::unitTriangle(), {}, 4)},
-                               "Mixed");
+    const int mesh =
+        g.addMesh({g.primitive(test::unitTriangle(), {}, 1), g.primitive(test::unitTriangle(), {}, 0),
+                   g.primitive(test::unitTriangle(), {}, 4)},
+                  "Mixed");
     g.setScene({g.addNode({{"mesh", mesh}})});
     const Scene s = loadGltf(g.writeGltf(test::testDir(), "lines"));
     EXPECT_EQ(s.triangles.size(), 1u);
@@ -264,7 +263,7 @@ TEST(GltfLoader, MissingNormalsBecomeFlatWhereOthersHaveThem) {
     // Without normals anywhere, Scene::normals stays empty and vertices stay shared.
     TestGltf h;
     h.setScene({h.addNode({{"mesh", h.addMesh({h.primitive(bent, {0, 1, 2, 0, 2, 3})})}})});
-    const Scene t = loadGltf(h.writeGltf(test::testDir() , "none"));
+    const Scene t = loadGltf(h.writeGltf(test::testDir(), "none"));
     EXPECT_TRUE(t.normals.empty());
     EXPECT_EQ(t.positions.size(), 4u);
 }
@@ -299,8 +298,8 @@ TEST(GltfLoader, MaterialsAndDefaults) {
     TestGltf g;
     const int m = g.addMaterial(
         {{"name", "Glow"},
-         {"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.25, 1, 0.8}}, {"metallicFactor", 0.3},
-                                   {"roughnessFactor", 0.6}}},
+         {"pbrMetallicRoughness",
+          {{"baseColorFactor", {0.5, 0.25, 1, 0.8}}, {"metallicFactor", 0.3}, {"roughnessFactor", 0.6}}},
          {"emissiveFactor", {1, 0.5, 0.25}},
          {"alphaMode", "MASK"},
          {"alphaCutoff", 0.3},
@@ -357,10 +356,10 @@ TEST(GltfLoader, TexturesDecodedSrgbAndLinear) {
     g.doc["images"] = nlohmann::json::array({{{"bufferView", view}, {"mimeType", "image/png"}}});
     g.doc["samplers"] = nlohmann::json::array({{{"wrapS", 33071}}});  // CLAMP_TO_EDGE
     g.doc["textures"] = nlohmann::json::array({{{"source", 0}, {"sampler", 0}}});
-    const int m = g.addMaterial(
-        {{"pbrMetallicRoughness",
-          {{"baseColorTexture", {{"index", 0}}}, {"metallicRoughnessTexture", {{"index", 0}}}}},
-         {"normalTexture", {{"index", 0}}}});
+    const int m =
+        g.addMaterial({{"pbrMetallicRoughness",
+                        {{"baseColorTexture", {{"index", 0}}}, {"metallicRoughnessTexture", {{"index", 0}}}}},
+                       {"normalTexture", {{"index", 0}}}});
     const int mesh = g.addMesh({g.primitive(test::unitTriangle(), {}, 4, {}, m)});
     g.setScene({g.addNode({{"mesh", mesh}})});
     const Scene s = loadGltf(g.writeGlb(test::testDir(), "tex"));
@@ -377,7 +376,7 @@ TEST(GltfLoader, TexturesDecodedSrgbAndLinear) {
     EXPECT_NEAR(srgb.texels[0].r, 0.21586f, 1e-4f);
     EXPECT_EQ(srgb.texels[0].b, 1.0f);
     EXPECT_NEAR(srgb.texels[1].a, 128.0f / 255.0f, 1e-6f);  // alpha stays linear
-    EXPECT_NEAR(srgb.texels[3].r, 0.05127f, 1e-4f);          // sRGB 64 -> 0.05127, bottom row
+    EXPECT_NEAR(srgb.texels[3].r, 0.05127f, 1e-4f);         // sRGB 64 -> 0.05127, bottom row
     EXPECT_NEAR(lin.texels[0].r, 128.0f / 255.0f, 1e-6f);
     EXPECT_NEAR(lin.texels[3].g, 64.0f / 255.0f, 1e-6f);
     EXPECT_TRUE(hasUnsupported(s, "normal textures are ignored"));
@@ -389,13 +388,17 @@ TEST(GltfLoader, PunctualLightsFromNodes) {
     g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
     g.doc["extensions"]["KHR_lights_punctual"]["lights"] = {
         {{"type", "point"}, {"color", {1, 0.5, 0.25}}, {"intensity", 8}},
-        {{"type", "spot"}, {"intensity", 2}, {"range", 10},
+        {{"type", "spot"},
+         {"intensity", 2},
+         {"range", 10},
          {"spot", {{"innerConeAngle", 0.2}, {"outerConeAngle", 0.4}}}},
         {{"type", "directional"}, {"name", "Sun"}}};
     const float r = 1.0f / std::sqrt(2.0f);
-    const int p = g.addNode({{"translation", {1, 2, 3}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    const int p =
+        g.addNode({{"translation", {1, 2, 3}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
     // Spot rotated -90° about X: local -Z points to world -Y (straight down).
-    const int sp = g.addNode({{"translation", {0, 5, 0}}, {"rotation", {-r, 0, 0, r}},
+    const int sp = g.addNode({{"translation", {0, 5, 0}},
+                              {"rotation", {-r, 0, 0, r}},
                               {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
     const int sun = g.addNode({{"extensions", {{"KHR_lights_punctual", {{"light", 2}}}}}});
     g.setScene({0, p, sp, sun});
@@ -416,9 +419,12 @@ TEST(GltfLoader, PunctualLightsFromNodes) {
 TEST(GltfLoader, CamerasInTraversalOrder) {
     auto g = test::oneTriangle();
     g.doc["cameras"] = {
-        {{"name", "A"}, {"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}, {"aspectRatio", 1.5}}}},
+        {{"name", "A"},
+         {"type", "perspective"},
+         {"perspective", {{"yfov", 0.5}, {"znear", 0.1}, {"aspectRatio", 1.5}}}},
         {{"name", "B"}, {"type", "perspective"}, {"perspective", {{"yfov", 0.7}, {"znear", 0.1}}}},
-        {{"name", "O"}, {"type", "orthographic"},
+        {{"name", "O"},
+         {"type", "orthographic"},
          {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0.1}, {"zfar", 10}}}}};
     const float r = 1.0f / std::sqrt(2.0f);
     // Camera B sits under a parent translated by (0,0,5), rotated +90° about Y: local -Z

@@ -3,14 +3,14 @@
 // including rays straight through vertices and edge midpoints, the cases where a leaky mesh
 // or an edge-exclusive test would miss), the emissive quad fills the view, and the benchmark
 // scene hits its triangle target deterministically.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdint>
+#include <glm/gtc/constants.hpp>
 #include <map>
 #include <optional>
 #include <utility>
-
-#include <glm/gtc/constants.hpp>
-#include <gtest/gtest.h>
 
 #include "scene/procedural.h"
 
@@ -85,7 +85,7 @@ TEST(Procedural, FurnaceSphereIsClosedAndSeenFromInsideByFrontFaces) {
 
     std::vector<glm::dvec3> dirs = randomDirections(2000, 7u);
     for (const auto& t : s.triangles) {
-        dirs.push_back(glm::dvec3(s.positions[t.x]));                              // vertex
+        dirs.push_back(glm::dvec3(s.positions[t.x]));                                 // vertex
         dirs.push_back(glm::dvec3(s.positions[t.x]) + glm::dvec3(s.positions[t.y]));  // edge
     }
     for (const auto& d : dirs) {

@@ -2,6 +2,8 @@
 // every file loads cleanly, and each scene has the property it is in the set for: the small
 // light has the default light's power, the textured scene carries its 256x256 texture, and
 // the indirect-gap scene never shows its light to a camera ray.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -10,8 +12,6 @@
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "scene/gltf_loader.h"
 
@@ -96,12 +96,9 @@ struct Expected {
 
 // Every scene of the set, with sane triangle and emissive-triangle ranges.
 constexpr Expected kSet[] = {
-    {"cornell_box.gltf", 36, 36, 2, 2},
-    {"glossy_cornell.gltf", 1000, 2000, 2, 2},
-    {"furnace.gltf", 1280, 1280, 1280, 1280},
-    {"small_light.gltf", 36, 36, 2, 2},
-    {"indirect_gap.gltf", 40, 200, 2, 2},
-    {"textured.gltf", 36, 36, 2, 2},
+    {"cornell_box.gltf", 36, 36, 2, 2},       {"glossy_cornell.gltf", 1000, 2000, 2, 2},
+    {"furnace.gltf", 1280, 1280, 1280, 1280}, {"small_light.gltf", 36, 36, 2, 2},
+    {"indirect_gap.gltf", 40, 200, 2, 2},     {"textured.gltf", 36, 36, 2, 2},
 };
 
 TEST(SceneSet, EveryFileIsListedAndLoadsCleanly) {
@@ -114,8 +111,8 @@ TEST(SceneSet, EveryFileIsListedAndLoadsCleanly) {
     ASSERT_FALSE(files.empty());
     for (const std::string& f : files) {
         SCOPED_TRACE(f);
-        const auto* e = std::find_if(std::begin(kSet), std::end(kSet),
-                                     [&](const Expected& x) { return f == x.file; });
+        const auto* e =
+            std::find_if(std::begin(kSet), std::end(kSet), [&](const Expected& x) { return f == x.file; });
         ASSERT_NE(e, std::end(kSet)) << "scene not covered by this test";
         Scene s;
         ASSERT_NO_THROW(s = loadClean(f));
@@ -172,8 +169,8 @@ TEST(SceneSet, TexturedSceneSamplesItsDetailTexture) {
         if (s.materials[s.triangleMaterial[t]].baseColorTex == 0) ++textured;
     EXPECT_EQ(textured, 4u);
     ASSERT_EQ(s.uvs.size(), s.positions.size());
-    const auto [umin, umax] = std::minmax_element(s.uvs.begin(), s.uvs.end(),
-                                                  [](glm::vec2 a, glm::vec2 b) { return a.x < b.x; });
+    const auto [umin, umax] =
+        std::minmax_element(s.uvs.begin(), s.uvs.end(), [](glm::vec2 a, glm::vec2 b) { return a.x < b.x; });
     EXPECT_LT(umin->x, 0.0f);
     EXPECT_GT(umax->x, 0.0f);
 }

@@ -5,9 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <random>
-
 #include <glm/glm.hpp>
+#include <random>
 
 #include "gdpt_shared.h"
 #include "lib/shift.glsl"
@@ -29,14 +28,20 @@ public:
         const double r = std::sqrt(1.0 - z * z);
         return dvec3(r * std::cos(phi), r * std::sin(phi), z);
     }
-    dvec3 point(double extent) { return dvec3(uniform(-extent, extent), uniform(-extent, extent), uniform(-extent, extent)); }
+    dvec3 point(double extent) {
+        return dvec3(uniform(-extent, extent), uniform(-extent, extent), uniform(-extent, extent));
+    }
 
 private:
     std::mt19937 gen_;
 };
 
-vec3 toF(dvec3 v) { return vec3(v); }
-dvec3 toD(vec3 v) { return dvec3(v); }
+vec3 toF(dvec3 v) {
+    return vec3(v);
+}
+dvec3 toD(vec3 v) {
+    return dvec3(v);
+}
 
 // Two unit vectors orthogonal to unit w (tangent plane of the sphere of directions at w).
 void tangents(dvec3 w, dvec3& t1, dvec3& t2) {
@@ -107,9 +112,9 @@ TEST(ShiftReconnection, ReverseJacobianIsReciprocal) {
 
 TEST(ShiftReconnection, DegenerateConfigurationsGiveZero) {
     const vec3 n(0, 0, 1);
-    EXPECT_EQ(reconnectionJacobian(vec3(0), vec3(1, 0, 1), vec3(0), n), 0.0f);         // base at target
-    EXPECT_EQ(reconnectionJacobian(vec3(1, 0, 0), vec3(0, 0, 1), vec3(0), n), 0.0f);   // grazing base edge
-    EXPECT_EQ(reconnectionJacobian(vec3(0, 0, 1), vec3(0), vec3(0), n), 0.0f);         // offset at target
+    EXPECT_EQ(reconnectionJacobian(vec3(0), vec3(1, 0, 1), vec3(0), n), 0.0f);        // base at target
+    EXPECT_EQ(reconnectionJacobian(vec3(1, 0, 0), vec3(0, 0, 1), vec3(0), n), 0.0f);  // grazing base edge
+    EXPECT_EQ(reconnectionJacobian(vec3(0, 0, 1), vec3(0), vec3(0), n), 0.0f);        // offset at target
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -374,10 +379,14 @@ TEST(ShiftMis, FourStrategyWeightsOfForwardAndReverseSumToOne) {
         const float prefixRatio = static_cast<float>(std::pow(10.0, src.uniform(-4, 4)));
         const float j = reconnectionJacobian(toF(a), toF(aOffset), toF(y), toF(nLight));
         const float jRev = reconnectionJacobian(toF(aOffset), toF(a), toF(y), toF(nLight));
-        const float fB = gptMisWeight(float(pB), float(pL), prefixRatio * j * float(pBo), prefixRatio * j * float(pLo));
-        const float fL = gptMisWeight(float(pL), float(pB), prefixRatio * j * float(pLo), prefixRatio * j * float(pBo));
-        const float rB = gptMisWeight(float(pBo), float(pLo), jRev * float(pB) / prefixRatio, jRev * float(pL) / prefixRatio);
-        const float rL = gptMisWeight(float(pLo), float(pBo), jRev * float(pL) / prefixRatio, jRev * float(pB) / prefixRatio);
+        const float fB =
+            gptMisWeight(float(pB), float(pL), prefixRatio * j * float(pBo), prefixRatio * j * float(pLo));
+        const float fL =
+            gptMisWeight(float(pL), float(pB), prefixRatio * j * float(pLo), prefixRatio * j * float(pBo));
+        const float rB = gptMisWeight(float(pBo), float(pLo), jRev * float(pB) / prefixRatio,
+                                      jRev * float(pL) / prefixRatio);
+        const float rL = gptMisWeight(float(pLo), float(pBo), jRev * float(pL) / prefixRatio,
+                                      jRev * float(pB) / prefixRatio);
         EXPECT_NEAR(fB + fL + rB + rL, 1.0f, 2e-5f) << "config " << i;
         // The light pdf in the base's measure is the same for both (same light point):
         // pL' J = pL (the offset reconnects to the base's light point; the identity gpt.comp
@@ -418,7 +427,8 @@ TEST(ShiftClassification, ByLowestRoughnessOverAllComponents) {
     // Coated mirror: its diffuse lobe is rough, the vertex as a whole is not.
     EXPECT_FALSE(shiftIsRough(shiftRoughnessAll(coatedMirror), thr));
     // Black emitter material: nothing to shift through, counts as rough.
-    EXPECT_TRUE(shiftIsRough(shiftRoughnessAll(makeBsdfParams(vec3(0.0f), 0.0f, 1.0f, 0.0f, vec3(1.0f), 1.5f)), thr));
+    EXPECT_TRUE(
+        shiftIsRough(shiftRoughnessAll(makeBsdfParams(vec3(0.0f), 0.0f, 1.0f, 0.0f, vec3(1.0f), 1.5f)), thr));
 }
 
 TEST(ShiftClassification, ReconnectionAndInvertibilityRules) {

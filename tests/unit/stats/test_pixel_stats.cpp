@@ -6,11 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <glm/glm.hpp>
 #include <limits>
 #include <random>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "gdpt_shared.h"
 #include "lib/pixel_stats.glsl"

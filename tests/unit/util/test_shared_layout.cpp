@@ -2,9 +2,9 @@
 // pinned here. GLSL's scalar layout packs members at their natural 4-byte alignment, so the
 // C++ offsets below must equal the sums of the member sizes (the GPU sentinel test
 // tests/gpu/test_layout_gpu.cpp checks the GLSL side).
-#include <cstddef>
-
 #include <gtest/gtest.h>
+
+#include <cstddef>
 
 #include "gdpt_shared.h"
 
@@ -44,9 +44,9 @@ static_assert(offsetof(Counters, shiftFailures) == 20);
 static_assert(sizeof(TestRay) == 32);
 
 TEST(SharedLayout, BindingsAreDistinct) {
-    const uint bindings[] = {kBindTriGeom, kBindTriShading, kBindBvh, kBindMaterials, kBindTexInfo,
-                             kBindTexels, kBindLightTris, kBindPunctual, kBindSceneConst, kBindAccum,
-                             kBindCounters, kBindTestInput, kBindTestOutput, kBindTestOutput2};
+    const uint bindings[] = {kBindTriGeom,  kBindTriShading, kBindBvh,        kBindMaterials,  kBindTexInfo,
+                             kBindTexels,   kBindLightTris,  kBindPunctual,   kBindSceneConst, kBindAccum,
+                             kBindCounters, kBindTestInput,  kBindTestOutput, kBindTestOutput2};
     for (std::size_t i = 0; i < std::size(bindings); ++i)
         for (std::size_t j = i + 1; j < std::size(bindings); ++j) EXPECT_NE(bindings[i], bindings[j]);
 }
