@@ -1,5 +1,5 @@
 // edge.comp — finds the pixels that a geometric edge crosses, for G-PT's extra samples there
-// (EdgePass, src/render/edge_pass.h). One invocation = one pixel; writes mask[p] = 1 if the
+// (EdgePass, src/render/passes/edge_pass.h). One invocation = one pixel; writes mask[p] = 1 if the
 // pixel holds an edge, else 0, and probe[p] = what its first probe ray hit (EdgeProbe), which
 // the host compares across neighbouring pixels for first-hit demodulation.
 //

@@ -33,8 +33,8 @@ struct RenderArgs {
     std::string splitBounce = "auto";  // G-PT: auto, on, off (GptPassOptions::SplitBounce)
     std::uint32_t emitterSupersampling =
         kDefaultEmitterSupersampling;                 // render/passes/emitter_supersampling_pass.h
-    std::uint32_t edgeSamples = kDefaultEdgeSamples;  // G-PT: render/edge_pass.h
-    std::string demodulate = "auto";                  // G-PT: auto, on, off (Demodulation, render/gpt_pass.h)
+    std::uint32_t edgeSamples = kDefaultEdgeSamples;  // G-PT: render/passes/edge_pass.h
+    std::string demodulate = "auto";  // G-PT: auto, on, off (Demodulation, render/passes/gpt_pass.h)
     std::string recon = "l1";
     double alpha = 0.2;
     double tolerance = 1e-4;

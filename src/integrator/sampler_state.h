@@ -5,7 +5,7 @@
 //   G-PT: 11 = the ten per-pixel statistics of gpt.comp in binding order (central, four
 //         neighbours, four gradients, direct), then emitter supersampling's; 12 with
 //         demodulation, whose modulation statistics come last.
-// Checkpoints (render/checkpoint.h) store it; RenderOptions::resume restores it.
+// Checkpoints (integrator/checkpoint.h) store it; RenderOptions::resume restores it.
 #pragma once
 
 #include <cstdint>

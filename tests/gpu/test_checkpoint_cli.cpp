@@ -62,7 +62,7 @@ std::uint64_t pathsCompleted(const std::string& jsonPath) {
 }
 
 // Paths per camera sample of a render's --json: one per pixel, and G-PT's edge pixels
-// (render/edge_pass.h) `factor` more each.
+// (render/passes/edge_pass.h) `factor` more each.
 std::uint64_t pathsPerSample(const std::string& jsonPath, std::uint64_t pixels) {
     std::ifstream in(jsonPath);
     const auto j = nlohmann::json::parse(in);
@@ -183,7 +183,7 @@ TEST_F(CheckpointRefusal, CheckpointOfAnotherRenderIsRefused) {
     EXPECT_FALSE(fs::exists(path("out.exr")));
 }
 
-// G-PT records its edge samples per camera sample (render/edge_pass.h): a checkpoint
+// G-PT records its edge samples per camera sample (render/passes/edge_pass.h): a checkpoint
 // continues only with the same factor.
 TEST_F(CheckpointRefusal, GptCheckpointWithOtherEdgeSamplesIsRefused) {
     expectGptOptionRefused("--edge-samples 2", "--edge-samples 3", "edge_samples");

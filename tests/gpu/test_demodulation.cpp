@@ -1,4 +1,4 @@
-// G-PT's first-hit texture demodulation (gpt.comp kDemodulate, render/gpt_pass.h).
+// G-PT's first-hit texture demodulation (gpt.comp kDemodulate, render/passes/gpt_pass.h).
 //
 // - demodulationMask keeps exactly the pixels whose 3x3 neighbourhood shows one surface: hand-
 //   placed misses, a change of material, a step in depth and an edge pixel of the probe each

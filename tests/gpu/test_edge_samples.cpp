@@ -1,5 +1,5 @@
 // G-PT's extra samples in the pixels that a geometric edge crosses (edge.comp,
-// render/edge_pass.h), against closed forms: with the camera looking straight down at planes
+// render/passes/edge_pass.h), against closed forms: with the camera looking straight down at planes
 // parallel to the image, a rectangle's edges project to straight image lines, placed here on
 // pixel centres, so the pixels whose quarter probes (at x + 0.25 and x + 0.75) straddle an
 // edge are known exactly, with a quarter pixel to spare on either side. The probe must find
