@@ -163,7 +163,6 @@ int runRender(const RenderArgs& args) {
     Timer total;
     RenderOptions options = renderOptionsFor(args);
     const ReconTimeCache cache(ReconTimeCache::defaultPath());
-    const std::unique_ptr<Integrator> integrator = integratorFor(args, &cache);
 
     const Scene scene = loadGltf(args.scene);
     if (!scene.unsupported.empty() && !args.quiet) {
@@ -180,6 +179,8 @@ int runRender(const RenderArgs& args) {
     if (!args.quiet)
         std::fprintf(stderr, "gdpt: device '%s' (%s, %s)\n", ctx.info().name.c_str(), ctx.info().type.c_str(),
                      ctx.info().driverInfo.c_str());
+    // After the context: the integrator's device objects (G-PT's solver) go before it.
+    const std::unique_ptr<Integrator> integrator = integratorFor(args, &cache);
 
     // --time covers the whole render: sampling stops early by what the method needs after it
     // (G-PT: the reconstructions) and by what the rest took the last time for this device,

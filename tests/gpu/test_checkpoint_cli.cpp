@@ -129,7 +129,7 @@ protected:
     void SetUp() override {
         TempDirTest::SetUp();
         const RunResult r =
-            test::runGdpt("render " + kScene + kSize + "--spp 3 --seed 7 --quiet --checkpoint " +
+            test::runGdpt("render " + kScene + kSize + "--method pt --spp 3 --seed 7 --quiet --checkpoint " +
                           path("c.exr") + " -o " + path("a.exr"));
         ASSERT_EQ(r.code, 0) << r.output;
     }
@@ -160,13 +160,14 @@ protected:
 
 TEST_F(CheckpointRefusal, CheckpointOfAnotherRenderIsRefused) {
     const std::string c = path("c.exr");
-    const std::string same = kSize + "--spp 8 --seed 7";
-    expectRefused(c, kSize + "--spp 8 --seed 8", "seed");
-    expectRefused(c, " --width 16 --height 15 --spp 8 --seed 7", "height");
-    expectRefused(c, same + " --method gpt", "method");
+    // The checkpoint is PT's (SetUp); gpt is the default method.
+    const std::string same = kSize + "--method pt --spp 8 --seed 7";
+    expectRefused(c, kSize + "--method pt --spp 8 --seed 8", "seed");
+    expectRefused(c, " --width 16 --height 15 --method pt --spp 8 --seed 7", "height");
+    expectRefused(c, kSize + "--spp 8 --seed 7", "method");
     expectRefused(c, same + " --max-depth 3", "max_depth");
     expectRefused(c, same + " --env 0.5", "env");
-    expectRefused(c, kSize + "--spp 2 --seed 7", "more than --spp 2");
+    expectRefused(c, kSize + "--method pt --spp 2 --seed 7", "more than --spp 2");
     // Another scene: the same file name and geometry, a slightly wider camera.
     const std::string other = path("cornell_box.gltf");
     std::ifstream in(kScene);

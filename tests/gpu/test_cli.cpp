@@ -119,7 +119,7 @@ TEST_F(Cli, SmallValidatedRenderWritesExrPngAndJson) {
     const std::string out = path("cb.exr");
     const std::string json = path("cb.json");
     const RunResult r = run("render " + kScene + " -o " + out +
-                            " --width 24 --height 16 --spp 4 --validate --quiet "
+                            " --method pt --width 24 --height 16 --spp 4 --validate --quiet "
                             "--profile --json " +
                             json);
     ASSERT_EQ(r.code, 0) << r.output;
