@@ -11,7 +11,7 @@ namespace gdpt {
 
 // Default rays per camera sample in a refined pixel (`gdpt render --emitter-supersampling`).
 // On the Cornell box G-PT at 4-16 spp, 16 took the light rim's share of relMSE from 40-60 %
-// to a few percent at about 1 % more rays (bench/RESULTS.md, fifth session).
+// to a few percent at about 1 % more rays (bench/RESULTS.md, emitter supersampling).
 constexpr std::uint32_t kDefaultEmitterSupersampling = 16;
 // Upper bound of the factor: keeps the Sobol' index (factor × samples per pixel) within 32
 // bits up to the 2^24 samples that PixelStats counts exactly.
