@@ -10,7 +10,7 @@
 //  * All storage blocks use layout(scalar) (GL_EXT_scalar_block_layout); glm's 12-byte vec3
 //    then matches GLSL. Sizes and offsets are pinned by static_asserts in
 //    tests/unit/util/test_shared_layout.cpp and by a GPU sentinel test
-//    (tests/gpu/test_layout_gpu.cpp).
+//    (tests/gpu/device_scene/test_layout_gpu.cpp).
 //  * No bool in shared structs: use uint flags.
 //  * Append-only: new fields go at the end of a struct. Every field says its units/space.
 #ifndef GDPT_SHARED_H
@@ -295,7 +295,7 @@ kSpecWorkgroupX = 0u,
         14u  // gpt.comp: first-hit texture demodulation is on (gpt_shared.h kBindGptDemodMask)
     GDPT_ENUM_END();
 
-// A ray of the BVH tests (tests/gpu/test_bvh_gpu.cpp). 32 bytes.
+// A ray of the BVH tests (tests/gpu/device_scene/test_bvh_gpu.cpp). 32 bytes.
 struct TestRay {
     vec3 origin;  // world space
     float tMin;

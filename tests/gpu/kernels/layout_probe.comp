@@ -1,6 +1,6 @@
 // layout_probe.comp — test kernel: writes a distinct sentinel into every field of the shared
 // structs, so the host can check that C++ and GLSL agree on every offset
-// (tests/gpu/test_layout_gpu.cpp).
+// (tests/gpu/device_scene/test_layout_gpu.cpp).
 // Sentinel of field k (counting scalar components in declaration order from 1) is k.
 #version 460
 #extension GL_EXT_scalar_block_layout : require

@@ -76,7 +76,7 @@ void expectSameScene(const Scene& a, const Scene& b, float normalTol) {
 // ---------------------------------------------------------------------------------------
 
 // ../shared/scenes/cbox/cbox.gltf: the Cornell box in Bitterli's layout, the scene of the
-// independent reference image that tests/gpu/test_cbox_reference.cpp compares against (data
+// independent reference image that tests/gpu/integrator/test_cbox_reference.cpp compares against (data
 // outside the repository, so that gdpt's tests cannot have shaped it).
 std::string sharedCbox() {
     return test::sharedDataPath("scenes/cbox/cbox.gltf");

@@ -1,7 +1,7 @@
 // Host/shader layout, host side: sizes and offsets of every shared struct are
 // pinned here. GLSL's scalar layout packs members at their natural 4-byte alignment, so the
 // C++ offsets below must equal the sums of the member sizes (the GPU sentinel test
-// tests/gpu/test_layout_gpu.cpp checks the GLSL side).
+// tests/gpu/device_scene/test_layout_gpu.cpp checks the GLSL side).
 #include <gtest/gtest.h>
 
 #include <cstddef>
