@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "app/bench_util.h"
+#include "app/cli.h"
 #include "app/subcommand.h"
 #include "bvh/builder.h"
 #include "integrator/pt_sampler.h"
@@ -41,21 +42,12 @@ Scene benchScene(const std::string& name) {
     throw UsageError("--scenes: unknown scene '" + name + "' (cbox, 10k, 100k, 1m)");
 }
 
-WorkgroupSize parseWg(const std::string& s) {
-    unsigned x = 0, y = 0;
-    char sep = 0;
-    std::istringstream in(s);
-    if (!(in >> x >> sep >> y) || sep != 'x' || x == 0 || y == 0 || x * y > 1024)
-        throw UsageError("--workgroup '" + s + "' must be WxH, e.g. 8x8");
-    return {x, y};
-}
-
 int runBench(const BenchArgs& a) {
     using nlohmann::json;
     vk::ContextOptions co;
     co.device = a.device;
     vk::Context ctx(co);
-    const WorkgroupSize wg = parseWg(a.workgroup);
+    const WorkgroupSize wg = parseWorkgroup(a.workgroup);
     json out = {{"device", ctx.info().name},
                 {"driver", ctx.info().driverInfo},
                 {"width", a.width},

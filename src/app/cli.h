@@ -6,6 +6,7 @@
 #include <glm/glm.hpp>
 #include <string>
 
+#include "render/device_scene/scene_spec.h"
 #include "render/passes/edge_options.h"
 #include "render/passes/emitter_supersampling_options.h"
 
@@ -61,5 +62,8 @@ struct DevicesArgs {
 
 // Parses "R,G,B" (or a single value for gray) into a colour; throws gdpt::UsageError.
 glm::vec3 parseColor(const std::string& text, const std::string& flag);
+
+// Parses --workgroup "WxH" (W*H <= 1024); throws gdpt::UsageError.
+WorkgroupSize parseWorkgroup(const std::string& text);
 
 }  // namespace gdpt

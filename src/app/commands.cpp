@@ -21,6 +21,15 @@ namespace gdpt {
 
 using nlohmann::json;
 
+WorkgroupSize parseWorkgroup(const std::string& text) {
+    unsigned x = 0, y = 0;
+    char sep = 0;
+    std::istringstream in(text);
+    if (!(in >> x >> sep >> y) || sep != 'x' || x == 0 || y == 0 || x * y > 1024)
+        throw UsageError("--workgroup '" + text + "' must be WxH with W*H <= 1024, e.g. 8x8");
+    return {x, y};
+}
+
 glm::vec3 parseColor(const std::string& text, const std::string& flag) {
     std::vector<float> v;
     std::stringstream in(text);

@@ -96,7 +96,7 @@ public:
         // before the clock starts: it is calibration, not part of the run. Sampling gets the
         // rest.
         const double reserve = integrator.reserveAfterSampling(ctx_, a_.width, a_.height);
-        o.timeBudget = reserve > 0.0 ? std::max(0.05 * budget, budget - reserve) : budget;
+        o.timeBudget = std::max(0.05 * budget, budget - reserve);
         Timer total;
         const RenderOutput out = integrator.render(ctx_, scene_, o);
         r.seconds = total.seconds();

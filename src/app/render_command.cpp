@@ -38,15 +38,6 @@ extern "C" void onInterrupt(int) {
     gInterrupted.store(true);
 }
 
-WorkgroupSize parseWorkgroup(const std::string& text) {
-    unsigned x = 0, y = 0;
-    char sep = 0;
-    std::istringstream in(text);
-    if (!(in >> x >> sep >> y) || sep != 'x' || x == 0 || y == 0 || x * y > 1024)
-        throw UsageError("--workgroup '" + text + "' must be WxH with W*H <= 1024, e.g. 8x8");
-    return {x, y};
-}
-
 std::string previewPath(const std::string& exrPath) {
     const auto dot = exrPath.rfind('.');
     const auto slash = exrPath.rfind('/');

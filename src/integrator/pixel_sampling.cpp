@@ -36,13 +36,14 @@ PixelSampling::PixelSampling(const vk::Context& ctx, const Scene& scene, const R
     stats_.uploadMs = phase.ms() - stats_.bvhBuildMs;
 }
 
-void PixelSampling::submitAndWait(const std::string& what, const std::function<void(VkCommandBuffer)>& work) {
+void PixelSampling::submitAndWait(const std::string& what, const std::function<void(VkCommandBuffer)>& work,
+                                  const std::function<void()>& onWait) {
     VkCommandBuffer cmd = stream_.begin();
     if (options_.profile) timer_.reset(cmd);
     work(cmd);
     stream_.setWhat(what);
     stream_.submit();
-    stream_.waitAll();
+    stream_.waitAll(onWait);
     if (options_.profile) timer_.collect();
 }
 
@@ -64,15 +65,13 @@ void PixelSampling::run(const std::function<Image()>& preview) {
     runBatchLoop(
         options_, label.c_str(), total_, stats_,
         [&](std::uint32_t first, std::uint32_t n, std::uint32_t rows, const std::function<void()>& onWait) {
-            VkCommandBuffer cmd = stream_.begin();
-            if (options_.profile) timer_.reset(cmd);
-            pass_->record(cmd, first, n, options_.seed, timer(), rows);
-            stream_.setWhat(kind_ + " batch " + std::to_string(stats_.batches) + " (samples " +
-                            std::to_string(first) + ".." + std::to_string(first + n - 1) + ", seed " +
-                            std::to_string(options_.seed) + ")");
-            stream_.submit();
-            stream_.waitAll(onWait);
-            if (options_.profile) timer_.collect();
+            const std::string what = kind_ + " batch " + std::to_string(stats_.batches) + " (samples " +
+                                     std::to_string(first) + ".." + std::to_string(first + n - 1) +
+                                     ", seed " + std::to_string(options_.seed) + ")";
+            submitAndWait(
+                what,
+                [&](VkCommandBuffer cmd) { pass_->record(cmd, first, n, options_.seed, timer(), rows); },
+                onWait);
             return pass_->takeCounters();
         },
         snapshot);

@@ -40,8 +40,10 @@ public:
     [[nodiscard]] vk::CommandStream& stream() { return stream_; }
     // The timer to pass to recorded work when profiling, else null.
     [[nodiscard]] vk::GpuTimer* timer() { return options_.profile ? &timer_ : nullptr; }
-    // Records `work` into a command buffer, submits it and waits (profiled like a batch).
-    void submitAndWait(const std::string& what, const std::function<void(VkCommandBuffer)>& work);
+    // Records `work` into a command buffer, submits it and waits, calling onWait while the
+    // device works (profiled; `what` names it in device-loss messages). Every batch is one.
+    void submitAndWait(const std::string& what, const std::function<void(VkCommandBuffer)>& work,
+                       const std::function<void()>& onWait = {});
     // The statistics so far; finish() adds emitter supersampling and the kernel times.
     [[nodiscard]] RenderStats& stats() { return stats_; }
     void finish();
