@@ -10,6 +10,7 @@
 #include "image/png_preview.h"
 #include "poisson/poisson_clone.h"
 #include "util/error.h"
+#include "util/output_files.h"
 #include "vk/context.h"
 
 namespace gdpt {
@@ -38,6 +39,8 @@ int runClone(const CloneArgs& a) {
         throw UsageError("--offset '" + a.offset + "' must be X,Y (integers)");
     const bool png = endsWith(a.output, ".png");
     if (!png && !endsWith(a.output, ".exr")) throw UsageError("-o must end in .png or .exr");
+    OutputSet outputs({{"--source", a.source}, {"--target", a.target}, {"--mask", a.mask}});
+    const StagedFile& outFile = outputs.add(a.output, "-o");
     const Image source = readImage(a.source);
     const Image target = readImage(a.target);
     const Image mask = readImage(a.mask);
@@ -57,9 +60,10 @@ int runClone(const CloneArgs& a) {
         throw e.withContext(a.source + " -> " + a.target);
     }
     if (png)
-        writePngPreview(a.output, result);
+        writePngPreview(outFile, result);
     else
-        writeExr(a.output, result);
+        writeExr(outFile, {{"", result}});
+    outputs.commit();
     if (!a.quiet)
         std::fprintf(stderr, "gdpt: wrote %s (%d iterations, residual %.3g, %.1f ms)\n", a.output.c_str(),
                      report.iterations, report.residual, report.ms);

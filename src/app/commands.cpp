@@ -8,6 +8,7 @@
 
 #include "app/bench_util.h"
 #include "app/subcommand.h"
+#include "image/atomic_write.h"
 #include "image/exr_io.h"
 #include "image/metrics.h"
 #include "integrator/gpt_sampler.h"
@@ -15,6 +16,7 @@
 #include "scene/gltf_loader.h"
 #include "scene/light_sources.h"
 #include "util/error.h"
+#include "util/output_files.h"
 #include "vk/context.h"
 
 namespace gdpt {
@@ -50,6 +52,9 @@ glm::vec3 parseColor(const std::string& text, const std::string& flag) {
 }
 
 int runDiff(const DiffArgs& args) {
+    OutputSet outputs({{"test image", args.test}, {"reference", args.reference}});
+    const StagedFile* jsonFile =
+        args.json.empty() || args.json == "-" ? nullptr : &outputs.add(args.json, "--json");
     const Image test = readExrLayer(args.test);
     const Image reference = readExrLayer(args.reference);
     const ImageErrorStats e = compareImages(test, reference);
@@ -64,7 +69,13 @@ int runDiff(const DiffArgs& args) {
               {"mean_reference", e.meanReference},
               {"finite_pixels", e.finitePixels},
               {"nonfinite_pixels", e.nonFinitePixels}};
-    if (!args.json.empty()) writeTextOutput(args.json, j.dump(2) + "\n");
+    const std::string text = j.dump(2) + "\n";
+    if (jsonFile) {
+        writeStagedText(*jsonFile, text);
+        outputs.commit();
+    } else if (args.json == "-") {
+        std::fputs(text.c_str(), stdout);
+    }
     if (args.json != "-")
         std::printf("relMSE %.6g  MSE %.6g  MAE %.6g  max %.6g  bias %.3g  (%zu pixels, %zu non-finite)\n",
                     e.relMse, e.mse, e.mae, e.maxAbsError, e.meanBias, e.finitePixels, e.nonFinitePixels);

@@ -7,6 +7,7 @@
 // parsed: BVH build, upload, sampling and (G-PT) reconstruction.
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -25,6 +26,8 @@
 #include "scene/gltf_loader.h"
 #include "scene/light_sources.h"
 #include "util/error.h"
+#include "util/interrupt.h"
+#include "util/output_files.h"
 #include "util/timer.h"
 #include "vk/context.h"
 
@@ -99,6 +102,7 @@ public:
         o.timeBudget = std::max(0.05 * budget, budget - reserve);
         Timer total;
         const RenderOutput out = integrator.render(ctx_, scene_, o);
+        throwIfInterrupted("converging");
         r.seconds = total.seconds();
         r.reconSeconds = out.stats.reconstructionMs * 1e-3;
         r.spp = out.stats.spp;
@@ -117,6 +121,7 @@ public:
         RenderOptions o = options();
         o.spp = 1;
         (void)makeIntegrator(method, methodOptions())->render(ctx_, scene_, o);
+        throwIfInterrupted("converging");
     }
 
 private:
@@ -126,6 +131,7 @@ private:
         o.scene.height = a_.height;
         o.quiet = true;
         o.emitterSupersampling = a_.emitterSupersampling;
+        o.cancel = &interruptFlag();
         return o;
     }
 
@@ -148,8 +154,20 @@ private:
     std::map<std::string, std::unique_ptr<Integrator>> integrators_;
 };
 
-void writePlot(const fs::path& dir, const std::vector<std::string>& methods, const json& summary) {
-    std::ofstream dat(dir / "error_vs_time.dat");
+// The files converge writes into its output directory, staged before the first render.
+struct ConvergeOutputs {
+    OutputSet set;
+    const StagedFile* json = nullptr;
+    const StagedFile* csv = nullptr;
+    const StagedFile* dat = nullptr;
+    const StagedFile* gp = nullptr;
+    std::unique_ptr<StagedFile> png;  // committed only if gnuplot draws it
+};
+
+// Writes the plot's data and gnuplot script, and draws the PNG into its staged file.
+// Returns false (with a warning) if gnuplot is missing or draws nothing.
+bool writePlot(const ConvergeOutputs& out, const std::vector<std::string>& methods, const json& summary) {
+    std::ostringstream dat;
     for (std::size_t m = 0; m < methods.size(); ++m) {
         dat << "# " << methods[m] << "\n";
         for (const auto& s : summary)
@@ -158,21 +176,47 @@ void writePlot(const fs::path& dir, const std::vector<std::string>& methods, con
                     << s["relmse_min"].get<double>() << " " << s["relmse_max"].get<double>() << "\n";
         dat << "\n\n";
     }
-    dat.close();
-    std::ofstream gp(dir / "error_vs_time.gp");
-    gp << "set terminal pngcairo size 900,600 noenhanced\n"
-       << "set output '" << (dir / "error_vs_time.png").string() << "'\n"
-       << "set logscale xy\nset xlabel 'time (s)'\nset ylabel 'relMSE'\nset grid\nset key top right\n"
-       << "plot ";
-    for (std::size_t m = 0; m < methods.size(); ++m)
-        gp << (m ? ", " : "") << "'" << (dir / "error_vs_time.dat").string() << "' index " << m
-           << " with yerrorlines title '" << methods[m] << "'";
-    gp << "\n";
-    gp.close();
-    const std::string cmd = "gnuplot '" + (dir / "error_vs_time.gp").string() + "' 2>/dev/null";
-    if (std::system(cmd.c_str()) != 0)
-        std::fprintf(stderr, "gdpt converge: warning: gnuplot failed; the plot data is in %s\n",
-                     (dir / "error_vs_time.dat").c_str());
+    writeStagedText(*out.dat, dat.str());
+    // The script names the final paths (it is kept for re-plotting); gnuplot is run on a
+    // copy that reads the staged data and draws into the staged PNG.
+    const auto script = [&](const std::string& datPath, const std::string& pngPath) {
+        std::ostringstream gp;
+        gp << "set terminal pngcairo size 900,600 noenhanced\n"
+           << "set output '" << pngPath << "'\n"
+           << "set logscale xy\nset xlabel 'time (s)'\nset ylabel 'relMSE'\nset grid\nset key top right\n"
+           << "plot ";
+        for (std::size_t m = 0; m < methods.size(); ++m)
+            gp << (m ? ", " : "") << "'" << datPath << "' index " << m << " with yerrorlines title '"
+               << methods[m] << "'";
+        gp << "\n";
+        return gp.str();
+    };
+    const std::string kept = script(out.dat->path(), out.png->path());
+    writeStagedText(*out.gp, kept);
+    const std::string now = script(out.dat->tmpPath(), out.png->tmpPath());
+    bool drawn = false;
+    // Without gnuplot the pipe has no reader: a write error, not a SIGPIPE that ends gdpt.
+    const auto previousPipe = std::signal(SIGPIPE, SIG_IGN);
+    if (FILE* gnuplot = popen("gnuplot 2>/dev/null", "w")) {
+        const bool sent = std::fputs(now.c_str(), gnuplot) >= 0;
+        drawn = pclose(gnuplot) == 0 && sent;
+    }
+    std::signal(SIGPIPE, previousPipe);
+    std::error_code sizeError;
+    drawn = drawn && fs::file_size(out.png->tmpPath(), sizeError) > 0 && !sizeError;
+    if (!drawn)
+        std::fprintf(stderr, "gdpt converge: warning: gnuplot drew no plot; the plot data is in %s\n",
+                     out.dat->path().c_str());
+    return drawn;
+}
+
+// Refuses a reference that cannot measure an error: no finite pixel (e.g. all NaN).
+void checkReference(const Image& reference, const std::string& name) {
+    std::size_t finite = 0;
+    for (int c = 0; c < 3; ++c)
+        for (float v : reference.plane(c)) finite += std::isfinite(v) ? 1 : 0;
+    if (finite == 0)
+        throw Error(name + ": the reference has no finite pixel value: no error can be measured");
 }
 
 // Time at which the median relMSE of `method` first reaches `target`, interpolated in
@@ -196,43 +240,7 @@ double timeToReach(const json& summary, const std::string& method, double target
 }
 
 int runConverge(const ConvergeArgs& a) {
-    const Scene scene = loadGltf(a.scene);
-    if (const auto black = blackImageWarning(scene, glm::vec3(0.0f), /*envOption=*/false))
-        std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
-    vk::ContextOptions co;
-    co.device = a.device;
-    co.validation = a.validate;
-    vk::Context ctx(co);
-    const fs::path dir(a.output);
-    fs::create_directories(dir);
-
-    Image reference;
-    if (!a.reference.empty()) {
-        reference = readExrLayer(a.reference);
-    } else if (a.makeReference > 0) {
-        const fs::path cached =
-            dir / ("reference_" + referenceKey(a.scene, a.width, a.height, a.makeReference) + ".exr");
-        if (fs::exists(cached)) {
-            reference = readExrLayer(cached.string());
-        } else {
-            std::fprintf(stderr, "gdpt converge: rendering a %u spp PT reference (cached as %s)\n",
-                         a.makeReference, cached.c_str());
-            RenderOptions o;
-            o.scene.width = a.width;
-            o.scene.height = a.height;
-            o.spp = a.makeReference;
-            o.seed = 0xC0FFEEu;
-            reference = renderPt(ctx, scene, o).image;
-            writeExr(cached.string(), reference);
-        }
-    } else {
-        throw UsageError("give --reference REF.exr or --make-reference SPP");
-    }
-    if (reference.width() != a.width || reference.height() != a.height)
-        throw Error(a.reference + ": reference is " + std::to_string(reference.width()) + "x" +
-                    std::to_string(reference.height()) + ", the render is " + std::to_string(a.width) + "x" +
-                    std::to_string(a.height) + " (use --width/--height)");
-
+    // The arguments first: a usage error never waits for a scene or a reference.
     const auto methods = splitList(a.methods);
     if (methods.empty()) throw UsageError("--methods: no method given");
     for (const std::string& m : methods) (void)makeIntegrator(m);  // unknown names fail before any render
@@ -245,6 +253,62 @@ int runConverge(const ConvergeArgs& a) {
         }
         if (!(times.back() > 0.0)) throw UsageError("--times: budgets must be positive");
     }
+    if (times.empty()) throw UsageError("--times: no time budget given");
+    if (a.reference.empty() && a.makeReference == 0)
+        throw UsageError("give --reference REF.exr or --make-reference SPP");
+
+    installInterruptHandlers();
+    const fs::path dir(a.output);
+    std::error_code dirError;
+    fs::create_directories(dir, dirError);
+    if (dirError) throw Error(a.output + ": cannot create the output directory: " + dirError.message());
+    ConvergeOutputs out{OutputSet({{"scene", a.scene}, {"--reference", a.reference}})};
+    out.json = &out.set.add((dir / "results.json").string(), "results");
+    out.csv = &out.set.add((dir / "results.csv").string(), "results table");
+    out.dat = &out.set.add((dir / "error_vs_time.dat").string(), "plot data");
+    out.gp = &out.set.add((dir / "error_vs_time.gp").string(), "plot script");
+    out.png = std::make_unique<StagedFile>((dir / "error_vs_time.png").string());
+
+    const Scene scene = loadGltf(a.scene);
+    throwIfInterrupted("loading");
+    if (const auto black = blackImageWarning(scene, glm::vec3(0.0f), /*envOption=*/false))
+        std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
+    vk::ContextOptions co;
+    co.device = a.device;
+    co.validation = a.validate;
+    vk::Context ctx(co);
+
+    Image reference;
+    std::string referenceName = a.reference;
+    if (!a.reference.empty()) {
+        reference = readExrLayer(a.reference);
+    } else {
+        const fs::path cached =
+            dir / ("reference_" + referenceKey(a.scene, a.width, a.height, a.makeReference) + ".exr");
+        referenceName = cached.string();
+        if (fs::exists(cached)) {
+            reference = readExrLayer(cached.string());
+        } else {
+            std::fprintf(stderr, "gdpt converge: rendering a %u spp PT reference (cached as %s)\n",
+                         a.makeReference, cached.c_str());
+            RenderOptions o;
+            o.scene.width = a.width;
+            o.scene.height = a.height;
+            o.spp = a.makeReference;
+            o.seed = 0xC0FFEEu;
+            o.cancel = &interruptFlag();
+            const RenderResult made = renderPt(ctx, scene, o);
+            throwIfInterrupted("rendering the reference");
+            reference = made.image;
+            writeExr(cached.string(), reference);
+        }
+    }
+    if (reference.width() != a.width || reference.height() != a.height)
+        throw Error(referenceName + ": reference is " + std::to_string(reference.width()) + "x" +
+                    std::to_string(reference.height()) + ", the render is " + std::to_string(a.width) + "x" +
+                    std::to_string(a.height) + " (use --width/--height)");
+    checkReference(reference, referenceName);
+
     Converger conv(ctx, scene, a);
     std::vector<Run> runs;
     json summary = json::array();
@@ -336,10 +400,15 @@ int runConverge(const ConvergeArgs& a) {
                           {"equal_time", equalTime},
                           {"target_relmse", target},
                           {"time_to_target_s", reach}};
-    // Written via name.tmp + rename, so an interrupted run never leaves a truncated table.
-    writeTextFileAtomically((dir / "results.json").string(), results.dump(2) + "\n");
-    writeTextFileAtomically((dir / "results.csv").string(), csv.str());
-    writePlot(dir, methods, summary);
+    // Staged files, moved into place together: an interrupted or failed run leaves no
+    // truncated table and no table without its plot data.
+    const std::string resultsText = results.dump(2) + "\n";
+    writeStagedText(*out.json, resultsText);
+    writeStagedText(*out.csv, csv.str());
+    const bool plotted = writePlot(out, methods, summary);
+    throwIfInterrupted("writing");
+    out.set.commit();
+    if (plotted) out.png->commit();
 
     std::printf("%-10s", "budget(s)");
     for (const auto& m : methods) std::printf(" %12s", m.c_str());
@@ -351,7 +420,8 @@ int runConverge(const ConvergeArgs& a) {
     }
     std::printf("time to relMSE %.4g:", target);
     for (const auto& m : methods) std::printf("  %s %.3gs", m.c_str(), reach[m].get<double>());
-    std::printf("\nwrote %s/results.json, results.csv, error_vs_time.png\n", dir.c_str());
+    std::printf("\nwrote %s/results.json, results.csv, error_vs_time.dat, error_vs_time.gp%s\n", dir.c_str(),
+                plotted ? ", error_vs_time.png" : "");
     if (ctx.validationErrors() > 0) {
         std::fprintf(stderr, "gdpt converge: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
         return 1;

@@ -1,6 +1,6 @@
 // main.cpp — gdpt entry point: parses the command line (CLI11) and runs the chosen
 // subcommand. Exit codes: 0 success, 1 runtime or input error (one clear line on stderr),
-// 2 usage error.
+// 2 usage error, 130 interrupted (SIGINT or SIGTERM; no output written).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
@@ -8,6 +8,7 @@
 
 #include "app/subcommand.h"
 #include "util/error.h"
+#include "util/interrupt.h"
 
 int main(int argc, char** argv) {
     using namespace gdpt;
@@ -36,6 +37,9 @@ int main(int argc, char** argv) {
     } catch (const UsageError& e) {
         std::fprintf(stderr, "gdpt: usage error: %s\n", e.what());
         return 2;
+    } catch (const Interrupted& e) {  // SIGINT or SIGTERM (util/interrupt.h)
+        std::fprintf(stderr, "gdpt: %s\n", e.what());
+        return 130;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "gdpt: error: %s\n", e.what());
         return 1;

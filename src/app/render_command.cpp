@@ -2,8 +2,6 @@
 // --method, renders, and writes the EXR (every layer), the PNG preview and the JSON summary.
 // Time budgets, checkpoints and interrupts are handled here; the method is the integrator's.
 #include <algorithm>
-#include <atomic>
-#include <csignal>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -14,6 +12,7 @@
 #include "app/commands.h"
 #include "app/input_file.h"
 #include "app/subcommand.h"
+#include "image/atomic_write.h"
 #include "image/exr_io.h"
 #include "image/png_preview.h"
 #include "integrator/checkpoint.h"
@@ -23,6 +22,8 @@
 #include "scene/gltf_loader.h"
 #include "scene/light_sources.h"
 #include "util/error.h"
+#include "util/interrupt.h"
+#include "util/output_files.h"
 #include "util/timer.h"
 #include "vk/context.h"
 
@@ -30,13 +31,6 @@ namespace gdpt {
 namespace {
 
 using nlohmann::json;
-
-// Set by SIGINT/SIGTERM; the sampling loop stops at the next batch boundary.
-std::atomic<bool> gInterrupted{false};
-
-extern "C" void onInterrupt(int) {
-    gInterrupted.store(true);
-}
 
 std::string previewPath(const std::string& exrPath) {
     const auto dot = exrPath.rfind('.');
@@ -101,7 +95,7 @@ RenderOptions renderOptionsFor(const RenderArgs& args) {
     o.quiet = args.quiet;
     o.workgroup = parseWorkgroup(args.workgroup);
     o.emitterSupersampling = args.emitterSupersampling;
-    o.cancel = &gInterrupted;
+    o.cancel = &interruptFlag();
     return o;
 }
 
@@ -148,14 +142,38 @@ json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrato
     return j;
 }
 
+// Usage errors that the option checks alone cannot see (exit 2 before any work).
+void checkArgs(const RenderArgs& args) {
+    const bool l1 = args.recon == "l1" || args.recon == "wl1" || args.allRecon;
+    if (args.method == "gpt" && l1 && !(args.alpha > 0.0))
+        throw UsageError("--alpha " + std::to_string(args.alpha) +
+                         ": the L1 reconstructions (--recon l1 or wl1, or --all-recon) need --alpha > 0 (the "
+                         "primal term anchors each reweighted solve); use --recon l2 for alpha 0");
+}
+
 }  // namespace
 
 int runRender(const RenderArgs& args) {
+    installInterruptHandlers();
+    checkArgs(args);
     Timer total;
     RenderOptions options = renderOptionsFor(args);
     const ReconTimeCache cache(ReconTimeCache::defaultPath());
 
+    // Every output is checked (and its temporary file created) before the scene is loaded,
+    // so that a long render never fails at the end on a bad path, and no output may
+    // overwrite an input or another output. They are committed together at the end.
+    OutputSet outputs({{"scene", args.scene}, {"--resume checkpoint", args.resume}});
+    const StagedFile& exrFile = outputs.add(args.output, "-o");
+    const StagedFile& pngFile = outputs.add(previewPath(args.output), "PNG preview of -o");
+    const StagedFile* jsonFile =
+        args.json.empty() || args.json == "-" ? nullptr : &outputs.add(args.json, "--json");
+    // A checkpoint is written on its own schedule; it may continue the one resumed from.
+    if (!args.checkpoint.empty()) outputs.checkSeparate(args.checkpoint, "--checkpoint", {args.resume});
+
+    enterPhase("loading");
     const Scene scene = loadGltf(args.scene);
+    throwIfInterrupted("loading");
     if (!scene.unsupported.empty() && !args.quiet) {
         std::string list;
         for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
@@ -209,29 +227,46 @@ int runRender(const RenderArgs& args) {
         };
         options.checkpointEvery = args.checkpointEvery;
     }
-    std::signal(SIGINT, onInterrupt);
-    std::signal(SIGTERM, onInterrupt);
-
-    const RenderOutput out = integrator->render(ctx, scene, options);
+    const std::string checkpointNote = args.checkpoint.empty()
+                                           ? ""
+                                           : "; checkpoint written to " + args.checkpoint +
+                                                 " (continue with --resume " + args.checkpoint + ")";
+    enterPhase("sampling");
+    RenderOutput out;
+    try {
+        out = integrator->render(ctx, scene, options);
+    } catch (const Interrupted& e) {  // building the BVH, or a stage after sampling
+        if (e.phase() != "reconstructing") throw;
+        throw Interrupted(e.phase(), checkpointNote);  // sampling ended: the checkpoint is written
+    }
     const RenderStats& s = out.stats;
     const double afterSampling = total.seconds() - (s.readbackMs + s.reconstructionMs) * 1e-3;
     if (s.cancelled) {
-        if (args.checkpoint.empty())
-            std::fprintf(stderr, "gdpt: interrupted after %u spp; no output written\n", s.spp);
-        else
-            std::fprintf(
-                stderr,
-                "gdpt: interrupted after %u spp; checkpoint written to %s (continue with --resume %s)\n",
-                s.spp, args.checkpoint.c_str(), args.checkpoint.c_str());
+        std::fprintf(stderr, "gdpt: interrupted after %u spp; no output written%s\n", s.spp,
+                     checkpointNote.c_str());
         return 130;
     }
+    enterPhase("writing");
     Timer writeTimer;
-    writeExr(args.output, out.layers);
-    writePngPreview(previewPath(args.output), out.image());
+    writeExr(exrFile, out.layers);
+    throwIfInterrupted("writing");
+    writePngPreview(pngFile, out.image());
+    throwIfInterrupted("writing");
     const double writeMs = writeTimer.ms();
     const double seconds = total.seconds();
-    if (timed) cache.put(finishKey, std::max(0.0, seconds - afterSampling - s.reconstructionMs * 1e-3));
     if (args.profile) printProfile(s.kernels);
+    if (!args.json.empty()) {
+        const std::string text =
+            summaryJson(args, ctx, *integrator, s, seconds, reserved, finishReserved, writeMs).dump(2) + "\n";
+        if (jsonFile)
+            writeStagedText(*jsonFile, text);
+        else
+            std::fputs(text.c_str(), stdout);
+        throwIfInterrupted("writing");
+    }
+    outputs.commit();
+    if (timed)
+        cache.put(finishKey, std::max(0.0, total.seconds() - afterSampling - s.reconstructionMs * 1e-3));
     if (!args.quiet) {
         const std::string partial =
             s.partialPassRows ? " + 1 in the top " + std::to_string(s.partialPassRows) + " rows" : "";
@@ -242,11 +277,6 @@ int runRender(const RenderArgs& args) {
                      s.bvhBuildMs, s.samplingMs, double(s.raysTraced) / (s.samplingMs * 1e-3) * 1e-6,
                      double(s.pathsCompleted) / (s.samplingMs * 1e-3) * 1e-6);
     }
-    if (!args.json.empty())
-        writeTextOutput(
-            args.json,
-            summaryJson(args, ctx, *integrator, s, seconds, reserved, finishReserved, writeMs).dump(2) +
-                "\n");
     if (ctx.validationErrors() > 0) {
         std::fprintf(stderr, "gdpt: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
         return 1;
@@ -346,7 +376,7 @@ Subcommand addRenderCommand(CLI::App& app) {
 
     const char* budget = "Time budget and checkpoints";
     r->add_option("--time", a.time, "Seconds for the whole render, reconstruction included; overrides --spp")
-        ->check(CLI::Range(0.0, 1e7))
+        ->check(CLI::Range(1e-3, 1e7))
         ->group(budget);
     CLI::Option* checkpoint =
         r->add_option("--checkpoint", a.checkpoint,

@@ -11,6 +11,8 @@
 #include "integrator/gpt_sampler.h"
 #include "poisson/poisson_gpu.h"
 #include "util/error.h"
+#include "util/interrupt.h"
+#include "util/output_files.h"
 #include "util/progress.h"
 #include "util/timer.h"
 #include "vk/context.h"
@@ -48,6 +50,10 @@ int runSolve(const SolveArgs& a) {
     if (separate && (a.primal.empty() || a.dx.empty() || a.dy.empty()))
         throw UsageError("--primal, --dx and --dy must be given together");
     if (!separate && a.input.empty()) throw UsageError("missing INPUT.exr (or --primal/--dx/--dy)");
+    installInterruptHandlers();
+    OutputSet outputs(
+        {{"input", a.input}, {"--primal input", a.primal}, {"--dx input", a.dx}, {"--dy input", a.dy}});
+    const StagedFile& outFile = outputs.add(a.output, "-o");
     SolveOptions o;
     o.method = parseReconstruction(a.recon);
     o.solver = parseGpuSolver(a.solver);
@@ -101,6 +107,7 @@ int runSolve(const SolveArgs& a) {
     Timer started;
     bool shown = false;
     o.progress = [&](int roundsDone, int rounds, int iterations) {
+        throwIfInterrupted("solving");
         if (started.seconds() < 2.0) return;
         shown = true;
         progress.update(double(roundsDone) / rounds,
@@ -114,7 +121,9 @@ int runSolve(const SolveArgs& a) {
         progress.update(1.0);
         progress.finish(std::to_string(report.iterations) + " iterations");
     }
-    writeExr(a.output, {{"", gptFinal(recon, modulation, direct)}, {"recon", recon}});
+    writeExr(outFile, {{"", gptFinal(recon, modulation, direct)}, {"recon", recon}});
+    throwIfInterrupted("writing");
+    outputs.commit();
     if (!a.quiet) {
         std::fprintf(
             stderr,

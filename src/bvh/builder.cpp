@@ -21,6 +21,8 @@
 #include <string>
 #include <thread>
 
+#include "util/interrupt.h"
+
 namespace gdpt {
 namespace {
 
@@ -31,6 +33,8 @@ constexpr uint32_t kMaxBins = 256;
 // not depend on the thread count, so the output is the same for any buildThreads.
 constexpr uint32_t kSeparateMinTriangles = 16384;
 constexpr uint32_t kSeparateDepth = 4;
+// Subtrees at least this large poll the interrupt flag (util/interrupt.h) when they start.
+constexpr uint32_t kInterruptPollMinTriangles = 1024;
 // Padding of triangle bounds, relative to a coordinate magnitude: 2^-18 = 32 float ulps.
 // Applied twice: per triangle (its largest coordinate; covers the rounding of
 // e1 = p1 - p0, <= 1 ulp) and per scene (the largest scene coordinate; covers the rounding
@@ -230,6 +234,9 @@ ChildRef SubtreeBuilder::appendSubtree(SubtreeBuilder& sub, ChildRef ref) {
 
 ChildRef SubtreeBuilder::build(const Range& r, uint32_t depth) {
     const uint32_t n = r.size();
+    // SIGINT/SIGTERM: large subtrees poll (a relaxed load per ~thousand triangles' work);
+    // an exception in a worker thread reaches the caller below.
+    if (n >= kInterruptPollMinTriangles && interruptRequested()) throw Interrupted("building the BVH");
     const bool centroidsCoincide = !(r.centroids.hi.x > r.centroids.lo.x) &&
                                    !(r.centroids.hi.y > r.centroids.lo.y) &&
                                    !(r.centroids.hi.z > r.centroids.lo.z);

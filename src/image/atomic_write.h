@@ -1,5 +1,6 @@
-// atomic_write.h — "write to name.tmp, rename() on success", so that an
-// interrupted or failed write never leaves a half-written output under the final name.
+// atomic_write.h — "write to a unique temporary file beside the target, rename() when it is
+// whole" (util/output_files.h), so that an interrupted or failed write never leaves a
+// half-written output under the final name and concurrent runs never share bytes.
 #pragma once
 
 #include <functional>
@@ -7,10 +8,19 @@
 
 namespace gdpt {
 
-// Calls write(tmpPath) with tmpPath = path + ".tmp"; if it returns normally, renames the
-// temporary file onto `path` (atomic on POSIX within one file system). If write() throws,
-// or the rename fails, the temporary file is removed and a gdpt::Error naming `path` is
-// thrown (gdpt::Error messages from write() are kept and prefixed with the path).
+class StagedFile;
+
+// Calls write(file.tmpPath()); a failure becomes a gdpt::Error naming file.path(). The
+// caller commits (StagedFile::commit or OutputSet::commit); the temporary file is removed if
+// it never does.
+void writeStaged(const StagedFile& file, const std::function<void(const std::string& tmpPath)>& write);
+
+// writeStaged for text: the staged file holds exactly `text`.
+void writeStagedText(const StagedFile& file, const std::string& text);
+
+// Stages `path`, calls write(tmpPath) and renames the temporary file onto `path`. If
+// write() throws, or the rename fails, the temporary file is removed and a gdpt::Error
+// naming `path` is thrown (gdpt::Error messages from write() are kept).
 void writeFileAtomically(const std::string& path,
                          const std::function<void(const std::string& tmpPath)>& write);
 

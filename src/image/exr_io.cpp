@@ -11,7 +11,9 @@
 #include <OpenEXR/ImfThreading.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <set>
@@ -19,9 +21,15 @@
 
 #include "image/atomic_write.h"
 #include "util/error.h"
+#include "util/output_files.h"
 
 namespace gdpt {
 namespace {
+
+// ": <the OS's reason>" when the last failed call set errno, else nothing.
+std::string osReason() {
+    return errno != 0 ? std::string(": ") + std::strerror(errno) : std::string();
+}
 
 // Refuse absurd data windows before allocating: a corrupt header must produce an error,
 // not a multi-gigabyte allocation. 2^27 pixels = 1.5 GiB per RGB float layer.
@@ -70,8 +78,9 @@ void writeLayers(const std::string& tmpPath, const std::vector<NamedLayer>& laye
     // We own the std::ofstream so that errors OpenEXR swallows in OutputFile's destructor
     // (it writes the line-offset table there and cannot throw) still show up as a failed
     // stream state, checked after the OutputFile is gone.
+    errno = 0;
     std::ofstream os(tmpPath, std::ios::binary | std::ios::trunc);
-    if (!os) throw Error("cannot open " + tmpPath + " for writing");
+    if (!os) throw Error("cannot open " + tmpPath + " for writing" + osReason());
     {
         Imf::StdOFStream stream(os, tmpPath.c_str());
         Imf::OutputFile file(stream, header, exrThreads());
@@ -79,9 +88,9 @@ void writeLayers(const std::string& tmpPath, const std::vector<NamedLayer>& laye
         file.writePixels(height);
     }
     os.flush();
-    if (!os) throw Error("write error on " + tmpPath);
+    if (!os) throw Error("write error on " + tmpPath + osReason());
     os.close();
-    if (os.fail()) throw Error("cannot close " + tmpPath);
+    if (os.fail()) throw Error("cannot close " + tmpPath + osReason());
 }
 
 void validateLayers(const std::vector<NamedLayer>& layers) {
@@ -175,6 +184,16 @@ void writeExr(const std::string& path, const std::vector<NamedLayer>& layers,
         throw e.withContext(path);
     }
     writeFileAtomically(path, [&](const std::string& tmpPath) { writeLayers(tmpPath, layers, attributes); });
+}
+
+void writeExr(const StagedFile& file, const std::vector<NamedLayer>& layers,
+              const ExrAttributes& attributes) {
+    try {
+        validateLayers(layers);
+    } catch (const Error& e) {
+        throw e.withContext(file.path());
+    }
+    writeStaged(file, [&](const std::string& tmpPath) { writeLayers(tmpPath, layers, attributes); });
 }
 
 void writeExr(const std::string& path, const Image& image) {

@@ -18,9 +18,12 @@ struct NamedLayer {
     Image image;
 };
 
-// Writes all layers into one EXR at `path` (via path.tmp + rename, so that a failed
-// write never leaves a half-written file under `path`). All layers
-// must have the same non-zero size and distinct names. Throws gdpt::Error naming the file.
+class StagedFile;
+
+// Writes all layers into one EXR at `path` (staged in a unique temporary file and renamed
+// into place, so that a failed write never leaves a half-written file under `path`). All
+// layers must have the same non-zero size and distinct names. Throws gdpt::Error naming the
+// file and, for I/O failures, the OS's reason.
 void writeExr(const std::string& path, const std::vector<NamedLayer>& layers);
 
 // Text attributes stored in an EXR header (name -> value), e.g. the render state that a gdpt
@@ -34,6 +37,10 @@ void writeExr(const std::string& path, const std::vector<NamedLayer>& layers,
 
 // Convenience: one image into the default R,G,B channels.
 void writeExr(const std::string& path, const Image& image);
+
+// Writes the EXR into a staged file of an OutputSet (util/output_files.h); the caller commits.
+void writeExr(const StagedFile& file, const std::vector<NamedLayer>& layers,
+              const ExrAttributes& attributes = {});
 
 // Reads every layer of a (single-part, flat) EXR. Channels are grouped by the prefix
 // before their last '.'; the unprefixed group is the layer "". Within a group:

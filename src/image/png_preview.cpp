@@ -14,6 +14,7 @@
 #include "image/atomic_write.h"
 #include "image/exr_io.h"
 #include "util/error.h"
+#include "util/output_files.h"
 
 namespace gdpt {
 
@@ -36,7 +37,12 @@ std::uint8_t previewCode(float linear, const PreviewOptions& options) {
     return static_cast<std::uint8_t>(std::lround(255.0 * linearToSrgb(v)));
 }
 
-void writePngPreview(const std::string& path, const Image& image, const PreviewOptions& options) {
+namespace {
+
+// The PNG file's bytes (stb_image_write encodes into memory; the caller writes them with
+// every write checked, which stbi_write_png does not do).
+std::vector<unsigned char> encodePng(const std::string& path, const Image& image,
+                                     const PreviewOptions& options) {
     if (image.empty()) throw Error(path + ": cannot write an empty image");
     const int w = image.width();
     const int h = image.height();
@@ -45,10 +51,28 @@ void writePngPreview(const std::string& path, const Image& image, const PreviewO
         for (int x = 0; x < w; ++x)
             for (int c = 0; c < 3; ++c)
                 rgb[image.index(x, y) * 3 + c] = previewCode(image.at(x, y, c), options);
-    writeFileAtomically(path, [&](const std::string& tmpPath) {
-        if (stbi_write_png(tmpPath.c_str(), w, h, 3, rgb.data(), w * 3) == 0)
-            throw Error("stbi_write_png failed on " + tmpPath);
-    });
+    std::vector<unsigned char> png;
+    const auto append = [](void* context, void* data, int size) {
+        auto* out = static_cast<std::vector<unsigned char>*>(context);
+        const auto* bytes = static_cast<const unsigned char*>(data);
+        out->insert(out->end(), bytes, bytes + size);
+    };
+    if (stbi_write_png_to_func(append, &png, w, h, 3, rgb.data(), w * 3) == 0 || png.empty())
+        throw Error(path + ": cannot encode the PNG");
+    return png;
+}
+
+}  // namespace
+
+void writePngPreview(const std::string& path, const Image& image, const PreviewOptions& options) {
+    const std::vector<unsigned char> png = encodePng(path, image, options);
+    writeFileAtomically(path,
+                        [&](const std::string& tmpPath) { writeBytes(tmpPath, png.data(), png.size()); });
+}
+
+void writePngPreview(const StagedFile& file, const Image& image, const PreviewOptions& options) {
+    const std::vector<unsigned char> png = encodePng(file.path(), image, options);
+    writeStaged(file, [&](const std::string& tmpPath) { writeBytes(tmpPath, png.data(), png.size()); });
 }
 
 Image readPng(const std::string& path) {

@@ -28,8 +28,14 @@ struct PreviewOptions {
 // nearest. NaN and negative values map to 0, +inf to 255 (Clamp) or 255 (Reinhard limit).
 [[nodiscard]] std::uint8_t previewCode(float linear, const PreviewOptions& options = {});
 
-// Writes an RGB8 PNG preview of `image` (via path.tmp + rename). Throws gdpt::Error.
+class StagedFile;
+
+// Writes an RGB8 PNG preview of `image` (staged in a unique temporary file and renamed into
+// place; every write checked). Throws gdpt::Error naming the file and the OS's reason.
 void writePngPreview(const std::string& path, const Image& image, const PreviewOptions& options = {});
+
+// Writes the preview into a staged file of an OutputSet (util/output_files.h); the caller commits.
+void writePngPreview(const StagedFile& file, const Image& image, const PreviewOptions& options = {});
 
 // Reads an 8- or 16-bit PNG (gray, gray+alpha, RGB or RGBA; alpha dropped) and converts it
 // to linear float with the exact inverse sRGB OETF. Throws gdpt::Error naming the file.

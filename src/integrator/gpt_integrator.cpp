@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "integrator/render_identity.h"
+#include "util/interrupt.h"
 #include "util/timer.h"
 #include "vk/context.h"
 
@@ -95,7 +96,14 @@ RenderOutput GptIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     input.varDy = &g.varDy;
     std::vector<NamedLayer> recons;
     Timer reconTimer;
-    for (const SolveOptions& so : solveList) {
+    enterPhase("reconstruction");
+    // An interrupt stops the reconstruction after the solver's current batch of iterations.
+    const auto stopIfCancelled = [&options] {
+        if (options.cancel && options.cancel->load()) throw Interrupted("reconstructing");
+    };
+    for (SolveOptions so : solveList) {
+        stopIfCancelled();
+        so.progress = [&](int, int, int) { stopIfCancelled(); };
         Image recon;
         const SolveReport report = solver_->solve(input, so, recon);
         if (!options.quiet)

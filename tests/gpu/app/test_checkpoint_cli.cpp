@@ -105,7 +105,7 @@ TEST_P(CheckpointCli, InterruptedRenderResumesToTheUninterruptedResult) {
     pclose(pipe);
     ASSERT_EQ(rc, 130);
     EXPECT_FALSE(fs::exists(path("never.exr")));
-    EXPECT_FALSE(fs::exists(ckpt + ".tmp"));
+    EXPECT_TRUE(temporaryFiles().empty());
     const ExrAttributes a = readExrAttributes(ckpt);
     const unsigned long done = std::stoul(a.at("gdpt.spp"));
     ASSERT_GT(done, 0u);

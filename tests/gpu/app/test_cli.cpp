@@ -83,7 +83,7 @@ TEST_F(Cli, MalformedSceneIsAnErrorNamingTheFileAndWritesNothing) {
     EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << "one line: " << r.output;
     EXPECT_FALSE(fs::exists(out));
     EXPECT_FALSE(fs::exists(path("out.png")));
-    EXPECT_FALSE(fs::exists(out + ".tmp"));
+    EXPECT_TRUE(temporaryFiles().empty());
 }
 
 // A scene with nothing that emits light renders black: render and info say so (and what to
@@ -289,7 +289,7 @@ TEST_F(Cli, HugeImageRendersOrIsRefusedNamingTheDeviceLimit) {
     EXPECT_EQ(r.code, 1) << r.output;
     EXPECT_NE(r.output.find("maxStorageBufferRange"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(out));
-    EXPECT_FALSE(fs::exists(out + ".tmp"));
+    EXPECT_TRUE(temporaryFiles().empty());
     EXPECT_FALSE(fs::exists(path("huge.png")));
 }
 
@@ -365,7 +365,7 @@ TEST_F(Cli, InterruptStopsPromptlyWithoutOutput) {
     // CI machine.
     EXPECT_LT(stopMs, 3000);
     EXPECT_FALSE(fs::exists(out));
-    EXPECT_FALSE(fs::exists(out + ".tmp"));
+    EXPECT_TRUE(temporaryFiles().empty());
 }
 
 }  // namespace

@@ -159,8 +159,7 @@ TEST_F(ConvergeCli, ResultsJsonFollowsTheSchemaAndMatchesTheCsv) {
     ASSERT_EQ(r.code, 0) << r.output;
     checkResults(dir_ / "out", {"pt", "gpt-l2"}, {0.05, 0.1}, 2, 8, 8);
     EXPECT_TRUE(fs::exists(dir_ / "out" / "error_vs_time.dat"));
-    EXPECT_FALSE(fs::exists(dir_ / "out" / "results.json.tmp"));
-    EXPECT_FALSE(fs::exists(dir_ / "out" / "results.csv.tmp"));
+    EXPECT_TRUE(temporaryFiles("out").empty());
 }
 
 // Why the error must fall between the two budgets, for every method.

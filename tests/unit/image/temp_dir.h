@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace gdpt::test {
 
@@ -20,6 +21,15 @@ protected:
     }
     void TearDown() override { std::filesystem::remove_all(dir_); }
     [[nodiscard]] std::string path(const std::string& name) const { return (dir_ / name).string(); }
+    // Temporary files of staged outputs (".<name>.gdpt-XXXXXX", util/output_files.h) left in
+    // `sub` (default: the test's directory): a failed or interrupted write must leave none.
+    [[nodiscard]] std::vector<std::string> temporaryFiles(const std::string& sub = "") const {
+        std::vector<std::string> found;
+        for (const auto& e : std::filesystem::directory_iterator(sub.empty() ? dir_ : dir_ / sub))
+            if (e.path().filename().string().find(".gdpt-") != std::string::npos)
+                found.push_back(e.path().filename().string());
+        return found;
+    }
 
     std::filesystem::path dir_;
 };

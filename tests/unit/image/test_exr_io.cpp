@@ -45,7 +45,7 @@ TEST_F(ExrIo, RoundTripOfSeveralLayersIsBitExact) {
         {"", randomImage(7, 5, 1)}, {"dx", randomImage(7, 5, 2)}, {"dy", randomImage(7, 5, 3)}};
     const std::string file = path("layers.exr");
     writeExr(file, layers);
-    EXPECT_FALSE(std::filesystem::exists(file + ".tmp"));
+    EXPECT_TRUE(temporaryFiles().empty());
     const std::vector<NamedLayer> back = readExr(file);
     ASSERT_EQ(back.size(), 3u);
     EXPECT_EQ(back[0].name, "");
@@ -190,11 +190,11 @@ TEST_F(ExrIo, FailedWriteLeavesNoFile) {
     const std::string impossible = path("no_such_dir/out.exr");
     EXPECT_THROW(writeExr(impossible, randomImage(4, 4, 7)), Error);
     EXPECT_FALSE(std::filesystem::exists(impossible));
-    EXPECT_FALSE(std::filesystem::exists(impossible + ".tmp"));
-    // Target is a directory: the tmp file is written, rename() fails, tmp must be removed.
+    EXPECT_TRUE(temporaryFiles().empty());
+    // Target is a directory: refused before anything is written.
     std::filesystem::create_directories(path("is_a_dir.exr"));
     EXPECT_THROW(writeExr(path("is_a_dir.exr"), randomImage(4, 4, 8)), Error);
-    EXPECT_FALSE(std::filesystem::exists(path("is_a_dir.exr.tmp")));
+    EXPECT_TRUE(temporaryFiles().empty());
 }
 
 }  // namespace

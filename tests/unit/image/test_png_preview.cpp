@@ -42,7 +42,7 @@ TEST_F(PngPreview, WriteThenReadGivesLinearOfTheCodes) {
         for (int c = 0; c < 3; ++c) image.at(x, 0, c) = values[x] * (c == 1 ? 0.5f : 1.0f);
     const std::string file = path("preview.png");
     writePngPreview(file, image);
-    EXPECT_FALSE(std::filesystem::exists(file + ".tmp"));
+    EXPECT_TRUE(temporaryFiles().empty());
     const Image back = readPng(file);
     ASSERT_EQ(back.width(), 4);
     ASSERT_EQ(back.height(), 1);
@@ -60,7 +60,7 @@ TEST_F(PngPreview, WriteThenReadGivesLinearOfTheCodes) {
 TEST_F(PngPreview, FailuresThrowAndLeaveNoFile) {
     const std::string impossible = path("missing_dir/p.png");
     EXPECT_THROW(writePngPreview(impossible, Image(2, 2)), Error);
-    EXPECT_FALSE(std::filesystem::exists(impossible + ".tmp"));
+    EXPECT_TRUE(temporaryFiles().empty());
     EXPECT_THROW(writePngPreview(path("empty.png"), Image()), Error);
     try {
         readPng(path("absent.png"));
