@@ -98,10 +98,15 @@ RenderOutput GptIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     for (const SolveOptions& so : solveList) {
         Image recon;
         const SolveReport report = solver_->solve(input, so, recon);
+        // Not converged (the iteration cap, or a tolerance below what float32 residuals
+        // reach) is said as `gdpt solve` says it, and recorded for the JSON summary.
         if (!options.quiet)
-            std::fprintf(stderr, "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g, %.1f ms\n",
+            std::fprintf(stderr,
+                         "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g%s, %.1f ms\n",
                          toString(so.method), report.iterations, report.irlsIterations, report.residual,
-                         report.ms);
+                         report.converged ? "" : " NOT converged", report.ms);
+        out.stats.reconstructions.push_back({toString(so.method), report.iterations, report.irlsIterations,
+                                             report.residual, so.tolerance, report.converged, report.ms});
         out.stats.reconstructionMs += report.ms;
         recons.push_back({std::string("recon_") + toString(so.method), std::move(recon)});
     }
@@ -134,6 +139,16 @@ void GptIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
     j["gpt_split_bounce"] = s.gptSplitBounce;
     j["edge_samples"] = {{"factor", s.edgeSamples}, {"pixels", s.edgePixels}};
     j["demodulation"] = {{"on", s.demodulated}, {"pixels", s.demodulatedPixels}};
+    nlohmann::json recons = nlohmann::json::array();
+    for (const ReconstructionStats& r : s.reconstructions)
+        recons.push_back({{"method", r.method},
+                          {"iterations", r.iterations},
+                          {"irls_iterations", r.irlsIterations},
+                          {"residual", r.residual},
+                          {"tolerance", r.tolerance},
+                          {"converged", r.converged},
+                          {"ms", r.ms}});
+    j["reconstructions"] = recons;
 }
 
 std::string GptIntegrator::summary(const RenderStats& s) const {
