@@ -7,6 +7,7 @@
 
 #include "app/subcommand.h"
 #include "image/exr_io.h"
+#include "image/finite_check.h"
 #include "image/png_preview.h"
 #include "poisson/poisson_clone.h"
 #include "util/error.h"
@@ -56,6 +57,7 @@ int runClone(const CloneArgs& a) {
     } catch (const Error& e) {
         throw e.withContext(a.source + " -> " + a.target);
     }
+    checkFinite({{"", result}}, a.output);  // the last guard before writing
     if (png)
         writePngPreview(a.output, result);
     else

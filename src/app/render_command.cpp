@@ -15,6 +15,7 @@
 #include "app/input_file.h"
 #include "app/subcommand.h"
 #include "image/exr_io.h"
+#include "image/finite_check.h"
 #include "image/png_preview.h"
 #include "integrator/checkpoint.h"
 #include "integrator/integrator.h"
@@ -226,6 +227,7 @@ int runRender(const RenderArgs& args) {
         return 130;
     }
     Timer writeTimer;
+    checkFinite(out.layers, args.output);
     writeExr(args.output, out.layers);
     writePngPreview(previewPath(args.output), out.image());
     const double writeMs = writeTimer.ms();

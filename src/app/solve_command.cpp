@@ -8,6 +8,7 @@
 
 #include "app/subcommand.h"
 #include "image/exr_io.h"
+#include "image/finite_check.h"
 #include "integrator/gpt_sampler.h"
 #include "poisson/poisson_gpu.h"
 #include "util/error.h"
@@ -114,6 +115,8 @@ int runSolve(const SolveArgs& a) {
         progress.update(1.0);
         progress.finish(std::to_string(report.iterations) + " iterations");
     }
+    // The last guard: nothing non-finite is written (e.g. a final image that overflows).
+    checkFinite({{"", gptFinal(recon, modulation, direct)}, {"recon", recon}}, a.output);
     writeExr(a.output, {{"", gptFinal(recon, modulation, direct)}, {"recon", recon}});
     if (!a.quiet) {
         std::fprintf(
@@ -127,6 +130,12 @@ int runSolve(const SolveArgs& a) {
                 stderr,
                 "gdpt: warning: replaced non-finite inputs: primal %zu, dx %zu, dy %zu, variance %zu\n",
                 report.nonFinite.primal, report.nonFinite.dx, report.nonFinite.dy, report.nonFinite.variance);
+        if (report.scaleExponent > 0)
+            std::fprintf(
+                stderr,
+                "gdpt: note: inputs above %g were scaled by 2^-%d for the solve (its float32 sums of "
+                "squares would overflow) and the result by 2^%d\n",
+                kSolveMaxMagnitude, report.scaleExponent, report.scaleExponent);
     }
     return 0;
 }

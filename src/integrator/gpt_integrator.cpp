@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <string>
 #include <utility>
 
 #include "integrator/render_identity.h"
@@ -100,11 +101,14 @@ RenderOutput GptIntegrator::render(const vk::Context& ctx, const Scene& scene, c
         const SolveReport report = solver_->solve(input, so, recon);
         // Not converged (the iteration cap, or a tolerance below what float32 residuals
         // reach) is said as `gdpt solve` says it, and recorded for the JSON summary.
-        if (!options.quiet)
+        if (!options.quiet) {
+            const std::string scaled =
+                report.scaleExponent ? ", inputs scaled by 2^-" + std::to_string(report.scaleExponent) : "";
             std::fprintf(stderr,
-                         "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g%s, %.1f ms\n",
+                         "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g%s%s, %.1f ms\n",
                          toString(so.method), report.iterations, report.irlsIterations, report.residual,
-                         report.converged ? "" : " NOT converged", report.ms);
+                         report.converged ? "" : " NOT converged", scaled.c_str(), report.ms);
+        }
         out.stats.reconstructions.push_back({toString(so.method), report.iterations, report.irlsIterations,
                                              report.residual, so.tolerance, report.converged, report.ms});
         out.stats.reconstructionMs += report.ms;

@@ -57,6 +57,21 @@ float inverseVariance(const Image& var, std::size_t i, double eps, std::size_t& 
     return static_cast<float>(1.0 / (v + eps));
 }
 
+// The largest magnitude of the (finite) values.
+float maxMagnitude(const std::vector<float>& values) {
+    float m = 0.0f;
+    for (float v : values) m = std::max(m, std::abs(v));
+    return m;
+}
+
+// k >= 0 such that magnitude · 2^-k <= kSolveMaxMagnitude.
+int scaleExponentFor(double magnitude) {
+    if (!(magnitude > kSolveMaxMagnitude)) return 0;
+    int exponent = 0;
+    (void)std::frexp(magnitude / kSolveMaxMagnitude, &exponent);  // magnitude/max < 2^exponent
+    return exponent;
+}
+
 int growBatch(int batch, int cap) {
     return std::min(batch * 2, cap);
 }
@@ -370,9 +385,16 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
 
     SolveReport report;
     std::vector<std::uint8_t> okP, okX, okY;
-    const std::vector<float> primal = sanitise(*in.primal, report.nonFinite.primal, okP);
-    const std::vector<float> dx = sanitise(*in.dx, report.nonFinite.dx, okX);
-    const std::vector<float> dy = sanitise(*in.dy, report.nonFinite.dy, okY);
+    std::vector<float> primal = sanitise(*in.primal, report.nonFinite.primal, okP);
+    std::vector<float> dx = sanitise(*in.dx, report.nonFinite.dx, okX);
+    std::vector<float> dy = sanitise(*in.dy, report.nonFinite.dy, okY);
+    // Inputs too large for the device's float32 sums of squares: the same solve scaled by
+    // 2^-k (see poisson_gpu.h), the IRLS regulariser with them; undone after the download.
+    report.scaleExponent =
+        scaleExponentFor(std::max({maxMagnitude(primal), maxMagnitude(dx), maxMagnitude(dy)}));
+    if (report.scaleExponent > 0)
+        for (std::vector<float>* v : {&primal, &dx, &dy})
+            for (float& x : *v) x = std::ldexp(x, -report.scaleExponent);
     std::vector<float> weights(3 * n, 1.0f);
     const bool wl2 = o.method == Reconstruction::WeightedL2;
     const bool wl1 = o.method == Reconstruction::WeightedL1;
@@ -458,7 +480,7 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
         report.converged = r.converged;
         report.irlsIterations = 1;
     } else {
-        double reg = o.irlsRegInit;
+        double reg = std::ldexp(o.irlsRegInit, -report.scaleExponent);  // radiance units, scaled
         for (int k = 0; k < rounds_; ++k) {
             const bool last = k + 1 == rounds_;
             const double tol = last ? o.tolerance : std::max(o.tolerance, o.irlsInnerTolerance);
@@ -501,6 +523,8 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
             const double shift = sw > 0.0 ? swd / sw : sd / double(n);
             for (std::size_t i = 0; i < n; ++i) sol[o0 + i] = static_cast<float>(sol[o0 + i] + shift);
         }
+        if (report.scaleExponent > 0)
+            for (std::size_t i = 0; i < n; ++i) sol[o0 + i] = std::ldexp(sol[o0 + i], report.scaleExponent);
         std::copy(sol.begin() + static_cast<std::ptrdiff_t>(o0),
                   sol.begin() + static_cast<std::ptrdiff_t>(o0 + n), out.plane(c).begin());
     }

@@ -22,6 +22,14 @@
 // becomes 0 with primal weight 0, a non-finite gradient 0 with row weight 0, a non-finite
 // variance gives weight 0. α = 0 (or all primal weights 0) leaves A singular; the solution
 // is then shifted so its weighted mean equals the primal's (the α → 0 limit, poisson_cpu.h).
+//
+// Large inputs: the device sums squares in float32 (‖b‖², the CG dot products), which
+// overflow once values pass about 1e19 (the solve then saw ‖b‖ = inf and stopped after 0
+// iterations with residual 0). Inputs whose largest magnitude exceeds kSolveMaxMagnitude are
+// scaled by 2^-k first (primal, gradients and the IRLS regulariser alike; the variance
+// weights are unchanged by a common factor) and the result by 2^k: a power of two commutes
+// exactly with float arithmetic short of underflow, so this is the same solve
+// (SolveReport::scaleExponent = k).
 #pragma once
 
 #include <array>
@@ -91,6 +99,10 @@ struct NonFiniteCounts {
     [[nodiscard]] std::size_t total() const { return primal + dx + dy + variance + weight; }
 };
 
+// Largest input magnitude the device solves unscaled (2^32): squares up to 2^64, summed over
+// 2^28 pixels (16384²) with weights, stay far below float's 3.4e38.
+inline constexpr double kSolveMaxMagnitude = 4294967296.0;
+
 struct SolveReport {
     int iterations = 0;      // inner iterations, summed over IRLS rounds
     int irlsIterations = 0;  // 1 for L2/WL2
@@ -99,6 +111,9 @@ struct SolveReport {
     bool converged = false;  // every channel of the last solve reached the tolerance
     double ms = 0.0;         // wall time of the solve (upload to download)
     NonFiniteCounts nonFinite;
+    // The inputs were scaled by 2^-scaleExponent for the device and the result back by
+    // 2^scaleExponent (0: unscaled; kSolveMaxMagnitude).
+    int scaleExponent = 0;
     // Test mode: relative residual ‖r_k‖/‖b‖ per channel after iteration k of the last
     // solve (k = 0 is the initial guess; Jacobi records every second sweep).
     std::vector<std::array<double, 3>> history;
