@@ -43,17 +43,18 @@ std::vector<float> sanitise(const Image& im, std::size_t& count, std::vector<std
     return out;
 }
 
-// Row weight from an RGB variance image: 1/(mean variance + ε), 0 for non-finite/negative.
-float inverseVariance(const Image& var, std::size_t i, double eps, std::size_t& bad) {
+// Row weight from an RGB variance image: 1/(mean variance + ε); 0 where a channel is
+// non-finite or negative (no variance is), counted in `counts`.
+float inverseVariance(const Image& var, std::size_t i, double eps, NonFiniteCounts& counts) {
     if (!finite3(var, i)) {
-        ++bad;
+        ++counts.variance;
+        return 0.0f;
+    }
+    if (var.plane(0)[i] < 0.0f || var.plane(1)[i] < 0.0f || var.plane(2)[i] < 0.0f) {
+        ++counts.negativeVariance;
         return 0.0f;
     }
     const double v = (double(var.plane(0)[i]) + var.plane(1)[i] + var.plane(2)[i]) / 3.0;
-    if (v < 0.0) {
-        ++bad;
-        return 0.0f;
-    }
     return static_cast<float>(1.0 / (v + eps));
 }
 
@@ -94,18 +95,21 @@ bool needsVariance(Reconstruction r) {
     return r == Reconstruction::WeightedL2 || r == Reconstruction::WeightedL1;
 }
 
-std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& bad) {
+std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& nonFinite,
+                                       std::size_t& negative) {
     const int w = var.width(), h = var.height();
     const std::size_t n = var.pixelCount();
     // Per-pixel RGB mean and validity, then running sums along x and along y.
     std::vector<double> value(n, 0.0), count(n, 0.0);
     for (std::size_t i = 0; i < n; ++i) {
         const double v = (double(var.plane(0)[i]) + var.plane(1)[i] + var.plane(2)[i]) / 3.0;
-        if (finite3(var, i) && v >= 0.0) {
+        if (!finite3(var, i)) {
+            ++nonFinite;
+        } else if (var.plane(0)[i] < 0.0f || var.plane(1)[i] < 0.0f || var.plane(2)[i] < 0.0f) {
+            ++negative;
+        } else {
             value[i] = v;
             count[i] = 1.0;
-        } else {
-            ++bad;
         }
     }
     const auto pass = [&](std::vector<double>& a, std::vector<double>& c, bool alongX) {
@@ -400,9 +404,10 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
     const bool wl1 = o.method == Reconstruction::WeightedL1;
     std::vector<float> varP, varX, varY;  // WL1: box-filtered variances (-1 = none valid)
     if (wl1) {
-        varP = boxFilteredVariance(*in.varPrimal, o.varianceFilterRadius, report.nonFinite.variance);
-        varX = boxFilteredVariance(*in.varDx, o.varianceFilterRadius, report.nonFinite.variance);
-        varY = boxFilteredVariance(*in.varDy, o.varianceFilterRadius, report.nonFinite.variance);
+        NonFiniteCounts& nf = report.nonFinite;
+        varP = boxFilteredVariance(*in.varPrimal, o.varianceFilterRadius, nf.variance, nf.negativeVariance);
+        varX = boxFilteredVariance(*in.varDx, o.varianceFilterRadius, nf.variance, nf.negativeVariance);
+        varY = boxFilteredVariance(*in.varDy, o.varianceFilterRadius, nf.variance, nf.negativeVariance);
     }
     const auto inverseFiltered = [&](const std::vector<float>& v, std::size_t i) {
         return v[i] < 0.0f ? 0.0f : static_cast<float>(1.0 / (double(v[i]) + o.varianceEpsilon));
@@ -422,9 +427,9 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
         *wx = userWeight(in.weightDx);
         *wy = userWeight(in.weightDy);
         if (wl2) {
-            *wp *= inverseVariance(*in.varPrimal, i, o.varianceEpsilon, report.nonFinite.variance);
-            *wx *= inverseVariance(*in.varDx, i, o.varianceEpsilon, report.nonFinite.variance);
-            *wy *= inverseVariance(*in.varDy, i, o.varianceEpsilon, report.nonFinite.variance);
+            *wp *= inverseVariance(*in.varPrimal, i, o.varianceEpsilon, report.nonFinite);
+            *wx *= inverseVariance(*in.varDx, i, o.varianceEpsilon, report.nonFinite);
+            *wy *= inverseVariance(*in.varDy, i, o.varianceEpsilon, report.nonFinite);
         }
         if (wl1) {
             *wp *= inverseFiltered(varP, i);

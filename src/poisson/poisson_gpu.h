@@ -20,8 +20,9 @@
 //
 // Non-finite inputs are counted and neutralised before upload: a non-finite primal value
 // becomes 0 with primal weight 0, a non-finite gradient 0 with row weight 0, a non-finite
-// variance gives weight 0. α = 0 (or all primal weights 0) leaves A singular; the solution
-// is then shifted so its weighted mean equals the primal's (the α → 0 limit, poisson_cpu.h).
+// or negative variance gives weight 0 (counted apart: NonFiniteCounts::negativeVariance).
+// α = 0 (or all primal weights 0) leaves A singular; the solution is then shifted so its
+// weighted mean equals the primal's (the α → 0 limit, poisson_cpu.h).
 //
 // Large inputs: the device sums squares in float32 (‖b‖², the CG dot products), which
 // overflow once values pass about 1e19 (the solve then saw ‖b‖ = inf and stopped after 0
@@ -94,9 +95,13 @@ struct SolveOptions {
     std::function<void(int roundsDone, int rounds, int iterations)> progress;
 };
 
+// Values replaced (each counted once per value; a variance per pixel and layer).
 struct NonFiniteCounts {
-    std::size_t primal = 0, dx = 0, dy = 0, variance = 0, weight = 0;  // values replaced
-    [[nodiscard]] std::size_t total() const { return primal + dx + dy + variance + weight; }
+    std::size_t primal = 0, dx = 0, dy = 0, variance = 0, weight = 0;  // NaN or infinite
+    std::size_t negativeVariance = 0;  // finite but negative: not a variance (weight 0)
+    [[nodiscard]] std::size_t total() const {
+        return primal + dx + dy + variance + weight + negativeVariance;
+    }
 };
 
 // Largest input magnitude the device solves unscaled (2^32): squares up to 2^64, summed over
@@ -139,10 +144,11 @@ bool isIrls(Reconstruction r);
 bool needsVariance(Reconstruction r);
 
 // Mean over RGB of `var`, averaged over the (2·radius+1)² box around each pixel (clipped at
-// the borders; separable, linear in the pixels). A pixel whose variance is not finite or
-// whose RGB mean is negative counts as missing: they are left out of the averages and counted in `bad`; a box
-// with no valid value gives -1 (the caller's weight 0).
-std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& bad);
+// the borders; separable, linear in the pixels). A pixel with a non-finite or a negative
+// channel counts as missing: it is left out of the averages and counted in `nonFinite` or
+// `negative`; a box with no valid value gives -1 (the caller's weight 0).
+std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& nonFinite,
+                                       std::size_t& negative);
 
 class PoissonSolverGpu {
 public:
