@@ -6,7 +6,8 @@
 // Notation: m_X(p) = mean of quantity X at pixel p over its N samples, v_X(p) = variance of
 // that mean = M2 / (N − 1) / N; δ_i = right, down, left, up.
 //   primal(p) = [m_central(p) + Σ_{i: p−δ_i in image} m_neighbor_i(p − δ_i)] / k(p)
-// where k(p) = number of neighbours of p inside the image (2, 3 or 4). Each pixel pair
+// where k(p) = number of neighbours of p inside the image (1 to 4; in a 1x1 image 0, and
+// central holds the one pair of gptPairCounted there, so k = 1). Each pixel pair
 // (p, q) gives one unbiased estimator of I(p): the base part from p's samples plus the
 // offset part from q's samples (their MIS weights sum to 1, shift.glsl). central(p) holds
 // the base parts of the k(p) pairs and p receives exactly k(p) neighbour parts, so the
@@ -74,8 +75,11 @@ void main() {
     }
 
     GptResolved r;
-    r.primal = k > 0.0 ? sum / k : vec3(0.0);  // k = 0 only for a 1x1 image
-    r.varPrimal = k > 0.0 ? var / (k * k) : vec3(0.0);
+    // k = 0 only in a 1x1 image, whose central holds one pair: the lone base path's
+    // (gptPairCounted in gpt_path.glsl), an estimate of I(p) by itself.
+    k = max(k, 1.0);
+    r.primal = sum / k;
+    r.varPrimal = var / (k * k);
     r.dx = vec3(0.0);
     r.varDx = vec3(0.0);
     if (x + 1u < w) {

@@ -48,7 +48,7 @@
     if (!bsdfIsDeltaOnly(bsdf) && sampleLight(sh.p, ul, ls) && dot(ls.wi, sh.ng) > 0.0) {
         BaseNee nee = gptBaseNee(ls, ul, bsdf, woLocal, t, b, sh.ns, origin, beta, rays);
         for (uint i = 0u; i < kGptNumOffsets; ++i) {
-            if (!gptPairExists(px, py, i)) continue;
+            if (!gptPairCounted(px, py, i)) continue;
             bool own = offs[i].alive && ownVertex(offs[i], GDPT_GPT_GENERAL);
             OffsetNee on = gptPairNee(offs[i], offV[i], own, lightStrategy[i], nee, bsdf, sh.p, rays);
             float w = gptMisWeight(ls.pdf, nee.pdfBsdf, on.qLight, on.qBsdf);
@@ -84,7 +84,7 @@
     // ---- 5. Emission reached by the BSDF sample: the environment or an emitter ----
     if (kHasEnv && seg.missed) {  // (kHasEnv: else the path ended above; lets the compiler drop this)
         for (uint i = 0u; i < kGptNumOffsets; ++i) {
-            if (gptPairExists(px, py, i)) gptPairEnvironment(offs[i], beta, scene.envRadiance);
+            if (gptPairCounted(px, py, i)) gptPairEnvironment(offs[i], beta, scene.envRadiance);
         }
         { pathEnded = true; break; }
     }
@@ -96,7 +96,7 @@
             pdfLight = lightTrianglePdf(seg.next.triangle, sh.p, seg.next.p, nl);
         }
         for (uint i = 0u; i < kGptNumOffsets; ++i) {
-            if (!gptPairExists(px, py, i)) continue;
+            if (!gptPairCounted(px, py, i)) continue;
             // The light strategy competes only where NEE counted for this pair.
             gptPairEmitter(offs[i], ownVertex(offs[i], GDPT_GPT_GENERAL), beta, le, seg.bs.pdf,
                            lightStrategy[i] ? pdfLight : 0.0);

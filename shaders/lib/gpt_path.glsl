@@ -30,6 +30,16 @@ bool gptPairExists(uint px, uint py, uint i) {
     return q.x >= 0 && q.y >= 0 && q.x < int(scene.width) && q.y < int(scene.height);
 }
 
+// Whether the base path accumulates the pair (p, p + δ_i): every existing pair, and in a 1x1
+// image, which has none, the right one as a pair whose shift always fails (its offset is never
+// alive, gpt.comp). Its weights are then the lone base's, the path tracer's (MIS of NEE and
+// BSDF sampling alone), so central(p) is PT's estimate of I(p) and gpt_resolve.comp's primal
+// is unbiased there too; without it a 1x1 primal is zero. Images one pixel wide or high need
+// no such pair: each pixel has one or two real ones.
+bool gptPairCounted(uint px, uint py, uint i) {
+    return gptPairExists(px, py, i) || (scene.width == 1u && scene.height == 1u && i == kGptRight);
+}
+
 // Vertex classification; a scene without glossy/specular vertices (kHasGlossy false) has
 // every vertex rough, which the compiler folds away with the half-vector branch.
 //

@@ -7,6 +7,7 @@
 
 #include "app/subcommand.h"
 #include "image/exr_io.h"
+#include "image/finite_check.h"
 #include "image/png_preview.h"
 #include "poisson/poisson_clone.h"
 #include "util/error.h"
@@ -44,6 +45,21 @@ int runClone(const CloneArgs& a) {
     const Image source = readImage(a.source);
     const Image target = readImage(a.target);
     const Image mask = readImage(a.mask);
+    // Invalid values, found up front and named with their file (poisson_clone.h says what the
+    // clone does with them): a target must be finite; a source's NaN/Inf pixels give no
+    // guidance; a mask's select nothing.
+    if (const PixelScan bad = scanNonFinite(target); bad.any())
+        throw Error(a.target + ": NaN or infinite values in " + bad.describe() +
+                    "; the target is copied into the result, so it cannot be cloned into");
+    if (const PixelScan bad = scanNonFinite(source); bad.any() && !a.quiet)
+        std::fprintf(stderr,
+                     "gdpt: warning: %s: NaN or infinite values in %s; the gradients that touch them are "
+                     "replaced by the target's\n",
+                     a.source.c_str(), bad.describe().c_str());
+    if (const PixelScan bad = scanNonFinite(mask); bad.any() && !a.quiet)
+        std::fprintf(stderr,
+                     "gdpt: warning: %s: NaN or infinite values in %s; those pixels are not selected\n",
+                     a.mask.c_str(), bad.describe().c_str());
     vk::ContextOptions co;
     co.device = a.device;
     vk::Context ctx(co);
@@ -59,6 +75,7 @@ int runClone(const CloneArgs& a) {
     } catch (const Error& e) {
         throw e.withContext(a.source + " -> " + a.target);
     }
+    checkFinite({{"", result}}, a.output);  // the last guard before writing
     if (png)
         writePngPreview(outFile, result);
     else

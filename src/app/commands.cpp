@@ -5,11 +5,13 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <utility>
 
 #include "app/bench_util.h"
 #include "app/subcommand.h"
 #include "image/atomic_write.h"
 #include "image/exr_io.h"
+#include "image/finite_check.h"
 #include "image/metrics.h"
 #include "integrator/gpt_sampler.h"
 #include "render/device_scene/features.h"
@@ -57,7 +59,25 @@ int runDiff(const DiffArgs& args) {
         args.json.empty() || args.json == "-" ? nullptr : &outputs.add(args.json, "--json");
     const Image test = readExrLayer(args.test);
     const Image reference = readExrLayer(args.reference);
+    const auto size = [](const Image& im) {
+        return std::to_string(im.width()) + "x" + std::to_string(im.height());
+    };
+    if (!test.sameSize(reference))
+        throw Error("cannot compare " + args.test + " (" + size(test) + ") with the reference " +
+                    args.reference + " (" + size(reference) + "): the sizes differ");
+    // Pixels with a NaN or infinite value in either image are left out of every metric
+    // (metrics.h); say which file has them, and fail when no pixel is left to compare.
+    const PixelScan badTest = scanNonFinite(test), badReference = scanNonFinite(reference);
     const ImageErrorStats e = compareImages(test, reference);
+    if (e.finitePixels == 0)
+        throw Error("no pixel is finite in both " + args.test + " and " + args.reference +
+                    " (NaN or infinite: " + badTest.describe() + " of " + args.test + ", " +
+                    badReference.describe() + " of " + args.reference + "); nothing to compare");
+    for (const auto& [file, bad] :
+         {std::pair{&args.test, &badTest}, std::pair{&args.reference, &badReference}})
+        if (bad->any())
+            std::fprintf(stderr, "gdpt: warning: %s: NaN or infinite values in %s, left out of the metrics\n",
+                         file->c_str(), bad->describe().c_str());
     json j = {{"test", args.test},
               {"reference", args.reference},
               {"relmse", e.relMse},

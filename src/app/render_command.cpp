@@ -14,6 +14,7 @@
 #include "app/subcommand.h"
 #include "image/atomic_write.h"
 #include "image/exr_io.h"
+#include "image/finite_check.h"
 #include "image/png_preview.h"
 #include "integrator/checkpoint.h"
 #include "integrator/integrator.h"
@@ -248,6 +249,7 @@ int runRender(const RenderArgs& args) {
     }
     enterPhase("writing");
     Timer writeTimer;
+    checkFinite(out.layers, args.output);
     writeExr(exrFile, out.layers);
     throwIfInterrupted("writing");
     writePngPreview(pngFile, out.image());

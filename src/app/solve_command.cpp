@@ -3,11 +3,13 @@
 // EXR, or separate --primal/--dx/--dy EXR files, and writes the final image (reconstruction
 // + direct; modulation × reconstruction + direct where the EXR has the `modulation` layer of a
 // demodulated render) in the default channels plus a `recon` layer (tmp + rename).
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
 #include "app/subcommand.h"
 #include "image/exr_io.h"
+#include "image/finite_check.h"
 #include "integrator/gpt_sampler.h"
 #include "poisson/poisson_gpu.h"
 #include "util/error.h"
@@ -42,6 +44,58 @@ const Image* findLayer(const std::vector<NamedLayer>& layers, const std::string&
         if (l.name == name) return &l.image;
     return nullptr;
 }
+
+// Invalid input values, one policy for every layer (what the solver does with them,
+// poisson_gpu.h): NaN or infinite values in primal, dx or dy leave their rows out of the
+// solve (weight 0); non-finite or negative values in a variance the reconstruction uses
+// leave the rows they weight out; non-finite values in direct or modulation count as zero.
+// Each is reported with the layer (or file), how many pixels and the first of them. A layer
+// with no usable pixel at all is refused: the solve would silently return something else
+// (the primal, or an image without its primal).
+class InputCheck {
+public:
+    explicit InputCheck(bool quiet) : quiet_(quiet) {}
+
+    // A layer whose non-finite values leave its rows out of the solve.
+    void rows(const std::string& what, const Image& im) {
+        const PixelScan bad = scanNonFinite(im);
+        if (bad.all())
+            throw Error(what + " has no finite pixel (NaN or infinite everywhere); nothing to solve");
+        warn(what, "NaN or infinite values", bad, "their rows are left out of the solve (weight 0)");
+    }
+    // A variance layer that weights rows: non-finite and negative values leave them out.
+    void variance(const std::string& what, const Image& im, const char* recon) {
+        const PixelScan bad = scanNonFinite(im), negative = scanNegative(im);
+        if (bad.pixels + negative.pixels >= im.pixelCount())
+            throw Error(what + " has no valid variance (finite and >= 0; " + std::to_string(bad.pixels) +
+                        " pixels NaN or infinite, " + std::to_string(negative.pixels) +
+                        " negative): --recon " + recon +
+                        " cannot weight its rows (--recon l2 does not use it)");
+        warn(what, "NaN or infinite values", bad,
+             "the rows they weight are left out of the solve (weight 0)");
+        warn(what, "negative values (not a variance)", negative,
+             "the rows they weight are left out of the solve (weight 0)");
+    }
+    // A layer applied after the solve (direct, modulation): non-finite values become 0.
+    Image zeroed(const std::string& what, const Image& im) {
+        const PixelScan bad = scanNonFinite(im);
+        warn(what, "NaN or infinite values", bad, "they are counted as zero");
+        Image out = im;
+        if (bad.any())
+            for (int c = 0; c < 3; ++c)
+                for (float& v : out.plane(c))
+                    if (!std::isfinite(v)) v = 0.0f;
+        return out;
+    }
+
+private:
+    void warn(const std::string& what, const char* found, const PixelScan& s, const char* done) const {
+        if (s.any() && !quiet_)
+            std::fprintf(stderr, "gdpt: warning: %s: %s in %s; %s\n", what.c_str(), found,
+                         s.describe().c_str(), done);
+    }
+    bool quiet_;
+};
 
 int runSolve(const SolveArgs& a) {
     const bool separate = !a.primal.empty() || !a.dx.empty() || !a.dy.empty();
@@ -97,6 +151,28 @@ int runSolve(const SolveArgs& a) {
     if (needsVariance(o.method) && !(varP && varX && varY))
         throw Error((separate ? a.primal : a.input) + ": --recon " + toString(o.method) +
                     " needs the layers var_primal, var_dx and var_dy");
+    // What each input is called in messages: its file, or the layer of INPUT.exr.
+    const auto named = [&](const std::string& layer, const std::string& file) {
+        return separate ? file : a.input + ": layer '" + layer + "'";
+    };
+    InputCheck check(a.quiet);
+    check.rows(named("primal", a.primal), primal);
+    check.rows(named("dx", a.dx), dx);
+    check.rows(named("dy", a.dy), dy);
+    if (needsVariance(o.method)) {
+        check.variance(named("var_primal", ""), *varP, toString(o.method));
+        check.variance(named("var_dx", ""), *varX, toString(o.method));
+        check.variance(named("var_dy", ""), *varY, toString(o.method));
+    }
+    Image directValid, modulationValid;
+    if (direct) {
+        directValid = check.zeroed(named("direct", ""), *direct);
+        direct = &directValid;
+    }
+    if (modulation) {
+        modulationValid = check.zeroed(named("modulation", ""), *modulation);
+        modulation = &modulationValid;
+    }
 
     vk::ContextOptions co;
     co.device = a.device;
@@ -121,7 +197,10 @@ int runSolve(const SolveArgs& a) {
         progress.update(1.0);
         progress.finish(std::to_string(report.iterations) + " iterations");
     }
-    writeExr(outFile, {{"", gptFinal(recon, modulation, direct)}, {"recon", recon}});
+    // The last guard: nothing non-finite is written (e.g. a final image that overflows).
+    const std::vector<NamedLayer> result = {{"", gptFinal(recon, modulation, direct)}, {"recon", recon}};
+    checkFinite(result, a.output);
+    writeExr(outFile, result);
     throwIfInterrupted("writing");
     outputs.commit();
     if (!a.quiet) {
@@ -131,11 +210,12 @@ int runSolve(const SolveArgs& a) {
             a.output.c_str(), primal.width(), primal.height(), toString(o.method), toString(o.solver),
             o.alpha, report.iterations, report.irlsIterations, report.residual,
             report.converged ? "" : " NOT converged", report.ms);
-        if (report.nonFinite.total() > 0)
+        if (report.scaleExponent > 0)
             std::fprintf(
                 stderr,
-                "gdpt: warning: replaced non-finite inputs: primal %zu, dx %zu, dy %zu, variance %zu\n",
-                report.nonFinite.primal, report.nonFinite.dx, report.nonFinite.dy, report.nonFinite.variance);
+                "gdpt: note: inputs above %g were scaled by 2^-%d for the solve (its float32 sums of "
+                "squares would overflow) and the result by 2^%d\n",
+                kSolveMaxMagnitude, report.scaleExponent, report.scaleExponent);
     }
     return 0;
 }

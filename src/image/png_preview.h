@@ -38,7 +38,9 @@ void writePngPreview(const std::string& path, const Image& image, const PreviewO
 void writePngPreview(const StagedFile& file, const Image& image, const PreviewOptions& options = {});
 
 // Reads an 8- or 16-bit PNG (gray, gray+alpha, RGB or RGBA; alpha dropped) and converts it
-// to linear float with the exact inverse sRGB OETF. Throws gdpt::Error naming the file.
+// to linear float with the exact inverse sRGB OETF. Throws gdpt::Error naming the file, with
+// a one-line plain-text reason ("the PNG data is truncated (the file ends early)", "corrupt
+// PNG data (bad zlib header)", ...).
 Image readPng(const std::string& path);
 
 // Reads any supported image: .exr (its default layer, or its first layer if it has no

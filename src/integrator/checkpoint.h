@@ -32,9 +32,11 @@ struct Checkpoint {
 void writeCheckpoint(const std::string& path, const ExrAttributes& identity, const ExrAttributes& info,
                      const SamplerState& state);
 
-// Reads and validates a checkpoint: format, attributes, every state layer present, counts
-// whole numbers <= spp, means and M2 finite. Throws gdpt::Error naming the file and the
-// first problem found.
+// Reads and validates a checkpoint: format, attributes, the statistics buffers of its method
+// (gdpt.id.method) with every layer present, sample counts consistent with gdpt.spp (path
+// statistics: spp in every pixel, spp x (1 + edge_samples) in G-PT's edge pixels, the same in
+// every path statistic of a pixel; emitter supersampling's: 0 or spp), means finite, M2
+// finite and >= 0. Throws gdpt::Error naming the file, the layer and the first bad pixel.
 Checkpoint readCheckpoint(const std::string& path);
 
 // Throws gdpt::Error naming `path` and the first identity key whose recorded value differs

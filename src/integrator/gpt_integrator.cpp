@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <string>
 #include <utility>
 
 #include "integrator/render_identity.h"
@@ -106,10 +107,18 @@ RenderOutput GptIntegrator::render(const vk::Context& ctx, const Scene& scene, c
         so.progress = [&](int, int, int) { stopIfCancelled(); };
         Image recon;
         const SolveReport report = solver_->solve(input, so, recon);
-        if (!options.quiet)
-            std::fprintf(stderr, "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g, %.1f ms\n",
+        // Not converged (the iteration cap, or a tolerance below what float32 residuals
+        // reach) is said as `gdpt solve` says it, and recorded for the JSON summary.
+        if (!options.quiet) {
+            const std::string scaled =
+                report.scaleExponent ? ", inputs scaled by 2^-" + std::to_string(report.scaleExponent) : "";
+            std::fprintf(stderr,
+                         "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g%s%s, %.1f ms\n",
                          toString(so.method), report.iterations, report.irlsIterations, report.residual,
-                         report.ms);
+                         report.converged ? "" : " NOT converged", scaled.c_str(), report.ms);
+        }
+        out.stats.reconstructions.push_back({toString(so.method), report.iterations, report.irlsIterations,
+                                             report.residual, so.tolerance, report.converged, report.ms});
         out.stats.reconstructionMs += report.ms;
         recons.push_back({std::string("recon_") + toString(so.method), std::move(recon)});
     }
@@ -142,6 +151,16 @@ void GptIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
     j["gpt_split_bounce"] = s.gptSplitBounce;
     j["edge_samples"] = {{"factor", s.edgeSamples}, {"pixels", s.edgePixels}};
     j["demodulation"] = {{"on", s.demodulated}, {"pixels", s.demodulatedPixels}};
+    nlohmann::json recons = nlohmann::json::array();
+    for (const ReconstructionStats& r : s.reconstructions)
+        recons.push_back({{"method", r.method},
+                          {"iterations", r.iterations},
+                          {"irls_iterations", r.irlsIterations},
+                          {"residual", r.residual},
+                          {"tolerance", r.tolerance},
+                          {"converged", r.converged},
+                          {"ms", r.ms}});
+    j["reconstructions"] = recons;
 }
 
 std::string GptIntegrator::summary(const RenderStats& s) const {

@@ -5,6 +5,7 @@
 
 #include "integrator/sampling_loop.h"
 #include "render/passes/emitter_supersampling_pass.h"
+#include "scene/radiance_range.h"
 #include "vk/context.h"
 
 namespace gdpt {
@@ -23,6 +24,9 @@ RenderOptions withBatchLimit(RenderOptions options, std::uint64_t pixelSamplesPe
 PixelSampling::PixelSampling(const vk::Context& ctx, const Scene& scene, const RenderOptions& options,
                              std::string kind, const MakePass& makePass)
     : ctx_(ctx), options_(options), kind_(std::move(kind)), timer_(ctx), stream_(ctx, kind_) {
+    // Emission whose samples or their squares would overflow float32 is refused before any
+    // work (radiance_range.h), rather than written as NaN/Inf pixels.
+    checkRadianceRange(scene, options.scene.envRadiance);
     Timer phase;
     // The pipelines compile on worker threads (lavapipe: most of the set-up, on one core)
     // while this thread builds the BVH and uploads the scene.

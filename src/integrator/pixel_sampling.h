@@ -25,9 +25,9 @@ namespace gdpt {
 
 class PixelSampling {
 public:
-    // Creates the pass (from the scene's spec, pipelines in the background) and uploads the
-    // scene. `kind` names the pass in progress lines and device-loss messages ("pt", "gpt");
-    // options.maxBatchSpp must be resolved (non-zero).
+    // Checks the scene's emission (checkRadianceRange), creates the pass (from the scene's
+    // spec, pipelines in the background) and uploads the scene. `kind` names the pass in progress lines and
+    // device-loss messages ("pt", "gpt"); options.maxBatchSpp must be resolved (non-zero).
     using MakePass = std::function<std::unique_ptr<SamplingPass>(const SceneSpec& spec)>;
     PixelSampling(const vk::Context& ctx, const Scene& scene, const RenderOptions& options, std::string kind,
                   const MakePass& makePass);

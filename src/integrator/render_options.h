@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "image/image.h"
 #include "integrator/sampler_state.h"
@@ -57,6 +58,17 @@ struct RenderOptions {
     std::function<void()> whileCompiling;
 };
 
+// One screened Poisson reconstruction of a render (G-PT): the solver's report in brief.
+struct ReconstructionStats {
+    std::string method;      // "l1", "l2", "wl2", "wl1"
+    int iterations = 0;      // inner iterations, summed over IRLS rounds
+    int irlsIterations = 0;  // 1 for L2/WL2
+    double residual = 0.0;   // final relative residual, max over channels
+    double tolerance = 0.0;  // the relative residual asked for
+    bool converged = false;  // every channel reached the tolerance
+    double ms = 0.0;
+};
+
 struct RenderStats {
     std::uint32_t spp = 0;              // samples in every pixel
     std::uint32_t partialPassRows = 0;  // timed renders: rows (from the top) with one sample more
@@ -67,7 +79,8 @@ struct RenderStats {
     double pipelineWaitMs = 0.0;         // of which: waiting for the pipelines after the scene upload
     double samplingMs = 0.0;             // wall time of the batch loop
     double readbackMs = 0.0;
-    double reconstructionMs = 0.0;  // G-PT: screened Poisson solve(s)
+    double reconstructionMs = 0.0;                     // G-PT: screened Poisson solve(s)
+    std::vector<ReconstructionStats> reconstructions;  // G-PT: one per reconstruction, in order
     std::uint64_t raysTraced = 0;
     std::uint64_t pathsCompleted = 0;
     std::uint64_t nanSamples = 0;

@@ -16,6 +16,10 @@ Image seamlessClone(const vk::Context& ctx, const Image& source, const Image& ta
                     " but the source is " + std::to_string(source.width()) + "x" +
                     std::to_string(source.height()));
     if (target.empty() || source.empty()) throw Error("clone: empty source or target image");
+    // The target is copied outside the mask and is the boundary inside: it must be finite.
+    for (int c = 0; c < 3; ++c)
+        for (float v : target.plane(c))
+            if (!std::isfinite(v)) throw Error("clone: the target has NaN or infinite values");
     const int w = target.width(), h = target.height();
     const std::size_t n = target.pixelCount();
     // Ω in target coordinates.
@@ -25,11 +29,17 @@ Image seamlessClone(const vk::Context& ctx, const Image& source, const Image& ta
         sy = y - o.offsetY;
         return sx >= 0 && sy >= 0 && sx < source.width() && sy < source.height();
     };
+    // Red > 0.5 selects; a NaN or infinite value in any channel does not.
+    auto selected = [&](int sx, int sy) {
+        for (int c = 0; c < 3; ++c)
+            if (!std::isfinite(mask.at(sx, sy, c))) return false;
+        return mask.at(sx, sy, 0) > 0.5f;
+    };
     std::size_t count = 0;
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             int sx = 0, sy = 0;
-            if (sourceAt(x, y, sx, sy) && mask.at(sx, sy, 0) > 0.5f) {
+            if (sourceAt(x, y, sx, sy) && selected(sx, sy)) {
                 inside[target.index(x, y)] = 1;
                 ++count;
             }
@@ -50,6 +60,8 @@ Image seamlessClone(const vk::Context& ctx, const Image& source, const Image& ta
             nt += double(gt[c]) * gt[c];
             ns += double(gs[c]) * gs[c];
         }
+        // A source gradient through a NaN or infinite pixel is no guidance: the target's.
+        haveSource = haveSource && std::isfinite(ns);
         const bool useSource = haveSource && (!o.mixed || ns > nt);
         for (int c = 0; c < 3; ++c) out[c] = useSource ? gs[c] : gt[c];
     };

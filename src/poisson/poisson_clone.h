@@ -28,9 +28,11 @@ struct CloneOptions {
     GpuSolver solver = GpuSolver::MgPcg;
 };
 
-// `mask` has the source's size; a source pixel belongs to Ω when mask channel 0 > 0.5 and
-// it lands inside the target. Returns an image of the target's size. Throws gdpt::Error on
-// size mismatches.
+// `mask` has the source's size; a source pixel belongs to Ω when mask channel 0 > 0.5 and no
+// channel of it is NaN or infinite, and it lands inside the target. Where a source gradient
+// touches a NaN or infinite source pixel, the guidance is the target's gradient. Returns an
+// image of the target's size. Throws gdpt::Error on size mismatches and on a target with
+// NaN or infinite values (it is copied outside Ω).
 Image seamlessClone(const vk::Context& ctx, const Image& source, const Image& target, const Image& mask,
                     const CloneOptions& options, SolveReport* report = nullptr);
 

@@ -43,18 +43,34 @@ std::vector<float> sanitise(const Image& im, std::size_t& count, std::vector<std
     return out;
 }
 
-// Row weight from an RGB variance image: 1/(mean variance + ε), 0 for non-finite/negative.
-float inverseVariance(const Image& var, std::size_t i, double eps, std::size_t& bad) {
+// Row weight from an RGB variance image: 1/(mean variance + ε); 0 where a channel is
+// non-finite or negative (no variance is), counted in `counts`.
+float inverseVariance(const Image& var, std::size_t i, double eps, NonFiniteCounts& counts) {
     if (!finite3(var, i)) {
-        ++bad;
+        ++counts.variance;
+        return 0.0f;
+    }
+    if (var.plane(0)[i] < 0.0f || var.plane(1)[i] < 0.0f || var.plane(2)[i] < 0.0f) {
+        ++counts.negativeVariance;
         return 0.0f;
     }
     const double v = (double(var.plane(0)[i]) + var.plane(1)[i] + var.plane(2)[i]) / 3.0;
-    if (v < 0.0) {
-        ++bad;
-        return 0.0f;
-    }
     return static_cast<float>(1.0 / (v + eps));
+}
+
+// The largest magnitude of the (finite) values.
+float maxMagnitude(const std::vector<float>& values) {
+    float m = 0.0f;
+    for (float v : values) m = std::max(m, std::abs(v));
+    return m;
+}
+
+// k >= 0 such that magnitude · 2^-k <= kSolveMaxMagnitude.
+int scaleExponentFor(double magnitude) {
+    if (!(magnitude > kSolveMaxMagnitude)) return 0;
+    int exponent = 0;
+    (void)std::frexp(magnitude / kSolveMaxMagnitude, &exponent);  // magnitude/max < 2^exponent
+    return exponent;
 }
 
 int growBatch(int batch, int cap) {
@@ -79,18 +95,21 @@ bool needsVariance(Reconstruction r) {
     return r == Reconstruction::WeightedL2 || r == Reconstruction::WeightedL1;
 }
 
-std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& bad) {
+std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& nonFinite,
+                                       std::size_t& negative) {
     const int w = var.width(), h = var.height();
     const std::size_t n = var.pixelCount();
     // Per-pixel RGB mean and validity, then running sums along x and along y.
     std::vector<double> value(n, 0.0), count(n, 0.0);
     for (std::size_t i = 0; i < n; ++i) {
         const double v = (double(var.plane(0)[i]) + var.plane(1)[i] + var.plane(2)[i]) / 3.0;
-        if (finite3(var, i) && v >= 0.0) {
+        if (!finite3(var, i)) {
+            ++nonFinite;
+        } else if (var.plane(0)[i] < 0.0f || var.plane(1)[i] < 0.0f || var.plane(2)[i] < 0.0f) {
+            ++negative;
+        } else {
             value[i] = v;
             count[i] = 1.0;
-        } else {
-            ++bad;
         }
     }
     const auto pass = [&](std::vector<double>& a, std::vector<double>& c, bool alongX) {
@@ -370,17 +389,25 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
 
     SolveReport report;
     std::vector<std::uint8_t> okP, okX, okY;
-    const std::vector<float> primal = sanitise(*in.primal, report.nonFinite.primal, okP);
-    const std::vector<float> dx = sanitise(*in.dx, report.nonFinite.dx, okX);
-    const std::vector<float> dy = sanitise(*in.dy, report.nonFinite.dy, okY);
+    std::vector<float> primal = sanitise(*in.primal, report.nonFinite.primal, okP);
+    std::vector<float> dx = sanitise(*in.dx, report.nonFinite.dx, okX);
+    std::vector<float> dy = sanitise(*in.dy, report.nonFinite.dy, okY);
+    // Inputs too large for the device's float32 sums of squares: the same solve scaled by
+    // 2^-k (see poisson_gpu.h), the IRLS regulariser with them; undone after the download.
+    report.scaleExponent =
+        scaleExponentFor(std::max({maxMagnitude(primal), maxMagnitude(dx), maxMagnitude(dy)}));
+    if (report.scaleExponent > 0)
+        for (std::vector<float>* v : {&primal, &dx, &dy})
+            for (float& x : *v) x = std::ldexp(x, -report.scaleExponent);
     std::vector<float> weights(3 * n, 1.0f);
     const bool wl2 = o.method == Reconstruction::WeightedL2;
     const bool wl1 = o.method == Reconstruction::WeightedL1;
     std::vector<float> varP, varX, varY;  // WL1: box-filtered variances (-1 = none valid)
     if (wl1) {
-        varP = boxFilteredVariance(*in.varPrimal, o.varianceFilterRadius, report.nonFinite.variance);
-        varX = boxFilteredVariance(*in.varDx, o.varianceFilterRadius, report.nonFinite.variance);
-        varY = boxFilteredVariance(*in.varDy, o.varianceFilterRadius, report.nonFinite.variance);
+        NonFiniteCounts& nf = report.nonFinite;
+        varP = boxFilteredVariance(*in.varPrimal, o.varianceFilterRadius, nf.variance, nf.negativeVariance);
+        varX = boxFilteredVariance(*in.varDx, o.varianceFilterRadius, nf.variance, nf.negativeVariance);
+        varY = boxFilteredVariance(*in.varDy, o.varianceFilterRadius, nf.variance, nf.negativeVariance);
     }
     const auto inverseFiltered = [&](const std::vector<float>& v, std::size_t i) {
         return v[i] < 0.0f ? 0.0f : static_cast<float>(1.0 / (double(v[i]) + o.varianceEpsilon));
@@ -400,9 +427,9 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
         *wx = userWeight(in.weightDx);
         *wy = userWeight(in.weightDy);
         if (wl2) {
-            *wp *= inverseVariance(*in.varPrimal, i, o.varianceEpsilon, report.nonFinite.variance);
-            *wx *= inverseVariance(*in.varDx, i, o.varianceEpsilon, report.nonFinite.variance);
-            *wy *= inverseVariance(*in.varDy, i, o.varianceEpsilon, report.nonFinite.variance);
+            *wp *= inverseVariance(*in.varPrimal, i, o.varianceEpsilon, report.nonFinite);
+            *wx *= inverseVariance(*in.varDx, i, o.varianceEpsilon, report.nonFinite);
+            *wy *= inverseVariance(*in.varDy, i, o.varianceEpsilon, report.nonFinite);
         }
         if (wl1) {
             *wp *= inverseFiltered(varP, i);
@@ -458,7 +485,7 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
         report.converged = r.converged;
         report.irlsIterations = 1;
     } else {
-        double reg = o.irlsRegInit;
+        double reg = std::ldexp(o.irlsRegInit, -report.scaleExponent);  // radiance units, scaled
         for (int k = 0; k < rounds_; ++k) {
             const bool last = k + 1 == rounds_;
             const double tol = last ? o.tolerance : std::max(o.tolerance, o.irlsInnerTolerance);
@@ -501,6 +528,8 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
             const double shift = sw > 0.0 ? swd / sw : sd / double(n);
             for (std::size_t i = 0; i < n; ++i) sol[o0 + i] = static_cast<float>(sol[o0 + i] + shift);
         }
+        if (report.scaleExponent > 0)
+            for (std::size_t i = 0; i < n; ++i) sol[o0 + i] = std::ldexp(sol[o0 + i], report.scaleExponent);
         std::copy(sol.begin() + static_cast<std::ptrdiff_t>(o0),
                   sol.begin() + static_cast<std::ptrdiff_t>(o0 + n), out.plane(c).begin());
     }

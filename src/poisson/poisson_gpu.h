@@ -20,8 +20,17 @@
 //
 // Non-finite inputs are counted and neutralised before upload: a non-finite primal value
 // becomes 0 with primal weight 0, a non-finite gradient 0 with row weight 0, a non-finite
-// variance gives weight 0. α = 0 (or all primal weights 0) leaves A singular; the solution
-// is then shifted so its weighted mean equals the primal's (the α → 0 limit, poisson_cpu.h).
+// or negative variance gives weight 0 (counted apart: NonFiniteCounts::negativeVariance).
+// α = 0 (or all primal weights 0) leaves A singular; the solution is then shifted so its
+// weighted mean equals the primal's (the α → 0 limit, poisson_cpu.h).
+//
+// Large inputs: the device sums squares in float32 (‖b‖², the CG dot products), which
+// overflow once values pass about 1e19 (the solve then saw ‖b‖ = inf and stopped after 0
+// iterations with residual 0). Inputs whose largest magnitude exceeds kSolveMaxMagnitude are
+// scaled by 2^-k first (primal, gradients and the IRLS regulariser alike; the variance
+// weights are unchanged by a common factor) and the result by 2^k: a power of two commutes
+// exactly with float arithmetic short of underflow, so this is the same solve
+// (SolveReport::scaleExponent = k).
 #pragma once
 
 #include <array>
@@ -86,10 +95,18 @@ struct SolveOptions {
     std::function<void(int roundsDone, int rounds, int iterations)> progress;
 };
 
+// Values replaced (each counted once per value; a variance per pixel and layer).
 struct NonFiniteCounts {
-    std::size_t primal = 0, dx = 0, dy = 0, variance = 0, weight = 0;  // values replaced
-    [[nodiscard]] std::size_t total() const { return primal + dx + dy + variance + weight; }
+    std::size_t primal = 0, dx = 0, dy = 0, variance = 0, weight = 0;  // NaN or infinite
+    std::size_t negativeVariance = 0;  // finite but negative: not a variance (weight 0)
+    [[nodiscard]] std::size_t total() const {
+        return primal + dx + dy + variance + weight + negativeVariance;
+    }
 };
+
+// Largest input magnitude the device solves unscaled (2^32): squares up to 2^64, summed over
+// 2^28 pixels (16384²) with weights, stay far below float's 3.4e38.
+inline constexpr double kSolveMaxMagnitude = 4294967296.0;
 
 struct SolveReport {
     int iterations = 0;      // inner iterations, summed over IRLS rounds
@@ -99,6 +116,9 @@ struct SolveReport {
     bool converged = false;  // every channel of the last solve reached the tolerance
     double ms = 0.0;         // wall time of the solve (upload to download)
     NonFiniteCounts nonFinite;
+    // The inputs were scaled by 2^-scaleExponent for the device and the result back by
+    // 2^scaleExponent (0: unscaled; kSolveMaxMagnitude).
+    int scaleExponent = 0;
     // Test mode: relative residual ‖r_k‖/‖b‖ per channel after iteration k of the last
     // solve (k = 0 is the initial guess; Jacobi records every second sweep).
     std::vector<std::array<double, 3>> history;
@@ -124,10 +144,11 @@ bool isIrls(Reconstruction r);
 bool needsVariance(Reconstruction r);
 
 // Mean over RGB of `var`, averaged over the (2·radius+1)² box around each pixel (clipped at
-// the borders; separable, linear in the pixels). A pixel whose variance is not finite or
-// whose RGB mean is negative counts as missing: they are left out of the averages and counted in `bad`; a box
-// with no valid value gives -1 (the caller's weight 0).
-std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& bad);
+// the borders; separable, linear in the pixels). A pixel with a non-finite or a negative
+// channel counts as missing: it is left out of the averages and counted in `nonFinite` or
+// `negative`; a box with no valid value gives -1 (the caller's weight 0).
+std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& nonFinite,
+                                       std::size_t& negative);
 
 class PoissonSolverGpu {
 public:

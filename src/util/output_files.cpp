@@ -42,7 +42,8 @@ mode_t defaultFileMode() {
 // An exclusive flock on a directory, held while a group of files is renamed into it.
 class DirectoryLock {
 public:
-    explicit DirectoryLock(const std::string& dir) : fd_(::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC)) {
+    explicit DirectoryLock(const std::string& dir)
+        : fd_(::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC)) {
         if (fd_ < 0) return;  // the renames will report what is wrong with the directory
         while (::flock(fd_, LOCK_EX) != 0 && errno == EINTR) {
         }
@@ -60,9 +61,11 @@ private:
 // A unique new file `<dir>/.<name>.<tag>XXXXXX`; returns its path. Throws with the reason.
 std::string makeUniqueFile(const std::string& target, const char* tag) {
     const fs::path p(target);
-    std::string pattern = (fs::path(directoryOf(target)) / ("." + p.filename().string() + "." + tag + "XXXXXX")).string();
+    std::string pattern =
+        (fs::path(directoryOf(target)) / ("." + p.filename().string() + "." + tag + "XXXXXX")).string();
     const int fd = ::mkostemp(pattern.data(), O_CLOEXEC);
-    if (fd < 0) throw Error(target + ": cannot create a file in " + directoryOf(target) + ": " + osReason(errno));
+    if (fd < 0)
+        throw Error(target + ": cannot create a file in " + directoryOf(target) + ": " + osReason(errno));
     ::fchmod(fd, defaultFileMode());
     ::close(fd);
     return pattern;
@@ -179,7 +182,8 @@ void OutputSet::checkSeparate(const std::string& path, const std::string& what,
 void OutputSet::commit() {
     for (const auto& o : outputs_) o.second->sync();
     std::set<std::string> dirs;
-    for (const auto& o : outputs_) dirs.insert(fs::weakly_canonical(fs::absolute(directoryOf(o.second->path()))).string());
+    for (const auto& o : outputs_)
+        dirs.insert(fs::weakly_canonical(fs::absolute(directoryOf(o.second->path()))).string());
     std::vector<std::unique_ptr<DirectoryLock>> locks;  // in sorted order: no deadlock between runs
     for (const std::string& d : dirs) locks.push_back(std::make_unique<DirectoryLock>(d));
 

@@ -42,8 +42,8 @@ public:
 
 private:
     friend class OutputSet;
-    void sync() const;     // fsync the temporary file; throws on error
-    void discard();        // remove the temporary file (idempotent)
+    void sync() const;  // fsync the temporary file; throws on error
+    void discard();     // remove the temporary file (idempotent)
     std::string path_;
     std::string tmpPath_;
     bool committed_ = false;

@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -17,10 +18,17 @@ struct RunResult {
     std::string output;  // stdout + stderr
 };
 
+// The gdpt binary under test: GDPT_BINARY (this build's), or the file named by the
+// environment variable GDPT_TEST_BINARY, so that the CLI tests can be run against another
+// build (e.g. an older binary, to show that a regression test fails there).
+inline std::string gdptBinary() {
+    const char* other = std::getenv("GDPT_TEST_BINARY");
+    return other && *other ? std::string(other) : std::string(GDPT_BINARY);
+}
+
 // Runs `gdpt <args>` through the shell; `env` ("NAME=value ..."), if given, is set for it.
 inline RunResult runGdpt(const std::string& args, const std::string& env = "") {
-    const std::string cmd =
-        (env.empty() ? "" : "env " + env + " ") + std::string(GDPT_BINARY) + " " + args + " 2>&1";
+    const std::string cmd = (env.empty() ? "" : "env " + env + " ") + gdptBinary() + " " + args + " 2>&1";
     RunResult r;
     FILE* pipe = popen(cmd.c_str(), "r");
     if (!pipe) return r;

@@ -67,6 +67,21 @@ vk::KernelDesc resolveDesc(WorkgroupSize wg, const EmitterSupersamplingPass& vis
     return d;
 }
 
+// The per-pixel buffers of the pass and the passes it owns (checkPixelBuffers).
+std::vector<PixelBuffer> pixelBuffers(const GptPassOptions& options) {
+    std::vector<PixelBuffer> b = {{"each G-PT per-pixel statistics buffer", sizeof(gpu::PixelStats)},
+                                  {"the resolved G-PT images", sizeof(gpu::GptResolved)},
+                                  {"the emitter-supersampling statistics", sizeof(gpu::PixelStats)},
+                                  {"the emitter-supersampling probe", sizeof(std::uint32_t)},
+                                  {"the edge mask", sizeof(std::uint32_t)},
+                                  {"the edge probe", sizeof(gpu::EdgeProbe)}};
+    if (options.demodulate) {
+        b.push_back({"the demodulation mask", sizeof(std::uint32_t)});
+        b.push_back({"the modulation statistics", sizeof(gpu::PixelStats)});
+    }
+    return b;
+}
+
 std::array<vk::Buffer, kNumStats> makeStats(const vk::Context& ctx, std::uint64_t pixels) {
     auto make = [&](std::uint32_t i) {
         return vk::Buffer(ctx, pixels * sizeof(gpu::PixelStats), kStatNames[i]);
@@ -126,6 +141,7 @@ GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize w
       options_(options),
       halfVector_(options.forceHalfVector || needsHalfVector(scene)),
       splitBounce_(splitBounceFor(ctx.info(), options.splitBounce)),
+      checked_(ctx, width_, height_, pixelBuffers(options)),
       counters_(ctx, sizeof(gpu::Counters), "gpt counters"),
       emitterSupersampling_(ctx, scene, wg, options.emitterSupersampling, counters_, creation),
       edges_(ctx, scene, wg, options.edgeSamples, creation, options.demodulate),
@@ -139,9 +155,6 @@ GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize w
                  "gpt demodulation mask"),
       modulation_(ctx, options.demodulate ? std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats) : 0,
                   "gpt modulation") {
-    const std::string what = " of a " + std::to_string(width_) + "x" + std::to_string(height_) + " image";
-    ctx.checkStorageBufferSize(stats_[0].size(), "each G-PT per-pixel statistics buffer" + what);
-    ctx.checkStorageBufferSize(resolved_.size(), "the resolved G-PT images" + what);
     kernel_.bind(gpu::kBindCounters, counters_);
     for (std::uint32_t i = 0; i < kNumStats; ++i) {
         kernel_.bind(gpu::kBindGptCentral + i, stats_[i]);

@@ -132,6 +132,7 @@ private:
     GptPassOptions options_;
     bool halfVector_ = false;
     bool splitBounce_ = false;
+    PixelBuffersChecked checked_;  // before any buffer below exists
     vk::Buffer counters_;
     EmitterSupersamplingPass emitterSupersampling_;
     EdgePass edges_;

@@ -55,12 +55,15 @@ PtPass::PtPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize wg,
     : ctx_(ctx),
       width_(scene.width()),
       height_(scene.height()),
+      // Its accumulation and emitter supersampling's statistics and probe.
+      checked_(ctx, width_, height_,
+               {{"the per-pixel statistics", sizeof(gpu::PixelStats)},
+                {"the emitter-supersampling statistics", sizeof(gpu::PixelStats)},
+                {"the emitter-supersampling probe", sizeof(std::uint32_t)}}),
       counters_(ctx, sizeof(gpu::Counters), "pt counters"),
       emitterSupersampling_(ctx, scene, wg, emitterSupersampling, counters_, creation),
       kernel_(ctx, ptDesc(scene, wg, emitterSupersampling_), creation),
       accum_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats), "pt pixel statistics") {
-    ctx.checkStorageBufferSize(accum_.size(), "the per-pixel statistics of a " + std::to_string(width_) +
-                                                  "x" + std::to_string(height_) + " image");
     kernel_.bind(gpu::kBindAccum, accum_);
     kernel_.bind(gpu::kBindCounters, counters_);
     emitterSupersampling_.bindTo(kernel_);

@@ -11,6 +11,7 @@
 #include "image/image.h"
 #include "render/device_scene/scene_gpu.h"
 #include "render/passes/emitter_supersampling_pass.h"
+#include "render/passes/pixel_buffers.h"
 #include "render/passes/sampling_pass.h"
 #include "vk/buffer.h"
 #include "vk/kernel.h"
@@ -100,6 +101,7 @@ public:
 private:
     const vk::Context& ctx_;
     std::uint32_t width_, height_;
+    PixelBuffersChecked checked_;  // before any buffer below exists
     vk::Buffer counters_;
     EmitterSupersamplingPass emitterSupersampling_;
     vk::Kernel kernel_;

@@ -219,6 +219,78 @@ TEST_F(CheckpointRefusal, CorruptOrForeignCheckpointIsRefused) {
     expectRefused(path("nolayer.exr"), flags, "state0.m2");
 }
 
+// Rewrites checkpoint `from` into `to` with `edit` applied to layer `name`'s pixel (x, y) in
+// all three channels, and `attributes` changed as given.
+void editCheckpoint(const std::string& from, const std::string& to, const std::string& name, int x, int y,
+                    float value, const ExrAttributes& changed = {}) {
+    auto layers = readExr(from);
+    for (NamedLayer& l : layers)
+        if (l.name == name)
+            for (int c = 0; c < 3; ++c) l.image.at(x, y, c) = value;
+    ExrAttributes attributes = readExrAttributes(from);
+    for (const auto& [key, text] : changed) attributes[key] = text;
+    writeExr(to, layers, attributes);
+}
+
+// Guards the class "checkpoint statistics are validated on resume": a checkpoint whose
+// sample counts do not fit its header (sampler_state.h: path statistics hold gdpt.spp
+// samples in every pixel, emitter supersampling's 0 or gdpt.spp), or whose M2 is negative,
+// would resume into an image labelled with one spp that holds another. Each is refused with
+// one line naming the file, the layer and the first bad pixel.
+TEST_F(CheckpointRefusal, CheckpointWithInconsistentStatisticsIsRefused) {
+    const std::string c = path("c.exr");  // PT, 3 spp (SetUp)
+    const std::string flags = kSize + "--method pt --spp 64 --seed 7";
+    editCheckpoint(c, path("zero.exr"), "state0.count", 5, 2, 0.0f);
+    expectRefused(path("zero.exr"), flags, "state0.count (path samples): pixel (5, 2) has sample count 0");
+    editCheckpoint(c, path("fewer.exr"), "state0.count", 1, 0, 2.0f);
+    expectRefused(path("fewer.exr"), flags, "pixel (1, 0) has sample count 2, expected 3 (gdpt.spp)");
+    // The header claims more samples than every pixel holds.
+    editCheckpoint(c, path("more.exr"), "", 0, 0, 0.0f, {{"gdpt.spp", "32"}});
+    expectRefused(path("more.exr"), flags, "pixel (0, 0) has sample count 3, expected 32 (gdpt.spp)");
+    editCheckpoint(c, path("visible.exr"), "state1.count", 3, 4, 1.0f);
+    expectRefused(path("visible.exr"), flags, "state1.count (visible emission): pixel (3, 4)");
+    editCheckpoint(c, path("m2.exr"), "state0.m2", 6, 1, -0.5f);
+    expectRefused(path("m2.exr"), flags, "state0.m2 (path samples): pixel (6, 1) has M2 -0.5");
+    // A missing buffer (the header and the layers agree on one): named by its first layer.
+    auto layers = readExr(c);
+    layers.erase(std::remove_if(layers.begin(), layers.end(),
+                                [](const NamedLayer& l) { return l.name.rfind("state1.", 0) == 0; }),
+                 layers.end());
+    ExrAttributes attributes = readExrAttributes(c);
+    attributes["gdpt.buffers"] = "1";
+    writeExr(path("one.exr"), layers, attributes);
+    expectRefused(path("one.exr"), flags, "layer 'state1.mean' (visible emission) is missing");
+}
+
+// The same for G-PT: every path statistic of a pixel (central, neighbours, gradients,
+// direct) merged the same samples, so one differing count is a corrupt checkpoint.
+TEST_F(CheckpointRefusal, GptCheckpointWithInconsistentCountsIsRefused) {
+    const std::string c = path("g.exr");
+    const RunResult r = test::runGdpt("render " + kScene + kSize + "--spp 2 --seed 7 --method gpt --quiet " +
+                                      "--checkpoint " + c + " -o " + path("g_out.exr"));
+    ASSERT_EQ(r.code, 0) << r.output;
+    editCheckpoint(c, path("g3.exr"), "state3.count", 2, 9, 4.0f);
+    expectRefused(
+        path("g3.exr"), kSize + "--spp 4 --seed 7 --method gpt",
+        "state3.count (gpt neighbor left): pixel (2, 9) has sample count 4, but state0.count has 2");
+}
+
+// Guards the class "a refused resume names the real difference": another method or size
+// also changes the largest batch (max_batch_spp, a function of both), which sorts first; the
+// message must name the method or the size. 128x128: PT's largest batch is 16, G-PT's 4, and
+// PT's at 256x128 is 8.
+TEST_F(CheckpointRefusal, MethodOrSizeMismatchIsNamedBeforeTheBatchSize) {
+    const std::string c = path("big.exr");
+    const std::string size = " --width 128 --height 128 ";
+    const RunResult r = test::runGdpt("render " + kScene + size + "--method pt --spp 1 --seed 7 --quiet " +
+                                      "--checkpoint " + c + " -o " + path("big_out.exr"));
+    ASSERT_EQ(r.code, 0) << r.output;
+    expectRefused(c, size + "--method gpt --spp 2 --seed 7",
+                  "rendered with method pt, this render has method gpt");
+    expectRefused(c, " --width 256 --height 128 --method pt --spp 2 --seed 7",
+                  "rendered with width 128, this render has width 256");
+}
+
 TEST_F(CheckpointRefusal, HelpDocumentsTheFlagsAndCheckpointEveryNeedsCheckpoint) {
     const RunResult help = test::runGdpt("render --help");
     for (const char* flag : {"--checkpoint", "--checkpoint-every", "--resume"})

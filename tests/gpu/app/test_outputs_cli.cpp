@@ -90,7 +90,8 @@ TEST_F(OutputsCli, BadOutputPathsFailBeforeRenderingAndLeaveNothing) {
     EXPECT_TRUE(says(r, "nodir/out.exr") && says(r, "No such file or directory")) << r.output;
     EXPECT_FALSE(says(r, "gdpt: device")) << "the render ran before the path was checked:\n" << r.output;
 
-    r = test::runGdpt("render " + kScene + noQuiet + "-o " + path("out.exr") + " --json " + path("nodir/s.json"));
+    r = test::runGdpt("render " + kScene + noQuiet + "-o " + path("out.exr") + " --json " +
+                      path("nodir/s.json"));
     EXPECT_EQ(r.code, 1);
     EXPECT_TRUE(says(r, "nodir/s.json")) << r.output;
     EXPECT_FALSE(says(r, "gdpt: device")) << r.output;
@@ -109,8 +110,9 @@ TEST_F(OutputsCli, BadOutputPathsFailBeforeRenderingAndLeaveNothing) {
 // temporary file is left.
 TEST_F(OutputsCli, AFullDiskIsAnErrorAndLeavesNoOutput) {
     // ulimit -f counts 1024-byte blocks. 2 KiB holds none of a G-PT EXR (13 layers).
-    const std::string cmd = "sh -c 'ulimit -f 2; exec " + std::string(GDPT_BINARY) + " render " + kScene +
-                            " --width 16 --height 16 --spp 2 --method gpt --quiet -o " + path("out.exr") + "' 2>&1";
+    const std::string cmd = "sh -c 'ulimit -f 2; exec " + test::gdptBinary() + " render " + kScene +
+                            " --width 16 --height 16 --spp 2 --method gpt --quiet -o " + path("out.exr") +
+                            "' 2>&1";
     FILE* pipe = popen(cmd.c_str(), "r");
     ASSERT_NE(pipe, nullptr);
     std::string output;
@@ -133,15 +135,16 @@ TEST_F(OutputsCli, ConcurrentRendersToOneOutputNeverMix) {
     const int runs = 4;
     for (int seed = 1; seed <= runs; ++seed) {
         const std::string base = path("alone" + std::to_string(seed));
-        ASSERT_EQ(test::runGdpt("render " + kScene + args + "--seed " + std::to_string(seed) + " -o " + base + ".exr")
+        ASSERT_EQ(test::runGdpt("render " + kScene + args + "--seed " + std::to_string(seed) + " -o " + base +
+                                ".exr")
                       .code,
                   0);
     }
     for (int round = 0; round < 3; ++round) {
         std::string cmd;
         for (int seed = 1; seed <= runs; ++seed)
-            cmd += std::string(GDPT_BINARY) + " render " + kScene + args + "--seed " + std::to_string(seed) + " -o " +
-                   path("out.exr") + " --json " + path("out.json") + " & ";
+            cmd += test::gdptBinary() + " render " + kScene + args + "--seed " + std::to_string(seed) +
+                   " -o " + path("out.exr") + " --json " + path("out.json") + " & ";
         cmd += "fails=0; for j in $(jobs -p); do wait $j || fails=$((fails+1)); done; echo $fails";
         FILE* pipe = popen(("bash -c '" + cmd + "' 2>&1").c_str(), "r");
         ASSERT_NE(pipe, nullptr);
@@ -154,10 +157,11 @@ TEST_F(OutputsCli, ConcurrentRendersToOneOutputNeverMix) {
         const nlohmann::json j = nlohmann::json::parse(slurp(path("out.json")));
         const std::string seed = std::to_string(j.at("seed").get<int>());
         // (compared as booleans: a failure would print megabytes of EXR)
-        EXPECT_TRUE(slurp(path("out.exr")) == slurp(path("alone" + seed + ".exr"))) << "EXR not seed " << seed << "'s";
-        EXPECT_TRUE(slurp(path("out.png")) == slurp(path("alone" + seed + ".png"))) << "PNG not seed " << seed << "'s";
-        for (const std::string& name : listing())
-            EXPECT_NE(name[0], '.') << "temporary file left: " << name;
+        EXPECT_TRUE(slurp(path("out.exr")) == slurp(path("alone" + seed + ".exr")))
+            << "EXR not seed " << seed << "'s";
+        EXPECT_TRUE(slurp(path("out.png")) == slurp(path("alone" + seed + ".png")))
+            << "PNG not seed " << seed << "'s";
+        for (const std::string& name : listing()) EXPECT_NE(name[0], '.') << "temporary file left: " << name;
     }
 }
 

@@ -41,9 +41,10 @@ class SignalsCli : public test::TempDirTest, public ::testing::WithParamInterfac
 // exit 130, the phase named, nothing written.
 TEST_P(SignalsCli, EveryPhaseStopsWith130AndNoOutput) {
     const Case c = GetParam();
-    const RunResult r = test::runGdpt("render " + kScene + " --width 16 --height 16 --spp 4 --method gpt --all-recon -o " +
-                                          path("out.exr") + " --json " + path("out.json"),
-                                      std::string("GDPT_TEST_SIGNAL_AT=") + c.phase + c.signal);
+    const RunResult r =
+        test::runGdpt("render " + kScene + " --width 16 --height 16 --spp 4 --method gpt --all-recon -o " +
+                          path("out.exr") + " --json " + path("out.json"),
+                      std::string("GDPT_TEST_SIGNAL_AT=") + c.phase + c.signal);
     EXPECT_EQ(r.code, 130) << r.output;
     EXPECT_NE(r.output.find("interrupted"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("no output written"), std::string::npos) << r.output;
@@ -55,10 +56,10 @@ TEST_P(SignalsCli, EveryPhaseStopsWith130AndNoOutput) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Phases, SignalsCli,
-                         ::testing::Values(Case{"loading", ""}, Case{"loading", ":TERM"}, Case{"sampling", ""},
-                                           Case{"sampling", ":TERM"}, Case{"reconstruction", ""},
-                                           Case{"reconstruction", ":TERM"}, Case{"writing", ""},
-                                           Case{"writing", ":TERM"}),
+                         ::testing::Values(Case{"loading", ""}, Case{"loading", ":TERM"},
+                                           Case{"sampling", ""}, Case{"sampling", ":TERM"},
+                                           Case{"reconstruction", ""}, Case{"reconstruction", ":TERM"},
+                                           Case{"writing", ""}, Case{"writing", ":TERM"}),
                          [](const auto& p) {
                              return std::string(p.param.phase) + (p.param.signal[0] ? "Term" : "Int");
                          });
@@ -71,6 +72,7 @@ TEST(SignalsCliReal, TermDuringTheReconstructionStopsWithinASolverBatch) {
     fs::remove_all(dir);
     fs::create_directories(dir);
     const std::string out = (dir / "out.exr").string();
+    const std::string binary = test::gdptBinary();
     int fds[2];
     ASSERT_EQ(::pipe(fds), 0);
     const pid_t pid = ::fork();
@@ -78,8 +80,9 @@ TEST(SignalsCliReal, TermDuringTheReconstructionStopsWithinASolverBatch) {
         ::dup2(fds[1], 2);
         ::dup2(fds[1], 1);
         ::close(fds[0]);
-        ::execl(GDPT_BINARY, GDPT_BINARY, "render", kScene.c_str(), "--width", "256", "--height", "256", "--spp", "2",
-                "--method", "gpt", "--all-recon", "--tolerance", "1e-6", "-o", out.c_str(), static_cast<char*>(nullptr));
+        ::execl(binary.c_str(), binary.c_str(), "render", kScene.c_str(), "--width", "256", "--height", "256",
+                "--spp", "2", "--method", "gpt", "--all-recon", "--tolerance", "1e-6", "-o", out.c_str(),
+                static_cast<char*>(nullptr));
         ::_exit(127);
     }
     ::close(fds[1]);
@@ -103,7 +106,8 @@ TEST(SignalsCliReal, TermDuringTheReconstructionStopsWithinASolverBatch) {
     std::fclose(in);
     int status = 0;
     ::waitpid(pid, &status, 0);
-    const double stopSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sentAt).count();
+    const double stopSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - sentAt).count();
     ASSERT_TRUE(sent) << output;
     ASSERT_TRUE(WIFEXITED(status)) << output;
     EXPECT_EQ(WEXITSTATUS(status), 130) << output;

@@ -592,12 +592,13 @@ TEST(BoxFilteredVariance, AveragesTheClippedBoxOfValidValues) {
         for (int x = 0; x < w; ++x)
             for (int c = 0; c < 3; ++c) var.at(x, y, c) = float(x + 10 * y + c);
     var.at(2, 1, 1) = std::nanf("");
-    var.at(5, 3, 0) = -400.0f;  // RGB mean negative
+    var.at(5, 3, 0) = -400.0f;  // a negative channel: no variance
     const auto valid = [&](int x, int y) { return !((x == 2 && y == 1) || (x == 5 && y == 3)); };
     for (int radius : {0, 1, 2, 9}) {
-        std::size_t bad = 0;
-        const std::vector<float> f = boxFilteredVariance(var, radius, bad);
-        EXPECT_EQ(bad, 2u);
+        std::size_t nonFinite = 0, negative = 0;
+        const std::vector<float> f = boxFilteredVariance(var, radius, nonFinite, negative);
+        EXPECT_EQ(nonFinite, 1u);
+        EXPECT_EQ(negative, 1u);
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) {
                 double sum = 0.0;
@@ -628,8 +629,8 @@ TEST_F(PoissonGpu, WeightedL1IsL1WithFilteredInverseVarianceWeights) {
     const SolveReport r = solve(primal, dx, dy, o, wl1, &vars);
     EXPECT_EQ(r.irlsIterations, o.irlsIterations);
     const auto inverse = [&](const Image& v) {
-        std::size_t bad = 0;
-        std::vector<float> f = boxFilteredVariance(v, o.varianceFilterRadius, bad);
+        std::size_t nonFinite = 0, negative = 0;
+        std::vector<float> f = boxFilteredVariance(v, o.varianceFilterRadius, nonFinite, negative);
         for (float& x : f) x = static_cast<float>(1.0 / (double(x) + o.varianceEpsilon));
         return f;
     };

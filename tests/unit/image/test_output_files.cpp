@@ -40,7 +40,9 @@ protected:
         s << in.rdbuf();
         return s.str();
     }
-    static void put(const std::string& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+    static void put(const std::string& p, const std::string& text) {
+        std::ofstream(p, std::ios::binary) << text;
+    }
 };
 
 // Expects `f` to throw gdpt::Error whose message contains every one of `parts`.
@@ -49,7 +51,8 @@ void expectError(const std::function<void()>& f, const std::vector<std::string>&
         f();
         ADD_FAILURE() << "no error";
     } catch (const Error& e) {
-        for (const std::string& p : parts) EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what();
+        for (const std::string& p : parts)
+            EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what();
     }
 }
 
@@ -114,7 +117,8 @@ TEST_F(OutputFiles, AnOutputMayNotBeAnInputOrAnotherOutput) {
                 {"PNG preview of -o", "is also the -o", "cannot share"});
     // A checkpoint may continue the file it resumes from, but not overwrite an output.
     outputs.checkSeparate(path("scene.gltf"), "--checkpoint", {path("scene.gltf")});
-    expectError([&] { outputs.checkSeparate(path("x.png"), "--checkpoint"); }, {"--checkpoint", "is also the -o"});
+    expectError([&] { outputs.checkSeparate(path("x.png"), "--checkpoint"); },
+                {"--checkpoint", "is also the -o"});
     EXPECT_TRUE(fs::exists(path("scene.gltf")));
     EXPECT_EQ(slurp(path("scene.gltf")), "{}");
 }
@@ -188,7 +192,9 @@ TEST_F(OutputFiles, AFullDiskFailsTheWriteAndLeavesNothing) {
     const Image image = noise(64, 64);  // 12 KiB of noise: PNG and EXR are both > 4 KiB
     EXPECT_EQ(underFileSizeLimit(4096, [&] { writePngPreview(path("p.png"), image); }), 1);
     EXPECT_EQ(underFileSizeLimit(4096, [&] { writeExr(path("e.exr"), image); }), 1);
-    EXPECT_EQ(underFileSizeLimit(4096, [&] { writeTextFileAtomically(path("t.json"), std::string(5000, 'x')); }), 1);
+    EXPECT_EQ(
+        underFileSizeLimit(4096, [&] { writeTextFileAtomically(path("t.json"), std::string(5000, 'x')); }),
+        1);
     EXPECT_TRUE(listing().empty());
     // The same writes succeed without the limit (the limit is what failed them).
     EXPECT_EQ(underFileSizeLimit(RLIM_INFINITY, [&] { writePngPreview(path("p.png"), image); }), 0);

@@ -3,7 +3,10 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
+#include <string>
 
 #include "image/png_preview.h"
 #include "temp_dir.h"
@@ -68,6 +71,60 @@ TEST_F(PngPreview, FailuresThrowAndLeaveNoFile) {
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("absent.png"), std::string::npos);
     }
+}
+
+// Guards the class "an unreadable image gives a clean one-line reason": stb_image's reasons
+// are codes ("outofdata"), and for an unknown PNG chunk it copies the chunk's raw type bytes
+// into the text, so a corrupt PNG printed binary bytes, and one with a zero byte there an
+// empty reason ("cannot decode ()"). Every cut of a valid PNG and every corrupted chunk type
+// must give a message that names the file, is one line of printable ASCII, and has a
+// reason; a cut inside the data says that the file is truncated.
+TEST_F(PngPreview, UnreadablePngGivesACleanOneLineReason) {
+    Image image(16, 16);
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x)
+            for (int c = 0; c < 3; ++c) image.at(x, y, c) = float((x * 7 + y * 13 + c * 5) % 17) / 17.0f;
+    writePngPreview(path("good.png"), image);
+    std::ifstream in(path("good.png"), std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_GT(bytes.size(), 60u);
+    const auto reasonOf = [&](const std::string& name, const std::string& content) {
+        const std::string file = path(name);
+        std::ofstream(file, std::ios::binary) << content;
+        try {
+            readPng(file);
+        } catch (const Error& e) {
+            const std::string m = e.what();
+            const std::string prefix = file + ": cannot read image: ";
+            EXPECT_EQ(m.rfind(prefix, 0), 0u) << m;
+            for (char ch : m)
+                EXPECT_TRUE(ch >= 0x20 && ch < 0x7f) << name << ": byte " << int(ch) << " in: " << m;
+            const std::string reason = m.size() > prefix.size() ? m.substr(prefix.size()) : "";
+            EXPECT_GE(reason.size(), 8u) << name << ": no reason in: " << m;
+            EXPECT_EQ(reason.find("()"), std::string::npos) << m;
+            return reason;
+        }
+        ADD_FAILURE() << name << " was read";
+        return std::string();
+    };
+    // Cuts after the signature (inside IHDR, the data, before the end chunk) say so; a cut
+    // inside the signature is not recognisably a PNG.
+    for (std::size_t cut :
+         {std::size_t{8}, std::size_t{20}, std::size_t{40}, bytes.size() / 2, bytes.size() - 13})
+        EXPECT_NE(reasonOf("cut" + std::to_string(cut) + ".png", bytes.substr(0, cut)).find("truncated"),
+                  std::string::npos)
+            << "cut at " << cut;
+    reasonOf("cut4.png", bytes.substr(0, 4));
+    // Corrupt chunk types after IHDR (bytes 37..40 hold the second chunk's type): binary
+    // bytes, a zero byte, lower-case (a critical chunk must be upper-case).
+    for (const std::string& type : {std::string("\x97(\xe5"
+                                                "D"),
+                                    std::string("ID\0T", 4), std::string("idat")}) {
+        std::string corrupt = bytes;
+        corrupt.replace(37, 4, type);
+        EXPECT_NE(reasonOf("chunk.png", corrupt).find("corrupt PNG data"), std::string::npos);
+    }
+    EXPECT_NE(reasonOf("text.png", "not an image at all\n").find("not an image format"), std::string::npos);
 }
 
 }  // namespace

@@ -1,0 +1,40 @@
+// pixel_buffers.h — the device limits a sampling pass's per-pixel buffers must fit, checked
+// before the pass creates any of them: an image too large for the device then fails with a
+// message naming the buffer, its size and the limit (as the Poisson solver's fields do),
+// instead of a failed vkCreateBuffer or vkAllocateMemory halfway through the set-up.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace gdpt {
+
+namespace vk {
+class Context;
+}
+
+// One buffer with `bytesPerPixel` bytes for every pixel; `name` as in "the path-tracing
+// statistics".
+struct PixelBuffer {
+    std::string name;
+    std::uint64_t bytesPerPixel;
+};
+
+// Throws gdpt::Error for the first buffer of a width x height image that exceeds
+// maxStorageBufferRange (the kernels bind each whole) or maxMemoryAllocationSize (each is
+// one allocation). The heap is not checked: the per-buffer limits bind first on the
+// devices seen (lavapipe: 128 MiB per buffer, a 2 GiB heap it overcommits), and a sum would
+// have to include the Poisson solver's fields and the scene to mean anything.
+void checkPixelBuffers(const vk::Context& ctx, std::uint32_t width, std::uint32_t height,
+                       const std::vector<PixelBuffer>& buffers);
+
+// The same as a member initialised before a pass's buffers, so that the check runs first.
+struct PixelBuffersChecked {
+    PixelBuffersChecked(const vk::Context& ctx, std::uint32_t width, std::uint32_t height,
+                        const std::vector<PixelBuffer>& buffers) {
+        checkPixelBuffers(ctx, width, height, buffers);
+    }
+};
+
+}  // namespace gdpt
