@@ -65,6 +65,8 @@ struct Context {
 
 // "mesh 'Floor'" when the element has a name, else "mesh 3".
 std::string elementName(const char* kind, int index, const std::string& name);
+// A number in messages: "%g" ("-0.5", "1e+38", "nan").
+std::string formatNumber(double v);
 
 // Checks of the JSON text (gltf_precheck.cpp), in order: nesting depth (kMaxJsonDepth),
 // required extensions, bufferView strides, every accessor's count and byte range against its

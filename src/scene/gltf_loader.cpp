@@ -37,6 +37,12 @@ std::string elementName(const char* kind, int index, const std::string& name) {
                         : std::string(kind) + " '" + name + "'";
 }
 
+std::string formatNumber(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", v);
+    return text;
+}
+
 namespace {
 
 constexpr std::uintmax_t kMaxFileBytes = 2ull << 30;
@@ -267,6 +273,15 @@ void addLight(gltf::Context& ctx, const tinygltf::Value& ext, const glm::dmat4& 
         if (light.color.size() != 3) throw Error(label + ": color must have 3 numbers");
         color = glm::dvec3(light.color[0], light.color[1], light.color[2]);
     }
+    // KHR_lights_punctual light.schema.json: color components in [0, 1]; a negative or NaN
+    // color or intensity would emit negative or NaN radiance.
+    for (int c = 0; c < 3; ++c)
+        if (!(color[c] >= 0.0 && color[c] <= 1.0))
+            throw Error(label + ": color component " + std::to_string(c) + " is " +
+                        gltf::formatNumber(color[c]) + ", outside [0, 1] (KHR_lights_punctual)");
+    if (!(light.intensity >= 0.0) || !std::isfinite(light.intensity))
+        throw Error(label + ": intensity " + gltf::formatNumber(light.intensity) +
+                    " is not a finite value >= 0");
     // Intensity in candela, treated as W/sr (see gdpt_shared.h PunctualLight).
     out.intensity = glm::vec3(color * light.intensity);
     out.position = glm::vec3(world * glm::dvec4(0, 0, 0, 1));
