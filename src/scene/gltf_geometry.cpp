@@ -6,6 +6,7 @@
 // "Buffers and Buffer Views", §3.6.2 "Accessors").
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <numeric>
 
@@ -438,12 +439,21 @@ void addMeshInstance(Context& ctx, const MeshInstance& inst, bool sceneHasNormal
             std::vector<glm::uvec3> tris = assembleTriangles(idx, mode);
             const std::uint32_t material = materialIndex(ctx, prim.material);
 
-            // World-space vertices of this primitive.
+            // World-space vertices of this primitive, within the coordinates gdpt renders
+            // (kMaxSceneExtent).
             std::vector<glm::vec3> wPos(pos.size());
             for (std::size_t i = 0; i < pos.size(); ++i) {
                 const glm::dvec3 p = glm::dvec3(inst.world * glm::dvec4(glm::dvec3(pos[i]), 1.0));
-                if (!allFinite(p) || glm::any(glm::greaterThan(glm::abs(p), glm::dvec3(1e30))))
-                    throw Error("vertex " + std::to_string(i) + " is not finite after the node transform");
+                if (!allFinite(p))
+                    throw Error("vertex " + std::to_string(i) + " overflows after the node transform");
+                if (glm::any(glm::greaterThan(glm::abs(p), glm::dvec3(kMaxSceneExtent)))) {
+                    char limit[64];
+                    std::snprintf(limit, sizeof limit, "|x|, |y|, |z| <= %.2g", kMaxSceneExtent);
+                    throw Error("vertex " + std::to_string(i) + " is at (" + formatNumber(p.x) + ", " +
+                                formatNumber(p.y) + ", " + formatNumber(p.z) +
+                                ") after the node transform, outside the coordinates gdpt renders (" + limit +
+                                "; single-precision triangle normals and areas); scale the scene down");
+                }
                 wPos[i] = glm::vec3(p);
             }
             if (flip)

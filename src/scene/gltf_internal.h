@@ -40,6 +40,18 @@ constexpr int kMaxJsonDepth = 128;
 // that a file cannot make it allocate far more than its own size.
 constexpr std::uint64_t kZeroFilledAllowance = 1ull << 20;  // bytes
 
+// Supported size of a scene: the extent of its bounding box (largest side) and the
+// magnitude of any vertex coordinate, in scene units. Triangle normals and areas are computed
+// in single precision from |e1 x e2|, whose square grows as the fourth power of the triangle's
+// size: at 2^31 even a triangle spanning the whole box has |e1 x e2|^2 <= 9 * 2^124, below
+// FLT_MAX = 2^128, and at 2^-31 a right triangle as large as the scene still has
+// |e1 x e2|^2 >= 2^-124, above the smallest normal float 2^-126 (GPUs may flush smaller
+// values to zero). Outside, the normals overflow or vanish and the image is black (measured
+// on lavapipe with the 2-unit Cornell box: scaled by 1e9 and 1e-10 it renders as unscaled, by
+// 4e9 and 1e-11 wrongly; lavapipe keeps denormals, which is why 1e-10 still works there).
+constexpr double kMaxSceneExtent = 2147483648.0;        // 2^31, about 2.1e9
+constexpr double kMinSceneExtent = 1.0 / 2147483648.0;  // 2^-31, about 4.7e-10
+
 // Extensions whose content gdpt renders; a file may require only these (glTF 2.0 §3.12).
 bool supportedExtension(const std::string& name);
 

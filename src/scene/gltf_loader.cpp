@@ -241,14 +241,17 @@ void addCamera(gltf::Context& ctx, const tinygltf::Node& node, const glm::dmat4&
     out.position = glm::vec3(world * glm::dvec4(0, 0, 0, 1));
     // Camera looks down local -Z with local +Y up (§3.10.1); scale is removed by
     // normalising and the up vector is made orthogonal (Gram-Schmidt).
+    // Degenerate means relative to the transform's own scale: a camera in a scene scaled by
+    // 1e-12 is fine (the scene's size is checked on its own, see kMinSceneExtent).
     const glm::dvec3 fwd = glm::dmat3(world) * glm::dvec3(0, 0, -1);
     const glm::dvec3 up = glm::dmat3(world) * glm::dvec3(0, 1, 0);
     const double fl = glm::length(fwd);
-    if (!(fl > 1e-12) || !std::isfinite(fl)) throw Error(label + ": degenerate camera transform");
+    if (!(fl > 0.0) || !std::isfinite(fl)) throw Error(label + ": degenerate camera transform");
     const glm::dvec3 f = fwd / fl;
     const glm::dvec3 u = up - glm::dot(up, f) * f;
     const double ul = glm::length(u);
-    if (!(ul > 1e-12) || !std::isfinite(ul)) throw Error(label + ": degenerate camera transform");
+    if (!(ul > 1e-9 * glm::length(up)) || !std::isfinite(ul))
+        throw Error(label + ": degenerate camera transform");
     out.forward = glm::vec3(f);
     out.up = glm::vec3(u / ul);
     out.yfov = static_cast<float>(yfov);
@@ -338,6 +341,21 @@ void refuseBeyondLimits(const SceneEstimate& e, const LoadOptions& opts) {
                     gibibytes(e.bytes) + ", more than the memory budget of " + gibibytes(budget) +
                     (opts.memoryBudget != 0 ? "" : " (this machine's memory)"));
     if (opts.checkEstimate) opts.checkEstimate(e);
+}
+
+// Refuses a scene whose size single precision cannot render (see kMaxSceneExtent).
+void checkSceneExtent(const Scene& scene) {
+    if (scene.triangles.empty()) return;
+    const Bounds b = scene.bounds();
+    const glm::vec3 size = b.max - b.min;
+    const double extent = std::max({size.x, size.y, size.z});
+    if (extent >= gltf::kMinSceneExtent && extent <= gltf::kMaxSceneExtent) return;
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "the scene is %.3g units across; gdpt renders scenes from %.2g to %.2g units across "
+                  "(single-precision triangle normals and areas), so scale it into that range",
+                  extent, gltf::kMinSceneExtent, gltf::kMaxSceneExtent);
+    throw Error(text);
 }
 
 Scene loadImpl(const std::string& path, const LoadOptions& opts) {
@@ -432,6 +450,7 @@ Scene loadImpl(const std::string& path, const LoadOptions& opts) {
                              std::to_string(scene.triangles.size()) + " triangles");
     }
     if (progress) progress->finish(std::to_string(scene.triangles.size()) + " triangles");
+    checkSceneExtent(scene);
     return scene;
 }
 
