@@ -20,6 +20,7 @@
 #include "integrator/integrator.h"
 #include "integrator/recon_reserve.h"
 #include "integrator/render_identity.h"
+#include "render/device_scene/scene_gpu.h"
 #include "scene/gltf_loader.h"
 #include "scene/light_sources.h"
 #include "util/error.h"
@@ -99,6 +100,7 @@ RenderOptions renderOptionsFor(const RenderArgs& args) {
     o.seed = args.seed;
     o.profile = args.profile;
     o.quiet = args.quiet;
+    o.scene.quiet = args.quiet;
     o.workgroup = parseWorkgroup(args.workgroup);
     o.emitterSupersampling = args.emitterSupersampling;
     o.cancel = &gInterrupted;
@@ -155,7 +157,7 @@ int runRender(const RenderArgs& args) {
     RenderOptions options = renderOptionsFor(args);
     const ReconTimeCache cache(ReconTimeCache::defaultPath());
 
-    const Scene scene = loadGltf(args.scene);
+    const Scene scene = loadGltf(args.scene, deviceLoadOptions(args.device, args.quiet));
     if (!scene.unsupported.empty() && !args.quiet) {
         std::string list;
         for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
