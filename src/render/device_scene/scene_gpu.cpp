@@ -100,9 +100,15 @@ LoadOptions deviceLoadOptions(const std::string& device, bool quiet) {
         if (estimate.triangles <= 65536 / gpu::kTriangleShadingTexels) return;
         vk::ContextOptions probe;
         probe.device = device;
-        const vk::Context ctx(probe);
-        if (estimate.triangles > maxDeviceTriangles(ctx.info()))
-            throw Error("the scene has up to " + beyondDevice(estimate.triangles, ctx.info()));
+        std::optional<vk::Context> ctx;
+        try {
+            ctx.emplace(probe);
+        } catch (const Error& e) {
+            // The loader puts the scene's name in front; say that the device is the problem.
+            throw e.withContext("no device to check the scene's size against");
+        }
+        if (estimate.triangles > maxDeviceTriangles(ctx->info()))
+            throw Error("the scene has up to " + beyondDevice(estimate.triangles, ctx->info()));
     };
     return options;
 }
