@@ -41,6 +41,11 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "gdpt: %s\n", e.what());
         return 130;
     } catch (const std::exception& e) {
+        // A signal that ended a phase through a layer that re-wrapped the error.
+        if (interruptRequested()) {
+            std::fprintf(stderr, "gdpt: interrupted; no output written (%s)\n", e.what());
+            return 130;
+        }
         std::fprintf(stderr, "gdpt: error: %s\n", e.what());
         return 1;
     }

@@ -20,6 +20,7 @@
 #include "integrator/integrator.h"
 #include "integrator/recon_reserve.h"
 #include "integrator/render_identity.h"
+#include "render/device_scene/scene_gpu.h"
 #include "scene/gltf_loader.h"
 #include "scene/light_sources.h"
 #include "util/error.h"
@@ -94,6 +95,7 @@ RenderOptions renderOptionsFor(const RenderArgs& args) {
     o.seed = args.seed;
     o.profile = args.profile;
     o.quiet = args.quiet;
+    o.scene.quiet = args.quiet;
     o.workgroup = parseWorkgroup(args.workgroup);
     o.emitterSupersampling = args.emitterSupersampling;
     o.cancel = &interruptFlag();
@@ -173,7 +175,7 @@ int runRender(const RenderArgs& args) {
     if (!args.checkpoint.empty()) outputs.checkSeparate(args.checkpoint, "--checkpoint", {args.resume});
 
     enterPhase("loading");
-    const Scene scene = loadGltf(args.scene);
+    const Scene scene = loadGltf(args.scene, deviceLoadOptions(args.device, args.quiet));
     throwIfInterrupted("loading");
     if (!scene.unsupported.empty() && !args.quiet) {
         std::string list;

@@ -6,6 +6,7 @@
 // "Buffers and Buffer Views", §3.6.2 "Accessors").
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <numeric>
 
@@ -158,12 +159,32 @@ const unsigned char* checkedRange(const tinygltf::Model& model, int view, std::u
     return model.buffers[static_cast<std::size_t>(bv.buffer)].data.data() + bv.byteOffset + byteOffset;
 }
 
-// Reads accessor `index` as count x components doubles after checking its type against
-// `expectedType` and its componentType against `allowedComponentTypes`. Handles strided
-// views, accessors without bufferView (all zeros) and sparse substitution (§3.6.2.3).
-std::vector<double> readAccessor(const tinygltf::Model& model, int index, const char* role, int expectedType,
-                                 std::initializer_list<int> allowedComponentTypes, std::size_t* countOut) {
-    const std::string label = accessorLabel(index, role);
+// Accessor `index` after every check against its bufferView, buffer and sparse storage:
+// what readElements reads, with nothing allocated yet (precheckJson has checked the same on
+// the JSON; these checks keep the readers safe on their own).
+struct CheckedAccessor {
+    std::string label;
+    std::size_t count = 0;
+    int components = 0;
+    int componentType = 0;
+    bool normalized = false;
+    std::uint64_t stride = 0;
+    const unsigned char* data = nullptr;  // first element; null: zeros (no bufferView) or count 0
+    // Sparse substitution (§3.6.2.3): `sparseCount` indices of `sparseIndexType`, then as
+    // many values.
+    std::uint64_t sparseCount = 0;
+    int sparseIndexType = 0;
+    const unsigned char* sparseIndices = nullptr;
+    const unsigned char* sparseValues = nullptr;
+};
+
+// Checks accessor `index`: its type against `expectedType`, its componentType against
+// `allowedComponentTypes`, its count, and the byte ranges of its data and sparse storage.
+CheckedAccessor checkAccessor(const tinygltf::Model& model, int index, const char* role, int expectedType,
+                              std::initializer_list<int> allowedComponentTypes) {
+    CheckedAccessor out;
+    out.label = accessorLabel(index, role);
+    const std::string& label = out.label;
     if (index < 0 || static_cast<std::size_t>(index) >= model.accessors.size())
         throw Error(label + " out of range (file has " + std::to_string(model.accessors.size()) +
                     " accessors)");
@@ -181,27 +202,25 @@ std::vector<double> readAccessor(const tinygltf::Model& model, int index, const 
     if (acc.count > kMaxAccessorCount)
         throw Error(label + " has count " + std::to_string(acc.count) + ", more than the limit " +
                     std::to_string(kMaxAccessorCount));
-    const int nComp = componentCount(acc.type);
-    const std::uint64_t elemSize = std::uint64_t(nComp) * std::uint64_t(componentSize(acc.componentType));
-    std::vector<double> out(acc.count * static_cast<std::size_t>(nComp), 0.0);
-    *countOut = acc.count;
+    out.count = acc.count;
+    out.components = componentCount(acc.type);
+    out.componentType = acc.componentType;
+    out.normalized = acc.normalized;
+    const std::uint64_t elemSize =
+        std::uint64_t(out.components) * std::uint64_t(componentSize(acc.componentType));
+    out.stride = elemSize;
 
     if (acc.bufferView >= 0) {
         const auto& bv = model.bufferViews.size() > static_cast<std::size_t>(acc.bufferView)
                              ? model.bufferViews[static_cast<std::size_t>(acc.bufferView)]
                              : tinygltf::BufferView{};
-        const std::uint64_t stride = bv.byteStride != 0 ? bv.byteStride : elemSize;
-        if (stride < elemSize)
+        if (bv.byteStride != 0) out.stride = bv.byteStride;
+        if (out.stride < elemSize)
             throw Error(label + ": bufferView " + std::to_string(acc.bufferView) + " byteStride " +
-                        std::to_string(stride) + " is smaller than the element size " +
+                        std::to_string(out.stride) + " is smaller than the element size " +
                         std::to_string(elemSize));
-        const unsigned char* base =
-            checkedRange(model, acc.bufferView, acc.byteOffset, acc.count, elemSize, stride, label);
-        for (std::size_t i = 0; i < acc.count; ++i)
-            for (int c = 0; c < nComp; ++c)
-                out[i * static_cast<std::size_t>(nComp) + static_cast<std::size_t>(c)] = readComponent(
-                    base + i * stride + static_cast<std::size_t>(c * componentSize(acc.componentType)),
-                    acc.componentType, acc.normalized);
+        out.data =
+            checkedRange(model, acc.bufferView, acc.byteOffset, acc.count, elemSize, out.stride, label);
     }
 
     if (acc.sparse.isSparse) {
@@ -216,26 +235,43 @@ std::vector<double> readAccessor(const tinygltf::Model& model, int index, const 
         if (sp.count < 0 || static_cast<std::uint64_t>(sp.count) > acc.count)
             throw Error(spLabel + " count " + std::to_string(sp.count) + " is out of [0, " +
                         std::to_string(acc.count) + "]");
-        const auto n = static_cast<std::uint64_t>(sp.count);
+        out.sparseCount = static_cast<std::uint64_t>(sp.count);
+        out.sparseIndexType = idxType;
         const std::uint64_t idxSize = std::uint64_t(componentSize(idxType));
-        const unsigned char* idx =
-            checkedRange(model, sp.indices.bufferView, std::uint64_t(std::max(sp.indices.byteOffset, 0)), n,
-                         idxSize, idxSize, spLabel + " indices");
-        const unsigned char* val =
-            checkedRange(model, sp.values.bufferView, std::uint64_t(std::max(sp.values.byteOffset, 0)), n,
-                         elemSize, elemSize, spLabel + " values");
-        for (std::uint64_t k = 0; k < n; ++k) {
-            const auto target = static_cast<std::uint64_t>(readComponent(idx + k * idxSize, idxType, false));
-            if (target >= acc.count)
-                throw Error(spLabel + " index " + std::to_string(target) + " is out of range of " +
-                            std::to_string(acc.count) + " elements");
-            for (int c = 0; c < nComp; ++c)
-                out[target * std::uint64_t(nComp) + std::uint64_t(c)] =
-                    readComponent(val + k * elemSize + std::uint64_t(c * componentSize(acc.componentType)),
-                                  acc.componentType, acc.normalized);
-        }
+        out.sparseIndices =
+            checkedRange(model, sp.indices.bufferView, std::uint64_t(std::max(sp.indices.byteOffset, 0)),
+                         out.sparseCount, idxSize, idxSize, spLabel + " indices");
+        out.sparseValues =
+            checkedRange(model, sp.values.bufferView, std::uint64_t(std::max(sp.values.byteOffset, 0)),
+                         out.sparseCount, elemSize, elemSize, spLabel + " values");
     }
     return out;
+}
+
+// Calls set(element, component, value) for the accessor's data (nothing for zeros), then
+// for its sparse substitutions, which overwrite elements.
+template <typename Set>
+void readElements(const CheckedAccessor& a, Set&& set) {
+    const std::uint64_t componentBytes = std::uint64_t(componentSize(a.componentType));
+    if (a.data != nullptr)
+        for (std::size_t i = 0; i < a.count; ++i)
+            for (int c = 0; c < a.components; ++c)
+                set(i, c,
+                    readComponent(a.data + i * a.stride + std::uint64_t(c) * componentBytes, a.componentType,
+                                  a.normalized));
+    const std::uint64_t idxSize = std::uint64_t(componentSize(a.sparseIndexType));
+    const std::uint64_t elemSize = std::uint64_t(a.components) * componentBytes;
+    for (std::uint64_t k = 0; k < a.sparseCount; ++k) {
+        const auto target = static_cast<std::uint64_t>(
+            readComponent(a.sparseIndices + k * idxSize, a.sparseIndexType, false));
+        if (target >= a.count)
+            throw Error(a.label + " sparse index " + std::to_string(target) + " is out of range of " +
+                        std::to_string(a.count) + " elements");
+        for (int c = 0; c < a.components; ++c)
+            set(static_cast<std::size_t>(target), c,
+                readComponent(a.sparseValues + k * elemSize + std::uint64_t(c) * componentBytes,
+                              a.componentType, a.normalized));
+    }
 }
 
 const char* modeName(int mode) {
@@ -302,46 +338,38 @@ void noteIgnoredAttributes(Context& ctx, const tinygltf::Primitive& prim) {
 }  // namespace
 
 std::vector<glm::vec3> readVec3(const tinygltf::Model& model, int accessor, const char* role) {
-    std::size_t count = 0;
-    const auto raw =
-        readAccessor(model, accessor, role, TINYGLTF_TYPE_VEC3, {TINYGLTF_COMPONENT_TYPE_FLOAT}, &count);
-    std::vector<glm::vec3> out(count);
-    for (std::size_t i = 0; i < count; ++i) {
-        const glm::dvec3 v(raw[3 * i], raw[3 * i + 1], raw[3 * i + 2]);
-        if (!allFinite(v))
-            throw Error(accessorLabel(accessor, role) + " element " + std::to_string(i) + " is not finite");
-        out[i] = glm::vec3(v);
-    }
+    const CheckedAccessor a =
+        checkAccessor(model, accessor, role, TINYGLTF_TYPE_VEC3, {TINYGLTF_COMPONENT_TYPE_FLOAT});
+    std::vector<glm::vec3> out(a.count);  // zeros where the accessor has no bufferView
+    readElements(a, [&](std::size_t i, int c, double v) { out[i][c] = static_cast<float>(v); });
+    for (std::size_t i = 0; i < out.size(); ++i)
+        if (!std::isfinite(out[i].x) || !std::isfinite(out[i].y) || !std::isfinite(out[i].z))
+            throw Error(a.label + " element " + std::to_string(i) + " is not finite");
     return out;
 }
 
 std::vector<glm::vec2> readTexcoords(const tinygltf::Model& model, int accessor, const char* role) {
-    std::size_t count = 0;
     // §3.7.2.1: TEXCOORD_n is float, or normalized unsigned byte/short.
-    const auto raw = readAccessor(model, accessor, role, TINYGLTF_TYPE_VEC2,
-                                  {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
-                                   TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
-                                  &count);
-    std::vector<glm::vec2> out(count);
-    for (std::size_t i = 0; i < count; ++i) {
-        out[i] = glm::vec2(static_cast<float>(raw[2 * i]), static_cast<float>(raw[2 * i + 1]));
+    const CheckedAccessor a =
+        checkAccessor(model, accessor, role, TINYGLTF_TYPE_VEC2,
+                      {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                       TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
+    std::vector<glm::vec2> out(a.count);
+    readElements(a, [&](std::size_t i, int c, double v) { out[i][c] = static_cast<float>(v); });
+    for (std::size_t i = 0; i < out.size(); ++i)
         if (!std::isfinite(out[i].x) || !std::isfinite(out[i].y))
-            throw Error(accessorLabel(accessor, role) + " element " + std::to_string(i) + " is not finite");
-    }
+            throw Error(a.label + " element " + std::to_string(i) + " is not finite");
     return out;
 }
 
 std::vector<std::uint32_t> readIndices(const tinygltf::Model& model, int accessor) {
-    std::size_t count = 0;
-    const auto raw =
-        readAccessor(model, accessor, "indices", TINYGLTF_TYPE_SCALAR,
-                     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
-                      TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT},
-                     &count);
-    if (model.accessors[static_cast<std::size_t>(accessor)].normalized)
-        throw Error(accessorLabel(accessor, "indices") + " must not be normalized");
-    std::vector<std::uint32_t> out(count);
-    for (std::size_t i = 0; i < count; ++i) out[i] = static_cast<std::uint32_t>(raw[i]);
+    const CheckedAccessor a =
+        checkAccessor(model, accessor, "indices", TINYGLTF_TYPE_SCALAR,
+                      {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+                       TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT});
+    if (a.normalized) throw Error(a.label + " must not be normalized");
+    std::vector<std::uint32_t> out(a.count);
+    readElements(a, [&](std::size_t i, int, double v) { out[i] = static_cast<std::uint32_t>(v); });
     return out;
 }
 
@@ -411,12 +439,21 @@ void addMeshInstance(Context& ctx, const MeshInstance& inst, bool sceneHasNormal
             std::vector<glm::uvec3> tris = assembleTriangles(idx, mode);
             const std::uint32_t material = materialIndex(ctx, prim.material);
 
-            // World-space vertices of this primitive.
+            // World-space vertices of this primitive, within the coordinates gdpt renders
+            // (kMaxSceneExtent).
             std::vector<glm::vec3> wPos(pos.size());
             for (std::size_t i = 0; i < pos.size(); ++i) {
                 const glm::dvec3 p = glm::dvec3(inst.world * glm::dvec4(glm::dvec3(pos[i]), 1.0));
-                if (!allFinite(p) || glm::any(glm::greaterThan(glm::abs(p), glm::dvec3(1e30))))
-                    throw Error("vertex " + std::to_string(i) + " is not finite after the node transform");
+                if (!allFinite(p))
+                    throw Error("vertex " + std::to_string(i) + " overflows after the node transform");
+                if (glm::any(glm::greaterThan(glm::abs(p), glm::dvec3(kMaxSceneExtent)))) {
+                    char limit[64];
+                    std::snprintf(limit, sizeof limit, "|x|, |y|, |z| <= %.2g", kMaxSceneExtent);
+                    throw Error("vertex " + std::to_string(i) + " is at (" + formatNumber(p.x) + ", " +
+                                formatNumber(p.y) + ", " + formatNumber(p.z) +
+                                ") after the node transform, outside the coordinates gdpt renders (" + limit +
+                                "; single-precision triangle normals and areas); scale the scene down");
+                }
                 wPos[i] = glm::vec3(p);
             }
             if (flip)

@@ -1,6 +1,7 @@
 // gltf_internal.h — shared state and helpers of the glTF loader's translation units
-// (gltf_loader.cpp: file, node graph, cameras, lights; gltf_geometry.cpp: accessors and
-// primitives; gltf_materials.cpp: materials and textures; gltf_images.cpp: image decoding).
+// (gltf_loader.cpp: file, node graph, cameras, lights; gltf_precheck.cpp: checks of the JSON
+// text before tinygltf parses it; gltf_geometry.cpp: accessors and primitives;
+// gltf_materials.cpp: materials and textures; gltf_images.cpp: image decoding).
 // Not part of the public API.
 #pragma once
 
@@ -9,10 +10,13 @@
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <map>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
+#include "scene/gltf_loader.h"
 #include "scene/scene.h"
 #include "util/error.h"
 
@@ -23,6 +27,33 @@ namespace gdpt::gltf {
 constexpr std::uint64_t kMaxAccessorCount = 1ull << 28;  // elements per accessor
 constexpr std::uint64_t kMaxSceneVertices = 1ull << 30;  // vertices after instancing
 constexpr std::uint64_t kMaxImagePixels = 1ull << 28;    // texels per image
+
+// Deepest nesting of JSON arrays and objects accepted. glTF's own schema nests about ten
+// levels (root > materials > material > extensions > extension > textureInfo > extensions >
+// KHR_texture_transform > offset); the rest is room for `extras`. tinygltf converts JSON to
+// its Value type recursively: 20,000 levels overflowed an 8 MiB stack (10,000 did not), so 128
+// keeps the recursion two orders of magnitude below that.
+constexpr int kMaxJsonDepth = 128;
+
+// Accessors without a bufferView are zeros (glTF 2.0 §3.6.2.3) the file does not hold. The
+// loader creates at most this much such data beyond the byteLength of the file's buffers, so
+// that a file cannot make it allocate far more than its own size.
+constexpr std::uint64_t kZeroFilledAllowance = 1ull << 20;  // bytes
+
+// Supported size of a scene: the extent of its bounding box (largest side) and the
+// magnitude of any vertex coordinate, in scene units. Triangle normals and areas are computed
+// in single precision from |e1 x e2|, whose square grows as the fourth power of the triangle's
+// size: at 2^31 even a triangle spanning the whole box has |e1 x e2|^2 <= 9 * 2^124, below
+// FLT_MAX = 2^128, and at 2^-31 a right triangle as large as the scene still has
+// |e1 x e2|^2 >= 2^-124, above the smallest normal float 2^-126 (GPUs may flush smaller
+// values to zero). Outside, the normals overflow or vanish and the image is black (measured
+// on lavapipe with the 2-unit Cornell box: scaled by 1e9 and 1e-10 it renders as unscaled, by
+// 4e9 and 1e-11 wrongly; lavapipe keeps denormals, which is why 1e-10 still works there).
+constexpr double kMaxSceneExtent = 2147483648.0;        // 2^31, about 2.1e9
+constexpr double kMinSceneExtent = 1.0 / 2147483648.0;  // 2^-31, about 4.7e-10
+
+// Extensions whose content gdpt renders; a file may require only these (glTF 2.0 §3.12).
+bool supportedExtension(const std::string& name);
 
 // One mesh instance found by the node traversal: mesh index and its world matrix.
 struct MeshInstance {
@@ -46,6 +77,15 @@ struct Context {
 
 // "mesh 'Floor'" when the element has a name, else "mesh 3".
 std::string elementName(const char* kind, int index, const std::string& name);
+// A number in messages: "%g" ("-0.5", "1e+38", "nan").
+std::string formatNumber(double v);
+
+// Checks of the JSON text (gltf_precheck.cpp), in order: nesting depth (kMaxJsonDepth),
+// required extensions, bufferView strides, every accessor's count and byte range against its
+// bufferView and buffer, the zero-filled data allowance; then estimates the instanced scene.
+// Throws gdpt::Error naming the element. Returns nothing when the text is not JSON at all
+// (tinygltf reports that).
+std::optional<SceneEstimate> precheckJson(std::string_view text);
 
 // Accessor readers (gltf_geometry.cpp). `role` names the use in messages ("POSITION").
 // Throw gdpt::Error naming the accessor on any inconsistency.

@@ -4,9 +4,12 @@
 // materials are converted in gltf_geometry.cpp and gltf_materials.cpp.
 #include "scene/gltf_loader.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -14,13 +17,13 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
-#include <nlohmann/json.hpp>
 #include <optional>
-#include <set>
 #include <sstream>
 #include <string_view>
 
 #include "scene/gltf_internal.h"
+#include "util/interrupt.h"
+#include "util/progress.h"
 
 namespace gdpt {
 namespace gltf {
@@ -35,19 +38,24 @@ std::string elementName(const char* kind, int index, const std::string& name) {
                         : std::string(kind) + " '" + name + "'";
 }
 
+std::string formatNumber(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", v);
+    return text;
+}
+
 namespace {
 
 constexpr std::uintmax_t kMaxFileBytes = 2ull << 30;
 
-// Extensions whose content we render; any other listed extension is reported, and a file
-// that requires any other is refused (requiredExtensionsError).
-const std::set<std::string> kSupportedExtensions = {
-    "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_materials_ior", "KHR_lights_punctual"};
-// Geometry we cannot decode at all.
-const std::set<std::string> kCompressionExtensions = {"KHR_draco_mesh_compression", "EXT_meshopt_compression",
-                                                      "KHR_meshopt_compression"};
+bool isGlb(const std::vector<unsigned char>& bytes) {
+    return bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+}
 
-std::vector<unsigned char> readFile(const std::string& path) {
+// Reads `path`; with jsonOnly, a .glb only up to the end of its JSON chunk (a 12-byte header,
+// then the chunk's length, its type and its data; glTF 2.0 §4.4), so that the JSON can be
+// checked before the BIN chunk is read.
+std::vector<unsigned char> readFile(const std::string& path, bool jsonOnly) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw Error("cannot open file: it does not exist");
     if (!std::filesystem::is_regular_file(path, ec)) throw Error("cannot open file: not a regular file");
@@ -56,10 +64,33 @@ std::vector<unsigned char> readFile(const std::string& path) {
     if (size > kMaxFileBytes) throw Error("file is larger than 2 GiB");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(std::string("cannot open file: ") + std::strerror(errno));
-    std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
-    if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size)))
+    std::uintmax_t wanted = size;
+    if (jsonOnly && size >= 20) {
+        unsigned char header[20];
+        if (!in.read(reinterpret_cast<char*>(header), 20)) throw Error("cannot read file");
+        std::uint32_t jsonLength = 0;
+        std::memcpy(&jsonLength, header + 12, 4);
+        if (std::memcmp(header, "glTF", 4) == 0)
+            wanted = std::min<std::uintmax_t>(size, 20 + std::uintmax_t(jsonLength));
+        in.seekg(0);
+    }
+    std::vector<unsigned char> bytes(static_cast<std::size_t>(wanted));
+    if (wanted > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(wanted)))
         throw Error("cannot read file");
     return bytes;
+}
+
+// tinygltf reads external buffers and images whole before comparing their size with the
+// declared byteLength; refuse files it could not use before reading them.
+bool readExternalFile(std::vector<unsigned char>* out, std::string* err, const std::string& path,
+                      void* user) {
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (!ec && size > kMaxFileBytes) {
+        if (err) *err += "File " + path + " is larger than 2 GiB\n";
+        return false;
+    }
+    return tinygltf::ReadWholeFile(out, err, path, user);
 }
 
 // tinygltf's messages are newline-separated; join them into one line.
@@ -67,27 +98,6 @@ std::string oneLine(std::string s) {
     while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
     std::replace(s.begin(), s.end(), '\n', ';');
     return s;
-}
-
-// Why a file whose extensionsRequired is `required` cannot be loaded (glTF 2.0 §3.12: a
-// loader must not load a file that requires an extension it does not support), or nothing.
-std::optional<std::string> requiredExtensionsError(const std::vector<std::string>& required) {
-    std::vector<std::string> missing;
-    bool compression = false;
-    for (const std::string& ext : required) {
-        if (kSupportedExtensions.count(ext) ||
-            std::find(missing.begin(), missing.end(), ext) != missing.end())
-            continue;
-        missing.push_back(ext);
-        compression = compression || kCompressionExtensions.count(ext) > 0;
-    }
-    if (missing.empty()) return std::nullopt;
-    std::string list;
-    for (const std::string& ext : missing) list += (list.empty() ? "" : ", ") + ext;
-    std::string message = (missing.size() == 1 ? "required extension " : "required extensions ") + list +
-                          (missing.size() == 1 ? " is" : " are") + " not supported by gdpt";
-    if (compression) message += " (compressed geometry: decompress the file first)";
-    return message;
 }
 
 void checkFinite(const std::vector<double>& v, const std::string& what) {
@@ -139,27 +149,10 @@ std::string_view jsonText(const std::vector<unsigned char>& bytes, bool binary) 
     return {data + 20, length};
 }
 
-// The top-level "extensionsRequired" names of a glTF JSON text, without building the rest of
-// the document; empty when the text is not valid JSON (the parser reports that).
-std::vector<std::string> requiredExtensions(std::string_view text) {
-    using nlohmann::json;
-    const json::parser_callback_t onlyRequired = [](int depth, json::parse_event_t event, json& parsed) {
-        return !(depth == 1 && event == json::parse_event_t::key && parsed != "extensionsRequired");
-    };
-    const json doc = json::parse(text.begin(), text.end(), onlyRequired, /*allow_exceptions=*/false);
-    std::vector<std::string> out;
-    if (!doc.is_object()) return out;
-    const auto it = doc.find("extensionsRequired");
-    if (it == doc.end() || !it->is_array()) return out;
-    for (const json& name : *it)
-        if (name.is_string()) out.push_back(name.get<std::string>());
-    return out;
-}
-
 void checkExtensions(gltf::Context& ctx) {
     const tinygltf::Model& model = ctx.model;
     for (const auto& ext : model.extensionsUsed)
-        if (!kSupportedExtensions.count(ext)) ctx.unsupported("extension " + ext);
+        if (!gltf::supportedExtension(ext)) ctx.unsupported("extension " + ext);
     if (!model.skins.empty()) ctx.unsupported("skins (meshes rendered in their bind pose)");
     if (!model.animations.empty()) ctx.unsupported("animations (the static pose is rendered)");
 }
@@ -249,14 +242,17 @@ void addCamera(gltf::Context& ctx, const tinygltf::Node& node, const glm::dmat4&
     out.position = glm::vec3(world * glm::dvec4(0, 0, 0, 1));
     // Camera looks down local -Z with local +Y up (§3.10.1); scale is removed by
     // normalising and the up vector is made orthogonal (Gram-Schmidt).
+    // Degenerate means relative to the transform's own scale: a camera in a scene scaled by
+    // 1e-12 is fine (the scene's size is checked on its own, see kMinSceneExtent).
     const glm::dvec3 fwd = glm::dmat3(world) * glm::dvec3(0, 0, -1);
     const glm::dvec3 up = glm::dmat3(world) * glm::dvec3(0, 1, 0);
     const double fl = glm::length(fwd);
-    if (!(fl > 1e-12) || !std::isfinite(fl)) throw Error(label + ": degenerate camera transform");
+    if (!(fl > 0.0) || !std::isfinite(fl)) throw Error(label + ": degenerate camera transform");
     const glm::dvec3 f = fwd / fl;
     const glm::dvec3 u = up - glm::dot(up, f) * f;
     const double ul = glm::length(u);
-    if (!(ul > 1e-12) || !std::isfinite(ul)) throw Error(label + ": degenerate camera transform");
+    if (!(ul > 1e-9 * glm::length(up)) || !std::isfinite(ul))
+        throw Error(label + ": degenerate camera transform");
     out.forward = glm::vec3(f);
     out.up = glm::vec3(u / ul);
     out.yfov = static_cast<float>(yfov);
@@ -281,6 +277,15 @@ void addLight(gltf::Context& ctx, const tinygltf::Value& ext, const glm::dmat4& 
         if (light.color.size() != 3) throw Error(label + ": color must have 3 numbers");
         color = glm::dvec3(light.color[0], light.color[1], light.color[2]);
     }
+    // KHR_lights_punctual light.schema.json: color components in [0, 1]; a negative or NaN
+    // color or intensity would emit negative or NaN radiance.
+    for (int c = 0; c < 3; ++c)
+        if (!(color[c] >= 0.0 && color[c] <= 1.0))
+            throw Error(label + ": color component " + std::to_string(c) + " is " +
+                        gltf::formatNumber(color[c]) + ", outside [0, 1] (KHR_lights_punctual)");
+    if (!(light.intensity >= 0.0) || !std::isfinite(light.intensity))
+        throw Error(label + ": intensity " + gltf::formatNumber(light.intensity) +
+                    " is not a finite value >= 0");
     // Intensity in candela, treated as W/sr (see gdpt_shared.h PunctualLight).
     out.intensity = glm::vec3(color * light.intensity);
     out.position = glm::vec3(world * glm::dvec4(0, 0, 0, 1));
@@ -306,25 +311,84 @@ void addLight(gltf::Context& ctx, const tinygltf::Value& ext, const glm::dmat4& 
     ctx.scene.punctualLights.push_back(out);
 }
 
-Scene loadImpl(const std::string& path) {
-    const std::vector<unsigned char> bytes = readFile(path);
+// The machine's physical memory in bytes (0 if unknown).
+std::uint64_t physicalMemory() {
+    const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && pageSize > 0 ? std::uint64_t(pages) * std::uint64_t(pageSize) : 0;
+}
+
+std::string gibibytes(std::uint64_t bytes) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f GiB", double(bytes) / double(1ull << 30));
+    return text;
+}
+
+// The checks of the file's JSON (precheckJson) and the estimate of what loading it costs;
+// an empty estimate if the JSON is not parseable (tinygltf reports that).
+SceneEstimate precheck(const std::vector<unsigned char>& jsonBytes) {
+    return gltf::precheckJson(jsonText(jsonBytes, isGlb(jsonBytes))).value_or(SceneEstimate{});
+}
+
+// Refuses a scene beyond the loader's limits or the caller's (LoadOptions::checkEstimate).
+void refuseBeyondLimits(const SceneEstimate& e, const LoadOptions& opts) {
+    if (e.vertices > gltf::kMaxSceneVertices)
+        throw Error("the scene has " + std::to_string(e.vertices) +
+                    " vertices after instancing, more than the limit " +
+                    std::to_string(gltf::kMaxSceneVertices));
+    const std::uint64_t budget = opts.memoryBudget != 0 ? opts.memoryBudget : physicalMemory();
+    if (budget != 0 && e.bytes > budget)
+        throw Error("loading the scene (" + std::to_string(e.triangles) + " triangles, " +
+                    std::to_string(e.vertices) + " vertices after instancing) needs about " +
+                    gibibytes(e.bytes) + ", more than the memory budget of " + gibibytes(budget) +
+                    (opts.memoryBudget != 0 ? "" : " (this machine's memory)"));
+    if (opts.checkEstimate) opts.checkEstimate(e);
+}
+
+// Refuses a scene whose size single precision cannot render (see kMaxSceneExtent).
+void checkSceneExtent(const Scene& scene) {
+    if (scene.triangles.empty()) return;
+    const Bounds b = scene.bounds();
+    const glm::vec3 size = b.max - b.min;
+    const double extent = std::max({size.x, size.y, size.z});
+    if (extent >= gltf::kMinSceneExtent && extent <= gltf::kMaxSceneExtent) return;
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "the scene is %.3g units across; gdpt renders scenes from %.2g to %.2g units across "
+                  "(single-precision triangle normals and areas), so scale it into that range",
+                  extent, gltf::kMinSceneExtent, gltf::kMaxSceneExtent);
+    throw Error(text);
+}
+
+Scene loadImpl(const std::string& path, const LoadOptions& opts) {
+    // The JSON alone first: its checks and the estimate come before the parser, a .glb's BIN
+    // chunk and any external buffer are read, and before anything is allocated per element.
+    std::vector<unsigned char> bytes = readFile(path, /*jsonOnly=*/true);
+    const SceneEstimate estimate = precheck(bytes);
+    refuseBeyondLimits(estimate, opts);
+    std::optional<Progress> progress;
+    if (!opts.quiet && estimate.triangles >= opts.progressTriangles) {
+        progress.emplace("loading " + path, static_cast<double>(estimate.triangles), false);
+        progress->update(0.0, "reading buffers");
+    }
+    const bool binary = isGlb(bytes);
+    if (binary) bytes = readFile(path, /*jsonOnly=*/false);
+
     tinygltf::Model model;
     tinygltf::TinyGLTF parser;
     parser.SetImageLoader(&gltf::decodeImage, &model);  // model: see decodeImage
+    parser.SetFsCallbacks({&tinygltf::FileExists, &tinygltf::ExpandFilePath, &readExternalFile,
+                           &tinygltf::WriteWholeFile, nullptr});
     std::string err, warn;
     std::string baseDir = std::filesystem::path(path).parent_path().string();
     if (baseDir.empty()) baseDir = ".";
-    const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
-    // Before the parser: it would fail on what such an extension replaces (e.g. a Draco mesh's
-    // accessors have no bufferView) with a message that does not name the extension.
-    if (const auto message = requiredExtensionsError(requiredExtensions(jsonText(bytes, binary))))
-        throw Error(*message);
     const bool ok =
         binary ? parser.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
                                              static_cast<unsigned int>(bytes.size()), baseDir)
                : parser.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
                                             static_cast<unsigned int>(bytes.size()), baseDir);
     if (!ok) throw Error("glTF parse error: " + oneLine(err.empty() ? "unknown error" : err));
+    bytes = {};
+    throwIfInterrupted("loading");  // SIGINT/SIGTERM (util/interrupt.h): between the stages
 
     Scene scene;
     scene.sourcePath = path;
@@ -375,16 +439,32 @@ Scene loadImpl(const std::string& path) {
             anyNormals = anyNormals || prim.attributes.count("NORMAL") > 0;
             anyUvs = anyUvs || prim.attributes.count("TEXCOORD_0") > 0;
         }
-    for (const auto& inst : instances) gltf::addMeshInstance(ctx, inst, anyNormals, anyUvs);
+    // The estimate bounds what the instances add (fewer when triangles are degenerate).
+    scene.positions.reserve(static_cast<std::size_t>(estimate.vertices));
+    if (anyNormals) scene.normals.reserve(static_cast<std::size_t>(estimate.vertices));
+    if (anyUvs) scene.uvs.reserve(static_cast<std::size_t>(estimate.vertices));
+    scene.triangles.reserve(static_cast<std::size_t>(estimate.triangles));
+    scene.triangleMaterial.reserve(static_cast<std::size_t>(estimate.triangles));
+    for (const auto& inst : instances) {
+        throwIfInterrupted("loading");
+        gltf::addMeshInstance(ctx, inst, anyNormals, anyUvs);
+        if (progress)
+            progress->update(static_cast<double>(scene.triangles.size()),
+                             std::to_string(scene.triangles.size()) + " triangles");
+    }
+    if (progress) progress->finish(std::to_string(scene.triangles.size()) + " triangles");
+    checkSceneExtent(scene);
     return scene;
 }
 
 }  // namespace
 }  // namespace gltf
 
-Scene loadGltf(const std::string& path, const LoadOptions& /*opts*/) {
+Scene loadGltf(const std::string& path, const LoadOptions& opts) {
     try {
-        return gltf::loadImpl(path);
+        return gltf::loadImpl(path, opts);
+    } catch (const Interrupted&) {
+        throw;  // not a problem of the file
     } catch (const Error& e) {
         throw e.withContext(path);
     } catch (const std::bad_alloc&) {
@@ -392,6 +472,16 @@ Scene loadGltf(const std::string& path, const LoadOptions& /*opts*/) {
     } catch (const std::exception& e) {
         // tinygltf or the standard library threw something other than our errors.
         throw Error(path + ": " + e.what());
+    }
+}
+
+SceneEstimate estimateGltf(const std::string& path) {
+    try {
+        return gltf::precheck(gltf::readFile(path, /*jsonOnly=*/true));
+    } catch (const Error& e) {
+        throw e.withContext(path);
+    } catch (const std::bad_alloc&) {
+        throw Error(path + ": out of memory while reading its JSON");
     }
 }
 

@@ -13,19 +13,48 @@
 // normals). Otherwise primitives without NORMAL get flat normals, as glTF 2.0 §3.7.2.1
 // requires ("client implementations MUST calculate flat normals"), by giving each of their
 // triangles three own vertices carrying the face normal.
+//
+// Hostile input is refused before it costs anything: the JSON's nesting depth is bounded
+// before any parser sees it, and every accessor, bufferView and the instanced scene's size are
+// checked on the JSON alone (estimateGltf) before tinygltf reads a buffer or the loader
+// allocates an element. Scenes too large for the memory budget or, through
+// LoadOptions::checkEstimate, for the device are refused at that point.
 #pragma once
 
+#include <cstdint>
+#include <functional>
 #include <string>
 
 #include "scene/scene.h"
 
 namespace gdpt {
 
-// Options of the loader. Empty for now; kept so that callers need not change later.
-struct LoadOptions {};
+// What loading a file will produce and cost, worked out from its JSON alone (the default
+// scene's node hierarchy and the counts of the accessors its meshes use).
+struct SceneEstimate {
+    std::uint64_t triangles = 0;  // after instancing; an upper bound (degenerate ones are dropped)
+    std::uint64_t vertices = 0;   // after instancing, flat-shaded primitives counted 3 per triangle
+    std::uint64_t bytes = 0;      // peak memory of the loader's scene arrays and per-primitive buffers
+};
+
+struct LoadOptions {
+    // Called with the estimate after the file's structure has been checked and before any
+    // buffer, image or accessor is read into memory; throwing gdpt::Error refuses the scene
+    // (e.g. beyond a device limit). The loader prefixes the file name.
+    std::function<void(const SceneEstimate&)> checkEstimate;
+    // Most memory the loader may need (SceneEstimate::bytes); 0 = the machine's physical memory.
+    std::uint64_t memoryBudget = 0;
+    // Progress on stderr for scenes of at least this many (estimated) triangles, unless quiet.
+    std::uint64_t progressTriangles = 1'000'000;
+    bool quiet = false;
+};
 
 // Loads `path` (.gltf or .glb, detected from the file's magic bytes). Throws gdpt::Error.
 [[nodiscard]] Scene loadGltf(const std::string& path, const LoadOptions& opts = {});
+
+// The estimate of `path` from its JSON alone (a .glb's BIN chunk and external buffers are not
+// read), after the same structural checks loadGltf makes first. Throws gdpt::Error.
+[[nodiscard]] SceneEstimate estimateGltf(const std::string& path);
 
 // A camera used when the file has none: looks from +Z towards -Z at the centre of the
 // scene bounds, far enough that the bounding sphere fits the 45° vertical field of view.

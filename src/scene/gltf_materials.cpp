@@ -6,6 +6,7 @@
 // Context::unsupported.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "scene/gltf_internal.h"
 
@@ -36,9 +37,23 @@ glm::vec3 vec3Or(const tinygltf::Value& obj, const char* key, glm::vec3 fallback
     return out;
 }
 
-float clamp01(double v) {
-    return static_cast<float>(std::clamp(v, 0.0, 1.0));
+// A material factor as a float after checking that it lies in [lo, hi]. The glTF 2.0 schema
+// bounds every factor (material.schema.json, material.pbrMetallicRoughness.schema.json and
+// the extensions'); a value outside, or NaN, would give negative, NaN or energy-gaining
+// radiance, so the file is refused rather than clamped.
+float checkedFactor(double v, double lo, double hi, const std::string& what) {
+    if (!(v >= lo && v <= hi) || !std::isfinite(v))
+        throw Error(what + " is " + formatNumber(v) + ", outside [" + formatNumber(lo) + ", " +
+                    (std::isinf(hi) ? std::string("inf)") : formatNumber(hi) + "]") + " (glTF 2.0 schema)");
+    return static_cast<float>(v);
 }
+
+// Component c of factor `name` (an array), checked as by checkedFactor.
+float checkedComponent(const std::vector<double>& v, std::size_t c, double lo, double hi, const char* name) {
+    return checkedFactor(v[c], lo, hi, std::string(name) + " component " + std::to_string(c));
+}
+
+constexpr double kUnbounded = std::numeric_limits<double>::infinity();
 
 // Resolves a texture reference to an index into scene.textures, decoding the image on
 // first use in the requested colour space. Returns -1 when the texture cannot be used.
@@ -103,11 +118,11 @@ gpu::Material convertMaterial(Context& ctx, const tinygltf::Material& m) {
     gpu::Material out{};
     const auto& pbr = m.pbrMetallicRoughness;
     if (pbr.baseColorFactor.size() != 4) throw Error("baseColorFactor must have 4 numbers");
-    out.baseColor =
-        glm::vec4(static_cast<float>(pbr.baseColorFactor[0]), static_cast<float>(pbr.baseColorFactor[1]),
-                  static_cast<float>(pbr.baseColorFactor[2]), static_cast<float>(pbr.baseColorFactor[3]));
-    out.metallic = clamp01(pbr.metallicFactor);
-    out.roughness = clamp01(pbr.roughnessFactor);
+    for (std::size_t c = 0; c < 4; ++c)
+        out.baseColor[static_cast<int>(c)] =
+            checkedComponent(pbr.baseColorFactor, c, 0.0, 1.0, "baseColorFactor");
+    out.metallic = checkedFactor(pbr.metallicFactor, 0.0, 1.0, "metallicFactor");
+    out.roughness = checkedFactor(pbr.roughnessFactor, 0.0, 1.0, "roughnessFactor");
     out.baseColorTex = resolveTexture(ctx, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
                                       pbr.baseColorTexture.extensions, true, "baseColorTexture");
     out.metallicRoughnessTex =
@@ -115,15 +130,20 @@ gpu::Material convertMaterial(Context& ctx, const tinygltf::Material& m) {
                        pbr.metallicRoughnessTexture.extensions, false, "metallicRoughnessTexture");
 
     // Emission: emissiveFactor × KHR_materials_emissive_strength = radiance.
+    // Emission above 1 needs the extension: emissiveFactor is in [0, 1].
     if (m.emissiveFactor.size() != 3) throw Error("emissiveFactor must have 3 numbers");
+    for (std::size_t c = 0; c < 3; ++c) checkedComponent(m.emissiveFactor, c, 0.0, 1.0, "emissiveFactor");
     double strength = 1.0;
     if (auto it = m.extensions.find(kEmissiveStrength); it != m.extensions.end())
         strength = numberOr(it->second, "emissiveStrength", 1.0);
     if (!(strength >= 0.0) || !std::isfinite(strength))
-        throw Error("emissiveStrength " + std::to_string(strength) + " is not a finite value >= 0");
+        throw Error("emissiveStrength " + formatNumber(strength) + " is not a finite value >= 0");
     out.emissive = glm::vec3(static_cast<float>(m.emissiveFactor[0] * strength),
                              static_cast<float>(m.emissiveFactor[1] * strength),
                              static_cast<float>(m.emissiveFactor[2] * strength));
+    if (!std::isfinite(out.emissive.x) || !std::isfinite(out.emissive.y) || !std::isfinite(out.emissive.z))
+        throw Error("emissiveFactor x emissiveStrength " + formatNumber(strength) +
+                    " overflows single precision");
     out.emissiveTex = resolveTexture(ctx, m.emissiveTexture.index, m.emissiveTexture.texCoord,
                                      m.emissiveTexture.extensions, true, "emissiveTexture");
 
@@ -131,21 +151,30 @@ gpu::Material convertMaterial(Context& ctx, const tinygltf::Material& m) {
     out.specular = 1.0f;
     out.specularColor = glm::vec3(1.0f);
     if (auto it = m.extensions.find(kSpecular); it != m.extensions.end()) {
-        out.specular = clamp01(numberOr(it->second, "specularFactor", 1.0));
+        out.specular = checkedFactor(numberOr(it->second, "specularFactor", 1.0), 0.0, 1.0, "specularFactor");
         out.specularColor = vec3Or(it->second, "specularColorFactor", glm::vec3(1.0f));
+        // material.KHR_materials_specular.schema.json: components >= 0, no upper bound.
+        for (int c = 0; c < 3; ++c)
+            checkedFactor(out.specularColor[c], 0.0, kUnbounded,
+                          "specularColorFactor component " + std::to_string(c));
         if (it->second.Has("specularTexture") || it->second.Has("specularColorTexture"))
             ctx.unsupported("KHR_materials_specular textures (factors used)");
     }
     // KHR_materials_ior: default 1.5; 0 is allowed by the extension (meaning "infinite").
     out.ior = 1.5f;
-    if (auto it = m.extensions.find(kIor); it != m.extensions.end())
-        out.ior = static_cast<float>(numberOr(it->second, "ior", 1.5));
+    if (auto it = m.extensions.find(kIor); it != m.extensions.end()) {
+        const double ior = numberOr(it->second, "ior", 1.5);
+        if (!(ior == 0.0 || (ior >= 1.0 && std::isfinite(ior))))
+            throw Error("ior " + formatNumber(ior) +
+                        " is neither 0 nor a finite value >= 1 (KHR_materials_ior)");
+        out.ior = static_cast<float>(ior);
+    }
 
     out.flags = 0;
     out.alphaCutoff = 0.5f;
     if (m.alphaMode == "MASK") {
         out.flags |= gpu::kMatFlagAlphaMask;
-        out.alphaCutoff = static_cast<float>(m.alphaCutoff);
+        out.alphaCutoff = checkedFactor(m.alphaCutoff, 0.0, kUnbounded, "alphaCutoff");
     } else if (m.alphaMode == "BLEND") {
         ctx.unsupported("alphaMode BLEND (rendered opaque)");
     } else if (m.alphaMode != "OPAQUE" && !m.alphaMode.empty()) {

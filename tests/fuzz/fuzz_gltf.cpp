@@ -1,5 +1,8 @@
 // fuzz_gltf.cpp — libFuzzer harness for the glTF loader. Any input must either load or
-// throw gdpt::Error; a crash, hang, sanitizer report or other exception is a bug.
+// throw gdpt::Error; a crash, hang, sanitizer report or other exception is a bug. The loader
+// gets a small memory budget, so a scene it accepts is cheap by its own estimate: an
+// allocation beyond scripts/fuzz.sh's -malloc_limit_mb, or memory beyond -rss_limit_mb,
+// means something was materialised before it was checked (also a bug).
 // Build: configure with clang and -DGDPT_FUZZ=ON (see tests/fuzz/README.md).
 #include <unistd.h>
 
@@ -17,8 +20,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (!f) return 0;
     std::fwrite(data, 1, size, f);
     std::fclose(f);
+    gdpt::LoadOptions options;
+    options.memoryBudget = 64ull << 20;
+    options.quiet = true;
     try {
-        (void)gdpt::loadGltf(path);
+        (void)gdpt::loadGltf(path, options);
     } catch (const gdpt::Error&) {
         // The expected way to reject malformed input.
     }

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <glm/gtc/packing.hpp>
+#include <optional>
 
 #include "bvh/builder.h"
 #include "bvh/wide_bvh.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
+#include "util/progress.h"
 #include "vk/context.h"
 #include "vk/kernel.h"
 
@@ -65,6 +67,52 @@ std::vector<gpu::TriangleShading> makeShading(const Scene& scene, const std::vec
 
 }  // namespace
 
+std::uint64_t maxDeviceTriangles(const vk::DeviceInfo& device) {
+    return device.maxTexelBufferElements / gpu::kTriangleShadingTexels;
+}
+
+namespace {
+
+// "N triangles, more than the K that device 'X' can hold (...)".
+std::string beyondDevice(std::uint64_t triangles, const vk::DeviceInfo& device) {
+    return std::to_string(triangles) + " triangles, more than the " +
+           std::to_string(maxDeviceTriangles(device)) + " that device '" + device.name +
+           "' can hold (maxTexelBufferElements = " + std::to_string(device.maxTexelBufferElements) +
+           " texels, " + std::to_string(gpu::kTriangleShadingTexels) +
+           " per triangle's shading record); use a smaller scene";
+}
+
+}  // namespace
+
+void checkTrianglesFit(const vk::DeviceInfo& device, std::uint64_t triangles, const std::string& source) {
+    if (triangles <= maxDeviceTriangles(device)) return;
+    throw Error((source.empty() ? std::string("generated scene") : source) + ": the scene has " +
+                beyondDevice(triangles, device));
+}
+
+LoadOptions deviceLoadOptions(const std::string& device, bool quiet) {
+    LoadOptions options;
+    options.quiet = quiet;
+    options.checkEstimate = [device](const SceneEstimate& estimate) {
+        // Every device holds this many (Vulkan's required minimum of maxTexelBufferElements is
+        // 65536); larger scenes are compared with the device's own limit, read from a
+        // short-lived context that chooses the device as the render's will.
+        if (estimate.triangles <= 65536 / gpu::kTriangleShadingTexels) return;
+        vk::ContextOptions probe;
+        probe.device = device;
+        std::optional<vk::Context> ctx;
+        try {
+            ctx.emplace(probe);
+        } catch (const Error& e) {
+            // The loader puts the scene's name in front; say that the device is the problem.
+            throw e.withContext("no device to check the scene's size against");
+        }
+        if (estimate.triangles > maxDeviceTriangles(ctx->info()))
+            throw Error("the scene has up to " + beyondDevice(estimate.triangles, ctx->info()));
+    };
+    return options;
+}
+
 void setCamera(gpu::SceneConstants& c, const Camera& camera, int width, int height) {
     c.camPosition = camera.position;
     c.camForward = glm::normalize(camera.forward);
@@ -81,13 +129,21 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
 
 SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOptions& options, SceneSpec spec)
     : spec_(std::move(spec)) {
-    if (scene.triangles.empty()) throw Error("scene has no triangles to render");
+    checkHasTriangles(scene);
     if (options.width < 1 || options.height < 1) throw Error("image size must be at least 1x1");
+    // Before the BVH is built: the per-triangle tables must fit the device (makeBuffer checks
+    // every table again on upload).
+    checkTrianglesFit(ctx.info(), scene.triangles.size(), scene.sourcePath);
+    std::optional<Progress> progress;
+    if (!options.quiet && scene.triangles.size() >= kSceneProgressTriangles)
+        progress.emplace("building " + std::to_string(scene.triangles.size()) + " triangles", 3.0, false);
 
     // BVH over the world-space triangles (the spec's, for a small scene); everything
     // per-triangle is laid out in leaf order.
     std::shared_ptr<const SceneBvh> built = spec_.bvh();
+    if (progress) progress->update(0.0, "BVH");
     if (!built) built = std::make_shared<const SceneBvh>(buildSceneBvh(scene));
+    if (progress) progress->update(1.0, "triangle tables");
     const Bvh& bvh = built->binary;
     bvhInfo_.buildMs = built->buildMs;
     bvhInfo_.nodes = static_cast<std::uint32_t>(bvh.nodes.size());
@@ -157,6 +213,7 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     const Bounds b = scene.bounds();
     constants_.sceneRadius = 0.5f * glm::length(b.max - b.min);
 
+    if (progress) progress->update(2.0, "upload");
     triGeom_ = makeBuffer(ctx, geoms, "triangle geometry", gpu::kBindTriGeom);
     triShading_ = makeBuffer(ctx, shading, "triangle shading", gpu::kBindTriShading);
     bvh_ = makeBuffer(ctx, built->wide.nodes, "BVH nodes (4-wide)", gpu::kBindBvh);
@@ -167,6 +224,10 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     punctual_ = makeBuffer(ctx, scene.punctualLights, "punctual lights", gpu::kBindPunctual);
     sceneConst_ = makeBuffer(ctx, std::vector<gpu::SceneConstants>{constants_}, "scene constants",
                              gpu::kBindSceneConst);
+    if (progress) {
+        progress->update(3.0);
+        progress->finish("uploaded");
+    }
 }
 
 void SceneGpu::bindTo(vk::Kernel& kernel) const {

@@ -4,12 +4,14 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "gdpt_shared.h"
 #include "render/device_scene/features.h"
 #include "render/device_scene/scene_spec.h"
+#include "scene/gltf_loader.h"
 #include "scene/scene.h"
 #include "vk/buffer.h"
 #include "vk/kernel.h"
@@ -18,7 +20,27 @@ namespace gdpt {
 
 namespace vk {
 class Context;
+struct DeviceInfo;
 }  // namespace vk
+
+// Scenes of at least this many triangles show progress while SceneGpu builds them (the BVH
+// of tens of millions of triangles takes minutes on a CPU device).
+inline constexpr std::size_t kSceneProgressTriangles = 1'000'000;
+
+// The most triangles `device` can hold: every per-triangle table is one texel buffer of at
+// most maxTexelBufferElements texels, and the largest, TriangleShading, takes
+// kTriangleShadingTexels texels per triangle. (The BVH, smaller per triangle, and the other
+// tables are checked as they are uploaded.)
+[[nodiscard]] std::uint64_t maxDeviceTriangles(const vk::DeviceInfo& device);
+
+// Throws gdpt::Error naming `source` (the scene file) and the limit if `triangles` exceed
+// maxDeviceTriangles(device).
+void checkTrianglesFit(const vk::DeviceInfo& device, std::uint64_t triangles, const std::string& source);
+
+// Load options for a scene that is to be rendered on the device `device` selects
+// (vk::ContextOptions::device): the loader refuses a scene whose estimated triangles exceed
+// maxDeviceTriangles before it reads the scene's buffers, and shows progress unless quiet.
+[[nodiscard]] LoadOptions deviceLoadOptions(const std::string& device, bool quiet);
 
 struct BvhBuildInfo {
     double buildMs = 0.0;

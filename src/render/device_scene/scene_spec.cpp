@@ -16,6 +16,13 @@ SceneBvh buildSceneBvh(const Scene& scene) {
     return out;
 }
 
+void checkHasTriangles(const Scene& scene) {
+    if (!scene.triangles.empty()) return;
+    throw Error((scene.sourcePath.empty() ? std::string("generated scene") : scene.sourcePath) +
+                ": the scene has no triangles to render (its nodes instance no mesh with triangles, or "
+                "every triangle is degenerate; `gdpt info` lists what was not rendered)");
+}
+
 SceneSpec::SceneSpec(const Scene& scene, const SceneGpuOptions& options)
     : features_(analyzeScene(scene, options.envRadiance, options.shiftThreshold)),
       width_(static_cast<std::uint32_t>(std::max(options.width, 0))),
@@ -26,7 +33,7 @@ SceneSpec::SceneSpec(const Scene& scene, const SceneGpuOptions& options)
       maxDepthSpec_(std::min<std::uint32_t>(options.maxDepth + 1, 1024)),
       genericFeatures_(options.genericFeatures) {
     // Before any kernel is created from this spec (SceneGpu checks the same).
-    if (scene.triangles.empty()) throw Error("scene has no triangles to render");
+    checkHasTriangles(scene);
     if (options.width < 1 || options.height < 1) throw Error("image size must be at least 1x1");
     std::uint32_t lights = 0;
     for (std::size_t t = 0; t < scene.triangles.size(); ++t)

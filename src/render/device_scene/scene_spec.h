@@ -43,6 +43,8 @@ struct SceneGpuOptions {
     // in memory, which every tree fits). For `gdpt bench-features`, which
     // measures what each specialisation saves; renders leave it 0.
     std::uint32_t genericFeatures = 0;
+    // No progress output while SceneGpu builds a large scene (kSceneProgressTriangles).
+    bool quiet = false;
 };
 
 // The scene's BVH: the binary tree (its triangle order lays out every per-triangle table)
@@ -58,6 +60,9 @@ SceneBvh buildSceneBvh(const Scene& scene);
 // (cbox's 36 take 0.08 ms, 5k triangles about 5 ms); larger trees need more than
 // kBvhRegisterStackMax stack entries anyway (a 5k-triangle soup of spheres needs 20).
 inline constexpr std::size_t kSpecBvhTriangles = 4096;
+
+// Throws gdpt::Error naming the scene's file if it has no triangles to render.
+void checkHasTriangles(const Scene& scene);
 
 class SceneSpec {
 public:

@@ -32,6 +32,9 @@ class TestGltf {
 public:
     nlohmann::json doc;
     std::vector<unsigned char> bin;
+    // JSON text written as the document's top-level "extras" as it is (e.g. nesting deeper
+    // than nlohmann::json can dump without recursion); empty = none.
+    std::string rawExtras;
 
     TestGltf() {
         doc["asset"] = {{"version", "2.0"}};
@@ -105,7 +108,7 @@ public:
             d["buffers"] = nlohmann::json::array({{{"uri", name + ".bin"}, {"byteLength", bin.size()}}});
             writeBytes(dir + "/" + name + ".bin", bin);
         }
-        const std::string text = d.dump(1);
+        const std::string text = withRawExtras(d.dump(1));
         writeBytes(dir + "/" + name + ".gltf", std::vector<unsigned char>(text.begin(), text.end()));
         return dir + "/" + name + ".gltf";
     }
@@ -115,7 +118,7 @@ public:
         std::vector<unsigned char> body = bin;
         while (body.size() % 4) body.push_back(0);
         if (!body.empty()) d["buffers"] = nlohmann::json::array({{{"byteLength", bin.size()}}});
-        std::string json = d.dump();
+        std::string json = withRawExtras(d.dump());
         while (json.size() % 4) json.push_back(' ');
         std::vector<unsigned char> out;
         auto u32 = [&](std::uint32_t v) {
@@ -135,6 +138,12 @@ public:
         }
         writeBytes(dir + "/" + name + ".glb", out);
         return dir + "/" + name + ".glb";
+    }
+
+    std::string withRawExtras(std::string text) const {
+        if (rawExtras.empty()) return text;
+        const std::size_t close = text.rfind('}');
+        return text.substr(0, close) + ",\"extras\":" + rawExtras + text.substr(close);
     }
 
     static void writeBytes(const std::string& path, const std::vector<unsigned char>& data) {
