@@ -16,6 +16,7 @@
 
 #include "image/atomic_write.h"
 #include "image/exr_io.h"
+#include "util/decode_failure.h"
 #include "util/error.h"
 #include "util/output_files.h"
 
@@ -78,69 +79,6 @@ void writePngPreview(const StagedFile& file, const Image& image, const PreviewOp
     writeStaged(file, [&](const std::string& tmpPath) { writeBytes(tmpPath, png.data(), png.size()); });
 }
 
-namespace {
-
-// The format a file's first bytes announce (for messages): "PNG", "JPEG" or "image".
-std::string formatOf(const std::string& path) {
-    unsigned char head[8] = {};
-    std::FILE* f = std::fopen(path.c_str(), "rb");
-    const std::size_t n = f ? std::fread(head, 1, sizeof head, f) : 0;
-    if (f) std::fclose(f);
-    if (n == 8 && std::memcmp(head, "\x89PNG\r\n\x1a\n", 8) == 0) return "PNG";
-    if (n >= 3 && head[0] == 0xff && head[1] == 0xd8 && head[2] == 0xff) return "JPEG";
-    return "image";
-}
-
-// Whether a PNG file ends before its IEND chunk: walks the chunks (4-byte big-endian data
-// length, 4-byte type, data, 4-byte CRC; PNG specification, ISO/IEC 15948 §5.3) from the
-// 8-byte signature. stb_image reads past the end as zeros, so a cut file otherwise fails
-// with whatever those zeros mean ("first not IHDR", a garbage chunk type).
-bool pngEndsEarly(const std::string& path) {
-    std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) return false;
-    std::vector<unsigned char> bytes;
-    unsigned char buf[65536];
-    for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) bytes.insert(bytes.end(), buf, buf + n);
-    std::fclose(f);
-    std::uint64_t pos = 8;
-    while (pos + 8 <= bytes.size()) {
-        const unsigned char* c = bytes.data() + pos;
-        const std::uint64_t length = (std::uint64_t{c[0]} << 24) | (std::uint64_t{c[1]} << 16) |
-                                     (std::uint64_t{c[2]} << 8) | std::uint64_t{c[3]};
-        if (std::memcmp(c + 4, "IEND", 4) == 0) return false;
-        pos += 12 + length;
-    }
-    return true;
-}
-
-// A one-line, plain-text reason for a failed stb_image decode. stb's reasons are terse codes
-// ("outofdata"), and its reason for an unknown PNG chunk starts with the chunk's four type
-// bytes, raw: a corrupt file printed binary bytes, or only what preceded a zero byte ("IDA",
-// or nothing at all). So the codes that matter are translated, and a reason that is not
-// plain lower-case text is not shown.
-std::string decodeFailure(const std::string& path, const char* stbReason) {
-    const std::string reason = stbReason ? stbReason : "";
-    const std::string format = formatOf(path);
-    if (reason == "can't fopen") return "cannot open the file";
-    if (reason == "unknown image type")
-        return format == "image" ? "not an image format gdpt reads (PNG, JPEG, BMP, TGA, ...)"
-                                 : "corrupt " + format + " header";
-    if (reason == "outofdata" || reason == "unexpected end" || reason == "read past buffer" ||
-        (format == "PNG" && pngEndsEarly(path)))
-        return "the " + format + " data is truncated (the file ends early)";
-    if (reason == "outofmem") return "out of memory while decoding";
-    if (reason.find("too large") != std::string::npos) return "the image is too large";
-    // Plain text: ASCII letters, digits, spaces and a little punctuation; at least 5
-    // characters (a chunk-type fragment is shorter) and not the unknown-chunk text.
-    bool plain = reason.size() >= 5 && reason.find("chunk not known") == std::string::npos;
-    for (char ch : reason)
-        plain =
-            plain && (std::isalnum(static_cast<unsigned char>(ch)) || ch == ' ' || ch == '-' || ch == '/');
-    return "corrupt " + format + " data" + (plain ? " (" + reason + ")" : std::string());
-}
-
-}  // namespace
-
 Image readPng(const std::string& path) {
     int w = 0, h = 0, components = 0;
     const bool sixteen = stbi_is_16_bit(path.c_str()) != 0;
@@ -149,7 +87,17 @@ Image readPng(const std::string& path) {
         sixteen ? static_cast<void*>(stbi_load_16(path.c_str(), &w, &h, &components, 3))
                 : static_cast<void*>(stbi_load(path.c_str(), &w, &h, &components, 3)),
         stbi_image_free);
-    if (!pixels) throw Error(path + ": cannot read image: " + decodeFailure(path, stbi_failure_reason()));
+    if (!pixels) {
+        const char* reason = stbi_failure_reason();
+        std::vector<unsigned char> bytes;  // the reason looks at the file's bytes
+        if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
+            unsigned char buf[65536];
+            for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;)
+                bytes.insert(bytes.end(), buf, buf + n);
+            std::fclose(f);
+        }
+        throw Error(path + ": cannot read image: " + decodeFailure(bytes.data(), bytes.size(), reason));
+    }
     Image image(w, h);
     const double maxCode = sixteen ? 65535.0 : 255.0;
     // Precomputing a table would be faster for 8 bit; readImage is not on a hot path.

@@ -13,6 +13,7 @@
 #include <limits>
 
 #include "scene/gltf_internal.h"
+#include "util/decode_failure.h"
 
 namespace gdpt::gltf {
 namespace {
@@ -52,15 +53,18 @@ bool decodeImage(tinygltf::Image* image, int imageIndex, std::string* err, std::
     if (bytes == nullptr || size <= 0) return fail("no image data");
     int w = 0, h = 0, comp = 0;
     if (!stbi_info_from_memory(bytes, size, &w, &h, &comp))
-        return fail(std::string("cannot decode (") + stbi_failure_reason() +
-                    "); only PNG and JPEG are supported");
+        return fail(
+            "cannot decode: " + decodeFailure(bytes, static_cast<std::size_t>(size), stbi_failure_reason()) +
+            "; glTF textures are PNG or JPEG");
     if (w <= 0 || h <= 0 || std::uint64_t(w) * std::uint64_t(h) > kMaxImagePixels)
         return fail("size " + std::to_string(w) + "x" + std::to_string(h) + " is out of range");
 
     const bool sixteen = stbi_is_16_bit_from_memory(bytes, size) != 0;
     void* pixels = sixteen ? static_cast<void*>(stbi_load_16_from_memory(bytes, size, &w, &h, &comp, 4))
                            : static_cast<void*>(stbi_load_from_memory(bytes, size, &w, &h, &comp, 4));
-    if (pixels == nullptr) return fail(std::string("cannot decode (") + stbi_failure_reason() + ")");
+    if (pixels == nullptr)
+        return fail("cannot decode: " +
+                    decodeFailure(bytes, static_cast<std::size_t>(size), stbi_failure_reason()));
     const std::size_t bytesPerChannel = sixteen ? 2 : 1;
     const std::size_t total = std::size_t(w) * std::size_t(h) * 4 * bytesPerChannel;
     image->width = w;

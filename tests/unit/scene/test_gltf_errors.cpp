@@ -229,6 +229,37 @@ TEST(GltfErrors, UndecodableImage) {
     expectError(g.writeGltf(test::testDir(), "img"), {"image 0", "cannot decode"});
 }
 
+// Class: messages that say nothing ("cannot decode ()") or print raw bytes. A texture PNG cut
+// short names the image and says it is truncated, in plain text.
+TEST(GltfErrors, TruncatedTextureSaysItIsTruncated) {
+    std::vector<unsigned char> png;
+    std::vector<unsigned char> pixels(64 * 64 * 4);
+    for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = static_cast<unsigned char>(i * 7919u >> 3);
+    stbi_write_png_to_func(
+        [](void* ctx, void* data, int size) {
+            auto* v = static_cast<std::vector<unsigned char>*>(ctx);
+            v->insert(v->end(), static_cast<unsigned char*>(data), static_cast<unsigned char*>(data) + size);
+        },
+        &png, 64, 64, 4, pixels.data(), 64 * 4);
+    png.resize(png.size() / 2);  // cut in the middle of the image data
+    auto g = test::oneTriangle();
+    const int view = g.addView(png.data(), png.size());
+    g.doc["images"] = nlohmann::json::array({{{"bufferView", view}, {"mimeType", "image/png"}}});
+    g.doc["textures"] = nlohmann::json::array({{{"source", 0}}});
+    g.addMaterial({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+    g.doc["meshes"][0]["primitives"][0]["material"] = 0;
+    try {
+        (void)loadGltf(g.writeGltf(test::testDir(), "cut"));
+        ADD_FAILURE() << "a truncated texture loaded";
+    } catch (const Error& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("image 0"), std::string::npos) << m;
+        EXPECT_NE(m.find("truncated"), std::string::npos) << m;
+        EXPECT_EQ(m.find("()"), std::string::npos) << m;
+        for (char ch : m) EXPECT_TRUE(ch >= 0x20 && ch < 0x7f) << "raw byte in: " << m;
+    }
+}
+
 TEST(GltfErrors, ImageBufferViewOutsideBuffer) {
     // tinygltf does not check this itself; it would hand the decoder a wild pointer.
     auto g = test::oneTriangle();
