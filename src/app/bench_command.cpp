@@ -44,6 +44,7 @@ Scene benchScene(const std::string& name) {
 
 int runBench(const BenchArgs& a) {
     using nlohmann::json;
+    TextOutput output(a.output);
     vk::ContextOptions co;
     co.device = a.device;
     vk::Context ctx(co);
@@ -121,7 +122,7 @@ int runBench(const BenchArgs& a) {
                                  {"pt_sampling_ms", median(ptMs)},
                                  {"pt_kernels", kernels}});
     }
-    writeTextOutput(a.output, out.dump(2) + "\n");
+    output.write(out.dump(2) + "\n");
     return 0;
 }
 

@@ -91,6 +91,7 @@ int runBenchFeatures(const BenchFeaturesArgs& a) {
     using nlohmann::json;
     const std::vector<std::string> methods = splitList(a.methods);
     for (const std::string& m : methods) (void)makeIntegrator(m);  // unknown names fail first
+    TextOutput output(a.output);
     vk::ContextOptions co;
     co.device = a.device;
     vk::Context ctx(co);
@@ -141,7 +142,7 @@ int runBenchFeatures(const BenchFeaturesArgs& a) {
             out["results"].push_back({{"scene", path}, {"method", method}, {"variants", rows}});
         }
     }
-    writeTextOutput(a.output, out.dump(2) + "\n");
+    output.write(out.dump(2) + "\n");
     return 0;
 }
 

@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "image/atomic_write.h"
+#include "util/output_files.h"
 
 namespace gdpt {
 
@@ -30,12 +32,23 @@ inline std::vector<std::string> splitList(const std::string& text) {
     return out;
 }
 
-// A command's text output: stdout for "-", else the file, written atomically (tmp + rename).
-inline void writeTextOutput(const std::string& path, const std::string& text) {
-    if (path == "-")
-        std::fputs(text.c_str(), stdout);
-    else
-        writeTextFileAtomically(path, text);
-}
+// A command's text output: stdout for "-", else a file staged when the command starts (so
+// that a bad path fails before the work; util/output_files.h) and written whole at the end.
+class TextOutput {
+public:
+    explicit TextOutput(const std::string& path)
+        : file_(path == "-" ? nullptr : std::make_unique<StagedFile>(path)) {}
+    void write(const std::string& text) {
+        if (!file_) {
+            std::fputs(text.c_str(), stdout);
+            return;
+        }
+        writeStagedText(*file_, text);
+        file_->commit();
+    }
+
+private:
+    std::unique_ptr<StagedFile> file_;
+};
 
 }  // namespace gdpt

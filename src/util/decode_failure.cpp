@@ -51,7 +51,8 @@ std::string decodeFailure(const unsigned char* bytes, std::size_t size, const ch
     // characters (a chunk-type fragment is shorter) and not the unknown-chunk text.
     bool plain = reason.size() >= 5 && reason.find("chunk not known") == std::string::npos;
     for (char ch : reason)
-        plain = plain && (std::isalnum(static_cast<unsigned char>(ch)) || ch == ' ' || ch == '-' || ch == '/');
+        plain =
+            plain && (std::isalnum(static_cast<unsigned char>(ch)) || ch == ' ' || ch == '-' || ch == '/');
     return "corrupt " + format + " data" + (plain ? " (" + reason + ")" : std::string());
 }
 
