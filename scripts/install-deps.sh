@@ -26,6 +26,7 @@ packages=(
   libcli11-dev libfmt-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libeigen3-dev
   gnuplot-nox python3 clang libclang-rt-dev clang-format-14
+  assimp-testmodels
 )
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
