@@ -26,20 +26,6 @@ const std::string kSmall = " --width 16 --height 16 --spp 2 --quiet ";
 
 class OutputsCli : public test::TempDirTest {
 protected:
-    // Every name in the test's directory, hidden temporary files included.
-    [[nodiscard]] std::vector<std::string> listing(const fs::path& in = {}) const {
-        std::vector<std::string> names;
-        for (const auto& e : fs::directory_iterator(in.empty() ? dir_ : in))
-            names.push_back(e.path().filename().string());
-        std::sort(names.begin(), names.end());
-        return names;
-    }
-    static std::string slurp(const std::string& p) {
-        std::ifstream in(p, std::ios::binary);
-        std::stringstream s;
-        s << in.rdbuf();
-        return s.str();
-    }
     static bool says(const RunResult& r, const std::string& text) {
         return r.output.find(text) != std::string::npos;
     }
@@ -56,11 +42,11 @@ TEST_F(OutputsCli, OutputsThatWouldOverwriteAnInputOrEachOtherAreRefused) {
 
     // The scene itself.
     fs::copy_file(kScene, path("s.gltf"));  // its buffers are data: URIs
-    const std::string scene = slurp(path("s.gltf"));
+    const std::string scene = test::readText(path("s.gltf"));
     r = test::runGdpt("render " + path("s.gltf") + kSmall + "-o " + path("s.gltf"));
     EXPECT_EQ(r.code, 1) << r.output;
     EXPECT_TRUE(says(r, "is the scene")) << r.output;
-    EXPECT_TRUE(slurp(path("s.gltf")) == scene);
+    EXPECT_TRUE(test::readText(path("s.gltf")) == scene);
     // The JSON summary onto the EXR.
     r = test::runGdpt("render " + kScene + kSmall + "-o " + path("a.exr") + " --json " + path("a.exr"));
     EXPECT_EQ(r.code, 1) << r.output;
@@ -68,11 +54,11 @@ TEST_F(OutputsCli, OutputsThatWouldOverwriteAnInputOrEachOtherAreRefused) {
 
     // solve: its output onto its input layers.
     ASSERT_EQ(test::runGdpt("render " + kScene + kSmall + "--method gpt -o " + path("g.exr")).code, 0);
-    const std::string layers = slurp(path("g.exr"));
+    const std::string layers = test::readText(path("g.exr"));
     r = test::runGdpt("solve " + path("g.exr") + " --quiet -o " + path("g.exr"));
     EXPECT_EQ(r.code, 1) << r.output;
     EXPECT_TRUE(says(r, "is the input")) << r.output;
-    EXPECT_TRUE(slurp(path("g.exr")) == layers);
+    EXPECT_TRUE(test::readText(path("g.exr")) == layers);
     // clone: its output onto its target.
     r = test::runGdpt("clone --source " + path("g.png") + " --target " + path("g.png") + " --mask " +
                       path("g.png") + " --quiet -o " + path("g.png"));
@@ -102,7 +88,7 @@ TEST_F(OutputsCli, BadOutputPathsFailBeforeRenderingAndLeaveNothing) {
     EXPECT_EQ(r.code, 1);
     EXPECT_TRUE(says(r, "out.png") && says(r, "is a directory")) << r.output;
     EXPECT_EQ(listing(), std::vector<std::string>{"out.png"});
-    EXPECT_TRUE(listing(path("out.png")).empty());
+    EXPECT_TRUE(listing("out.png").empty());
 }
 
 // Class: unchecked writes. A full disk (a file-size limit: every write past it fails, as on a
@@ -154,12 +140,12 @@ TEST_F(OutputsCli, ConcurrentRendersToOneOutputNeverMix) {
         pclose(pipe);
         EXPECT_EQ(output, "0\n") << "a concurrent render failed: " << output;
 
-        const nlohmann::json j = nlohmann::json::parse(slurp(path("out.json")));
+        const nlohmann::json j = nlohmann::json::parse(test::readText(path("out.json")));
         const std::string seed = std::to_string(j.at("seed").get<int>());
         // (compared as booleans: a failure would print megabytes of EXR)
-        EXPECT_TRUE(slurp(path("out.exr")) == slurp(path("alone" + seed + ".exr")))
+        EXPECT_TRUE(test::readText(path("out.exr")) == test::readText(path("alone" + seed + ".exr")))
             << "EXR not seed " << seed << "'s";
-        EXPECT_TRUE(slurp(path("out.png")) == slurp(path("alone" + seed + ".png")))
+        EXPECT_TRUE(test::readText(path("out.png")) == test::readText(path("alone" + seed + ".png")))
             << "PNG not seed " << seed << "'s";
         for (const std::string& name : listing()) EXPECT_NE(name[0], '.') << "temporary file left: " << name;
     }
@@ -179,11 +165,11 @@ TEST_F(OutputsCli, ConvergeRefusesWhatCannotBeMeasuredAndWritesNothing) {
     EXPECT_EQ(r.code, 1) << r.output;
     EXPECT_TRUE(says(r, "nan.exr") && says(r, "no finite")) << r.output;
     EXPECT_FALSE(says(r, "wrote")) << r.output;
-    EXPECT_TRUE(listing(out).empty());
+    EXPECT_TRUE(listing("conv").empty());
 
     r = test::runGdpt("converge " + kScene + " --reference " + path("nan.exr") + " --methods '' -o " + out);
     EXPECT_EQ(r.code, 2) << r.output;
-    EXPECT_TRUE(listing(out).empty());
+    EXPECT_TRUE(listing("conv").empty());
 }
 
 // Class: --time 0 silently rendered 64 spp; --alpha 0 with an L1 reconstruction failed with

@@ -51,7 +51,8 @@ TEST_F(RealAssets, EveryFileLoadsOrIsRefusedNamingIt) {
         EXPECT_TRUE(r.code == 0 || r.code == 1) << f << " exit " << r.code << ":\n" << r.output;
         if (r.code == 1) {
             ++refused;
-            EXPECT_NE(r.output.find(f), std::string::npos) << "the error does not name the file:\n" << r.output;
+            EXPECT_NE(r.output.find(f), std::string::npos) << "the error does not name the file:\n"
+                                                           << r.output;
         }
     }
     // The broken-file regressions and required Draco/techniqueWebGL (9 of 46 at 5.2.5);
@@ -64,24 +65,26 @@ TEST_F(RealAssets, EveryFileLoadsOrIsRefusedNamingIt) {
 TEST_F(RealAssets, SampleModelsRenderFiniteLitImagesWithBothMethods) {
     GDPT_REQUIRE_ASSETS();
     const std::vector<std::string> models = {
-        "2CylinderEngine-glTF-Binary/2CylinderEngine.glb",            // 110k triangles, 34 materials
-        "BoxTextured-glTF-Binary/BoxTextured.glb",                    // texture in a .glb
-        "BoxTextured-glTF-Embedded/BoxTextured.gltf",                 // texture in a data URI
-        "cameras/Cameras.gltf",                                       // two cameras
-        "textureTransform/TextureTransformTest.gltf",                 // texture transforms (warned)
+        "2CylinderEngine-glTF-Binary/2CylinderEngine.glb",                   // 110k triangles, 34 materials
+        "BoxTextured-glTF-Binary/BoxTextured.glb",                           // texture in a .glb
+        "BoxTextured-glTF-Embedded/BoxTextured.gltf",                        // texture in a data URI
+        "cameras/Cameras.gltf",                                              // two cameras
+        "textureTransform/TextureTransformTest.gltf",                        // texture transforms (warned)
         "glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf",  // morph targets (warned)
     };
     for (const std::string& m : models)
         for (const char* method : {"gpt", "pt"}) {
             const std::string out = path("r.exr");
-            const RunResult r = test::runGdpt("render '" + kModels + "/" + m + "' --env 1 --width 24 --height 24 " +
-                                              "--spp 2 --quiet --method " + method + " -o " + out);
+            const RunResult r =
+                test::runGdpt("render '" + kModels + "/" + m + "' --env 1 --width 24 --height 24 " +
+                              "--spp 2 --quiet --method " + method + " -o " + out);
             ASSERT_EQ(r.code, 0) << m << " " << method << ":\n" << r.output;
             double sum = 0.0;
             for (const NamedLayer& layer : readExr(out))
                 for (int c = 0; c < 3; ++c)
                     for (float v : layer.image.plane(c)) {
-                        ASSERT_TRUE(std::isfinite(v)) << m << " " << method << " layer '" << layer.name << "'";
+                        ASSERT_TRUE(std::isfinite(v))
+                            << m << " " << method << " layer '" << layer.name << "'";
                         if (layer.name.empty()) sum += v;
                     }
             EXPECT_GT(sum, 0.0) << m << " " << method << ": black";
@@ -102,8 +105,8 @@ TEST_F(RealAssets, BrokenFilesAreRefusedSayingWhy) {
     };
     for (const auto& [file, why] : broken) {
         const std::string f = kModels + "/" + file;
-        const RunResult r = test::runGdpt("render '" + f + "' --env 1 --width 8 --height 8 --spp 1 --quiet -o " +
-                                          path("b.exr"));
+        const RunResult r = test::runGdpt(
+            "render '" + f + "' --env 1 --width 8 --height 8 --spp 1 --quiet -o " + path("b.exr"));
         EXPECT_EQ(r.code, 1) << f << ":\n" << r.output;
         EXPECT_NE(r.output.find(f), std::string::npos) << r.output;
         EXPECT_NE(r.output.find(why), std::string::npos) << r.output;

@@ -27,19 +27,6 @@ namespace fs = std::filesystem;
 
 class OutputFiles : public test::TempDirTest {
 protected:
-    // Names of the files in the scratch directory (temporary files included).
-    [[nodiscard]] std::vector<std::string> listing() const {
-        std::vector<std::string> names;
-        for (const auto& e : fs::directory_iterator(dir_)) names.push_back(e.path().filename().string());
-        std::sort(names.begin(), names.end());
-        return names;
-    }
-    static std::string slurp(const std::string& p) {
-        std::ifstream in(p, std::ios::binary);
-        std::stringstream s;
-        s << in.rdbuf();
-        return s.str();
-    }
     static void put(const std::string& p, const std::string& text) {
         std::ofstream(p, std::ios::binary) << text;
     }
@@ -70,9 +57,9 @@ TEST_F(OutputFiles, CommitPutsTheWholeFileInPlace) {
     put(path("a.txt"), "old");
     StagedFile f(path("a.txt"));
     writeBytes(f.tmpPath(), "new text", 8);
-    EXPECT_EQ(slurp(path("a.txt")), "old");  // untouched until the commit
+    EXPECT_EQ(test::readText(path("a.txt")), "old");  // untouched until the commit
     f.commit();
-    EXPECT_EQ(slurp(path("a.txt")), "new text");
+    EXPECT_EQ(test::readText(path("a.txt")), "new text");
     EXPECT_EQ(listing(), std::vector<std::string>{"a.txt"});
 }
 
@@ -84,9 +71,9 @@ TEST_F(OutputFiles, ConcurrentWritersOfOneTargetGetDistinctTemporaryFiles) {
     writeBytes(a.tmpPath(), "AAAA", 4);
     writeBytes(b.tmpPath(), "BB", 2);
     a.commit();
-    EXPECT_EQ(slurp(path("out.exr")), "AAAA");
+    EXPECT_EQ(test::readText(path("out.exr")), "AAAA");
     b.commit();
-    EXPECT_EQ(slurp(path("out.exr")), "BB");
+    EXPECT_EQ(test::readText(path("out.exr")), "BB");
     EXPECT_EQ(listing(), std::vector<std::string>{"out.exr"});
 }
 
@@ -120,7 +107,7 @@ TEST_F(OutputFiles, AnOutputMayNotBeAnInputOrAnotherOutput) {
     expectError([&] { outputs.checkSeparate(path("x.png"), "--checkpoint"); },
                 {"--checkpoint", "is also the -o"});
     EXPECT_TRUE(fs::exists(path("scene.gltf")));
-    EXPECT_EQ(slurp(path("scene.gltf")), "{}");
+    EXPECT_EQ(test::readText(path("scene.gltf")), "{}");
 }
 
 // The outputs of one command appear together or not at all: if one cannot be moved into
@@ -139,7 +126,7 @@ TEST_F(OutputFiles, AGroupCommitsTogetherOrNotAtAll) {
         fs::create_directories(path("c.json/inside"));
         expectError([&] { outputs.commit(); }, {"c.json"});
     }
-    EXPECT_EQ(slurp(path("a.exr")), "previous a");
+    EXPECT_EQ(test::readText(path("a.exr")), "previous a");
     EXPECT_FALSE(fs::exists(path("b.png")));
     EXPECT_EQ(listing(), (std::vector<std::string>{"a.exr", "c.json"}));
 
@@ -148,8 +135,8 @@ TEST_F(OutputFiles, AGroupCommitsTogetherOrNotAtAll) {
     writeBytes(outputs.add(path("a.exr"), "-o").tmpPath(), "A", 1);
     writeBytes(outputs.add(path("b.png"), "PNG").tmpPath(), "B", 1);
     outputs.commit();
-    EXPECT_EQ(slurp(path("a.exr")), "A");
-    EXPECT_EQ(slurp(path("b.png")), "B");
+    EXPECT_EQ(test::readText(path("a.exr")), "A");
+    EXPECT_EQ(test::readText(path("b.png")), "B");
     EXPECT_EQ(listing(), (std::vector<std::string>{"a.exr", "b.png"}));
 }
 

@@ -14,7 +14,20 @@
 #include <string>
 #include <vector>
 
+#include "scene/gltf_loader.h"
+#include "util/error.h"
+
 namespace gdpt::test {
+
+// The error message of loading `path`, or "" if it loads.
+inline std::string loadError(const std::string& path) {
+    try {
+        (void)loadGltf(path);
+        return "";
+    } catch (const Error& e) {
+        return e.what();
+    }
+}
 
 constexpr int kFloat = 5126, kUInt = 5125, kUShort = 5123, kUByte = 5121;
 

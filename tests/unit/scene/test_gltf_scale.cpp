@@ -13,16 +13,6 @@ namespace {
 
 using test::TestGltf;
 
-// The error of loading `path`, or "" if it loads.
-std::string errorOf(const std::string& path) {
-    try {
-        (void)loadGltf(path);
-        return "";
-    } catch (const Error& e) {
-        return e.what();
-    }
-}
-
 // oneTriangle (1 unit across) under a root node scaled by `k`.
 TestGltf scaledTriangle(double k) {
     auto g = test::oneTriangle();
@@ -42,14 +32,14 @@ TEST(GltfScale, ScenesOutsideTheSupportedSizeAreRefusedWithTheRange) {
     const std::string dir = test::testDir();
     for (const double k : {1e-12, 1e-10}) {
         const std::string path = scaledTriangle(k).writeGltf(dir, "tiny");
-        const std::string msg = errorOf(path);
+        const std::string msg = test::loadError(path);
         EXPECT_NE(msg.find(path + ": the scene is "), std::string::npos) << msg;
         EXPECT_NE(msg.find("units across; gdpt renders scenes from 4.7e-10 to 2.1e+09 units across"),
                   std::string::npos)
             << msg;
     }
     const std::string path = scaledTriangle(1e10).writeGltf(dir, "huge");
-    const std::string msg = errorOf(path);
+    const std::string msg = test::loadError(path);
     EXPECT_NE(msg.find(path + ": mesh 'Tri' primitive 0: vertex 1 is at (1e+10, 0, 0) after the node "
                               "transform, outside the coordinates gdpt "
                               "renders (|x|, |y|, |z| <= 2.1e+09"),
@@ -75,7 +65,7 @@ TEST(GltfScale, OutOfRangePositionSaysWhatIsWrong) {
     TestGltf g;
     const int mesh = g.addMesh({g.primitive({{0, 0, 0}, {1e38f, 0, 0}, {0, 1, 0}}, {0, 1, 2})}, "Far");
     g.setScene({g.addNode({{"mesh", mesh}})});
-    std::string msg = errorOf(g.writeGltf(dir, "far"));
+    std::string msg = test::loadError(g.writeGltf(dir, "far"));
     EXPECT_NE(
         msg.find("mesh 'Far' primitive 0: vertex 1 is at (1e+38, 0, 0) after the node transform, outside "
                  "the coordinates gdpt renders"),
@@ -84,7 +74,7 @@ TEST(GltfScale, OutOfRangePositionSaysWhatIsWrong) {
     EXPECT_EQ(msg.find("not finite"), std::string::npos) << msg;
 
     g.doc["nodes"][0]["scale"] = {1e300, 1, 1};
-    msg = errorOf(g.writeGltf(dir, "overflow"));
+    msg = test::loadError(g.writeGltf(dir, "overflow"));
     EXPECT_NE(msg.find("mesh 'Far' primitive 0: vertex 1 overflows after the node transform"),
               std::string::npos)
         << msg;

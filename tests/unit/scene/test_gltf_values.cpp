@@ -15,16 +15,6 @@ namespace {
 
 using test::TestGltf;
 
-// The error of loading `path`, or "" if it loads.
-std::string errorOf(const std::string& path) {
-    try {
-        (void)loadGltf(path);
-        return "";
-    } catch (const Error& e) {
-        return e.what();
-    }
-}
-
 // oneTriangle with material `m` on its primitive.
 TestGltf withMaterial(const nlohmann::json& m) {
     auto g = test::oneTriangle();
@@ -72,7 +62,7 @@ TEST(GltfValues, FactorsOutsideTheirRangeAreRefusedNamingTheMaterial) {
         m["name"] = "Bad";
         auto g = withMaterial(m);
         const std::string path = g.writeGltf(dir, "mat");
-        const std::string msg = errorOf(path);
+        const std::string msg = test::loadError(path);
         EXPECT_NE(msg.find(path + ": material 'Bad': " + c.expected), std::string::npos)
             << c.material.dump() << " -> '" << msg << "'";
     }
@@ -111,7 +101,7 @@ TEST(GltfValues, NegativeLightColorOrIntensityIsRefusedNamingTheLight) {
         g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
         g.doc["scenes"][0]["nodes"].push_back(
             g.addNode({{"name", "Lamp"}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}}));
-        const std::string msg = errorOf(g.writeGltf(dir, "light"));
+        const std::string msg = test::loadError(g.writeGltf(dir, "light"));
         EXPECT_NE(msg.find("node 'Lamp': " + expected), std::string::npos) << msg;
     }
 }
