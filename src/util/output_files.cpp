@@ -155,9 +155,11 @@ OutputSet::~OutputSet() = default;
 
 void OutputSet::checkDistinct(const std::string& path, const std::string& what,
                               const std::vector<std::string>& allowedInputs) const {
-    for (const auto& [inWhat, inPath] : inputs_) {
-        const bool allowed = std::any_of(allowedInputs.begin(), allowedInputs.end(),
-                                         [&](const std::string& a) { return a == inPath; });
+    for (const auto& input : inputs_) {
+        const std::string& inWhat = input.first;
+        const std::string& inPath = input.second;
+        const bool allowed =
+            std::find(allowedInputs.begin(), allowedInputs.end(), inPath) != allowedInputs.end();
         if (!allowed && sameFile(path, inPath))
             throw Error(what + " " + path + " is the " + inWhat + " " + inPath +
                         ", which would be overwritten: choose another output path");
