@@ -38,7 +38,8 @@ bool decodeImage(tinygltf::Image* image, int imageIndex, std::string* err, std::
     // stored in a bufferView without checking them against the buffer (found by the
     // mutation test), so check here, before reading a byte. userData is the Model being
     // filled; its buffers and bufferViews are complete when images are decoded.
-    const auto* model = static_cast<const tinygltf::Model*>(userData);
+    auto* decode = static_cast<ImageDecodeContext*>(userData);
+    const tinygltf::Model* model = decode ? decode->model : nullptr;
     if (model != nullptr && image->bufferView >= 0) {
         const auto view = static_cast<std::size_t>(image->bufferView);
         if (view >= model->bufferViews.size()) return fail("bufferView out of range");
@@ -60,6 +61,13 @@ bool decodeImage(tinygltf::Image* image, int imageIndex, std::string* err, std::
         return fail("size " + std::to_string(w) + "x" + std::to_string(h) + " is out of range");
 
     const bool sixteen = stbi_is_16_bit_from_memory(bytes, size) != 0;
+    const std::uint64_t needed =
+        std::uint64_t(w) * std::uint64_t(h) * ((sixteen ? 8u : 4u) + sizeof(glm::vec4));
+    if (decode && needed > decode->bytesLeft)
+        return fail("its " + std::to_string(w) + "x" + std::to_string(h) + " pixels need " +
+                    std::to_string(needed >> 20) + " MiB decoded, more than the " +
+                    std::to_string(decode->bytesLeft >> 20) + " MiB of the memory budget left for images");
+    if (decode) decode->bytesLeft -= needed;
     void* pixels = sixteen ? static_cast<void*>(stbi_load_16_from_memory(bytes, size, &w, &h, &comp, 4))
                            : static_cast<void*>(stbi_load_from_memory(bytes, size, &w, &h, &comp, 4));
     if (pixels == nullptr)

@@ -101,8 +101,18 @@ void addMeshInstance(Context& ctx, const MeshInstance& inst, bool sceneHasNormal
 void convertMaterials(Context& ctx);
 std::uint32_t materialIndex(Context& ctx, int material);
 
+// What decodeImage gets as its userData: the tinygltf::Model being loaded (to bounds-check
+// bufferView images) and the memory left for images. A decoded image costs its 8- or 16-bit
+// RGBA pixels plus the linear float texture made from them (imageToTexture); an image that
+// does not fit is refused from its header, before it is decoded (a few KB of PNG can
+// announce 2^28 pixels: 5 GiB).
+struct ImageDecodeContext {
+    const tinygltf::Model* model = nullptr;
+    std::uint64_t bytesLeft = ~std::uint64_t{0};
+};
+
 // Decodes PNG/JPEG bytes for tinygltf (gltf_images.cpp); registered with SetImageLoader
-// with userData = the tinygltf::Model being loaded (used to bounds-check bufferView images).
+// with userData = an ImageDecodeContext.
 bool decodeImage(tinygltf::Image* image, int imageIndex, std::string* err, std::string* warn, int reqWidth,
                  int reqHeight, const unsigned char* bytes, int size, void* userData);
 

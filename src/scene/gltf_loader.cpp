@@ -375,7 +375,12 @@ Scene loadImpl(const std::string& path, const LoadOptions& opts) {
 
     tinygltf::Model model;
     tinygltf::TinyGLTF parser;
-    parser.SetImageLoader(&gltf::decodeImage, &model);  // model: see decodeImage
+    // Images get the memory budget that the geometry leaves (see ImageDecodeContext).
+    const std::uint64_t budget = opts.memoryBudget != 0 ? opts.memoryBudget : physicalMemory();
+    gltf::ImageDecodeContext imageDecode{&model, budget == 0               ? ~std::uint64_t{0}
+                                                 : budget > estimate.bytes ? budget - estimate.bytes
+                                                                           : 0};
+    parser.SetImageLoader(&gltf::decodeImage, &imageDecode);
     parser.SetFsCallbacks({&tinygltf::FileExists, &tinygltf::ExpandFilePath, &readExternalFile,
                            &tinygltf::WriteWholeFile, nullptr});
     std::string err, warn;

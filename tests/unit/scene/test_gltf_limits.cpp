@@ -5,6 +5,7 @@
 // grow by only kHeadroom (bounded_child.h): a loader that allocates before it checks fails
 // there with "out of memory" (or crashes) instead of passing slowly.
 #include <gtest/gtest.h>
+#include <stb/stb_image_write.h>
 
 #include <string>
 
@@ -144,6 +145,48 @@ TEST(GltfLimits, InstancedSceneBeyondMemoryIsRefusedBeforeLoading) {
     expectCheapRefusal(g.writeGltf(test::testDir(), "instanced"),
                        {"loading the scene (274877382656 triangles", "after instancing) needs about",
                         "more than the memory budget"});
+}
+
+// Class: memory spent before the checks, for textures. A 70 KB PNG of 8192x4096 pixels decodes
+// to 128 MiB of RGBA and 512 MiB of float texels; with a 64 MiB budget it is refused from its
+// header, before anything is decoded (the child could not map the 640 MiB otherwise).
+TEST(GltfLimits, TextureBeyondTheMemoryBudgetIsRefusedBeforeDecoding) {
+    const int w = 8192, h = 4096;
+    std::vector<unsigned char> gray(std::size_t(w) * h, 0);
+    for (int x = 0; x < w; ++x) gray[std::size_t(x)] = static_cast<unsigned char>(x);  // one row of detail
+    std::vector<unsigned char> png;
+    stbi_write_png_to_func(
+        [](void* ctx, void* data, int size) {
+            auto* v = static_cast<std::vector<unsigned char>*>(ctx);
+            v->insert(v->end(), static_cast<unsigned char*>(data), static_cast<unsigned char*>(data) + size);
+        },
+        &png, w, h, 1, gray.data(), w);
+    gray = {};
+    ASSERT_LT(png.size(), 1u << 20);
+    auto g = test::oneTriangle();
+    g.doc["images"] = nlohmann::json::array(
+        {{{"bufferView", g.addView(png.data(), png.size())}, {"mimeType", "image/png"}}});
+    g.doc["textures"] = nlohmann::json::array({{{"source", 0}}});
+    g.addMaterial({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+    g.doc["meshes"][0]["primitives"][0]["material"] = 0;
+    const std::string path = g.writeGltf(test::testDir(), "bigtexture");
+    const auto load = [&](std::uint64_t budget) {
+        LoadOptions opts;
+        opts.memoryBudget = budget;
+        try {
+            (void)loadGltf(path, opts);
+            return std::string("loaded");
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+    };
+    const test::ChildResult r = test::runBounded([&] { return load(64ull << 20); }, kHeadroom, kTimeout);
+    ASSERT_TRUE(r.exited) << "signal " << r.signal << ": " << r.output;
+    EXPECT_NE(r.output.find("image 0"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("8192x4096 pixels need 640 MiB decoded"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("memory budget"), std::string::npos) << r.output;
+    // Power: with room for it, the same file loads.
+    EXPECT_EQ(load(1ull << 30), "loaded");
 }
 
 // Class: byteStride silently ignored. glTF 2.0 §5.11.4 allows 4..252, a multiple of 4;
