@@ -1,6 +1,8 @@
 // render_command.cpp — `gdpt render SCENE`: parses the options, makes the integrator of
 // --method, renders, and writes the EXR (every layer), the PNG preview and the JSON summary.
 // Time budgets, checkpoints and interrupts are handled here; the method is the integrator's.
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <memory>
@@ -102,6 +104,21 @@ RenderOptions renderOptionsFor(const RenderArgs& args) {
     return o;
 }
 
+// Peak memory: the process's resident set (getrusage) and gdpt's device allocations; per
+// megapixel of the image, which is how they grow (fixed costs, e.g. the scene, included).
+json memoryJson(const vk::Context& ctx, int width, int height) {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    const double host = double(usage.ru_maxrss) * 1024.0;  // Linux reports KiB
+    const double device = double(ctx.deviceBytesPeak());
+    const double megapixels = double(width) * double(height) * 1e-6;
+    return {{"host_peak_bytes", host},
+            {"device_peak_bytes", device},
+            {"megapixels", megapixels},
+            {"host_peak_bytes_per_megapixel", host / megapixels},
+            {"device_peak_bytes_per_megapixel", device / megapixels}};
+}
+
 json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrator& integrator,
                  const RenderStats& s, double seconds, double reserved, double finishReserved,
                  double writeMs) {
@@ -137,7 +154,8 @@ json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrato
               {"rays_per_s", double(s.raysTraced) / (s.samplingMs * 1e-3)},
               {"samples_per_s", double(s.pathsCompleted) / (s.samplingMs * 1e-3)},
               {"kernels", kernelJson(s.kernels, s.samplingMs)},
-              {"validation_errors", ctx.validationErrors()}};
+              {"validation_errors", ctx.validationErrors()},
+              {"memory", memoryJson(ctx, args.width, args.height)}};
     integrator.describe(j, s);
     j["emitter_supersampling"] = {{"factor", s.emitterSupersampling},
                                   {"rays_per_sample", s.emitterRaysPerSample},

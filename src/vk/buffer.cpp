@@ -46,8 +46,11 @@ Buffer::Buffer(const Context& ctx, std::uint64_t bytes, const std::string& name)
         throw Error("out of device memory allocating buffer '" + name + "' (" + std::to_string(size_ >> 20) +
                     " MiB)");
     VK_CHECK(r);
-    memory_ =
-        Handle<VkDeviceMemory>(memory, [device](VkDeviceMemory m) { vkFreeMemory(device, m, nullptr); });
+    ctx.noteAllocation(req.size);
+    memory_ = Handle<VkDeviceMemory>(memory, [device, ctxp = &ctx, bytes = req.size](VkDeviceMemory m) {
+        vkFreeMemory(device, m, nullptr);
+        ctxp->noteFree(bytes);
+    });
     VK_CHECK(vkBindBufferMemory(device, buffer, memory, 0));
     buffer_ = std::move(bufferOwner);
     if ((flags & kMappable) == kMappable)
@@ -107,7 +110,11 @@ void Buffer::stagedCopy(void* hostData, std::uint64_t bytes, std::uint64_t offse
         alloc.memoryTypeIndex = ctx_->findMemoryType(req.memoryTypeBits, kMappable);
         VkDeviceMemory m = VK_NULL_HANDLE;
         VK_CHECK(vkAllocateMemory(device, &alloc, nullptr, &m));
-        Handle<VkDeviceMemory> mem(m, [device](VkDeviceMemory x) { vkFreeMemory(device, x, nullptr); });
+        ctx_->noteAllocation(req.size);
+        Handle<VkDeviceMemory> mem(m, [device, ctxp = ctx_, bytes = req.size](VkDeviceMemory x) {
+            vkFreeMemory(device, x, nullptr);
+            ctxp->noteFree(bytes);
+        });
         VK_CHECK(vkBindBufferMemory(device, b, m, 0));
         VK_CHECK(vkMapMemory(device, m, 0, VK_WHOLE_SIZE, 0, &staging.mapped_));
         // Keep the memory alive as long as the buffer: destroy order buffer -> memory.

@@ -341,4 +341,15 @@ void Context::checkTexelBufferSize(std::uint64_t texels, const std::string& what
                     "'; use a smaller scene");
 }
 
+void Context::noteAllocation(std::uint64_t bytes) const {
+    const std::uint64_t now = deviceBytesNow_.fetch_add(bytes) + bytes;
+    std::uint64_t peak = deviceBytesPeak_.load();
+    while (now > peak && !deviceBytesPeak_.compare_exchange_weak(peak, now)) {
+    }
+}
+
+void Context::noteFree(std::uint64_t bytes) const {
+    deviceBytesNow_.fetch_sub(bytes);
+}
+
 }  // namespace gdpt::vk

@@ -79,6 +79,13 @@ public:
     // Debug name shown by validation messages and tools (no-op without debug utils).
     void setName(VkObjectType type, std::uint64_t handle, const std::string& name) const;
 
+    // Device memory held by gdpt's allocations (every vkAllocateMemory goes through
+    // vk::Buffer, which reports here): now, and the most at any time since the context was made.
+    [[nodiscard]] std::uint64_t deviceBytesNow() const { return deviceBytesNow_.load(); }
+    [[nodiscard]] std::uint64_t deviceBytesPeak() const { return deviceBytesPeak_.load(); }
+    void noteAllocation(std::uint64_t bytes) const;
+    void noteFree(std::uint64_t bytes) const;
+
     // Throws gdpt::Error naming the limit if a single storage buffer of `bytes` bytes
     // (what: "triangle geometry") exceeds the device's maxStorageBufferRange.
     void checkStorageBufferSize(std::uint64_t bytes, const std::string& what) const;
@@ -97,6 +104,8 @@ private:
     bool validation_ = false;
     bool printValidation_ = true;
     std::atomic<std::uint32_t> validationErrors_{0};
+    mutable std::atomic<std::uint64_t> deviceBytesNow_{0};
+    mutable std::atomic<std::uint64_t> deviceBytesPeak_{0};
     Handle<VkInstance> instance_;
     Handle<VkDebugUtilsMessengerEXT> messenger_;
     VkPhysicalDevice physical_ = VK_NULL_HANDLE;
