@@ -21,11 +21,20 @@ struct PixelBuffer {
     std::uint64_t bytesPerPixel;
 };
 
+struct Extent {
+    std::uint32_t width = 0, height = 0;
+};
+
+// The largest image with the aspect ratio of width x height (as near as whole pixels allow)
+// that has at most maxPixels pixels; width x height itself if it fits.
+[[nodiscard]] Extent largestFittingImage(std::uint32_t width, std::uint32_t height, std::uint64_t maxPixels);
+
 // Throws gdpt::Error for the first buffer of a width x height image that exceeds
 // maxStorageBufferRange (the kernels bind each whole) or maxMemoryAllocationSize (each is
 // one allocation). The heap is not checked: the per-buffer limits bind first on the
 // devices seen (lavapipe: 128 MiB per buffer, a 2 GiB heap it overcommits), and a sum would
-// have to include the Poisson solver's fields and the scene to mean anything.
+// have to include the Poisson solver's fields and the scene to mean anything. The message
+// names the largest image of the same shape that every buffer allows.
 void checkPixelBuffers(const vk::Context& ctx, std::uint32_t width, std::uint32_t height,
                        const std::vector<PixelBuffer>& buffers);
 

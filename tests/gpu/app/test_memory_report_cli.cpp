@@ -17,9 +17,9 @@ class MemoryReportCli : public test::TempDirTest {
 protected:
     nlohmann::json memoryAt(int size) {
         const std::string s = std::to_string(size);
-        const test::RunResult r = test::runGdpt("render " + kScene + " --method pt --spp 1 --quiet --width " + s +
-                                                " --height " + s + " -o " + path("m.exr") + " --json " +
-                                                path("m.json"));
+        const test::RunResult r =
+            test::runGdpt("render " + kScene + " --method pt --spp 1 --quiet --width " + s + " --height " +
+                          s + " -o " + path("m.exr") + " --json " + path("m.json"));
         EXPECT_EQ(r.code, 0) << r.output;
         return nlohmann::json::parse(test::readText(path("m.json"))).at("memory");
     }
