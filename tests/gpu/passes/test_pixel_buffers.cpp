@@ -30,7 +30,8 @@ std::uint64_t bestByBruteForce(std::uint32_t width, std::uint32_t height, std::u
 }
 
 TEST(PixelBuffers, LargestFittingImageKeepsTheShapeAndIsNearlyTheLargest) {
-    const std::uint32_t shapes[][2] = {{1920, 1080}, {3840, 2160}, {1000, 1}, {1, 777}, {4096, 4096}, {333, 1000}};
+    const std::uint32_t shapes[][2] = {{1920, 1080}, {3840, 2160}, {1000, 1},
+                                       {1, 777},     {4096, 4096}, {333, 1000}};
     for (const auto& s : shapes)
         for (std::uint64_t maxPixels : {1ull, 1000ull, 123457ull, 1ull << 20, 5000000ull}) {
             const Extent e = largestFittingImage(s[0], s[1], maxPixels);
@@ -47,13 +48,13 @@ TEST(PixelBuffers, LargestFittingImageKeepsTheShapeAndIsNearlyTheLargest) {
             // ratio give (whole pixels, and the shrinking, move it by that much at most).
             const double heightError = std::abs(double(e.width) * s[1] / s[0] - double(e.height));
             const double widthError = std::abs(double(e.height) * s[0] / s[1] - double(e.width));
-            EXPECT_LE(std::min(heightError, widthError), 2.0) << s[0] << "x" << s[1] << " -> " << e.width << "x"
-                                                              << e.height;
+            EXPECT_LE(std::min(heightError, widthError), 2.0)
+                << s[0] << "x" << s[1] << " -> " << e.width << "x" << e.height;
             // Nearly the largest: within 1 % of the brute-force best of the same shape (or a
             // few pixels for tiny budgets).
             const std::uint64_t best = bestByBruteForce(s[0], s[1], maxPixels);
-            EXPECT_GE(double(got) + 2.0 * (e.width + e.height), double(best)) << s[0] << "x" << s[1] << " max "
-                                                                             << maxPixels;
+            EXPECT_GE(double(got) + 2.0 * (e.width + e.height), double(best))
+                << s[0] << "x" << s[1] << " max " << maxPixels;
         }
 }
 
@@ -62,14 +63,15 @@ TEST(PixelBuffers, LargestFittingImageKeepsTheShapeAndIsNearlyTheLargest) {
 TEST(PixelBuffers, TheAdvisedSizeRenders) {
     const std::string scene = std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.gltf";
     const std::string out = ::testing::TempDir() + "gdpt_advised.exr";
-    const test::RunResult refused = test::runGdpt("render " + scene +
-                                                  " --method gpt --width 1920 --height 1080 --spp 1 --quiet -o " + out);
+    const test::RunResult refused = test::runGdpt(
+        "render " + scene + " --method gpt --width 1920 --height 1080 --spp 1 --quiet -o " + out);
     if (refused.code == 0) GTEST_SKIP() << "this device holds a 1080p G-PT render";
     ASSERT_EQ(refused.code, 1) << refused.output;
-    const std::size_t at = refused.output.find("image that fits is ");
+    const std::string advice = "image of this shape that fits is ";
+    const std::size_t at = refused.output.find(advice);
     ASSERT_NE(at, std::string::npos) << refused.output;
     unsigned w = 0, h = 0;
-    ASSERT_EQ(std::sscanf(refused.output.c_str() + at + 19, "%ux%u", &w, &h), 2) << refused.output;
+    ASSERT_EQ(std::sscanf(refused.output.c_str() + at + advice.size(), "%ux%u", &w, &h), 2) << refused.output;
     EXPECT_NEAR(double(w) / h, 1920.0 / 1080.0, 0.01);
     const test::RunResult advised =
         test::runGdpt("render " + scene + " --method gpt --width " + std::to_string(w) + " --height " +
