@@ -44,7 +44,8 @@ Scene benchScene(const std::string& name) {
 
 int runBench(const BenchArgs& a) {
     using nlohmann::json;
-    TextOutput output(a.output);
+    OutputSet outputs;
+    const TextOutput output(outputs, a.output, "-o");
     vk::ContextOptions co;
     co.device = a.device;
     vk::Context ctx(co);
@@ -123,6 +124,7 @@ int runBench(const BenchArgs& a) {
                                  {"pt_kernels", kernels}});
     }
     output.write(out.dump(2) + "\n");
+    outputs.commit();
     return 0;
 }
 

@@ -91,7 +91,8 @@ int runBenchFeatures(const BenchFeaturesArgs& a) {
     using nlohmann::json;
     const std::vector<std::string> methods = splitList(a.methods);
     for (const std::string& m : methods) (void)makeIntegrator(m);  // unknown names fail first
-    TextOutput output(a.output);
+    OutputSet outputs;
+    const TextOutput output(outputs, a.output, "-o");
     vk::ContextOptions co;
     co.device = a.device;
     vk::Context ctx(co);
@@ -143,6 +144,7 @@ int runBenchFeatures(const BenchFeaturesArgs& a) {
         }
     }
     output.write(out.dump(2) + "\n");
+    outputs.commit();
     return 0;
 }
 

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
-#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -32,23 +31,24 @@ inline std::vector<std::string> splitList(const std::string& text) {
     return out;
 }
 
-// A command's text output: stdout for "-", else a file staged when the command starts (so
-// that a bad path fails before the work; util/output_files.h) and written whole at the end.
+// A command's text output (-o, --json): stdout for "-", nothing for "", else a file staged in
+// `outputs` when the command starts (so that a bad path, or one that is an input, fails
+// before the work; util/output_files.h) and moved into place when `outputs` commits.
 class TextOutput {
 public:
-    explicit TextOutput(const std::string& path)
-        : file_(path == "-" ? nullptr : std::make_unique<StagedFile>(path)) {}
-    void write(const std::string& text) {
-        if (!file_) {
+    TextOutput(OutputSet& outputs, const std::string& path, const std::string& what)
+        : toStdout_(path == "-"), file_(path.empty() || path == "-" ? nullptr : &outputs.add(path, what)) {}
+    [[nodiscard]] bool wanted() const { return toStdout_ || file_ != nullptr; }
+    void write(const std::string& text) const {
+        if (file_)
+            writeStagedText(*file_, text);
+        else if (toStdout_)
             std::fputs(text.c_str(), stdout);
-            return;
-        }
-        writeStagedText(*file_, text);
-        file_->commit();
     }
 
 private:
-    std::unique_ptr<StagedFile> file_;
+    bool toStdout_;
+    const StagedFile* file_;
 };
 
 }  // namespace gdpt

@@ -55,8 +55,7 @@ glm::vec3 parseColor(const std::string& text, const std::string& flag) {
 
 int runDiff(const DiffArgs& args) {
     OutputSet outputs({{"test image", args.test}, {"reference", args.reference}});
-    const StagedFile* jsonFile =
-        args.json.empty() || args.json == "-" ? nullptr : &outputs.add(args.json, "--json");
+    const TextOutput jsonOutput(outputs, args.json, "--json");
     const Image test = readExrLayer(args.test);
     const Image reference = readExrLayer(args.reference);
     const auto size = [](const Image& im) {
@@ -89,13 +88,8 @@ int runDiff(const DiffArgs& args) {
               {"mean_reference", e.meanReference},
               {"finite_pixels", e.finitePixels},
               {"nonfinite_pixels", e.nonFinitePixels}};
-    const std::string text = j.dump(2) + "\n";
-    if (jsonFile) {
-        writeStagedText(*jsonFile, text);
-        outputs.commit();
-    } else if (args.json == "-") {
-        std::fputs(text.c_str(), stdout);
-    }
+    jsonOutput.write(j.dump(2) + "\n");
+    outputs.commit();
     if (args.json != "-")
         std::printf("relMSE %.6g  MSE %.6g  MAE %.6g  max %.6g  bias %.3g  (%zu pixels, %zu non-finite)\n",
                     e.relMse, e.mse, e.mae, e.maxAbsError, e.meanBias, e.finitePixels, e.nonFinitePixels);

@@ -20,6 +20,7 @@
 #include "app/subcommand.h"
 #include "image/atomic_write.h"
 #include "image/exr_io.h"
+#include "image/finite_check.h"
 #include "image/metrics.h"
 #include "integrator/integrator.h"
 #include "integrator/pt_sampler.h"
@@ -210,12 +211,10 @@ bool writePlot(const ConvergeOutputs& out, const std::vector<std::string>& metho
     return drawn;
 }
 
-// Refuses a reference that cannot measure an error: no finite pixel (e.g. all NaN).
+// Refuses a reference that cannot measure an error: no pixel finite in every channel (the
+// metrics leave such pixels out, metrics.h), e.g. all NaN.
 void checkReference(const Image& reference, const std::string& name) {
-    std::size_t finite = 0;
-    for (int c = 0; c < 3; ++c)
-        for (float v : reference.plane(c)) finite += std::isfinite(v) ? 1 : 0;
-    if (finite == 0)
+    if (scanNonFinite(reference).all())
         throw Error(name + ": the reference has no finite pixel value: no error can be measured");
 }
 

@@ -187,8 +187,7 @@ int runRender(const RenderArgs& args) {
     OutputSet outputs({{"scene", args.scene}, {"--resume checkpoint", args.resume}});
     const StagedFile& exrFile = outputs.add(args.output, "-o");
     const StagedFile& pngFile = outputs.add(previewPath(args.output), "PNG preview of -o");
-    const StagedFile* jsonFile =
-        args.json.empty() || args.json == "-" ? nullptr : &outputs.add(args.json, "--json");
+    const TextOutput jsonOutput(outputs, args.json, "--json");
     // A checkpoint is written on its own schedule; it may continue the one resumed from.
     if (!args.checkpoint.empty()) outputs.checkSeparate(args.checkpoint, "--checkpoint", {args.resume});
 
@@ -277,13 +276,10 @@ int runRender(const RenderArgs& args) {
     const double writeMs = writeTimer.ms();
     const double seconds = total.seconds();
     if (args.profile) printProfile(s.kernels);
-    if (!args.json.empty()) {
-        const std::string text =
-            summaryJson(args, ctx, *integrator, s, seconds, reserved, finishReserved, writeMs).dump(2) + "\n";
-        if (jsonFile)
-            writeStagedText(*jsonFile, text);
-        else
-            std::fputs(text.c_str(), stdout);
+    if (jsonOutput.wanted()) {
+        jsonOutput.write(
+            summaryJson(args, ctx, *integrator, s, seconds, reserved, finishReserved, writeMs).dump(2) +
+            "\n");
         throwIfInterrupted("writing");
     }
     outputs.commit();

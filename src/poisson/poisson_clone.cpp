@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "image/finite_check.h"
 #include "util/error.h"
 
 namespace gdpt {
@@ -17,9 +18,7 @@ Image seamlessClone(const vk::Context& ctx, const Image& source, const Image& ta
                     std::to_string(source.height()));
     if (target.empty() || source.empty()) throw Error("clone: empty source or target image");
     // The target is copied outside the mask and is the boundary inside: it must be finite.
-    for (int c = 0; c < 3; ++c)
-        for (float v : target.plane(c))
-            if (!std::isfinite(v)) throw Error("clone: the target has NaN or infinite values");
+    if (scanNonFinite(target).any()) throw Error("clone: the target has NaN or infinite values");
     const int w = target.width(), h = target.height();
     const std::size_t n = target.pixelCount();
     // Ω in target coordinates.

@@ -329,13 +329,18 @@ SceneEstimate precheck(const std::vector<unsigned char>& jsonBytes) {
     return gltf::precheckJson(jsonText(jsonBytes, isGlb(jsonBytes))).value_or(SceneEstimate{});
 }
 
+// LoadOptions::memoryBudget, else the machine's memory (0 if unknown).
+std::uint64_t memoryBudget(const LoadOptions& opts) {
+    return opts.memoryBudget != 0 ? opts.memoryBudget : physicalMemory();
+}
+
 // Refuses a scene beyond the loader's limits or the caller's (LoadOptions::checkEstimate).
 void refuseBeyondLimits(const SceneEstimate& e, const LoadOptions& opts) {
     if (e.vertices > gltf::kMaxSceneVertices)
         throw Error("the scene has " + std::to_string(e.vertices) +
                     " vertices after instancing, more than the limit " +
                     std::to_string(gltf::kMaxSceneVertices));
-    const std::uint64_t budget = opts.memoryBudget != 0 ? opts.memoryBudget : physicalMemory();
+    const std::uint64_t budget = memoryBudget(opts);
     if (budget != 0 && e.bytes > budget)
         throw Error("loading the scene (" + std::to_string(e.triangles) + " triangles, " +
                     std::to_string(e.vertices) + " vertices after instancing) needs about " +
@@ -376,7 +381,7 @@ Scene loadImpl(const std::string& path, const LoadOptions& opts) {
     tinygltf::Model model;
     tinygltf::TinyGLTF parser;
     // Images get the memory budget that the geometry leaves (see ImageDecodeContext).
-    const std::uint64_t budget = opts.memoryBudget != 0 ? opts.memoryBudget : physicalMemory();
+    const std::uint64_t budget = memoryBudget(opts);
     gltf::ImageDecodeContext imageDecode{&model, budget == 0               ? ~std::uint64_t{0}
                                                  : budget > estimate.bytes ? budget - estimate.bytes
                                                                            : 0};
