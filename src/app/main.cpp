@@ -7,10 +7,13 @@
 #include <vector>
 
 #include "app/subcommand.h"
+#include "distributed/mpi_world.h"
 #include "util/error.h"
 #include "util/interrupt.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
     using namespace gdpt;
     CLI::App app{"gdpt — headless gradient-domain path tracer (GLSL compute over Vulkan; lavapipe first)"};
     app.require_subcommand(1);
@@ -20,7 +23,7 @@ int main(int argc, char** argv) {
         addRenderCommand(app),        addDiffCommand(app),  addInfoCommand(app),
         addDevicesCommand(app),       addBenchCommand(app), addConvergeCommand(app),
         addSolveCommand(app),         addCloneCommand(app), addBenchPoissonCommand(app),
-        addBenchFeaturesCommand(app),
+        addBenchFeaturesCommand(app), addMergeCommand(app),
     };
 
     try {
@@ -50,4 +53,12 @@ int main(int argc, char** argv) {
         return 1;
     }
     return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    // Under mpirun, every rank runs the same command (distributed/mpi_world.h).
+    gdpt::MpiWorld::start(&argc, &argv);
+    return gdpt::MpiWorld::finish(run(argc, argv));
 }

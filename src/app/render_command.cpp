@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -14,6 +15,8 @@
 #include "app/commands.h"
 #include "app/input_file.h"
 #include "app/subcommand.h"
+#include "distributed/mpi_world.h"
+#include "distributed/shards.h"
 #include "image/atomic_write.h"
 #include "image/exr_io.h"
 #include "image/finite_check.h"
@@ -35,6 +38,12 @@ namespace gdpt {
 namespace {
 
 using nlohmann::json;
+
+std::string absolutePath(const std::string& path) {
+    std::error_code ec;
+    const std::filesystem::path p = std::filesystem::absolute(path, ec);
+    return ec ? path : p.lexically_normal().string();
+}
 
 std::string previewPath(const std::string& exrPath) {
     const auto dot = exrPath.rfind('.');
@@ -156,6 +165,11 @@ json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrato
               {"kernels", kernelJson(s.kernels, s.samplingMs)},
               {"validation_errors", ctx.validationErrors()},
               {"memory", memoryJson(ctx, args.width, args.height)}};
+    if (s.distributed.parts > 1)
+        j["distributed"] = {{"parts", s.distributed.parts},
+                            {"part_spp", s.distributed.partSpp},
+                            {"bytes_per_part", s.distributed.bytesPerPart},
+                            {"merge_s", s.distributed.mergeMs * 1e-3}};
     integrator.describe(j, s);
     j["emitter_supersampling"] = {{"factor", s.emitterSupersampling},
                                   {"rays_per_sample", s.emitterRaysPerSample},
@@ -174,78 +188,190 @@ void checkArgs(const RenderArgs& args) {
 
 }  // namespace
 
-int runRender(const RenderArgs& args) {
+std::string renderArgsJson(const RenderArgs& a) {
+    const json j = {{"method", a.method},
+                    {"width", a.width},
+                    {"height", a.height},
+                    {"camera", a.camera},
+                    {"env", a.env},
+                    {"spp", a.spp},
+                    {"time", a.time},
+                    {"seed", a.seed},
+                    {"max_depth", a.maxDepth},
+                    {"emitter_supersampling", a.emitterSupersampling},
+                    {"shift_threshold", a.shiftThreshold},
+                    {"edge_samples", a.edgeSamples},
+                    {"demodulate", a.demodulate},
+                    {"split_bounce", a.splitBounce},
+                    {"recon", a.recon},
+                    {"all_recon", a.allRecon},
+                    {"alpha", a.alpha},
+                    {"tolerance", a.tolerance},
+                    {"workgroup", a.workgroup}};
+    return j.dump();
+}
+
+RenderArgs renderArgsFromJson(const std::string& text, const std::string& where) {
+    RenderArgs a;
+    try {
+        const json j = json::parse(text);
+        a.method = j.at("method").get<std::string>();
+        a.width = j.at("width").get<int>();
+        a.height = j.at("height").get<int>();
+        a.camera = j.at("camera").get<int>();
+        a.env = j.at("env").get<std::string>();
+        a.spp = j.at("spp").get<std::uint32_t>();
+        a.time = j.at("time").get<double>();
+        a.seed = j.at("seed").get<std::uint32_t>();
+        a.maxDepth = j.at("max_depth").get<std::uint32_t>();
+        a.emitterSupersampling = j.at("emitter_supersampling").get<std::uint32_t>();
+        a.shiftThreshold = j.at("shift_threshold").get<float>();
+        a.edgeSamples = j.at("edge_samples").get<std::uint32_t>();
+        a.demodulate = j.at("demodulate").get<std::string>();
+        a.splitBounce = j.at("split_bounce").get<std::string>();
+        a.recon = j.at("recon").get<std::string>();
+        a.allRecon = j.at("all_recon").get<bool>();
+        a.alpha = j.at("alpha").get<double>();
+        a.tolerance = j.at("tolerance").get<double>();
+        a.workgroup = j.at("workgroup").get<std::string>();
+    } catch (const json::exception& e) {
+        throw Error(where + ": the render's settings (gdpt.info.render_args) cannot be read: " + e.what());
+    }
+    return a;
+}
+
+int runRender(const RenderArgs& args, const MergedShards* merged) {
     installInterruptHandlers();
     checkArgs(args);
     Timer total;
     RenderOptions options = renderOptionsFor(args);
     const ReconTimeCache cache(ReconTimeCache::defaultPath());
 
+    // A render split across processes: the ranks of mpirun (distributed/mpi_world.h), or a
+    // shard run as a job of its own (distributed/shards.h).
+    MpiWorld* world = MpiWorld::get();
+    const bool shard = !args.shard.empty();
+    if (shard) options.share = parseSampleShare(args.shard, "--shard");
+    if (world) {
+        if (shard) throw UsageError("--shard splits a render into independent jobs; under mpirun the ranks split it");
+        if (!args.checkpoint.empty() || !args.resume.empty())
+            throw UsageError("--checkpoint and --resume are per process: under mpirun with " +
+                             std::to_string(world->size()) +
+                             " ranks, render shards instead (--shard I/N, each with its own checkpoint)");
+        options.share = world->share();
+    }
+    if (options.share.split() && args.time <= 0.0 && args.spp < options.share.count)
+        throw UsageError("--spp " + std::to_string(args.spp) + " cannot be split into " +
+                         std::to_string(options.share.count) + " parts: every part takes at least one sample "
+                         "per pixel");
+    // Only rank 0 of mpirun writes, reports progress and finishes the render.
+    const bool writes = !world || world->root();
+    if (!writes) options.quiet = options.scene.quiet = true;
+    const bool quiet = options.quiet;
+
     // Every output is checked (and its temporary file created) before the scene is loaded,
     // so that a long render never fails at the end on a bad path, and no output may
     // overwrite an input or another output. They are committed together at the end.
     OutputSet outputs({{"scene", args.scene}, {"--resume checkpoint", args.resume}});
-    const StagedFile& exrFile = outputs.add(args.output, "-o");
-    const StagedFile& pngFile = outputs.add(previewPath(args.output), "PNG preview of -o");
-    const TextOutput jsonOutput(outputs, args.json, "--json");
+    const StagedFile* exrFile = writes ? &outputs.add(args.output, shard ? "-o (the shard)" : "-o") : nullptr;
+    const StagedFile* pngFile = writes && !shard ? &outputs.add(previewPath(args.output), "PNG preview of -o") : nullptr;
+    const TextOutput jsonOutput(outputs, writes ? args.json : "", "--json");
     // A checkpoint is written on its own schedule; it may continue the one resumed from.
     if (!args.checkpoint.empty()) outputs.checkSeparate(args.checkpoint, "--checkpoint", {args.resume});
 
-    enterPhase("loading");
-    const Scene scene = loadGltf(args.scene, deviceLoadOptions(args.device, args.quiet));
-    throwIfInterrupted("loading");
-    if (!scene.unsupported.empty() && !args.quiet) {
-        std::string list;
-        for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
-        std::fprintf(stderr, "gdpt: warning: %s: not rendered: %s\n", args.scene.c_str(), list.c_str());
-    }
-    if (const auto black = blackImageWarning(scene, options.scene.envRadiance); black && !args.quiet)
-        std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
-    vk::ContextOptions ctxOptions;
-    ctxOptions.device = args.device;
-    ctxOptions.validation = args.validate;
-    vk::Context ctx(ctxOptions);
-    if (!args.quiet)
-        std::fprintf(stderr, "gdpt: device '%s' (%s, %s)\n", ctx.info().name.c_str(), ctx.info().type.c_str(),
-                     ctx.info().driverInfo.c_str());
-    // After the context: the integrator's device objects (G-PT's solver) go before it.
-    const std::unique_ptr<Integrator> integrator = integratorFor(args, &cache);
-
-    // --time covers the whole render: sampling stops early by what the method needs after it
-    // (G-PT: the reconstructions) and by what the rest took the last time for this device,
-    // method, size and settings (readback, output layers, EXR + PNG; nothing the first time).
-    const bool timed = args.time > 0.0;
-    const double reserved = timed ? integrator->reserveAfterSampling(ctx, args.width, args.height) : 0.0;
-    const std::string finishKey =
-        "finish|" + reservationKey(ctx, args.width, args.height) + "|" + args.method +
-        (args.method == "gpt" ? "|" + std::to_string(args.allRecon ? 4 : 1) + " solves" : "");
-    const double finishReserved = timed ? cache.get(finishKey).value_or(0.0) : 0.0;
-    if (timed) options.timeBudget = std::max(0.05 * args.time, args.time - reserved - finishReserved);
-    options.elapsedBefore = total.seconds();
-
-    // Checkpoints: the identity of this render is recorded in every checkpoint written, and a
-    // checkpoint resumed from must have the same (render_identity.h).
-    const ExrAttributes identity = renderIdentity(*integrator, scene, options);
+    std::optional<Scene> loaded;
+    std::optional<vk::Context> context;
+    std::unique_ptr<Integrator> integrator;
     std::optional<Checkpoint> resumed;
-    if (!args.resume.empty()) {
-        resumed = readCheckpoint(args.resume);
-        checkIdentity(args.resume, resumed->identity, identity);
-        if (!timed && resumed->state.spp > args.spp)
-            throw Error(args.resume + ": checkpoint already has " + std::to_string(resumed->state.spp) +
-                        " spp, more than --spp " + std::to_string(args.spp));
-        if (!args.quiet && resumed->info.count("device") && resumed->info["device"] != ctx.info().name)
-            std::fprintf(stderr,
-                         "gdpt: warning: %s was rendered on '%s'; continuing on '%s' (same statistics, "
-                         "not the same bits)\n",
-                         args.resume.c_str(), resumed->info["device"].c_str(), ctx.info().name.c_str());
-        options.resume = &resumed->state;
+    ExrAttributes identity;
+    double reserved = 0.0, finishReserved = 0.0;
+    const bool timed = args.time > 0.0;
+    const std::string finishKey_method =
+        args.method + (args.method == "gpt" ? "|" + std::to_string(args.allRecon ? 4 : 1) + " solves" : "");
+    std::string finishKey;
+    try {
+        enterPhase("loading");
+        loaded.emplace(loadGltf(args.scene, deviceLoadOptions(args.device, quiet)));
+        const Scene& scene = *loaded;
+        throwIfInterrupted("loading");
+        if (!scene.unsupported.empty() && !quiet) {
+            std::string list;
+            for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
+            std::fprintf(stderr, "gdpt: warning: %s: not rendered: %s\n", args.scene.c_str(), list.c_str());
+        }
+        if (const auto black = blackImageWarning(scene, options.scene.envRadiance); black && !quiet)
+            std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
+        vk::ContextOptions ctxOptions;
+        ctxOptions.device = args.device;
+        ctxOptions.validation = args.validate;
+        const vk::Context& ctx = context.emplace(ctxOptions);
+        if (!quiet)
+            std::fprintf(stderr, "gdpt: device '%s' (%s, %s)%s\n", ctx.info().name.c_str(), ctx.info().type.c_str(),
+                         ctx.info().driverInfo.c_str(),
+                         world ? (", rank 0 of " + std::to_string(world->size())).c_str() : "");
+        // After the context: the integrator's device objects (G-PT's solver) go before it.
+        integrator = integratorFor(args, &cache);
+
+        // --time covers the whole render: sampling stops early by what the method needs after
+        // it (G-PT: the reconstructions) and by what the rest took the last time for this
+        // device, method, size and settings (readback, output layers, EXR + PNG; nothing the
+        // first time).
+        reserved = timed ? integrator->reserveAfterSampling(ctx, args.width, args.height) : 0.0;
+        finishKey = "finish|" + reservationKey(ctx, args.width, args.height) + "|" + finishKey_method;
+        finishReserved = timed ? cache.get(finishKey).value_or(0.0) : 0.0;
+        if (timed) options.timeBudget = std::max(0.05 * args.time, args.time - reserved - finishReserved);
+        options.elapsedBefore = total.seconds();
+
+        // Checkpoints: the identity of this render is recorded in every checkpoint written, and
+        // a checkpoint resumed from must have the same (render_identity.h).
+        identity = renderIdentity(*integrator, scene, options);
+        if (merged) {  // gdpt merge: the shards' statistics, merged
+            resumed = Checkpoint{merged->identity, merged->info, merged->state};
+            checkIdentity("the shards", resumed->identity, identity);
+            options.resume = &resumed->state;
+        } else if (!args.resume.empty()) {
+            resumed = readCheckpoint(args.resume);
+            checkIdentity(args.resume, resumed->identity, identity);
+            if (!timed && resumed->state.spp > options.share.localSpp(args.spp))
+                throw Error(args.resume + ": checkpoint already has " + std::to_string(resumed->state.spp) +
+                            " spp, more than --spp " + std::to_string(args.spp) +
+                            (shard ? " gives part " + options.share.text() : ""));
+            if (!quiet && resumed->info.count("device") && resumed->info["device"] != ctx.info().name)
+                std::fprintf(stderr,
+                             "gdpt: warning: %s was rendered on '%s'; continuing on '%s' (same statistics, "
+                             "not the same bits)\n",
+                             args.resume.c_str(), resumed->info["device"].c_str(), ctx.info().name.c_str());
+            options.resume = &resumed->state;
+        }
+        if (world) {
+            ExrAttributes description = identity;
+            description.erase("share");
+            description["spp"] = timed ? "--time " + std::to_string(args.time) : std::to_string(args.spp);
+            world->agree(description, "");
+        }
+    } catch (const std::exception& e) {
+        // Every rank takes part in the agreement, so that one rank's failure ends them all.
+        if (world && !world->agreed()) world->agree({}, e.what());
+        throw;
     }
+    const Scene& scene = *loaded;
+    const vk::Context& ctx = *context;
+
+    const ExrAttributes info = {{"device", ctx.info().name}, {"scene_file", args.scene}};
     if (!args.checkpoint.empty()) {
-        const ExrAttributes info = {{"device", ctx.info().name}, {"scene_file", args.scene}};
         options.checkpoint = [&args, identity, info](const SamplerState& state) {
             writeCheckpoint(args.checkpoint, identity, info, state);
         };
         options.checkpointEvery = args.checkpointEvery;
+    }
+    std::optional<SamplerState> shardState;
+    if (world) {
+        options.combine = [world](const SamplerState& mine, RenderStats& stats) { return world->combine(mine, stats); };
+    } else if (shard) {
+        options.combine = [&shardState](const SamplerState& mine, RenderStats& stats) -> std::optional<SamplerState> {
+            if (!stats.cancelled) shardState = mine;
+            return std::nullopt;
+        };
     }
     const std::string checkpointNote = args.checkpoint.empty()
                                            ? ""
@@ -256,43 +382,64 @@ int runRender(const RenderArgs& args) {
     try {
         out = integrator->render(ctx, scene, options);
     } catch (const Interrupted& e) {  // building the BVH, or a stage after sampling
+        if (world) world->fail(e.what(), true);
         if (e.phase() != "reconstructing") throw;
         throw Interrupted(e.phase(), checkpointNote);  // sampling ended: the checkpoint is written
+    } catch (const std::exception& e) {
+        if (world) world->fail(e.what(), interruptRequested());
+        throw;
     }
-    const RenderStats& s = out.stats;
+    RenderStats& s = out.stats;
+    if (merged) s.distributed = merged->stats;
     const double afterSampling = total.seconds() - (s.readbackMs + s.reconstructionMs) * 1e-3;
     if (s.cancelled) {
-        std::fprintf(stderr, "gdpt: interrupted after %u spp; no output written%s\n", s.spp,
-                     checkpointNote.c_str());
+        if (!quiet)
+            std::fprintf(stderr, "gdpt: interrupted after %u spp; no output written%s\n", s.spp,
+                         checkpointNote.c_str());
         return 130;
     }
+    if (s.handedOff && !shard) return 0;  // a rank other than 0: rank 0 finishes the render
     enterPhase("writing");
     Timer writeTimer;
-    checkFinite(out.layers, args.output);
-    writeExr(exrFile, out.layers);
-    throwIfInterrupted("writing");
-    writePngPreview(pngFile, out.image());
+    if (shard) {
+        ExrAttributes shardInfo = info;
+        shardInfo["render_spp"] = std::to_string(timed ? 0u : args.spp);
+        shardInfo["render_args"] = renderArgsJson(args);
+        shardInfo["scene_path"] = absolutePath(args.scene);
+        writeCheckpoint(*exrFile, identity, shardInfo, *shardState);
+    } else {
+        checkFinite(out.layers, args.output);
+        writeExr(*exrFile, out.layers);
+        throwIfInterrupted("writing");
+        writePngPreview(*pngFile, out.image());
+    }
     throwIfInterrupted("writing");
     const double writeMs = writeTimer.ms();
     const double seconds = total.seconds();
     if (args.profile) printProfile(s.kernels);
     if (jsonOutput.wanted()) {
-        jsonOutput.write(
-            summaryJson(args, ctx, *integrator, s, seconds, reserved, finishReserved, writeMs).dump(2) +
-            "\n");
+        json summary = summaryJson(args, ctx, *integrator, s, seconds, reserved, finishReserved, writeMs);
+        if (shard) summary["shard"] = options.share.text();
+        jsonOutput.write(summary.dump(2) + "\n");
         throwIfInterrupted("writing");
     }
     outputs.commit();
-    if (timed)
+    if (timed && !shard)
         cache.put(finishKey, std::max(0.0, total.seconds() - afterSampling - s.reconstructionMs * 1e-3));
-    if (!args.quiet) {
+    if (!quiet) {
         const std::string partial =
             s.partialPassRows ? " + 1 in the top " + std::to_string(s.partialPassRows) + " rows" : "";
+        std::string parts;
+        if (s.distributed.parts > 1)
+            parts = ", " + std::to_string(s.distributed.parts) + (merged ? " shards" : " ranks") + " merged in " +
+                    std::to_string(static_cast<long>(s.distributed.mergeMs)) + " ms";
+        if (shard) parts = ", part " + options.share.text() + " of " + std::to_string(args.spp) + " spp";
         std::fprintf(stderr,
-                     "gdpt: wrote %s (%u spp%s%s, %.2f s total, BVH %.1f ms, sampling %.1f ms, %.2f Mrays/s, "
+                     "gdpt: wrote %s%s (%u spp%s%s%s, %.2f s total, BVH %.1f ms, sampling %.1f ms, %.2f Mrays/s, "
                      "%.3f Msamples/s)\n",
-                     args.output.c_str(), s.spp, partial.c_str(), integrator->summary(s).c_str(), seconds,
-                     s.bvhBuildMs, s.samplingMs, double(s.raysTraced) / (s.samplingMs * 1e-3) * 1e-6,
+                     shard ? "shard " : "", args.output.c_str(), s.spp, partial.c_str(), parts.c_str(),
+                     integrator->summary(s).c_str(), seconds, s.bvhBuildMs, s.samplingMs,
+                     double(s.raysTraced) / (s.samplingMs * 1e-3) * 1e-6,
                      double(s.pathsCompleted) / (s.samplingMs * 1e-3) * 1e-6);
     }
     if (ctx.validationErrors() > 0) {
@@ -300,6 +447,10 @@ int runRender(const RenderArgs& args) {
         return 1;
     }
     return 0;
+}
+
+int runRender(const RenderArgs& args) {
+    return runRender(args, nullptr);
 }
 
 }  // namespace gdpt
@@ -408,6 +559,12 @@ Subcommand addRenderCommand(CLI::App& app) {
     r->add_option("--resume", a.resume, "Continue a checkpoint of the same render; --spp counts the total")
         ->check(InputFile)
         ->group(budget);
+
+    const char* split = "Distributed rendering (docs/distributed.md)";
+    r->add_option("--shard", a.shard,
+                  "I/N: render part I (from 0) of N of the samples and write their statistics to -o (no PNG); "
+                  "gdpt merge finishes the render. Under mpirun the ranks split the render instead")
+        ->group(split);
 
     const char* diagnostics = "Device and diagnostics";
     r->add_option("--device", a.device, "Vulkan device index or name substring (default: lavapipe)")

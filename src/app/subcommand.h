@@ -25,5 +25,6 @@ Subcommand addSolveCommand(CLI::App& app);
 Subcommand addCloneCommand(CLI::App& app);
 Subcommand addBenchPoissonCommand(CLI::App& app);
 Subcommand addBenchFeaturesCommand(CLI::App& app);
+Subcommand addMergeCommand(CLI::App& app);
 
 }  // namespace gdpt

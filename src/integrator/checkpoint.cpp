@@ -11,6 +11,7 @@
 
 #include "render/passes/edge_options.h"
 #include "util/error.h"
+#include "util/output_files.h"
 
 namespace gdpt {
 namespace {
@@ -93,8 +94,13 @@ std::string countText(double n) {
 
 }  // namespace
 
-void writeCheckpoint(const std::string& path, const ExrAttributes& identity, const ExrAttributes& info,
-                     const SamplerState& state) {
+namespace {
+
+// The checkpoint's layers and header; `path` names the file in errors.
+std::pair<std::vector<NamedLayer>, ExrAttributes> checkpointContents(const std::string& path,
+                                                                     const ExrAttributes& identity,
+                                                                     const ExrAttributes& info,
+                                                                     const SamplerState& state) {
     const int w = state.preview.width(), h = state.preview.height();
     ExrAttributes attributes = {{"gdpt.format", kFormat},
                                 {"gdpt.spp", std::to_string(state.spp)},
@@ -119,7 +125,21 @@ void writeCheckpoint(const std::string& path, const ExrAttributes& identity, con
         layers.push_back({bufferLayer(k, "m2"), std::move(m2)});
         layers.push_back({bufferLayer(k, "count"), std::move(count)});
     }
+    return {std::move(layers), std::move(attributes)};
+}
+
+}  // namespace
+
+void writeCheckpoint(const std::string& path, const ExrAttributes& identity, const ExrAttributes& info,
+                     const SamplerState& state) {
+    const auto [layers, attributes] = checkpointContents(path, identity, info, state);
     writeExr(path, layers, attributes);
+}
+
+void writeCheckpoint(const StagedFile& file, const ExrAttributes& identity, const ExrAttributes& info,
+                     const SamplerState& state) {
+    const auto [layers, attributes] = checkpointContents(file.path(), identity, info, state);
+    writeExr(file, layers, attributes);
 }
 
 Checkpoint readCheckpoint(const std::string& path) {

@@ -22,6 +22,8 @@
 
 namespace gdpt {
 
+class StagedFile;
+
 struct Checkpoint {
     ExrAttributes identity;  // key -> value, without the "gdpt.id." prefix
     ExrAttributes info;      // key -> value, without the "gdpt.info." prefix
@@ -30,6 +32,10 @@ struct Checkpoint {
 
 // Writes `state` (via path.tmp + rename). Throws gdpt::Error naming the file.
 void writeCheckpoint(const std::string& path, const ExrAttributes& identity, const ExrAttributes& info,
+                     const SamplerState& state);
+
+// The same into a staged file of an OutputSet (util/output_files.h); the caller commits.
+void writeCheckpoint(const StagedFile& file, const ExrAttributes& identity, const ExrAttributes& info,
                      const SamplerState& state);
 
 // Reads and validates a checkpoint: format, attributes, the statistics buffers of its method

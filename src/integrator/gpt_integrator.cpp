@@ -85,7 +85,7 @@ RenderOutput GptIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     RenderResultGpt g = renderGpt(ctx, scene, sampling, options_.sampling);
     RenderOutput out;
     out.stats = g.stats;
-    if (g.stats.cancelled) return out;
+    if (g.stats.cancelled || g.stats.handedOff) return out;
 
     // Stage 2, the screened Poisson reconstructions of the primal and gradients.
     PoissonInput input;

@@ -65,11 +65,16 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
                         &images.direct);
     });
 
+    RenderResultGpt result;
+    if (sampling.stats().handedOff) {  // the statistics went to another process (or a shard file)
+        sampling.finish();
+        result.stats = sampling.stats();
+        return result;
+    }
     // The gather after the last batch (a separate submission so its time is its own).
     Timer phase;
     resolveNow();
     GptImages images = pass->readback();
-    RenderResultGpt result;
     result.primal = std::move(images.primal);
     result.dx = std::move(images.dx);
     result.dy = std::move(images.dy);

@@ -65,20 +65,53 @@ void PixelSampling::run(const std::function<Image()>& preview) {
         state.buffers = pass_->downloadStats();
         state.preview = preview();
     };
-    const std::string label = kind_ == "pt" ? "render" : "render " + kind_;
+    const std::string label = (kind_ == "pt" ? "render" : "render " + kind_) +
+                              (options_.share.split() ? " (part " + options_.share.text() + ")" : "");
+    // A share of a split render (sample_share.h) runs the batch schedule over its own samples;
+    // its local sample j is the render's sample share.globalSample(j), recorded one sample per
+    // pixel at a time (what CPU devices do anyway, "One sample per dispatch").
+    const SampleShare share = options_.share;
+    RenderOptions loop = options_;
+    loop.spp = share.localSpp(options_.spp);
     runBatchLoop(
-        options_, label.c_str(), total_, stats_,
+        loop, label.c_str(), total_, stats_,
         [&](std::uint32_t first, std::uint32_t n, std::uint32_t rows, const std::function<void()>& onWait) {
+            const std::string samples =
+                share.split() ? std::to_string(n) + " of part " + share.text() + " from sample " +
+                                    std::to_string(share.globalSample(first))
+                              : std::to_string(first) + ".." + std::to_string(first + n - 1);
             const std::string what = kind_ + " batch " + std::to_string(stats_.batches) + " (samples " +
-                                     std::to_string(first) + ".." + std::to_string(first + n - 1) +
-                                     ", seed " + std::to_string(options_.seed) + ")";
+                                     samples + ", seed " + std::to_string(options_.seed) + ")";
             submitAndWait(
                 what,
-                [&](VkCommandBuffer cmd) { pass_->record(cmd, first, n, options_.seed, timer(), rows); },
+                [&](VkCommandBuffer cmd) {
+                    if (!share.split()) {
+                        pass_->record(cmd, first, n, options_.seed, timer(), rows);
+                        return;
+                    }
+                    for (std::uint32_t j = first; j < first + n; ++j)
+                        pass_->record(cmd, static_cast<std::uint32_t>(share.globalSample(j)), 1, options_.seed,
+                                      timer(), rows);
+                },
                 onWait);
             return pass_->takeCounters();
         },
         snapshot);
+    if (options_.combine) {
+        SamplerState mine;
+        mine.spp = stats_.spp;
+        mine.batches = stats_.batches;
+        if (!stats_.cancelled) snapshot(mine);
+        std::optional<SamplerState> merged = options_.combine(mine, stats_);
+        if (!merged) {
+            stats_.handedOff = true;
+            return;
+        }
+        Timer upload;
+        pass_->uploadStats(merged->buffers);
+        stats_.spp = merged->spp;
+        stats_.uploadMs += upload.ms();
+    }
 }
 
 void PixelSampling::finish() {

@@ -18,7 +18,7 @@ RenderOutput PtIntegrator::render(const vk::Context& ctx, const Scene& scene, co
     RenderResult r = renderPt(ctx, scene, options);
     RenderOutput out;
     out.stats = r.stats;
-    if (r.stats.cancelled) return out;
+    if (r.stats.cancelled || r.stats.handedOff) return out;
     out.layers = {{"", std::move(r.image)}, {"variance", std::move(r.varianceOfMean)}};
     return out;
 }

@@ -89,6 +89,8 @@ ExrAttributes renderIdentity(const Integrator& integrator, const Scene& scene, c
                         {"max_batch_spp", std::to_string(maxBatch)},
                         {"emitter_supersampling", std::to_string(options.emitterSupersampling)}};
     for (auto& [key, value] : integrator.identity(scene, options)) id[key] = value;
+    // A part of a split render takes other samples than the whole render (sample_share.h).
+    if (options.share.split()) id["share"] = options.share.text();
     return id;
 }
 

@@ -21,7 +21,8 @@ std::uint64_t sceneFingerprint(const Scene& scene);
 // The identity a checkpoint records and a resume must match: scene fingerprint, method,
 // image size, seed, max depth, environment, camera, largest batch, emitter supersampling,
 // and the method's own (Integrator::identity; G-PT: shift threshold, edge samples,
-// demodulation). Workgroup size, device and output options are not part of it.
+// demodulation), and the part of a split render ("share" = "I/N", sample_share.h). Workgroup
+// size, device and output options are not part of it.
 ExrAttributes renderIdentity(const Integrator& integrator, const Scene& scene, const RenderOptions& options);
 
 // Shortest text that reads back as the same float.

@@ -8,10 +8,12 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "image/image.h"
+#include "integrator/sample_share.h"
 #include "integrator/sampler_state.h"
 #include "render/device_scene/features.h"
 #include "render/device_scene/scene_spec.h"
@@ -26,6 +28,8 @@ namespace gdpt {
 // merge order and every bit of the result -- is the same on every run, and a batch stays
 // well under a second on lavapipe, so an interrupt is served promptly.
 std::uint32_t maxBatchSppFor(int width, int height, std::uint64_t pixelSamplesPerBatch);
+
+struct RenderStats;
 
 struct RenderOptions {
     SceneGpuOptions scene;
@@ -56,6 +60,16 @@ struct RenderOptions {
     // before sampling; for set-up of the caller's own that should overlap that compile (the
     // reconstruction's pipelines). Its time counts in the budget like everything else.
     std::function<void()> whileCompiling;
+    // A render split across processes (sample_share.h): this process takes only the samples of
+    // its share, and `spp` counts the whole render's samples per pixel (this process takes
+    // share.localSpp(spp) of them; a timed render's share samples for the whole budget).
+    SampleShare share;
+    // If set, called once when sampling ends, finished or cancelled, with this process's
+    // statistics (and a preview) and its stats (counters it may add to): returns the
+    // statistics the method's later stages continue from (the merge over every process, on the
+    // process that finishes the render), or nothing (the others, and a shard that writes its
+    // statistics: the method stops after sampling and returns no layers, stats.handedOff).
+    std::function<std::optional<SamplerState>(const SamplerState& mine, RenderStats& stats)> combine;
 };
 
 // One screened Poisson reconstruction of a render (G-PT): the solver's report in brief.
@@ -67,6 +81,14 @@ struct ReconstructionStats {
     double tolerance = 0.0;  // the relative residual asked for
     bool converged = false;  // every channel reached the tolerance
     double ms = 0.0;
+};
+
+// A render split across processes (sample_share.h): how its parts were merged.
+struct DistributedStats {
+    std::uint32_t parts = 1;               // processes (ranks) or shards; 1: not split
+    std::vector<std::uint32_t> partSpp;    // samples per pixel each part took, in part order
+    std::uint64_t bytesPerPart = 0;        // statistics each part sent (or wrote)
+    double mergeMs = 0.0;                  // gathering and merging them (rank 0, or gdpt merge)
 };
 
 struct RenderStats {
@@ -95,6 +117,10 @@ struct RenderStats {
     bool demodulated = false;             // G-PT: first-hit texture demodulation was on
     std::uint32_t demodulatedPixels = 0;  // G-PT: pixels it acted in (away from the edges)
     bool cancelled = false;
+    // RenderOptions::combine took the statistics to finish the render elsewhere (or to write
+    // them as a shard): no later stages ran, no layers.
+    bool handedOff = false;
+    DistributedStats distributed;
     std::map<std::string, vk::KernelTime> kernels;
     SceneFeatures features;
 };
