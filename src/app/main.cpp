@@ -37,6 +37,8 @@ int run(int argc, char** argv) {
     try {
         for (const Subcommand& c : commands)
             if (*c.app) return c.run();
+    } catch (const ReportedElsewhere&) {  // rank 0 of an MPI render reports it
+        return 1;
     } catch (const UsageError& e) {
         std::fprintf(stderr, "gdpt: usage error: %s\n", e.what());
         return 2;

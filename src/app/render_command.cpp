@@ -291,6 +291,7 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
     std::string finishKey;
     try {
         enterPhase("loading");
+        if (world) world->testFault("loading");
         loaded.emplace(loadGltf(args.scene, deviceLoadOptions(args.device, quiet)));
         const Scene& scene = *loaded;
         throwIfInterrupted("loading");
@@ -366,7 +367,10 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
     }
     std::optional<SamplerState> shardState;
     if (world) {
-        options.combine = [world](const SamplerState& mine, RenderStats& stats) { return world->combine(mine, stats); };
+        options.combine = [world](const SamplerState& mine, RenderStats& stats) {
+            world->testFault("sampling");
+            return world->combine(mine, stats);
+        };
     } else if (shard) {
         options.combine = [&shardState](const SamplerState& mine, RenderStats& stats) -> std::optional<SamplerState> {
             if (!stats.cancelled) shardState = mine;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -42,6 +43,17 @@ bool MpiWorld::available() {
 
 MpiWorld* MpiWorld::get() {
     return g_world.get();
+}
+
+void MpiWorld::testFault(const char* phase) const {
+    const char* fault = std::getenv("GDPT_TEST_RANK_FAULT");
+    if (!fault) return;
+    const std::string text = fault;
+    const auto colon = text.find(':');
+    if (colon == std::string::npos || text.substr(0, colon) != std::to_string(rank_)) return;
+    const std::string what = text.substr(colon + 1);
+    if (what == phase) throw Error("simulated failure while " + what + " (GDPT_TEST_RANK_FAULT)");
+    if (what == "killed" && std::string(phase) == "sampling") std::raise(SIGKILL);
 }
 
 #if GDPT_HAVE_MPI
@@ -159,7 +171,10 @@ void MpiWorld::agree(const ExrAttributes& description, const std::string& failur
     if (!root()) {
         sendText(mine.dump(), 0, kTagAgree, phase);
         const json verdict = json::parse(receiveText(0, kTagVerdict, phase));
-        if (!verdict.at("go").get<bool>()) throw Error(verdict.at("message").get<std::string>());
+        if (!verdict.at("go").get<bool>()) {
+            phase_ = Phase::Refused;
+            throw ReportedElsewhere(verdict.at("message").get<std::string>());
+        }
         phase_ = Phase::Agreed;
         return;
     }
@@ -178,7 +193,10 @@ void MpiWorld::agree(const ExrAttributes& description, const std::string& failur
     }
     const json verdict = {{"go", message.empty()}, {"message", message}};
     for (int r = 1; r < size_; ++r) sendText(verdict.dump(), r, kTagVerdict, phase);
-    if (!message.empty()) throw Error(message);
+    if (!message.empty()) {
+        phase_ = Phase::Refused;
+        throw Error(message);
+    }
     phase_ = Phase::Agreed;
 }
 

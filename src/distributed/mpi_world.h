@@ -37,6 +37,7 @@ public:
     [[nodiscard]] int rank() const { return rank_; }
     [[nodiscard]] int size() const { return size_; }
     [[nodiscard]] bool root() const { return rank_ == 0; }
+    // Whether agree() has run (whatever its verdict).
     [[nodiscard]] bool agreed() const { return phase_ != Phase::Start; }
     [[nodiscard]] SampleShare share() const {
         return {static_cast<std::uint32_t>(rank_), static_cast<std::uint32_t>(size_)};
@@ -59,9 +60,15 @@ public:
     // its combine (rank 0 itself failing then ends the job in finish()).
     void fail(const std::string& message, bool interrupted);
 
+    // For tests of the failure handling: if the environment variable GDPT_TEST_RANK_FAULT is
+    // "R:PHASE" and this is rank R, at `phase` ("loading" or "sampling", its end) this rank
+    // throws an error, or with "R:killed" it kills itself (SIGKILL) at the end of sampling,
+    // as a crashed node would.
+    void testFault(const char* phase) const;
+
 private:
     MpiWorld(int rank, int size) : rank_(rank), size_(size) {}
-    enum class Phase { Start, Agreed, Combined };
+    enum class Phase { Start, Refused, Agreed, Combined };
     int rank_ = 0;
     int size_ = 1;
     Phase phase_ = Phase::Start;

@@ -23,6 +23,13 @@ public:
     using Error::Error;
 };
 
+// An error that another process reports (rank 0 of an MPI render names the rank that
+// failed): main() exits 1 without printing it again.
+class ReportedElsewhere : public Error {
+public:
+    using Error::Error;
+};
+
 }  // namespace gdpt
 
 // GDPT_CHECK: a cheap invariant, checked in every build. Throws gdpt::Error with the
