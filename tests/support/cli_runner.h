@@ -28,9 +28,9 @@ inline std::string gdptBinary() {
     return other && *other ? std::string(other) : std::string(GDPT_BINARY);
 }
 
-// Runs `gdpt <args>` through the shell; `env` ("NAME=value ..."), if given, is set for it.
-inline RunResult runGdpt(const std::string& args, const std::string& env = "") {
-    const std::string cmd = (env.empty() ? "" : "env " + env + " ") + gdptBinary() + " " + args + " 2>&1";
+// Runs `command` through the shell, stderr with stdout.
+inline RunResult runShell(const std::string& command) {
+    const std::string cmd = command + " 2>&1";
     RunResult r;
     FILE* pipe = popen(cmd.c_str(), "r");
     if (!pipe) return r;
@@ -39,6 +39,11 @@ inline RunResult runGdpt(const std::string& args, const std::string& env = "") {
     const int status = pclose(pipe);
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     return r;
+}
+
+// Runs `gdpt <args>` through the shell; `env` ("NAME=value ..."), if given, is set for it.
+inline RunResult runGdpt(const std::string& args, const std::string& env = "") {
+    return runShell((env.empty() ? "" : "env " + env + " ") + gdptBinary() + " " + args);
 }
 
 }  // namespace gdpt::test
