@@ -27,6 +27,7 @@ packages=(
   libgtest-dev libgmock-dev libeigen3-dev
   gnuplot-nox python3 clang libclang-rt-dev clang-format-14
   assimp-testmodels
+  libopenmpi-dev openmpi-bin
 )
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"

@@ -33,6 +33,15 @@ void installInterruptHandlers();
     return interruptFlag().load(std::memory_order_relaxed);
 }
 
+// Files the first signal removes at once, from the handler (the staged temporary files of a
+// command's outputs, util/output_files.h): a signal always means "no output", and a process
+// that is sent SIGTERM and then, moments later, SIGKILL (mpirun, batch schedulers) then leaves
+// none behind. Returns a slot for keepOnSignal, or -1 if the path was not registered (more
+// than 32 at once, or a path longer than 4095 bytes).
+int removeOnSignal(const std::string& path);
+// The file of `slot` is no longer removed by a signal (it was committed or discarded).
+void keepOnSignal(int slot);
+
 // Throws Interrupted ("interrupted while <phase>; no output written") if a signal arrived.
 void throwIfInterrupted(const char* phase);
 

@@ -1,6 +1,8 @@
 // output_files.cpp — staged, checked, unique and grouped output files (POSIX).
 #include "util/output_files.h"
 
+#include "util/interrupt.h"
+
 #include <fcntl.h>
 #include <sys/file.h>
 #include <sys/stat.h>
@@ -134,6 +136,8 @@ void StagedFile::sync() const {
 }
 
 void StagedFile::discard() {
+    keepOnSignal(signalSlot_);
+    signalSlot_ = -1;
     if (!committed_ && !tmpPath_.empty()) ::unlink(tmpPath_.c_str());
     tmpPath_.clear();
 }
@@ -144,6 +148,8 @@ void StagedFile::commit() {
     if (::rename(tmpPath_.c_str(), path_.c_str()) != 0)
         throw Error(path_ + ": cannot move " + tmpPath_ + " into place: " + osReason(errno));
     committed_ = true;
+    keepOnSignal(signalSlot_);
+    signalSlot_ = -1;
 }
 
 OutputSet::OutputSet(std::vector<std::pair<std::string, std::string>> inputs) {
@@ -173,7 +179,10 @@ void OutputSet::checkDistinct(const std::string& path, const std::string& what,
 StagedFile& OutputSet::add(const std::string& path, const std::string& what) {
     checkDistinct(path, what, {});
     outputs_.emplace_back(what, std::make_unique<StagedFile>(path));
-    return *outputs_.back().second;
+    StagedFile& file = *outputs_.back().second;
+    // A command's outputs are written only if it is not interrupted: a signal removes them.
+    file.signalSlot_ = removeOnSignal(file.tmpPath_);
+    return file;
 }
 
 void OutputSet::checkSeparate(const std::string& path, const std::string& what,
@@ -217,6 +226,8 @@ void OutputSet::commit() {
             throw Error(f.path() + ": cannot move " + f.tmpPath() + " into place: " + osReason(err));
         }
         f.committed_ = true;
+        keepOnSignal(f.signalSlot_);
+        f.signalSlot_ = -1;
         done.push_back({&f, backup});
     }
     for (const Done& d : done)

@@ -47,6 +47,7 @@ private:
     std::string path_;
     std::string tmpPath_;
     bool committed_ = false;
+    int signalSlot_ = -1;  // removeOnSignal's slot (util/interrupt.h), for an OutputSet's files
 };
 
 // Writes `bytes` to `path` (opened with O_TRUNC), checking every write, fsync and close;

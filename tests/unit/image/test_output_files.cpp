@@ -18,6 +18,7 @@
 #include "image/png_preview.h"
 #include "temp_dir.h"
 #include "util/error.h"
+#include "util/interrupt.h"
 #include "util/output_files.h"
 
 namespace gdpt {
@@ -186,6 +187,43 @@ TEST_F(OutputFiles, AFullDiskFailsTheWriteAndLeavesNothing) {
     // The same writes succeed without the limit (the limit is what failed them).
     EXPECT_EQ(underFileSizeLimit(RLIM_INFINITY, [&] { writePngPreview(path("p.png"), image); }), 0);
     EXPECT_EQ(readPng(path("p.png")).width(), 64);
+}
+
+}  // namespace
+}  // namespace gdpt
+
+namespace gdpt {
+namespace {
+
+// SIGTERM, then SIGKILL moments later (what mpirun and batch schedulers send): the first
+// signal removes a command's staged outputs at once, so the kill leaves no temporary file.
+// The child ends with _exit right after the signal, skipping every destructor, as SIGKILL would.
+class SignalledOutputs : public test::TempDirTest {};
+
+TEST_F(SignalledOutputs, AKillRightAfterTheFirstSignalLeavesNoTemporaryFile) {
+    for (const bool signalled : {false, true}) {
+        const pid_t pid = ::fork();
+        if (pid == 0) {
+            installInterruptHandlers();
+            OutputSet outputs(std::vector<std::pair<std::string, std::string>>{});
+            StagedFile& exr = outputs.add(path("out.exr"), "-o");
+            (void)outputs.add(path("out.png"), "PNG preview");
+            writeBytes(exr.tmpPath(), "partial", 7);
+            if (signalled) std::raise(SIGTERM);
+            ::_exit(0);
+        }
+        int status = 0;
+        ::waitpid(pid, &status, 0);
+        ASSERT_TRUE(WIFEXITED(status));
+        if (signalled) {
+            EXPECT_TRUE(listing().empty()) << listing().size() << " files left, e.g. " << listing().front();
+        } else {
+            // The control: killed without a signal first, the temporary files stay (only the
+            // command's own cleanup or a signal removes them).
+            EXPECT_EQ(temporaryFiles().size(), 2u);
+            for (const std::string& name : listing()) std::filesystem::remove(path(name));
+        }
+    }
 }
 
 }  // namespace
