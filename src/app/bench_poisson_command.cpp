@@ -36,21 +36,6 @@ struct BenchPoissonArgs {
     std::string addressing = "auto";
 };
 
-// "N" (square) or "WxH".
-std::pair<int, int> parseSize(const std::string& s) {
-    int w = 0, h = 0;
-    char sep = 0;
-    std::istringstream in(s);
-    if (!(in >> w)) throw UsageError("--sizes: bad size '" + s + "'");
-    if (in >> sep) {
-        if (sep != 'x' || !(in >> h)) throw UsageError("--sizes: bad size '" + s + "' (N or WxH)");
-    } else {
-        h = w;
-    }
-    if (w <= 0 || h <= 0 || w > 16384 || h > 16384) throw UsageError("--sizes: bad size '" + s + "'");
-    return {w, h};
-}
-
 // Smooth shading, hard-edged discs and fine stripes: content with every frequency.
 Image proceduralImage(int w, int h) {
     Image im(w, h);

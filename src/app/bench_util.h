@@ -7,9 +7,11 @@
 #include <cstdio>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "image/atomic_write.h"
+#include "util/error.h"
 #include "util/output_files.h"
 
 namespace gdpt {
@@ -29,6 +31,21 @@ inline std::vector<std::string> splitList(const std::string& text) {
     while (std::getline(in, item, ','))
         if (!item.empty()) out.push_back(item);
     return out;
+}
+
+// "N" (square) or "WxH" of a --sizes list (1..16384 each); throws gdpt::UsageError.
+inline std::pair<int, int> parseSize(const std::string& s) {
+    int w = 0, h = 0;
+    char sep = 0;
+    std::istringstream in(s);
+    if (!(in >> w)) throw UsageError("--sizes: bad size '" + s + "'");
+    if (in >> sep) {
+        if (sep != 'x' || !(in >> h)) throw UsageError("--sizes: bad size '" + s + "' (N or WxH)");
+    } else {
+        h = w;
+    }
+    if (w <= 0 || h <= 0 || w > 16384 || h > 16384) throw UsageError("--sizes: bad size '" + s + "'");
+    return {w, h};
 }
 
 // A command's text output (-o, --json): stdout for "-", nothing for "", else a file staged in

@@ -26,5 +26,6 @@ Subcommand addCloneCommand(CLI::App& app);
 Subcommand addBenchPoissonCommand(CLI::App& app);
 Subcommand addBenchFeaturesCommand(CLI::App& app);
 Subcommand addMergeCommand(CLI::App& app);
+Subcommand addBenchMergeCommand(CLI::App& app);
 
 }  // namespace gdpt

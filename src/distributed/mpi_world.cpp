@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
@@ -236,7 +237,18 @@ std::optional<SamplerState> MpiWorld::combine(const SamplerState& mine, RenderSt
     for (const auto& b : mine.buffers) d.bytesPerPart += b.size() * sizeof(gpu::PixelStats);
     std::string failure;
     std::string interrupted = stats.cancelled ? "rank 0" : "";
-    std::vector<gpu::PixelStats> received;
+    // Two receive buffers: a worker thread merges one while this thread (the only one that
+    // calls MPI) receives the next.
+    std::vector<gpu::PixelStats> received[2];
+    std::thread merger;
+    int slot = 0;
+    const auto joinMerger = [&merger] {
+        if (merger.joinable()) merger.join();
+    };
+    struct JoinOnExit {
+        const std::function<void()> join;
+        ~JoinOnExit() { join(); }
+    } joinOnExit{joinMerger};
     for (int r = 1; r < size_; ++r) {
         const json header = json::parse(receiveText(r, kTagHeader, phase));
         const std::string status = header.at("status").get<std::string>();
@@ -255,9 +267,13 @@ std::optional<SamplerState> MpiWorld::combine(const SamplerState& mine, RenderSt
             failure = rank + " sent " + std::to_string(sizes.size()) + " statistics buffers, rank 0 has " +
                       std::to_string(merged.buffers.size());
         for (std::size_t k = 0; k < sizes.size(); ++k) {
-            received.resize(sizes[k]);
-            receiveBytes(received.data(), sizes[k] * sizeof(gpu::PixelStats), r, phase);
-            if (failure.empty() && interrupted.empty()) mergeStatsInto(merged.buffers[k], received.data(), sizes[k]);
+            std::vector<gpu::PixelStats>& into = received[slot];
+            into.resize(sizes[k]);
+            receiveBytes(into.data(), sizes[k] * sizeof(gpu::PixelStats), r, phase);
+            joinMerger();  // the previous buffer (it used the other slot)
+            if (failure.empty() && interrupted.empty())
+                merger = std::thread([&acc = merged.buffers[k], &into] { mergeStatsInto(acc, into.data(), into.size()); });
+            slot = 1 - slot;
         }
         const auto spp = header.at("spp").get<std::uint32_t>();
         merged.spp += spp;
@@ -268,6 +284,7 @@ std::optional<SamplerState> MpiWorld::combine(const SamplerState& mine, RenderSt
         stats.shiftPairs += header.at("shift_pairs").get<std::uint64_t>();
         stats.shiftFailures += header.at("shift_failures").get<std::uint64_t>();
     }
+    joinMerger();
     phase_ = Phase::Combined;
     d.mergeMs = timer.ms();
     if (!failure.empty()) throw Error(failure);
