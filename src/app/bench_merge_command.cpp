@@ -82,7 +82,7 @@ int runBenchMerge(const BenchMergeArgs& args) {
                 if (world) {
                     // The real exchange: rank 0 receives and merges the other ranks' parts.
                     RenderStats stats;
-                    (void)world->combine(mine, stats);
+                    (void)world->combine(mine, stats);  // a copy: the next repeat sends it again
                     seconds.push_back(stats.distributed.mergeMs * 1e-3 / double(parts - 1));
                 } else {
                     SamplerState acc = syntheticState(buffers, pixels, 4, 0);

@@ -169,7 +169,8 @@ json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrato
         j["distributed"] = {{"parts", s.distributed.parts},
                             {"part_spp", s.distributed.partSpp},
                             {"bytes_per_part", s.distributed.bytesPerPart},
-                            {"merge_s", s.distributed.mergeMs * 1e-3}};
+                            {"merge_s", s.distributed.mergeMs * 1e-3},
+                            {"wait_s", s.distributed.waitMs * 1e-3}};
     integrator.describe(j, s);
     j["emitter_supersampling"] = {{"factor", s.emitterSupersampling},
                                   {"rays_per_sample", s.emitterRaysPerSample},
@@ -286,8 +287,9 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
     ExrAttributes identity;
     double reserved = 0.0, finishReserved = 0.0;
     const bool timed = args.time > 0.0;
-    const std::string finishKey_method =
-        args.method + (args.method == "gpt" ? "|" + std::to_string(args.allRecon ? 4 : 1) + " solves" : "");
+    const std::string finishKeyMethod =
+        args.method + (args.method == "gpt" ? "|" + std::to_string(args.allRecon ? 4 : 1) + " solves" : "") +
+        (world ? "|" + std::to_string(world->size()) + " ranks" : "");
     std::string finishKey;
     try {
         enterPhase("loading");
@@ -318,7 +320,7 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
         // device, method, size and settings (readback, output layers, EXR + PNG; nothing the
         // first time).
         reserved = timed ? integrator->reserveAfterSampling(ctx, args.width, args.height) : 0.0;
-        finishKey = "finish|" + reservationKey(ctx, args.width, args.height) + "|" + finishKey_method;
+        finishKey = "finish|" + reservationKey(ctx, args.width, args.height) + "|" + finishKeyMethod;
         finishReserved = timed ? cache.get(finishKey).value_or(0.0) : 0.0;
         if (timed) options.timeBudget = std::max(0.05 * args.time, args.time - reserved - finishReserved);
         options.elapsedBefore = total.seconds();
@@ -348,7 +350,9 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
             ExrAttributes description = identity;
             description.erase("share");
             description["spp"] = timed ? "--time " + std::to_string(args.time) : std::to_string(args.spp);
-            world->agree(description, "");
+            // Every rank samples for rank 0's budget (its reservations: the reconstruction, and
+            // what the last such render spent after sampling, the merge included).
+            world->agree(description, "", timed ? &options.timeBudget : nullptr);
         }
     } catch (const std::exception& e) {
         // Every rank takes part in the agreement, so that one rank's failure ends them all.
@@ -367,13 +371,13 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
     }
     std::optional<SamplerState> shardState;
     if (world) {
-        options.combine = [world](const SamplerState& mine, RenderStats& stats) {
+        options.combine = [world](SamplerState mine, RenderStats& stats) {
             world->testFault("sampling");
-            return world->combine(mine, stats);
+            return world->combine(std::move(mine), stats);
         };
     } else if (shard) {
-        options.combine = [&shardState](const SamplerState& mine, RenderStats& stats) -> std::optional<SamplerState> {
-            if (!stats.cancelled) shardState = mine;
+        options.combine = [&shardState](SamplerState mine, RenderStats& stats) -> std::optional<SamplerState> {
+            if (!stats.cancelled) shardState = std::move(mine);
             return std::nullopt;
         };
     }
@@ -395,7 +399,10 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
     }
     RenderStats& s = out.stats;
     if (merged) s.distributed = merged->stats;
-    const double afterSampling = total.seconds() - (s.readbackMs + s.reconstructionMs) * 1e-3;
+    // The merge of a distributed render happens after sampling too.
+    const double afterSampling =
+        total.seconds() -
+        (s.readbackMs + s.reconstructionMs + (merged ? 0.0 : s.distributed.mergeMs + s.distributed.waitMs)) * 1e-3;
     if (s.cancelled) {
         if (!quiet)
             std::fprintf(stderr, "gdpt: interrupted after %u spp; no output written%s\n", s.spp,

@@ -166,7 +166,7 @@ int MpiWorld::finish(int exitCode) {
     return exitCode;
 }
 
-void MpiWorld::agree(const ExrAttributes& description, const std::string& failure) {
+void MpiWorld::agree(const ExrAttributes& description, const std::string& failure, double* timeBudget) {
     const char* phase = "waiting for the other ranks";
     const json mine = {{"failure", failure}, {"description", descriptionJson(description)}};
     if (!root()) {
@@ -176,6 +176,7 @@ void MpiWorld::agree(const ExrAttributes& description, const std::string& failur
             phase_ = Phase::Refused;
             throw ReportedElsewhere(verdict.at("message").get<std::string>());
         }
+        if (timeBudget) *timeBudget = verdict.at("time_budget").get<double>();
         phase_ = Phase::Agreed;
         return;
     }
@@ -192,7 +193,7 @@ void MpiWorld::agree(const ExrAttributes& description, const std::string& failur
             message = "rank " + std::to_string(r) + " would render another image than rank 0: " + d;
         }
     }
-    const json verdict = {{"go", message.empty()}, {"message", message}};
+    const json verdict = {{"go", message.empty()}, {"message", message}, {"time_budget", timeBudget ? *timeBudget : 0.0}};
     for (int r = 1; r < size_; ++r) sendText(verdict.dump(), r, kTagVerdict, phase);
     if (!message.empty()) {
         phase_ = Phase::Refused;
@@ -209,7 +210,7 @@ void MpiWorld::fail(const std::string& message, bool interrupted) {
     sendText(header.dump(), 0, kTagHeader, "reporting the failure to rank 0");
 }
 
-std::optional<SamplerState> MpiWorld::combine(const SamplerState& mine, RenderStats& stats) {
+std::optional<SamplerState> MpiWorld::combine(SamplerState mine, RenderStats& stats) {
     const char* phase = "gathering the statistics of the ranks";
     if (!root()) {
         json sizes = json::array();
@@ -229,12 +230,13 @@ std::optional<SamplerState> MpiWorld::combine(const SamplerState& mine, RenderSt
         return std::nullopt;
     }
     Timer timer;
-    SamplerState merged = mine;
+    SamplerState merged = std::move(mine);
     DistributedStats& d = stats.distributed;
     d.parts = static_cast<std::uint32_t>(size_);
-    d.partSpp = {mine.spp};
+    d.partSpp = {merged.spp};
     d.bytesPerPart = 0;
-    for (const auto& b : mine.buffers) d.bytesPerPart += b.size() * sizeof(gpu::PixelStats);
+    d.waitMs = 0.0;
+    for (const auto& b : merged.buffers) d.bytesPerPart += b.size() * sizeof(gpu::PixelStats);
     std::string failure;
     std::string interrupted = stats.cancelled ? "rank 0" : "";
     // Two receive buffers: a worker thread merges one while this thread (the only one that
@@ -250,7 +252,9 @@ std::optional<SamplerState> MpiWorld::combine(const SamplerState& mine, RenderSt
         ~JoinOnExit() { join(); }
     } joinOnExit{joinMerger};
     for (int r = 1; r < size_; ++r) {
+        Timer waiting;  // until rank r has finished sampling
         const json header = json::parse(receiveText(r, kTagHeader, phase));
+        d.waitMs += waiting.ms();
         const std::string status = header.at("status").get<std::string>();
         const std::string rank = "rank " + std::to_string(r);
         if (status == "failed") {
@@ -286,7 +290,7 @@ std::optional<SamplerState> MpiWorld::combine(const SamplerState& mine, RenderSt
     }
     joinMerger();
     phase_ = Phase::Combined;
-    d.mergeMs = timer.ms();
+    d.mergeMs = timer.ms() - d.waitMs;
     if (!failure.empty()) throw Error(failure);
     if (!interrupted.empty())
         throw Interrupted("sampling", " (" + interrupted + " was interrupted; every rank stops)");
@@ -308,11 +312,11 @@ int MpiWorld::finish(int exitCode) {
     return exitCode;
 }
 
-void MpiWorld::agree(const ExrAttributes&, const std::string&) {}
+void MpiWorld::agree(const ExrAttributes&, const std::string&, double*) {}
 
 void MpiWorld::fail(const std::string&, bool) {}
 
-std::optional<SamplerState> MpiWorld::combine(const SamplerState& mine, RenderStats&) {
+std::optional<SamplerState> MpiWorld::combine(SamplerState mine, RenderStats&) {
     return mine;
 }
 

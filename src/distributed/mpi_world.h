@@ -47,14 +47,16 @@ public:
     // render's identity, spp or time), `failure` its error so far ("" if none). Returns if
     // every rank is ready and describes the same render as rank 0; else throws gdpt::Error on
     // every rank, naming the first rank that failed (and why) or differs (and in what).
-    void agree(const ExrAttributes& description, const std::string& failure);
+    // `timeBudget`, if given, becomes rank 0's on every rank (a timed render's sampling budget,
+    // so that all ranks stop sampling together).
+    void agree(const ExrAttributes& description, const std::string& failure, double* timeBudget = nullptr);
 
     // RenderOptions::combine of a rank: sends this rank's statistics and counters to rank 0
     // (returns nothing), or on rank 0 receives every other rank's in rank order, merges them
     // into its own and returns the merge (adding their counters to `stats`). Throws on rank 0
     // if a rank failed or was interrupted (after receiving what the others sent, so every
     // rank ends cleanly).
-    std::optional<SamplerState> combine(const SamplerState& mine, RenderStats& stats);
+    std::optional<SamplerState> combine(SamplerState mine, RenderStats& stats);
 
     // A rank that fails after agree() and before combine() tells rank 0, which reports it at
     // its combine (rank 0 itself failing then ends the job in finish()).

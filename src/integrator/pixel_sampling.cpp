@@ -102,7 +102,7 @@ void PixelSampling::run(const std::function<Image()>& preview) {
         mine.spp = stats_.spp;
         mine.batches = stats_.batches;
         if (!stats_.cancelled) snapshot(mine);
-        std::optional<SamplerState> merged = options_.combine(mine, stats_);
+        std::optional<SamplerState> merged = options_.combine(std::move(mine), stats_);
         if (!merged) {
             stats_.handedOff = true;
             return;

@@ -69,7 +69,7 @@ struct RenderOptions {
     // statistics the method's later stages continue from (the merge over every process, on the
     // process that finishes the render), or nothing (the others, and a shard that writes its
     // statistics: the method stops after sampling and returns no layers, stats.handedOff).
-    std::function<std::optional<SamplerState>(const SamplerState& mine, RenderStats& stats)> combine;
+    std::function<std::optional<SamplerState>(SamplerState mine, RenderStats& stats)> combine;
 };
 
 // One screened Poisson reconstruction of a render (G-PT): the solver's report in brief.
@@ -88,7 +88,8 @@ struct DistributedStats {
     std::uint32_t parts = 1;               // processes (ranks) or shards; 1: not split
     std::vector<std::uint32_t> partSpp;    // samples per pixel each part took, in part order
     std::uint64_t bytesPerPart = 0;        // statistics each part sent (or wrote)
-    double mergeMs = 0.0;                  // gathering and merging them (rank 0, or gdpt merge)
+    double mergeMs = 0.0;                  // receiving and merging them (rank 0, or gdpt merge)
+    double waitMs = 0.0;                   // rank 0 waiting for the other ranks to end sampling
 };
 
 struct RenderStats {
