@@ -20,6 +20,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <nlohmann/json.hpp>
+#include <tuple>
 #include <string>
 #include <vector>
 
@@ -175,7 +177,7 @@ TEST_P(DistributedCli, MpiRanksEqualTheMergeOfAsManyShards) {
 
 INSTANTIATE_TEST_SUITE_P(Methods, DistributedCli, ::testing::Values("pt", "gpt"));
 
-class DistributedFailures : public test::TempDirTest {
+class DistributedRuns : public test::TempDirTest {
 protected:
     [[nodiscard]] static std::string render(const std::string& extra) {
         return "render " + kScene + " --width 24 --height 16 --spp 4 --quiet " + extra;
@@ -186,7 +188,7 @@ protected:
     }
 };
 
-TEST_F(DistributedFailures, ARankThatFailsOrDiesEndsTheRunWithNoOutput) {
+TEST_F(DistributedRuns, ARankThatFailsOrDiesEndsTheRunWithNoOutput) {
     if (!mpiUsable()) GTEST_SKIP() << "gdpt was built without MPI, or mpirun is not Open MPI's";
     const std::string out = " -o " + path("out.exr") + " --json " + path("out.json");
     RunResult r = test::runShell(mpirun(3, "GDPT_TEST_RANK_FAULT=2:sampling") + render(out));
@@ -202,7 +204,7 @@ TEST_F(DistributedFailures, ARankThatFailsOrDiesEndsTheRunWithNoOutput) {
     expectNoOutput();
 }
 
-TEST_F(DistributedFailures, RanksThatWouldRenderDifferentImagesAreRefusedBeforeSampling) {
+TEST_F(DistributedRuns, RanksThatWouldRenderDifferentImagesAreRefusedBeforeSampling) {
     if (!mpiUsable()) GTEST_SKIP() << "gdpt was built without MPI, or mpirun is not Open MPI's";
     // Each rank its own seed: the shell expands the rank Open MPI gives it.
     const RunResult r = test::runShell(mpiLauncher(2) + "sh -c 'exec " + test::gdptBinary() + " " +
@@ -213,7 +215,38 @@ TEST_F(DistributedFailures, RanksThatWouldRenderDifferentImagesAreRefusedBeforeS
     expectNoOutput();
 }
 
-TEST_F(DistributedFailures, BadShardsAndSplitsAreRefusedByName) {
+// --time: every part samples for the budget, and the merge counts what each took.
+TEST_F(DistributedRuns, TimedPartsSampleForTheBudgetAndTheMergeCountsWhatEachTook) {
+    const auto partSpp = [](const std::string& json) {
+        const nlohmann::json j = nlohmann::json::parse(json);
+        return std::make_pair(j.at("spp").get<std::uint32_t>(),
+                              j.at("distributed").at("part_spp").get<std::vector<std::uint32_t>>());
+    };
+    const std::string timed = "render " + kScene + " --width 24 --height 16 --method pt --quiet --time 1 ";
+    for (int i : {0, 1}) {
+        const RunResult r = test::runGdpt(timed + "--shard " + std::to_string(i) + "/2 -o " +
+                                          path("t" + std::to_string(i) + ".exr"));
+        ASSERT_EQ(r.code, 0) << r.output;
+    }
+    RunResult r = test::runGdpt("merge " + path("t1.exr") + " " + path("t0.exr") + " --quiet -o " + path("m.exr") +
+                                " --json " + path("m.json"));
+    ASSERT_EQ(r.code, 0) << r.output;
+    auto [spp, parts] = partSpp(test::readText(path("m.json")));
+    ASSERT_EQ(parts.size(), 2u);
+    EXPECT_GE(parts[0], 1u);
+    EXPECT_GE(parts[1], 1u);
+    EXPECT_EQ(spp, parts[0] + parts[1]);
+    if (!mpiUsable()) GTEST_SKIP() << "gdpt was built without MPI, or mpirun is not Open MPI's";
+    r = test::runShell(mpirun(2) + timed + "-o " + path("mpi.exr") + " --json " + path("mpi.json"));
+    ASSERT_EQ(r.code, 0) << r.output;
+    std::tie(spp, parts) = partSpp(test::readText(path("mpi.json")));
+    ASSERT_EQ(parts.size(), 2u);
+    EXPECT_GE(parts[0], 1u);
+    EXPECT_GE(parts[1], 1u);
+    EXPECT_EQ(spp, parts[0] + parts[1]);
+}
+
+TEST_F(DistributedRuns, BadShardsAndSplitsAreRefusedByName) {
     for (int i : {0, 2}) {
         const RunResult r = test::runGdpt(render("--method pt --shard " + std::to_string(i) + "/3 -o " +
                                                  path("s" + std::to_string(i) + ".exr")));
