@@ -64,9 +64,12 @@ int runBenchMerge(const BenchMergeArgs& args) {
     const bool writes = !world || world->root();
     OutputSet outputs(std::vector<std::pair<std::string, std::string>>{});
     const TextOutput out(outputs, writes ? args.output : "", "-o");
-    if (world) world->agree({{"command", "bench-merge"}, {"methods", args.methods}, {"sizes", args.sizes},
-                             {"repeats", std::to_string(args.repeats)}},
-                            "");
+    if (world)
+        world->agree({{"command", "bench-merge"},
+                      {"methods", args.methods},
+                      {"sizes", args.sizes},
+                      {"repeats", std::to_string(args.repeats)}},
+                     "");
     const int parts = world ? world->size() : 2;
     json results = json::array();
     for (const std::string& method : splitList(args.methods)) {
@@ -102,15 +105,16 @@ int runBenchMerge(const BenchMergeArgs& args) {
                                {"merge_s_per_part_all", seconds},
                                {"bytes_per_s", med > 0.0 ? bytes / med : 0.0}});
             if (writes)
-                std::fprintf(stderr, "bench-merge: %s %dx%d: %.1f MiB per part, %.3f s per part\n", method.c_str(),
-                             w, h, bytes / (1024.0 * 1024.0), med);
+                std::fprintf(stderr, "bench-merge: %s %dx%d: %.1f MiB per part, %.3f s per part\n",
+                             method.c_str(), w, h, bytes / (1024.0 * 1024.0), med);
         }
     }
     if (writes) {
-        const json j = {{"command", "bench-merge"},
-                        {"ranks", world ? world->size() : 1},
-                        {"what", world ? "transfer + merge per part (MpiWorld::combine)" : "host merge per part"},
-                        {"results", results}};
+        const json j = {
+            {"command", "bench-merge"},
+            {"ranks", world ? world->size() : 1},
+            {"what", world ? "transfer + merge per part (MpiWorld::combine)" : "host merge per part"},
+            {"results", results}};
         out.write(j.dump(2) + "\n");
         outputs.commit();
     }
@@ -121,10 +125,10 @@ int runBenchMerge(const BenchMergeArgs& args) {
 
 Subcommand addBenchMergeCommand(CLI::App& app) {
     auto args = std::make_shared<BenchMergeArgs>();
-    CLI::App* b = app.add_subcommand(
-        "bench-merge",
-        "JSON: bytes and seconds per part of merging a distributed render's statistics (alone: the host merge; "
-        "under mpirun: transfer + merge on rank 0)");
+    CLI::App* b = app.add_subcommand("bench-merge",
+                                     "JSON: bytes and seconds per part of merging a distributed render's "
+                                     "statistics (alone: the host merge; "
+                                     "under mpirun: transfer + merge on rank 0)");
     b->add_option("--methods", args->methods, "Comma-separated: pt, gpt")->capture_default_str();
     b->add_option("--sizes", args->sizes, "Comma-separated image sizes, N or WxH")->capture_default_str();
     b->add_option("--repeats", args->repeats, "Repeats per size (median reported)")

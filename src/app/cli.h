@@ -43,7 +43,7 @@ struct RenderArgs {
     std::string checkpoint;        // write the sampler state here on interrupt / periodically / at the end
     double checkpointEvery = 0.0;  // seconds between periodic checkpoints (0 = only at the end)
     std::string resume;            // continue from this checkpoint
-    std::string shard;             // "I/N": render part I of N and write its statistics (distributed/shards.h)
+    std::string shard;  // "I/N": render part I of N and write its statistics (distributed/shards.h)
 };
 
 struct DiffArgs {

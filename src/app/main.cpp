@@ -23,7 +23,7 @@ int run(int argc, char** argv) {
         addRenderCommand(app),        addDiffCommand(app),  addInfoCommand(app),
         addDevicesCommand(app),       addBenchCommand(app), addConvergeCommand(app),
         addSolveCommand(app),         addCloneCommand(app), addBenchPoissonCommand(app),
-        addBenchFeaturesCommand(app), addMergeCommand(app),   addBenchMergeCommand(app),
+        addBenchFeaturesCommand(app), addMergeCommand(app), addBenchMergeCommand(app),
     };
 
     try {

@@ -50,8 +50,8 @@ int runMerge(const MergeArgs& m) {
     args.quiet = m.quiet;
     args.validate = m.validate;
     if (!m.quiet)
-        std::fprintf(stderr, "gdpt: merged %u shards (%u spp) in %.1f ms\n", merged.stats.parts, merged.state.spp,
-                     merged.stats.mergeMs);
+        std::fprintf(stderr, "gdpt: merged %u shards (%u spp) in %.1f ms\n", merged.stats.parts,
+                     merged.state.spp, merged.stats.mergeMs);
     return runRender(args, &merged);
 }
 
@@ -59,18 +59,19 @@ int runMerge(const MergeArgs& m) {
 
 Subcommand addMergeCommand(CLI::App& app) {
     auto args = std::make_shared<MergeArgs>();
-    CLI::App* c = app.add_subcommand(
-        "merge",
-        "Merge the shards of a render (gdpt render --shard I/N) and finish it: reconstruct and write the EXR, PNG "
-        "and JSON as gdpt render does (docs/distributed.md)");
+    CLI::App* c = app.add_subcommand("merge",
+                                     "Merge the shards of a render (gdpt render --shard I/N) and finish it: "
+                                     "reconstruct and write the EXR, PNG "
+                                     "and JSON as gdpt render does (docs/distributed.md)");
     c->add_option("shards", args->shards, "Every shard file of the render, in any order")
         ->required()
         ->check(InputFile);
     c->add_option("-o,--output", args->output, "Output EXR; the PNG preview is written beside it")
         ->capture_default_str();
-    c->add_option("--scene", args->scene,
-                  "The render's glTF scene, if it moved since the shards were rendered (default: the path the "
-                  "shards recorded; its fingerprint must match)")
+    c->add_option(
+         "--scene", args->scene,
+         "The render's glTF scene, if it moved since the shards were rendered (default: the path the "
+         "shards recorded; its fingerprint must match)")
         ->check(InputFile);
     c->add_option("--device", args->device, "Vulkan device index or name substring (default: lavapipe)");
     c->add_option("--json", args->json, "Write the render's statistics as JSON to this file ('-' = stdout)");

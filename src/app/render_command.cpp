@@ -4,8 +4,8 @@
 #include <sys/resource.h>
 
 #include <algorithm>
-#include <filesystem>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -254,7 +254,9 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
     const bool shard = !args.shard.empty();
     if (shard) options.share = parseSampleShare(args.shard, "--shard");
     if (world) {
-        if (shard) throw UsageError("--shard splits a render into independent jobs; under mpirun the ranks split it");
+        if (shard)
+            throw UsageError(
+                "--shard splits a render into independent jobs; under mpirun the ranks split it");
         if (!args.checkpoint.empty() || !args.resume.empty())
             throw UsageError("--checkpoint and --resume are per process: under mpirun with " +
                              std::to_string(world->size()) +
@@ -263,7 +265,8 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
     }
     if (options.share.split() && args.time <= 0.0 && args.spp < options.share.count)
         throw UsageError("--spp " + std::to_string(args.spp) + " cannot be split into " +
-                         std::to_string(options.share.count) + " parts: every part takes at least one sample "
+                         std::to_string(options.share.count) +
+                         " parts: every part takes at least one sample "
                          "per pixel");
     // Only rank 0 of mpirun writes, reports progress and finishes the render.
     const bool writes = !world || world->root();
@@ -275,7 +278,8 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
     // overwrite an input or another output. They are committed together at the end.
     OutputSet outputs({{"scene", args.scene}, {"--resume checkpoint", args.resume}});
     const StagedFile* exrFile = writes ? &outputs.add(args.output, shard ? "-o (the shard)" : "-o") : nullptr;
-    const StagedFile* pngFile = writes && !shard ? &outputs.add(previewPath(args.output), "PNG preview of -o") : nullptr;
+    const StagedFile* pngFile =
+        writes && !shard ? &outputs.add(previewPath(args.output), "PNG preview of -o") : nullptr;
     const TextOutput jsonOutput(outputs, writes ? args.json : "", "--json");
     // A checkpoint is written on its own schedule; it may continue the one resumed from.
     if (!args.checkpoint.empty()) outputs.checkSeparate(args.checkpoint, "--checkpoint", {args.resume});
@@ -309,8 +313,8 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
         ctxOptions.validation = args.validate;
         const vk::Context& ctx = context.emplace(ctxOptions);
         if (!quiet)
-            std::fprintf(stderr, "gdpt: device '%s' (%s, %s)%s\n", ctx.info().name.c_str(), ctx.info().type.c_str(),
-                         ctx.info().driverInfo.c_str(),
+            std::fprintf(stderr, "gdpt: device '%s' (%s, %s)%s\n", ctx.info().name.c_str(),
+                         ctx.info().type.c_str(), ctx.info().driverInfo.c_str(),
                          world ? (", rank 0 of " + std::to_string(world->size())).c_str() : "");
         // After the context: the integrator's device objects (G-PT's solver) go before it.
         integrator = integratorFor(args, &cache);
@@ -376,7 +380,8 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
             return world->combine(std::move(mine), stats);
         };
     } else if (shard) {
-        options.combine = [&shardState](SamplerState mine, RenderStats& stats) -> std::optional<SamplerState> {
+        options.combine = [&shardState](SamplerState mine,
+                                        RenderStats& stats) -> std::optional<SamplerState> {
             if (!stats.cancelled) shardState = std::move(mine);
             return std::nullopt;
         };
@@ -402,7 +407,8 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
     // The merge of a distributed render happens after sampling too.
     const double afterSampling =
         total.seconds() -
-        (s.readbackMs + s.reconstructionMs + (merged ? 0.0 : s.distributed.mergeMs + s.distributed.waitMs)) * 1e-3;
+        (s.readbackMs + s.reconstructionMs + (merged ? 0.0 : s.distributed.mergeMs + s.distributed.waitMs)) *
+            1e-3;
     if (s.cancelled) {
         if (!quiet)
             std::fprintf(stderr, "gdpt: interrupted after %u spp; no output written%s\n", s.spp,
@@ -442,16 +448,18 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
             s.partialPassRows ? " + 1 in the top " + std::to_string(s.partialPassRows) + " rows" : "";
         std::string parts;
         if (s.distributed.parts > 1)
-            parts = ", " + std::to_string(s.distributed.parts) + (merged ? " shards" : " ranks") + " merged in " +
-                    std::to_string(static_cast<long>(s.distributed.mergeMs)) + " ms";
+            parts = ", " + std::to_string(s.distributed.parts) + (merged ? " shards" : " ranks") +
+                    " merged in " + std::to_string(static_cast<long>(s.distributed.mergeMs)) + " ms";
         if (shard) parts = ", part " + options.share.text() + " of " + std::to_string(args.spp) + " spp";
-        std::fprintf(stderr,
-                     "gdpt: wrote %s%s (%u spp%s%s%s, %.2f s total, BVH %.1f ms, sampling %.1f ms, %.2f Mrays/s, "
-                     "%.3f Msamples/s)\n",
-                     shard ? "shard " : "", args.output.c_str(), s.spp, partial.c_str(), parts.c_str(),
-                     integrator->summary(s).c_str(), seconds, s.bvhBuildMs, s.samplingMs,
-                     double(s.raysTraced) / (s.samplingMs * 1e-3) * 1e-6,
-                     double(s.pathsCompleted) / (s.samplingMs * 1e-3) * 1e-6);
+        char sampling[160] = "";  // gdpt merge samples nothing itself
+        if (!merged)
+            std::snprintf(sampling, sizeof sampling,
+                          ", BVH %.1f ms, sampling %.1f ms, %.2f Mrays/s, %.3f Msamples/s", s.bvhBuildMs,
+                          s.samplingMs, double(s.raysTraced) / (s.samplingMs * 1e-3) * 1e-6,
+                          double(s.pathsCompleted) / (s.samplingMs * 1e-3) * 1e-6);
+        std::fprintf(stderr, "gdpt: wrote %s%s (%u spp%s%s%s, %.2f s total%s)\n", shard ? "shard " : "",
+                     args.output.c_str(), s.spp, partial.c_str(), parts.c_str(),
+                     integrator->summary(s).c_str(), seconds, sampling);
     }
     if (ctx.validationErrors() > 0) {
         std::fprintf(stderr, "gdpt: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
@@ -572,9 +580,10 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->group(budget);
 
     const char* split = "Distributed rendering (docs/distributed.md)";
-    r->add_option("--shard", a.shard,
-                  "I/N: render part I (from 0) of N of the samples and write their statistics to -o (no PNG); "
-                  "gdpt merge finishes the render. Under mpirun the ranks split the render instead")
+    r->add_option(
+         "--shard", a.shard,
+         "I/N: render part I (from 0) of N of the samples and write their statistics to -o (no PNG); "
+         "gdpt merge finishes the render. Under mpirun the ranks split the render instead")
         ->group(split);
 
     const char* diagnostics = "Device and diagnostics";

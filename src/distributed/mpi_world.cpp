@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <chrono>
-#include <functional>
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -26,8 +26,8 @@
 namespace gdpt {
 namespace {
 
-bool g_started = false;                // MPI_Init was called
-std::unique_ptr<MpiWorld> g_world;     // only for more than one rank
+bool g_started = false;             // MPI_Init was called
+std::unique_ptr<MpiWorld> g_world;  // only for more than one rank
 
 // Whether an MPI launcher started this process: Open MPI, MPICH/Hydra and PMIx set these.
 bool launchedByMpi() {
@@ -133,8 +133,8 @@ json descriptionJson(const ExrAttributes& description) {
 std::string firstDifference(const json& root, const json& other) {
     for (const auto& [key, value] : root.items())
         if (!other.contains(key) || other[key] != value)
-            return key + " " + (other.contains(key) ? other[key].get<std::string>() : "(none)") + " (rank 0: " +
-                   value.get<std::string>() + ")";
+            return key + " " + (other.contains(key) ? other[key].get<std::string>() : "(none)") +
+                   " (rank 0: " + value.get<std::string>() + ")";
     for (const auto& [key, value] : other.items())
         if (!root.contains(key)) return key + " " + value.get<std::string>() + " (rank 0: none)";
     return "";
@@ -193,7 +193,8 @@ void MpiWorld::agree(const ExrAttributes& description, const std::string& failur
             message = "rank " + std::to_string(r) + " would render another image than rank 0: " + d;
         }
     }
-    const json verdict = {{"go", message.empty()}, {"message", message}, {"time_budget", timeBudget ? *timeBudget : 0.0}};
+    const json verdict = {
+        {"go", message.empty()}, {"message", message}, {"time_budget", timeBudget ? *timeBudget : 0.0}};
     for (int r = 1; r < size_; ++r) sendText(verdict.dump(), r, kTagVerdict, phase);
     if (!message.empty()) {
         phase_ = Phase::Refused;
@@ -226,7 +227,8 @@ std::optional<SamplerState> MpiWorld::combine(SamplerState mine, RenderStats& st
         phase_ = Phase::Combined;
         sendText(header.dump(), 0, kTagHeader, phase);
         if (!stats.cancelled)
-            for (const auto& b : mine.buffers) sendBytes(b.data(), b.size() * sizeof(gpu::PixelStats), 0, phase);
+            for (const auto& b : mine.buffers)
+                sendBytes(b.data(), b.size() * sizeof(gpu::PixelStats), 0, phase);
         return std::nullopt;
     }
     Timer timer;
@@ -276,7 +278,8 @@ std::optional<SamplerState> MpiWorld::combine(SamplerState mine, RenderStats& st
             receiveBytes(into.data(), sizes[k] * sizeof(gpu::PixelStats), r, phase);
             joinMerger();  // the previous buffer (it used the other slot)
             if (failure.empty() && interrupted.empty())
-                merger = std::thread([&acc = merged.buffers[k], &into] { mergeStatsInto(acc, into.data(), into.size()); });
+                merger = std::thread(
+                    [&acc = merged.buffers[k], &into] { mergeStatsInto(acc, into.data(), into.size()); });
             slot = 1 - slot;
         }
         const auto spp = header.at("spp").get<std::uint32_t>();

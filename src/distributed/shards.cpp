@@ -53,8 +53,9 @@ MergedShards mergeShards(const std::vector<std::string>& paths) {
         Shard s{path, {}, readCheckpoint(path)};
         const auto share = s.checkpoint.identity.find("share");
         if (share == s.checkpoint.identity.end())
-            throw Error(path + ": not a shard (a checkpoint of a whole render; write shards with gdpt render "
-                               "--shard I/N)");
+            throw Error(path +
+                        ": not a shard (a checkpoint of a whole render; write shards with gdpt render "
+                        "--shard I/N)");
         try {
             s.part = parseSampleShare(share->second, "gdpt.id.share");
         } catch (const UsageError& e) {
@@ -67,15 +68,16 @@ MergedShards mergeShards(const std::vector<std::string>& paths) {
     const std::uint32_t spp = renderSpp(first);
     for (const Shard& s : shards) {
         if (s.part.count != parts)
-            throw Error(s.path + " is part " + s.part.text() + " of a render in " + std::to_string(s.part.count) +
-                        " parts, " + first.path + " is part " + first.part.text() +
-                        ": they belong to different renders");
-        if (const std::string d = identityDifference(s.checkpoint.identity, first.checkpoint.identity, first.path);
+            throw Error(s.path + " is part " + s.part.text() + " of a render in " +
+                        std::to_string(s.part.count) + " parts, " + first.path + " is part " +
+                        first.part.text() + ": they belong to different renders");
+        if (const std::string d =
+                identityDifference(s.checkpoint.identity, first.checkpoint.identity, first.path);
             !d.empty())
             throw Error(s.path + " belongs to another render than " + first.path + ": " + d);
         if (renderSpp(s) != spp)
-            throw Error(s.path + " is a part of a " + std::to_string(renderSpp(s)) + "-spp render, " + first.path +
-                        " of a " + std::to_string(spp) + "-spp render");
+            throw Error(s.path + " is a part of a " + std::to_string(renderSpp(s)) + "-spp render, " +
+                        first.path + " of a " + std::to_string(spp) + "-spp render");
     }
     std::sort(shards.begin(), shards.end(),
               [](const Shard& a, const Shard& b) { return a.part.index < b.part.index; });
@@ -98,9 +100,10 @@ MergedShards mergeShards(const std::vector<std::string>& paths) {
                     " (render them with gdpt render --shard I/" + std::to_string(parts) + ")");
     for (const Shard& s : shards)
         if (spp > 0 && s.checkpoint.state.spp != s.part.localSpp(spp))
-            throw Error(s.path + " has " + std::to_string(s.checkpoint.state.spp) + " spp; part " + s.part.text() +
-                        " of a " + std::to_string(spp) + "-spp render takes " +
-                        std::to_string(s.part.localSpp(spp)) + " (an interrupted shard? resume it with --resume)");
+            throw Error(s.path + " has " + std::to_string(s.checkpoint.state.spp) + " spp; part " +
+                        s.part.text() + " of a " + std::to_string(spp) + "-spp render takes " +
+                        std::to_string(s.part.localSpp(spp)) +
+                        " (an interrupted shard? resume it with --resume)");
 
     MergedShards out;
     Timer timer;
@@ -108,7 +111,8 @@ MergedShards mergeShards(const std::vector<std::string>& paths) {
     out.identity.erase("share");
     out.info = first.checkpoint.info;
     out.stats.parts = parts;
-    for (const auto& b : first.checkpoint.state.buffers) out.stats.bytesPerPart += b.size() * sizeof(gpu::PixelStats);
+    for (const auto& b : first.checkpoint.state.buffers)
+        out.stats.bytesPerPart += b.size() * sizeof(gpu::PixelStats);
     out.state = std::move(shards.front().checkpoint.state);
     out.stats.partSpp = {out.state.spp};
     for (std::size_t i = 1; i < shards.size(); ++i) {

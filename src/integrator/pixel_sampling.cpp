@@ -76,10 +76,10 @@ void PixelSampling::run(const std::function<Image()>& preview) {
     runBatchLoop(
         loop, label.c_str(), total_, stats_,
         [&](std::uint32_t first, std::uint32_t n, std::uint32_t rows, const std::function<void()>& onWait) {
-            const std::string samples =
-                share.split() ? std::to_string(n) + " of part " + share.text() + " from sample " +
-                                    std::to_string(share.globalSample(first))
-                              : std::to_string(first) + ".." + std::to_string(first + n - 1);
+            const std::string samples = share.split()
+                                            ? std::to_string(n) + " of part " + share.text() +
+                                                  " from sample " + std::to_string(share.globalSample(first))
+                                            : std::to_string(first) + ".." + std::to_string(first + n - 1);
             const std::string what = kind_ + " batch " + std::to_string(stats_.batches) + " (samples " +
                                      samples + ", seed " + std::to_string(options_.seed) + ")";
             submitAndWait(
@@ -90,8 +90,8 @@ void PixelSampling::run(const std::function<Image()>& preview) {
                         return;
                     }
                     for (std::uint32_t j = first; j < first + n; ++j)
-                        pass_->record(cmd, static_cast<std::uint32_t>(share.globalSample(j)), 1, options_.seed,
-                                      timer(), rows);
+                        pass_->record(cmd, static_cast<std::uint32_t>(share.globalSample(j)), 1,
+                                      options_.seed, timer(), rows);
                 },
                 onWait);
             return pass_->takeCounters();

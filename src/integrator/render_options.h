@@ -85,11 +85,11 @@ struct ReconstructionStats {
 
 // A render split across processes (sample_share.h): how its parts were merged.
 struct DistributedStats {
-    std::uint32_t parts = 1;               // processes (ranks) or shards; 1: not split
-    std::vector<std::uint32_t> partSpp;    // samples per pixel each part took, in part order
-    std::uint64_t bytesPerPart = 0;        // statistics each part sent (or wrote)
-    double mergeMs = 0.0;                  // receiving and merging them (rank 0, or gdpt merge)
-    double waitMs = 0.0;                   // rank 0 waiting for the other ranks to end sampling
+    std::uint32_t parts = 1;             // processes (ranks) or shards; 1: not split
+    std::vector<std::uint32_t> partSpp;  // samples per pixel each part took, in part order
+    std::uint64_t bytesPerPart = 0;      // statistics each part sent (or wrote)
+    double mergeMs = 0.0;                // receiving and merging them (rank 0, or gdpt merge)
+    double waitMs = 0.0;                 // rank 0 waiting for the other ranks to end sampling
 };
 
 struct RenderStats {

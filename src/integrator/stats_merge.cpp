@@ -23,8 +23,9 @@ void mergeStatsInto(std::vector<gpu::PixelStats>& acc, const gpu::PixelStats* ne
         }
     };
     // Pixels are independent: large images merge on every core (the same bits).
-    const std::size_t threads =
-        count < (std::size_t(1) << 18) ? 1 : std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 8);
+    const std::size_t threads = count < (std::size_t(1) << 18)
+                                    ? 1
+                                    : std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 8);
     std::vector<std::thread> workers;
     const std::size_t step = (count + threads - 1) / threads;
     for (std::size_t t = 1; t < threads; ++t)

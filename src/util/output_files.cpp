@@ -1,8 +1,6 @@
 // output_files.cpp — staged, checked, unique and grouped output files (POSIX).
 #include "util/output_files.h"
 
-#include "util/interrupt.h"
-
 #include <fcntl.h>
 #include <sys/file.h>
 #include <sys/stat.h>
@@ -16,6 +14,7 @@
 #include <set>
 
 #include "util/error.h"
+#include "util/interrupt.h"
 
 namespace gdpt {
 namespace {

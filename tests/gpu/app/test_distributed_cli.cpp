@@ -21,8 +21,8 @@
 #include <cmath>
 #include <cstring>
 #include <nlohmann/json.hpp>
-#include <tuple>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "cli_runner.h"
@@ -65,9 +65,9 @@ std::vector<std::pair<std::string, std::string>> statisticLayers(const std::stri
 }
 
 struct BoundCheck {
-    std::size_t values = 0;      // channel values with variance
-    std::size_t beyond = 0;      // of which beyond the rounding bound
-    double worstRatio = 0.0;     // largest |a − b| / bound over all values
+    std::size_t values = 0;   // channel values with variance
+    std::size_t beyond = 0;   // of which beyond the rounding bound
+    double worstRatio = 0.0;  // largest |a − b| / bound over all values
 };
 
 // Compares the statistics layers of `a` and `b` against the rounding bound of the header.
@@ -104,8 +104,9 @@ bool mpiUsable() {
 // mpirun of Open MPI as the tests run it: as root if need be (CI runs as root), more ranks
 // than cores allowed.
 std::string mpiLauncher(int ranks, const std::string& env = "") {
-    return "env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 " + env +
-           " mpirun -n " + std::to_string(ranks) + " ";
+    return "env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
+           "OMPI_MCA_rmaps_base_oversubscribe=1 " +
+           env + " mpirun -n " + std::to_string(ranks) + " ";
 }
 std::string mpirun(int ranks, const std::string& env = "") {
     return mpiLauncher(ranks, env) + test::gdptBinary() + " ";
@@ -119,8 +120,9 @@ protected:
     }
     void renderShards(int parts, const std::string& prefix) const {
         for (int i = 0; i < parts; ++i) {
-            const RunResult r = test::runGdpt(render("--shard " + std::to_string(i) + "/" + std::to_string(parts) +
-                                                     " -o " + path(prefix + std::to_string(i) + ".exr")));
+            const RunResult r =
+                test::runGdpt(render("--shard " + std::to_string(i) + "/" + std::to_string(parts) + " -o " +
+                                     path(prefix + std::to_string(i) + ".exr")));
             ASSERT_EQ(r.code, 0) << r.output;
         }
     }
@@ -147,7 +149,8 @@ TEST_P(DistributedCli, ShardsMergedInAnyOrderEqualOneProcessUpToRounding) {
     const Image &x = layer(merged, ""), &y = layer(one, "");
     for (int c = 0; c < 3; ++c)
         for (std::size_t i = 0; i < x.pixelCount(); ++i)
-            EXPECT_NEAR(x.plane(c)[i], y.plane(c)[i], 1e-4 * (1.0 + std::abs(y.plane(c)[i]))) << "pixel " << i;
+            EXPECT_NEAR(x.plane(c)[i], y.plane(c)[i], 1e-4 * (1.0 + std::abs(y.plane(c)[i])))
+                << "pixel " << i;
 
     // Power: other samples of the same pixels (another seed) break the bound almost everywhere.
     r = test::runGdpt(render("-o " + path("other.exr"), /*seed=*/4));
@@ -165,8 +168,8 @@ TEST_P(DistributedCli, MpiRanksEqualTheMergeOfAsManyShards) {
         for (int i = 0; i < ranks; ++i) shards += " " + path("shard" + n + "_" + std::to_string(i) + ".exr");
         RunResult r = test::runGdpt("merge" + shards + " -o " + path("merged" + n + ".exr") + " --quiet");
         ASSERT_EQ(r.code, 0) << r.output;
-        r = test::runShell(mpirun(ranks) + render("-o " + path("mpi" + n + ".exr") + " --json " +
-                                                  path("mpi" + n + ".json")));
+        r = test::runShell(mpirun(ranks) +
+                           render("-o " + path("mpi" + n + ".exr") + " --json " + path("mpi" + n + ".json")));
         ASSERT_EQ(r.code, 0) << r.output;
         expectSameLayers(path("mpi" + n + ".exr"), path("merged" + n + ".exr"));
         const std::string json = test::readText(path("mpi" + n + ".json"));
@@ -193,7 +196,8 @@ TEST_F(DistributedRuns, ARankThatFailsOrDiesEndsTheRunWithNoOutput) {
     const std::string out = " -o " + path("out.exr") + " --json " + path("out.json");
     RunResult r = test::runShell(mpirun(3, "GDPT_TEST_RANK_FAULT=2:sampling") + render(out));
     EXPECT_NE(r.code, 0);
-    EXPECT_NE(r.output.find("rank 2 failed: simulated failure while sampling"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("rank 2 failed: simulated failure while sampling"), std::string::npos)
+        << r.output;
     expectNoOutput();
     r = test::runShell(mpirun(2, "GDPT_TEST_RANK_FAULT=1:loading") + render(out));
     EXPECT_NE(r.code, 0);
@@ -210,7 +214,8 @@ TEST_F(DistributedRuns, RanksThatWouldRenderDifferentImagesAreRefusedBeforeSampl
     const RunResult r = test::runShell(mpiLauncher(2) + "sh -c 'exec " + test::gdptBinary() + " " +
                                        render("-o " + path("out.exr")) + " --seed $OMPI_COMM_WORLD_RANK'");
     EXPECT_NE(r.code, 0);
-    EXPECT_NE(r.output.find("rank 1 would render another image than rank 0: seed 1 (rank 0: 0)"), std::string::npos)
+    EXPECT_NE(r.output.find("rank 1 would render another image than rank 0: seed 1 (rank 0: 0)"),
+              std::string::npos)
         << r.output;
     expectNoOutput();
 }
@@ -228,8 +233,8 @@ TEST_F(DistributedRuns, TimedPartsSampleForTheBudgetAndTheMergeCountsWhatEachToo
                                           path("t" + std::to_string(i) + ".exr"));
         ASSERT_EQ(r.code, 0) << r.output;
     }
-    RunResult r = test::runGdpt("merge " + path("t1.exr") + " " + path("t0.exr") + " --quiet -o " + path("m.exr") +
-                                " --json " + path("m.json"));
+    RunResult r = test::runGdpt("merge " + path("t1.exr") + " " + path("t0.exr") + " --quiet -o " +
+                                path("m.exr") + " --json " + path("m.json"));
     ASSERT_EQ(r.code, 0) << r.output;
     auto [spp, parts] = partSpp(test::readText(path("m.json")));
     ASSERT_EQ(parts.size(), 2u);

@@ -40,10 +40,11 @@ protected:
     // Writes part `part` of a `spp`-spp render; `seed` stands for any identity entry.
     std::string shard(const std::string& name, SampleShare part, std::uint32_t spp, std::uint32_t seed = 7,
                       std::uint32_t samples = ~0u) const {
-        const ExrAttributes identity = {{"scene_fingerprint", "0123"}, {"method", "pt"},
-                                        {"width", std::to_string(kW)}, {"height", std::to_string(kH)},
+        const ExrAttributes identity = {{"scene_fingerprint", "0123"},  {"method", "pt"},
+                                        {"width", std::to_string(kW)},  {"height", std::to_string(kH)},
                                         {"seed", std::to_string(seed)}, {"share", part.text()}};
-        const ExrAttributes info = {{"render_spp", std::to_string(spp)}, {"render_args", "{}"},
+        const ExrAttributes info = {{"render_spp", std::to_string(spp)},
+                                    {"render_args", "{}"},
                                     {"scene_path", "/nowhere/scene.gltf"}};
         const std::string p = path(name);
         writeCheckpoint(p, identity, info, shardState(part, samples == ~0u ? part.localSpp(spp) : samples));
@@ -61,7 +62,8 @@ protected:
 };
 
 TEST_F(Shards, MergeInPartOrderWhateverTheOrderGiven) {
-    const std::string a = shard("a.exr", {0, 3}, 10), b = shard("b.exr", {1, 3}, 10), c = shard("c.exr", {2, 3}, 10);
+    const std::string a = shard("a.exr", {0, 3}, 10), b = shard("b.exr", {1, 3}, 10),
+                      c = shard("c.exr", {2, 3}, 10);
     const MergedShards inOrder = mergeShards({a, b, c});
     EXPECT_EQ(inOrder.state.spp, 10u);
     EXPECT_EQ(inOrder.stats.parts, 3u);
@@ -84,7 +86,8 @@ TEST_F(Shards, MergeInPartOrderWhateverTheOrderGiven) {
 }
 
 TEST_F(Shards, MissingDuplicatedAndForeignShardsAreRefusedByName) {
-    const std::string a = shard("a.exr", {0, 3}, 10), b = shard("b.exr", {1, 3}, 10), c = shard("c.exr", {2, 3}, 10);
+    const std::string a = shard("a.exr", {0, 3}, 10), b = shard("b.exr", {1, 3}, 10),
+                      c = shard("c.exr", {2, 3}, 10);
     std::string e = mergeError({a, c});
     EXPECT_NE(e.find("1 of the 3 parts are missing: 1/3"), std::string::npos) << e;
     e = mergeError({a, b, shard("b2.exr", {1, 3}, 10), c});
@@ -104,8 +107,8 @@ TEST_F(Shards, MissingDuplicatedAndForeignShardsAreRefusedByName) {
 
 TEST_F(Shards, AWholeRendersCheckpointIsNotAShard) {
     const std::string whole = path("whole.exr");
-    writeCheckpoint(whole, {{"scene_fingerprint", "0123"}, {"method", "pt"}, {"width", "4"}, {"height", "3"}}, {},
-                    shardState({0, 1}, 5));
+    writeCheckpoint(whole, {{"scene_fingerprint", "0123"}, {"method", "pt"}, {"width", "4"}, {"height", "3"}},
+                    {}, shardState({0, 1}, 5));
     const std::string e = mergeError({whole});
     EXPECT_NE(e.find("whole.exr: not a shard"), std::string::npos) << e;
 }

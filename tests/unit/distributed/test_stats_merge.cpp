@@ -64,7 +64,8 @@ TEST(StatsMerge, StatesMergeBufferByBufferAndCountTheirSamples) {
     a.nextBatch = 4;
     a.buffers = {std::vector<PixelStats>(4, fold({{1, 1, 1}, {2, 2, 2}, {3, 3, 3}})),
                  std::vector<PixelStats>(4, PixelStats{})};  // e.g. a pass that took nothing
-    b.buffers = {std::vector<PixelStats>(4, fold({{4, 4, 4}, {5, 5, 5}})), std::vector<PixelStats>(4, PixelStats{})};
+    b.buffers = {std::vector<PixelStats>(4, fold({{4, 4, 4}, {5, 5, 5}})),
+                 std::vector<PixelStats>(4, PixelStats{})};
     mergeStateInto(a, b);
     EXPECT_EQ(a.spp, 5u);
     EXPECT_EQ(a.nextBatch, 4u);
