@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <string>
 #include <vector>
 
 #include "app/subcommand.h"
@@ -35,8 +36,16 @@ int run(int argc, char** argv) {
         return 1;
     }
     try {
-        for (const Subcommand& c : commands)
-            if (*c.app) return c.run();
+        for (const Subcommand& c : commands) {
+            if (!*c.app) continue;
+            // Under mpirun only these commands split their work; any other would run N times.
+            const std::string name = c.app->get_name();
+            if (MpiWorld::get() && name != "render" && name != "bench-merge")
+                throw UsageError("gdpt " + name +
+                                 " does not split across MPI ranks; run it without mpirun (only "
+                                 "render and bench-merge do)");
+            return c.run();
+        }
     } catch (const ReportedElsewhere&) {  // rank 0 of an MPI render reports it
         return 1;
     } catch (const UsageError& e) {
