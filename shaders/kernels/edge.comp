@@ -30,8 +30,12 @@
 layout(local_size_x_id = kSpecWorkgroupX, local_size_y_id = kSpecWorkgroupY) in;
 
 #include "lib/scene_buffers.glsl"
-layout(set = 0, binding = kBindGptEdgeMask, scalar) buffer EdgeMaskBuf { uint edgeMask[]; };
-layout(set = 0, binding = kBindGptEdgeProbe, scalar) buffer EdgeProbeBuf { EdgeProbe edgeProbe[]; };
+#include "lib/pixel_buffers.glsl"
+layout(buffer_reference, scalar, buffer_reference_align = 4) buffer EdgeProbeArray { EdgeProbe v[]; };
+GDPT_PIXEL_BUFFER(kBindGptEdgeMask, UintArray, edgeMask);
+#define edgeMask edgeMask_.v
+GDPT_PIXEL_BUFFER(kBindGptEdgeProbe, EdgeProbeArray, edgeProbe);
+#define edgeProbe edgeProbe_.v
 
 #include "lib/scene_access.glsl"
 #define GDPT_ANYHIT_FILTER(tri, u, v) alphaPasses(tri, u, v)

@@ -38,8 +38,11 @@ layout(local_size_x_id = kSpecWorkgroupX, local_size_y_id = kSpecWorkgroupY) in;
 
 #include "lib/scene_buffers.glsl"
 layout(set = 0, binding = kBindCounters, scalar) buffer CounterBuf { Counters counters; };
-layout(set = 0, binding = kBindVisibleStats, scalar) buffer VisibleStatsBuf { PixelStats visibleStats[]; };
-layout(set = 0, binding = kBindVisibleProbe, scalar) buffer VisibleProbeBuf { uint probe[]; };
+#include "lib/pixel_buffers.glsl"
+GDPT_PIXEL_BUFFER(kBindVisibleStats, PixelStatsArray, visibleStats);
+#define visibleStats visibleStats_.v
+GDPT_PIXEL_BUFFER(kBindVisibleProbe, UintArray, probe);
+#define probe probe_.v
 layout(set = 0, binding = kBindVisibleCounter, scalar) buffer VisibleCounterBuf { VisibleCounter visibleCounter; };
 layout(push_constant, scalar) uniform Push { VisibleParams params; };
 

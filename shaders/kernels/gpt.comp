@@ -51,19 +51,33 @@ layout(local_size_x_id = kSpecWorkgroupX, local_size_y_id = kSpecWorkgroupY) in;
 
 #include "lib/scene_buffers.glsl"
 layout(set = 0, binding = kBindCounters, scalar) buffer CounterBuf { Counters counters; };
-layout(set = 0, binding = kBindGptCentral, scalar) buffer CentralBuf { PixelStats statCentral[]; };
-layout(set = 0, binding = kBindGptNeighbor0, scalar) buffer Neighbor0Buf { PixelStats statNeighbor0[]; };
-layout(set = 0, binding = kBindGptNeighbor1, scalar) buffer Neighbor1Buf { PixelStats statNeighbor1[]; };
-layout(set = 0, binding = kBindGptNeighbor2, scalar) buffer Neighbor2Buf { PixelStats statNeighbor2[]; };
-layout(set = 0, binding = kBindGptNeighbor3, scalar) buffer Neighbor3Buf { PixelStats statNeighbor3[]; };
-layout(set = 0, binding = kBindGptGradient0, scalar) buffer Gradient0Buf { PixelStats statGradient0[]; };
-layout(set = 0, binding = kBindGptGradient1, scalar) buffer Gradient1Buf { PixelStats statGradient1[]; };
-layout(set = 0, binding = kBindGptGradient2, scalar) buffer Gradient2Buf { PixelStats statGradient2[]; };
-layout(set = 0, binding = kBindGptGradient3, scalar) buffer Gradient3Buf { PixelStats statGradient3[]; };
-layout(set = 0, binding = kBindGptDirect, scalar) buffer DirectBuf { PixelStats statDirect[]; };
-layout(set = 0, binding = kBindGptEdgeList, scalar) readonly buffer EdgeListBuf { uint edgeList[]; };
-layout(set = 0, binding = kBindGptDemodMask, scalar) readonly buffer DemodMaskBuf { uint demodMask[]; };
-layout(set = 0, binding = kBindGptModulation, scalar) buffer ModulationBuf { PixelStats statModulation[]; };
+#include "lib/pixel_buffers.glsl"
+GDPT_PIXEL_BUFFER(kBindGptCentral, PixelStatsArray, statCentral);
+#define statCentral statCentral_.v
+GDPT_PIXEL_BUFFER(kBindGptNeighbor0, PixelStatsArray, statNeighbor0);
+#define statNeighbor0 statNeighbor0_.v
+GDPT_PIXEL_BUFFER(kBindGptNeighbor1, PixelStatsArray, statNeighbor1);
+#define statNeighbor1 statNeighbor1_.v
+GDPT_PIXEL_BUFFER(kBindGptNeighbor2, PixelStatsArray, statNeighbor2);
+#define statNeighbor2 statNeighbor2_.v
+GDPT_PIXEL_BUFFER(kBindGptNeighbor3, PixelStatsArray, statNeighbor3);
+#define statNeighbor3 statNeighbor3_.v
+GDPT_PIXEL_BUFFER(kBindGptGradient0, PixelStatsArray, statGradient0);
+#define statGradient0 statGradient0_.v
+GDPT_PIXEL_BUFFER(kBindGptGradient1, PixelStatsArray, statGradient1);
+#define statGradient1 statGradient1_.v
+GDPT_PIXEL_BUFFER(kBindGptGradient2, PixelStatsArray, statGradient2);
+#define statGradient2 statGradient2_.v
+GDPT_PIXEL_BUFFER(kBindGptGradient3, PixelStatsArray, statGradient3);
+#define statGradient3 statGradient3_.v
+GDPT_PIXEL_BUFFER(kBindGptDirect, PixelStatsArray, statDirect);
+#define statDirect statDirect_.v
+GDPT_PIXEL_BUFFER(kBindGptEdgeList, UintArray, edgeList);
+#define edgeList edgeList_.v
+GDPT_PIXEL_BUFFER(kBindGptDemodMask, UintArray, demodMask);
+#define demodMask demodMask_.v
+GDPT_PIXEL_BUFFER(kBindGptModulation, PixelStatsArray, statModulation);
+#define statModulation statModulation_.v
 layout(constant_id = kSpecGptDemodulate) const bool kDemodulate = false;
 layout(push_constant, scalar) uniform Push { GptFrameParams frame; };
 

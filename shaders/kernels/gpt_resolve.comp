@@ -31,18 +31,31 @@
 
 layout(local_size_x_id = kSpecWorkgroupX, local_size_y_id = kSpecWorkgroupY) in;
 
-layout(set = 0, binding = kBindGptCentral, scalar) readonly buffer CentralBuf { PixelStats statCentral[]; };
-layout(set = 0, binding = kBindGptNeighbor0, scalar) readonly buffer Neighbor0Buf { PixelStats statNeighbor0[]; };
-layout(set = 0, binding = kBindGptNeighbor1, scalar) readonly buffer Neighbor1Buf { PixelStats statNeighbor1[]; };
-layout(set = 0, binding = kBindGptNeighbor2, scalar) readonly buffer Neighbor2Buf { PixelStats statNeighbor2[]; };
-layout(set = 0, binding = kBindGptNeighbor3, scalar) readonly buffer Neighbor3Buf { PixelStats statNeighbor3[]; };
-layout(set = 0, binding = kBindGptGradient0, scalar) readonly buffer Gradient0Buf { PixelStats statGradient0[]; };
-layout(set = 0, binding = kBindGptGradient1, scalar) readonly buffer Gradient1Buf { PixelStats statGradient1[]; };
-layout(set = 0, binding = kBindGptGradient2, scalar) readonly buffer Gradient2Buf { PixelStats statGradient2[]; };
-layout(set = 0, binding = kBindGptGradient3, scalar) readonly buffer Gradient3Buf { PixelStats statGradient3[]; };
-layout(set = 0, binding = kBindGptDirect, scalar) readonly buffer DirectBuf { PixelStats statDirect[]; };
+#include "lib/pixel_buffers.glsl"
+GDPT_PIXEL_BUFFER(kBindGptCentral, PixelStatsArray, statCentral);
+#define statCentral statCentral_.v
+GDPT_PIXEL_BUFFER(kBindGptNeighbor0, PixelStatsArray, statNeighbor0);
+#define statNeighbor0 statNeighbor0_.v
+GDPT_PIXEL_BUFFER(kBindGptNeighbor1, PixelStatsArray, statNeighbor1);
+#define statNeighbor1 statNeighbor1_.v
+GDPT_PIXEL_BUFFER(kBindGptNeighbor2, PixelStatsArray, statNeighbor2);
+#define statNeighbor2 statNeighbor2_.v
+GDPT_PIXEL_BUFFER(kBindGptNeighbor3, PixelStatsArray, statNeighbor3);
+#define statNeighbor3 statNeighbor3_.v
+GDPT_PIXEL_BUFFER(kBindGptGradient0, PixelStatsArray, statGradient0);
+#define statGradient0 statGradient0_.v
+GDPT_PIXEL_BUFFER(kBindGptGradient1, PixelStatsArray, statGradient1);
+#define statGradient1 statGradient1_.v
+GDPT_PIXEL_BUFFER(kBindGptGradient2, PixelStatsArray, statGradient2);
+#define statGradient2 statGradient2_.v
+GDPT_PIXEL_BUFFER(kBindGptGradient3, PixelStatsArray, statGradient3);
+#define statGradient3 statGradient3_.v
+GDPT_PIXEL_BUFFER(kBindGptDirect, PixelStatsArray, statDirect);
+#define statDirect statDirect_.v
 #include "lib/visible_emission.glsl"
-layout(set = 0, binding = kBindGptResolved, scalar) writeonly buffer ResolvedBuf { GptResolved resolved[]; };
+layout(buffer_reference, scalar, buffer_reference_align = 4) buffer GptResolvedArray { GptResolved v[]; };
+GDPT_PIXEL_BUFFER(kBindGptResolved, GptResolvedArray, resolved);
+#define resolved resolved_.v
 layout(push_constant, scalar) uniform Push { GptFrameParams frame; };
 
 void main() {

@@ -16,7 +16,9 @@
 layout(local_size_x_id = kSpecWorkgroupX, local_size_y_id = kSpecWorkgroupY) in;
 
 #include "lib/scene_buffers.glsl"
-layout(set = 0, binding = kBindAccum, scalar) buffer AccumBuf { PixelStats accum[]; };
+#include "lib/pixel_buffers.glsl"
+GDPT_PIXEL_BUFFER(kBindAccum, PixelStatsArray, accum);
+#define accum accum_.v
 layout(set = 0, binding = kBindCounters, scalar) buffer CounterBuf { Counters counters; };
 layout(push_constant, scalar) uniform Push { FrameParams frame; };
 

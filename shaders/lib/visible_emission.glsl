@@ -8,7 +8,9 @@
 // Off (the pass disabled: nothing in the scene the camera could see emit, or the user's
 // choice): the read is compiled out and the binding holds a placeholder.
 layout(constant_id = kSpecVisibleEmission) const bool kVisibleEmission = true;
-layout(set = 0, binding = kBindVisibleStats, scalar) readonly buffer VisibleStatsBuf { PixelStats visibleStats[]; };
+#include "lib/pixel_buffers.glsl"
+GDPT_PIXEL_BUFFER(kBindVisibleStats, PixelStatsArray, visibleStats);
+#define visibleStats visibleStats_.v
 
 bool emissionSupersampled(uint pixel) { return kVisibleEmission && visibleStats[pixel].count > 0u; }
 

@@ -76,10 +76,11 @@ RenderOutput GptIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     // compile.
     RenderOptions sampling = options;
     if (!solveList.empty()) {
-        PoissonSolverGpu& solverGpu = solver(ctx, width, height);
+        // The solver's fields are allocated here, after the sampling pass has checked that the
+        // image's per-pixel buffers fit the device (an image too large is refused at once).
         sampling.whileCompiling = [&] {
             if (options.whileCompiling) options.whileCompiling();
-            solverGpu.preparePipelines(solveList);
+            solver(ctx, width, height).preparePipelines(solveList);
         };
     }
     RenderResultGpt g = renderGpt(ctx, scene, sampling, options_.sampling);

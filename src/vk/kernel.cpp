@@ -216,6 +216,16 @@ void Kernel::bind(std::uint32_t binding, const Buffer& buffer) {
     vkUpdateDescriptorSets(ctx_.device(), 1, &write, 0, nullptr);
 }
 
+void Kernel::bindAddress(std::uint32_t binding, const Buffer& target) {
+    auto it = addresses_.find(binding);
+    if (it == addresses_.end())
+        it = addresses_.emplace(binding, Buffer(ctx_, sizeof(std::uint64_t), desc_.name + " address of " + target.name()))
+                 .first;
+    const std::uint64_t address = target.deviceAddress();
+    it->second.upload(&address, sizeof address);
+    bind(binding, it->second);
+}
+
 VkBufferView Kernel::createTexelView(const Buffer& buffer, VkFormat format) const {
     // The view covers the whole texels of the buffer.
     const std::uint64_t bytesPerTexel = texelBytes(format);

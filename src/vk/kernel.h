@@ -9,10 +9,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <future>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "vk/buffer.h"
 #include "vk/handle.h"
 
 namespace gdpt::vk {
@@ -91,6 +93,11 @@ public:
     // texels it holds, which the kernel owns). Not while a submitted command buffer that
     // uses this kernel is pending.
     void bind(std::uint32_t binding, const Buffer& buffer);
+    // Points `binding` at an 8-byte buffer (owned by the kernel) that holds `target`'s device
+    // address: for the per-pixel buffers the kernels reach through a buffer reference
+    // (shaders/lib/pixel_buffers.glsl), which maxStorageBufferRange does not limit. `target`
+    // must outlive the kernel's use of it.
+    void bindAddress(std::uint32_t binding, const Buffer& target);
     // Records bind + push constants + dispatch of groups (x, y, z). With a timer, the
     // dispatch is wrapped in a named timestamp scope.
     void dispatch(VkCommandBuffer cmd, std::uint32_t x, std::uint32_t y, std::uint32_t z,
@@ -127,6 +134,7 @@ private:
     Handle<VkDescriptorPool> pool_;
     VkDescriptorSet set_ = VK_NULL_HANDLE;
     std::vector<std::pair<std::uint32_t, Handle<VkBufferView>>> views_;  // texel bindings' views
+    std::map<std::uint32_t, Buffer> addresses_;  // bindAddress's 8-byte buffers, per binding
 };
 
 }  // namespace gdpt::vk

@@ -43,13 +43,11 @@ EdgePass::EdgePass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize
                    "edge probe"),
       list_(ctx, 0, "edge list") {
     if (!enabled()) return;
-    ctx.checkStorageBufferSize(maskBuffer_.size(), "the edge mask of a " + std::to_string(width_) + "x" +
-                                                       std::to_string(height_) + " image");
     vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("edge", GDPT_KERNEL_SPIRV(edge)), wg,
                                         {gpu::kBindGptEdgeMask, gpu::kBindGptEdgeProbe}, 0);
     kernel_.emplace(ctx, d, creation);
-    kernel_->bind(gpu::kBindGptEdgeMask, maskBuffer_);
-    kernel_->bind(gpu::kBindGptEdgeProbe, probeBuffer_);
+    kernel_->bindAddress(gpu::kBindGptEdgeMask, maskBuffer_);
+    kernel_->bindAddress(gpu::kBindGptEdgeProbe, probeBuffer_);
 }
 
 void EdgePass::attach(const SceneGpu& scene) {
@@ -61,7 +59,7 @@ void EdgePass::configure(vk::KernelDesc& desc) {
 }
 
 void EdgePass::bindTo(vk::Kernel& kernel) const {
-    kernel.bind(gpu::kBindGptEdgeList, list_);
+    kernel.bindAddress(gpu::kBindGptEdgeList, list_);
 }
 
 void EdgePass::find(vk::CommandStream& stream) {

@@ -48,17 +48,14 @@ EmitterSupersamplingPass::EmitterSupersamplingPass(const vk::Context& ctx, const
              "emitter-supersampling probe"),
       counter_(ctx, sizeof(gpu::VisibleCounter), "emitter-supersampling counter") {
     if (!enabled()) return;
-    ctx.checkStorageBufferSize(stats_.size(), "the emitter-supersampling statistics of a " +
-                                                  std::to_string(width_) + "x" + std::to_string(height_) +
-                                                  " image");
     vk::KernelDesc d = scene.kernelDesc(
         vk::kernelDesc("emitter_supersampling", GDPT_KERNEL_SPIRV(emitter_supersampling)), wg,
         {gpu::kBindCounters, gpu::kBindVisibleStats, gpu::kBindVisibleProbe, gpu::kBindVisibleCounter},
         sizeof(gpu::VisibleParams));
     kernel_.emplace(ctx, d, creation);
     kernel_->bind(gpu::kBindCounters, counters);
-    kernel_->bind(gpu::kBindVisibleStats, stats_);
-    kernel_->bind(gpu::kBindVisibleProbe, probe_);
+    kernel_->bindAddress(gpu::kBindVisibleStats, stats_);
+    kernel_->bindAddress(gpu::kBindVisibleProbe, probe_);
     kernel_->bind(gpu::kBindVisibleCounter, counter_);
     reset();
 }
@@ -73,7 +70,7 @@ void EmitterSupersamplingPass::configure(vk::KernelDesc& desc) const {
 }
 
 void EmitterSupersamplingPass::bindTo(vk::Kernel& kernel) const {
-    kernel.bind(gpu::kBindVisibleStats, stats_);
+    kernel.bindAddress(gpu::kBindVisibleStats, stats_);
 }
 
 void EmitterSupersamplingPass::reset() {

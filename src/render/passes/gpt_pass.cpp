@@ -157,12 +157,12 @@ GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize w
                   "gpt modulation") {
     kernel_.bind(gpu::kBindCounters, counters_);
     for (std::uint32_t i = 0; i < kNumStats; ++i) {
-        kernel_.bind(gpu::kBindGptCentral + i, stats_[i]);
-        resolveKernel_.bind(gpu::kBindGptCentral + i, stats_[i]);
+        kernel_.bindAddress(gpu::kBindGptCentral + i, stats_[i]);
+        resolveKernel_.bindAddress(gpu::kBindGptCentral + i, stats_[i]);
     }
-    resolveKernel_.bind(gpu::kBindGptResolved, resolved_);
-    kernel_.bind(gpu::kBindGptDemodMask, demodMask_);  // all 0 (no pixel) until findEdges()
-    kernel_.bind(gpu::kBindGptModulation, modulation_);
+    resolveKernel_.bindAddress(gpu::kBindGptResolved, resolved_);
+    kernel_.bindAddress(gpu::kBindGptDemodMask, demodMask_);  // all 0 (no pixel) until findEdges()
+    kernel_.bindAddress(gpu::kBindGptModulation, modulation_);
     demodMask_.zero();
     emitterSupersampling_.bindTo(kernel_);
     emitterSupersampling_.bindTo(resolveKernel_);

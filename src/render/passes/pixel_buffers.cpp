@@ -30,14 +30,12 @@ void checkPixelBuffers(const vk::Context& ctx, std::uint32_t width, std::uint32_
                        const std::vector<PixelBuffer>& buffers) {
     const std::uint64_t pixels = std::uint64_t{width} * height;
     const std::string image = " of a " + std::to_string(width) + "x" + std::to_string(height) + " image";
-    // The most pixels every buffer allows (each is bound whole and is one allocation).
-    const std::uint64_t perBuffer =
-        std::min(ctx.info().maxStorageBufferRange, ctx.info().maxMemoryAllocationSize);
+    // The most pixels every buffer allows (each is one allocation, reached by its address).
+    const std::uint64_t perBuffer = ctx.info().maxMemoryAllocationSize;
     std::uint64_t maxPixels = ~std::uint64_t{0};
     for (const PixelBuffer& b : buffers) maxPixels = std::min(maxPixels, perBuffer / b.bytesPerPixel);
     for (const PixelBuffer& b : buffers) {
         try {
-            ctx.checkStorageBufferSize(pixels * b.bytesPerPixel, b.name + image);
             ctx.checkAllocationSize(pixels * b.bytesPerPixel, b.name + image);
         } catch (const Error& e) {
             // Say what would fit: the largest image of the same shape.

@@ -30,11 +30,12 @@ struct Extent {
 [[nodiscard]] Extent largestFittingImage(std::uint32_t width, std::uint32_t height, std::uint64_t maxPixels);
 
 // Throws gdpt::Error for the first buffer of a width x height image that exceeds
-// maxStorageBufferRange (the kernels bind each whole) or maxMemoryAllocationSize (each is
-// one allocation). The heap is not checked: the per-buffer limits bind first on the
-// devices seen (lavapipe: 128 MiB per buffer, a 2 GiB heap it overcommits), and a sum would
-// have to include the Poisson solver's fields and the scene to mean anything. The message
-// names the largest image of the same shape that every buffer allows.
+// maxMemoryAllocationSize (each is one allocation). maxStorageBufferRange does not apply: the
+// kernels reach these buffers through device addresses (shaders/lib/pixel_buffers.glsl). The
+// heap is not checked: the per-buffer limit binds first on the devices seen (lavapipe
+// overcommits its heap), and a sum would have to include the Poisson solver's fields and the
+// scene to mean anything. The message names the largest image of the same shape that every
+// buffer allows.
 void checkPixelBuffers(const vk::Context& ctx, std::uint32_t width, std::uint32_t height,
                        const std::vector<PixelBuffer>& buffers);
 

@@ -64,7 +64,7 @@ PtPass::PtPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize wg,
       emitterSupersampling_(ctx, scene, wg, emitterSupersampling, counters_, creation),
       kernel_(ctx, ptDesc(scene, wg, emitterSupersampling_), creation),
       accum_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats), "pt pixel statistics") {
-    kernel_.bind(gpu::kBindAccum, accum_);
+    kernel_.bindAddress(gpu::kBindAccum, accum_);
     kernel_.bind(gpu::kBindCounters, counters_);
     emitterSupersampling_.bindTo(kernel_);
     reset();
