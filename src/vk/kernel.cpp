@@ -219,7 +219,9 @@ void Kernel::bind(std::uint32_t binding, const Buffer& buffer) {
 void Kernel::bindAddress(std::uint32_t binding, const Buffer& target) {
     auto it = addresses_.find(binding);
     if (it == addresses_.end())
-        it = addresses_.emplace(binding, Buffer(ctx_, sizeof(std::uint64_t), desc_.name + " address of " + target.name()))
+        it = addresses_
+                 .emplace(binding,
+                          Buffer(ctx_, sizeof(std::uint64_t), desc_.name + " address of " + target.name()))
                  .first;
     const std::uint64_t address = target.deviceAddress();
     it->second.upload(&address, sizeof address);

@@ -25,10 +25,9 @@ class RealSizes : public test::TempDirTest, public ::testing::WithParamInterface
 TEST_P(RealSizes, RendersAFiniteImageAndReportsItsMemory) {
     const Size s = GetParam();
     const std::string scene = std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.gltf";
-    const test::RunResult r =
-        test::runGdpt("render " + scene + " --method " + s.method + " --width " + std::to_string(s.width) +
-                      " --height " + std::to_string(s.height) + " --spp 1 --quiet -o " + path("out.exr") +
-                      " --json " + path("out.json"));
+    const test::RunResult r = test::runGdpt(
+        "render " + scene + " --method " + s.method + " --width " + std::to_string(s.width) + " --height " +
+        std::to_string(s.height) + " --spp 1 --quiet -o " + path("out.exr") + " --json " + path("out.json"));
     ASSERT_EQ(r.code, 0) << r.output;
     const auto layers = readExr(path("out.exr"));
     ASSERT_FALSE(layers.empty());
@@ -50,7 +49,8 @@ TEST_P(RealSizes, RendersAFiniteImageAndReportsItsMemory) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sizes, RealSizes,
-                         ::testing::Values(Size{"pt", 3840, 2160}, Size{"gpt", 3840, 2160}, Size{"pt", 7680, 4320}),
+                         ::testing::Values(Size{"pt", 3840, 2160}, Size{"gpt", 3840, 2160},
+                                           Size{"pt", 7680, 4320}),
                          [](const auto& p) {
                              return std::string(p.param.method) + "_" + std::to_string(p.param.width);
                          });

@@ -32,9 +32,9 @@ TEST_F(LargeImagesCli, BuffersBeyondTheStorageBufferRangeHoldEveryPixel) {
     for (const Case& c : {Case{"pt", 16384, 300, ""}, Case{"gpt", 4096, 352, "--recon l2"}}) {
         const std::string out = path(std::string(c.method) + ".exr");
         const test::RunResult r =
-            test::runGdpt("render " + scene + " --method " + c.method + " --width " + std::to_string(c.width) +
-                          " --height " + std::to_string(c.height) + " --spp 1 --max-depth 0 --quiet --validate " +
-                          c.extra + " -o " + out);
+            test::runGdpt("render " + scene + " --method " + c.method + " --width " +
+                          std::to_string(c.width) + " --height " + std::to_string(c.height) +
+                          " --spp 1 --max-depth 0 --quiet --validate " + c.extra + " -o " + out);
         ASSERT_EQ(r.code, 0) << c.method << ": " << r.output;
         const auto layers = readExr(out);
         ASSERT_FALSE(layers.empty());
