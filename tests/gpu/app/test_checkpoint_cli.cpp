@@ -22,6 +22,7 @@
 
 #include "cli_runner.h"
 #include "image/exr_io.h"
+#include "same_bits.h"
 
 namespace gdpt {
 namespace {
@@ -40,21 +41,6 @@ protected:
                extra;
     }
 };
-
-// Every layer of two EXRs has the same name and the same bits.
-void expectSameLayers(const std::string& a, const std::string& b) {
-    const auto la = readExr(a), lb = readExr(b);
-    ASSERT_EQ(la.size(), lb.size());
-    for (std::size_t i = 0; i < la.size(); ++i) {
-        EXPECT_EQ(la[i].name, lb[i].name);
-        ASSERT_TRUE(la[i].image.sameSize(lb[i].image)) << la[i].name;
-        for (int c = 0; c < 3; ++c)
-            EXPECT_EQ(std::memcmp(la[i].image.plane(c).data(), lb[i].image.plane(c).data(),
-                                  la[i].image.pixelCount() * sizeof(float)),
-                      0)
-                << "layer '" << la[i].name << "' channel " << c;
-    }
-}
 
 std::uint64_t pathsCompleted(const std::string& jsonPath) {
     std::ifstream in(jsonPath);
@@ -84,7 +70,7 @@ TEST_P(CheckpointCli, ResumedRenderEqualsUninterruptedRender) {
         render("--spp 63 --resume " + path("c.exr") + " -o " + path("r.exr") + " --json " + path("r.json")));
     ASSERT_EQ(resumed.code, 0) << resumed.output;
     ASSERT_EQ(test::runGdpt(render("--spp 63 -o " + path("u.exr"))).code, 0);
-    expectSameLayers(path("r.exr"), path("u.exr"));
+    test::expectSameExrLayers(path("r.exr"), path("u.exr"));
     EXPECT_EQ(pathsCompleted(path("r.json")), 48u * pathsPerSample(path("r.json"), 16u * 16u));
 }
 
@@ -119,7 +105,7 @@ TEST_P(CheckpointCli, InterruptedRenderResumesToTheUninterruptedResult) {
         test::runGdpt(render("--spp " + total + " --resume " + ckpt + " -o " + path("r.exr")));
     ASSERT_EQ(resumed.code, 0) << resumed.output;
     ASSERT_EQ(test::runGdpt(render("--spp " + total + " -o " + path("u.exr"))).code, 0);
-    expectSameLayers(path("r.exr"), path("u.exr"));
+    test::expectSameExrLayers(path("r.exr"), path("u.exr"));
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, CheckpointCli, ::testing::Values("pt", "gpt"));

@@ -27,6 +27,7 @@
 
 #include "cli_runner.h"
 #include "image/exr_io.h"
+#include "same_bits.h"
 
 namespace gdpt {
 namespace {
@@ -35,21 +36,6 @@ using test::RunResult;
 
 const std::string kScene = std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.gltf";
 constexpr int kSpp = 6;
-
-// Every layer of two EXRs has the same name and the same bits.
-void expectSameLayers(const std::string& a, const std::string& b) {
-    const auto la = readExr(a), lb = readExr(b);
-    ASSERT_EQ(la.size(), lb.size());
-    for (std::size_t i = 0; i < la.size(); ++i) {
-        EXPECT_EQ(la[i].name, lb[i].name);
-        ASSERT_TRUE(la[i].image.sameSize(lb[i].image)) << la[i].name;
-        for (int c = 0; c < 3; ++c)
-            EXPECT_EQ(std::memcmp(la[i].image.plane(c).data(), lb[i].image.plane(c).data(),
-                                  la[i].image.pixelCount() * sizeof(float)),
-                      0)
-                << a << " and " << b << ": layer '" << la[i].name << "' channel " << c;
-    }
-}
 
 const Image& layer(const std::vector<NamedLayer>& layers, const std::string& name) {
     for (const NamedLayer& l : layers)
@@ -138,7 +124,7 @@ TEST_P(DistributedCli, ShardsMergedInAnyOrderEqualOneProcessUpToRounding) {
     r = test::runGdpt("merge " + path("s1.exr") + " " + path("s2.exr") + " " + path("s0.exr") + " -o " +
                       path("m2.exr") + " --quiet --validate --json " + path("m2.json"));
     ASSERT_EQ(r.code, 0) << r.output;
-    expectSameLayers(path("m1.exr"), path("m2.exr"));
+    test::expectSameExrLayers(path("m1.exr"), path("m2.exr"));
     EXPECT_NE(test::readText(path("m2.json")).find("\"parts\": 3"), std::string::npos);
 
     const BoundCheck same = roundingBound(path("m1.exr"), path("one.exr"), GetParam());
@@ -171,7 +157,7 @@ TEST_P(DistributedCli, MpiRanksEqualTheMergeOfAsManyShards) {
         r = test::runShell(mpirun(ranks) +
                            render("-o " + path("mpi" + n + ".exr") + " --json " + path("mpi" + n + ".json")));
         ASSERT_EQ(r.code, 0) << r.output;
-        expectSameLayers(path("mpi" + n + ".exr"), path("merged" + n + ".exr"));
+        test::expectSameExrLayers(path("mpi" + n + ".exr"), path("merged" + n + ".exr"));
         const std::string json = test::readText(path("mpi" + n + ".json"));
         EXPECT_NE(json.find("\"parts\": " + n), std::string::npos) << json;
         EXPECT_NE(json.find("\"spp\": " + std::to_string(kSpp)), std::string::npos) << json;
