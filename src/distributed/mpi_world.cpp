@@ -38,10 +38,6 @@ bool launchedByMpi() {
 
 }  // namespace
 
-bool MpiWorld::available() {
-    return GDPT_HAVE_MPI != 0;
-}
-
 MpiWorld* MpiWorld::get() {
     return g_world.get();
 }

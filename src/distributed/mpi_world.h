@@ -31,8 +31,6 @@ public:
     // Ends MPI (MPI_Finalize; MPI_Abort with `exitCode` when rank 0 failed after the ranks
     // agreed, since the others may be waiting for it). Returns exitCode. Call last in main.
     static int finish(int exitCode);
-    // Whether gdpt was built with MPI (for --help and `gdpt devices`).
-    static bool available();
 
     [[nodiscard]] int rank() const { return rank_; }
     [[nodiscard]] int size() const { return size_; }
