@@ -59,7 +59,6 @@ SamplerState syntheticState(std::size_t buffers, std::size_t pixels, std::uint32
 
 int runBenchMerge(const BenchMergeArgs& args) {
     installInterruptHandlers();
-    if (args.repeats < 1) throw UsageError("--repeats must be at least 1");
     MpiWorld* world = MpiWorld::get();
     const bool writes = !world || world->root();
     OutputSet outputs(std::vector<std::pair<std::string, std::string>>{});

@@ -264,16 +264,19 @@ std::optional<SamplerState> MpiWorld::combine(SamplerState mine, RenderStats& st
             continue;
         }
         const auto sizes = header.at("buffers").get<std::vector<std::size_t>>();
+        // The same buffers of the same pixels as rank 0's (checked here: the merge runs on a
+        // worker thread, where an error could not be reported).
+        std::vector<std::size_t> ours;
+        for (const auto& b : merged.buffers) ours.push_back(b.size());
+        if (failure.empty() && interrupted.empty() && sizes != ours)
+            failure = rank + " sent statistics of another shape (buffers and pixels) than rank 0's";
         const bool merging = failure.empty() && interrupted.empty();
-        if (merging && sizes.size() != merged.buffers.size())
-            failure = rank + " sent " + std::to_string(sizes.size()) + " statistics buffers, rank 0 has " +
-                      std::to_string(merged.buffers.size());
         for (std::size_t k = 0; k < sizes.size(); ++k) {
             std::vector<gpu::PixelStats>& into = received[slot];
             into.resize(sizes[k]);
             receiveBytes(into.data(), sizes[k] * sizeof(gpu::PixelStats), r, phase);
             joinMerger();  // the previous buffer (it used the other slot)
-            if (failure.empty() && interrupted.empty())
+            if (merging)
                 merger = std::thread(
                     [&acc = merged.buffers[k], &into] { mergeStatsInto(acc, into.data(), into.size()); });
             slot = 1 - slot;

@@ -79,6 +79,7 @@ MergedShards mergeShards(const std::vector<std::string>& paths) {
             throw Error(s.path + " is a part of a " + std::to_string(renderSpp(s)) + "-spp render, " +
                         first.path + " of a " + std::to_string(spp) + "-spp render");
     }
+    // Part order (`first`, a reference into the vector, is not used past this point).
     std::sort(shards.begin(), shards.end(),
               [](const Shard& a, const Shard& b) { return a.part.index < b.part.index; });
     std::string missing;
@@ -107,11 +108,12 @@ MergedShards mergeShards(const std::vector<std::string>& paths) {
 
     MergedShards out;
     Timer timer;
-    out.identity = first.checkpoint.identity;
+    const Shard& part0 = shards.front();
+    out.identity = part0.checkpoint.identity;
     out.identity.erase("share");
-    out.info = first.checkpoint.info;
+    out.info = part0.checkpoint.info;
     out.stats.parts = parts;
-    for (const auto& b : first.checkpoint.state.buffers)
+    for (const auto& b : part0.checkpoint.state.buffers)
         out.stats.bytesPerPart += b.size() * sizeof(gpu::PixelStats);
     out.state = std::move(shards.front().checkpoint.state);
     out.stats.partSpp = {out.state.spp};
