@@ -68,13 +68,24 @@ GDPT_INLINE uint ldShuffledIndex(LdSample s, uint h) {
     return owenScramble(s.index, h);
 }
 
+// Primary-sample-space Metropolis (mlt.comp) defines GDPT_PSS_SAMPLER and, before including
+// this file, `bool pssLookup(uint dim, uint component, out float value)`: the decisions its
+// chain state holds are read from there, the others drawn as below.
 GDPT_INLINE float ldGet1(LdSample s, uint dim) {
+#ifdef GDPT_PSS_SAMPLER
+    float held;
+    if (pssLookup(dim, 0u, held)) return held;
+#endif
     uint h = ldDimSeed(s, dim);
     uint i = ldShuffledIndex(s, h);
     return ldToFloat(owenScramble(sobolReverseBits(i), pcgHash(h + 1u)));
 }
 
 GDPT_INLINE vec2 ldGet2(LdSample s, uint dim) {
+#ifdef GDPT_PSS_SAMPLER
+    float a, b;
+    if (pssLookup(dim, 0u, a) && pssLookup(dim, 1u, b)) return vec2(a, b);
+#endif
     uint h = ldDimSeed(s, dim);
     uint i = ldShuffledIndex(s, h);
     return vec2(ldToFloat(owenScramble(sobolReverseBits(i), pcgHash(h + 1u))),

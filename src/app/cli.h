@@ -43,7 +43,10 @@ struct RenderArgs {
     std::string checkpoint;        // write the sampler state here on interrupt / periodically / at the end
     double checkpointEvery = 0.0;  // seconds between periodic checkpoints (0 = only at the end)
     std::string resume;            // continue from this checkpoint
-    std::string shard;  // "I/N": render part I of N and write its statistics (distributed/shards.h)
+    std::string shard;          // "I/N": render part I of N and write its statistics (distributed/shards.h)
+    std::uint32_t chains = 0;   // pssmlt, gmlt: Markov chains (0 = per image size)
+    float largeStep = 0.3f;     // pssmlt, gmlt: probability of a large step
+    float targetAlpha = 0.25f;  // gmlt: weight of the radiance in the target
 };
 
 struct DiffArgs {

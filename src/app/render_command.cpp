@@ -88,6 +88,15 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
             if (args.recon != other) g.reconstructions.push_back(parseReconstruction(other));
     g.alpha = args.alpha;
     g.tolerance = args.tolerance;
+    MltOptions& mlt = m.mlt;
+    mlt.chains = args.chains;
+    mlt.largeStep = args.largeStep;
+    mlt.targetAlpha = args.targetAlpha;
+    mlt.reconstructions = {parseReconstruction(args.recon)};
+    if (args.allRecon && args.recon != "l2") mlt.reconstructions.push_back(Reconstruction::L2);
+    if (args.allRecon && args.recon != "l1") mlt.reconstructions.push_back(Reconstruction::L1);
+    mlt.alpha = args.alpha;
+    mlt.tolerance = args.tolerance;
     // Timed renders remember each configuration's reconstruction time.
     if (args.time > 0.0) g.reconCache = cache;
     return makeIntegrator(args.method, m);
@@ -181,7 +190,18 @@ json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrato
 // Usage errors that the option checks alone cannot see (exit 2 before any work).
 void checkArgs(const RenderArgs& args) {
     const bool l1 = args.recon == "l1" || args.recon == "wl1" || args.allRecon;
-    if (args.method == "gpt" && l1 && !(args.alpha > 0.0))
+    const bool mlt = args.method == "pssmlt" || args.method == "gmlt";
+    if (mlt && (!args.checkpoint.empty() || !args.resume.empty() || !args.shard.empty()))
+        throw UsageError(
+            "--method " + args.method +
+            " keeps its state in its Markov chains: --checkpoint, --resume and --shard are for pt "
+            "and gpt");
+    if (args.method == "gmlt" && (args.recon == "wl1" || args.recon == "wl2"))
+        throw UsageError(
+            "--recon " + args.recon +
+            " weights by per-pixel variances, which the correlated samples of Markov chains do not "
+            "give; --method gmlt reconstructs with l1 or l2");
+    if ((args.method == "gpt" || args.method == "gmlt") && l1 && !(args.alpha > 0.0))
         throw UsageError("--alpha " + std::to_string(args.alpha) +
                          ": the L1 reconstructions (--recon l1 or wl1, or --all-recon) need --alpha > 0 (the "
                          "primal term anchors each reweighted solve); use --recon l2 for alpha 0");
@@ -504,11 +524,15 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->group(image);
 
     const char* sampling = "Sampling";
-    r->add_option("--method", a.method, "gpt: gradient-domain path tracing; pt: path tracing (docs/gpt.md)")
+    r->add_option("--method", a.method,
+                  "gpt: gradient-domain path tracing; pt: path tracing (docs/gpt.md); gmlt: gradient-domain "
+                  "Metropolis; pssmlt: primary-sample-space Metropolis (docs/mlt.md)")
         ->capture_default_str()
         ->check(CLI::IsMember(methodNames()))
         ->group(sampling);
-    r->add_option("--spp", a.spp, "Samples per pixel (G-PT: camera samples, each a base + 4 offset paths)")
+    r->add_option("--spp", a.spp,
+                  "Samples per pixel (G-PT: camera samples, each a base + 4 offset paths; MLT: mutations per "
+                  "pixel on average)")
         ->capture_default_str()
         ->check(CLI::Range(1u, 1u << 24))
         ->group(sampling);
@@ -561,6 +585,21 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::IsMember({"auto", "on", "off"}))
         ->group(gpt);
+
+    const char* mlt = "Metropolis (pssmlt, gmlt; docs/mlt.md)";
+    r->add_option("--chains", a.chains, "Markov chains run at once (0 = one per 16 pixels, 1024 to 65536)")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, 1u << 20))
+        ->group(mlt);
+    r->add_option("--large-step", a.largeStep, "Probability of a large step (a fresh path) per mutation")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0f, 1.0f))
+        ->group(mlt);
+    r->add_option("--target-alpha", a.targetAlpha,
+                  "gmlt: weight of the path's radiance beside its gradients in the chains' target")
+        ->capture_default_str()
+        ->check(CLI::Range(1e-4f, 1e3f))
+        ->group(mlt);
 
     const char* budget = "Time budget and checkpoints";
     r->add_option("--time", a.time, "Seconds for the whole render, reconstruction included; overrides --spp")

@@ -81,12 +81,27 @@ struct GptOptions {
     const ReconTimeCache* reconCache = nullptr;
 };
 
+// The settings of Metropolis light transport (pssmlt, gmlt; mlt_integrator.h).
+struct MltOptions {
+    std::uint32_t chains = 0;             // Markov chains at once; 0 = per image size (defaultMltChains)
+    float largeStep = 0.3f;               // probability of a large step (a fresh state) per mutation
+    float targetAlpha = 0.25f;            // gmlt: weight of the radiance in the target (mlt.glsl gmltTarget)
+    std::uint32_t bootstrapPerPixel = 1;  // bootstrap samples per pixel (at least 16 per chain)
+    std::uint32_t directSamples = 16;     // camera samples per pixel of the very-direct image
+    // gmlt: the reconstructions (L1, L2; the variance-weighted ones need per-pixel variances,
+    // which a chain's correlated samples do not give), the first gives the final image.
+    std::vector<Reconstruction> reconstructions = {Reconstruction::L1};
+    double alpha = 0.2;       // weight of the primal term of the screened Poisson energy
+    double tolerance = 1e-4;  // relative residual at which each solve stops
+};
+
 // Every method's own settings; each integrator reads its part.
 struct MethodOptions {
     GptOptions gpt;
+    MltOptions mlt;
 };
 
-// Makes the integrator of `name`: a method name ("pt", "gpt"), or "gpt-<reconstruction>"
+// Makes the integrator of `name`: a method name ("pt", "gpt", "pssmlt", "gmlt"), or "gpt-<reconstruction>"
 // (gpt-l1, gpt-l2, gpt-wl1, gpt-wl2: G-PT with that reconstruction alone, as `converge`
 // names its methods). Throws gdpt::UsageError naming the known methods otherwise.
 std::unique_ptr<Integrator> makeIntegrator(const std::string& name, const MethodOptions& options = {});

@@ -3,24 +3,27 @@
 
 #include "integrator/gpt_integrator.h"
 #include "integrator/integrator.h"
+#include "integrator/mlt_integrator.h"
 #include "integrator/pt_integrator.h"
 #include "util/error.h"
 
 namespace gdpt {
 
 const std::vector<std::string>& methodNames() {
-    static const std::vector<std::string> names = {"pt", "gpt"};
+    static const std::vector<std::string> names = {"pt", "gpt", "pssmlt", "gmlt"};
     return names;
 }
 
 const std::vector<std::string>& methodVariantNames() {
-    static const std::vector<std::string> names = {"pt", "gpt", "gpt-l1", "gpt-l2", "gpt-wl1", "gpt-wl2"};
+    static const std::vector<std::string> names = {"pt",      "gpt",     "gpt-l1", "gpt-l2",
+                                                   "gpt-wl1", "gpt-wl2", "pssmlt", "gmlt"};
     return names;
 }
 
 std::unique_ptr<Integrator> makeIntegrator(const std::string& name, const MethodOptions& options) {
     if (name == "pt") return std::make_unique<PtIntegrator>();
     if (name == "gpt") return std::make_unique<GptIntegrator>(name, options.gpt);
+    if (name == "pssmlt" || name == "gmlt") return std::make_unique<MltIntegrator>(name, options.mlt);
     const std::string prefix = "gpt-";
     if (name.compare(0, prefix.size(), prefix) == 0) {
         GptOptions gpt = options.gpt;

@@ -92,6 +92,16 @@ struct DistributedStats {
     double waitMs = 0.0;                 // rank 0 waiting for the other ranks to end sampling
 };
 
+// Metropolis light transport (pssmlt, gmlt): the chains and the bootstrap.
+struct MltStats {
+    std::uint32_t chains = 0;
+    std::uint64_t mutations = 0;  // proposals, all chains
+    std::uint64_t proposedSmall = 0, acceptedSmall = 0, proposedLarge = 0, acceptedLarge = 0;
+    std::uint64_t bootstrapSamples = 0;
+    double normalisation = 0.0;        // b = ∫ T, the bootstrap's mean target
+    double normalisationStdErr = 0.0;  // its standard error
+};
+
 struct RenderStats {
     std::uint32_t spp = 0;              // samples in every pixel
     std::uint32_t partialPassRows = 0;  // timed renders: rows (from the top) with one sample more
@@ -122,6 +132,7 @@ struct RenderStats {
     // them as a shard): no later stages ran, no layers.
     bool handedOff = false;
     DistributedStats distributed;
+    MltStats mlt;
     std::map<std::string, vk::KernelTime> kernels;
     SceneFeatures features;
 };

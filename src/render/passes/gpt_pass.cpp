@@ -24,17 +24,6 @@ const char* const kStatNames[kNumStats] = {
     "gpt central",        "gpt neighbor right", "gpt neighbor down", "gpt neighbor left", "gpt neighbor up",
     "gpt gradient right", "gpt gradient down",  "gpt gradient left", "gpt gradient up",   "gpt direct"};
 
-// Whether some vertex can be classified glossy: a specular layer at or below the threshold,
-// or one below bsdf.glsl's Dirac cutoff (perceptual roughness 0.01), which
-// bsdfRoughnessForShift reports as 0 whatever the threshold. Same rule as features.cpp's
-// hasGlossy, evaluated for the spec's threshold (SceneGpuOptions::shiftThreshold).
-bool needsHalfVector(const SceneSpec& scene) {
-    const float threshold = scene.shiftThreshold();
-    const SceneFeatures& f = scene.features();
-    constexpr float kDiracRoughness = 0.01f;  // sqrt(kDeltaAlpha)
-    return f.hasSpecularLayer && (f.minRoughness <= threshold || f.minRoughness < kDiracRoughness);
-}
-
 bool splitBounceFor(const vk::DeviceInfo& device, GptPassOptions::SplitBounce s) {
     if (s == GptPassOptions::SplitBounce::Auto) return splitBounceDefault(device);
     return s == GptPassOptions::SplitBounce::On;
@@ -90,6 +79,17 @@ std::array<vk::Buffer, kNumStats> makeStats(const vk::Context& ctx, std::uint64_
 }
 }  // namespace
 
+// Whether some vertex can be classified glossy: a specular layer at or below the threshold,
+// or one below bsdf.glsl's Dirac cutoff (perceptual roughness 0.01), which
+// bsdfRoughnessForShift reports as 0 whatever the threshold. Same rule as features.cpp's
+// hasGlossy, evaluated for the spec's threshold (SceneGpuOptions::shiftThreshold).
+bool gptNeedsHalfVector(const SceneSpec& scene) {
+    const float threshold = scene.shiftThreshold();
+    const SceneFeatures& f = scene.features();
+    constexpr float kDiracRoughness = 0.01f;  // sqrt(kDeltaAlpha)
+    return f.hasSpecularLayer && (f.minRoughness <= threshold || f.minRoughness < kDiracRoughness);
+}
+
 bool splitBounceDefault(const vk::DeviceInfo& device) {
     return device.lavapipeBeforeMesa23;
 }
@@ -139,7 +139,7 @@ GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize w
       height_(scene.height()),
       shiftThreshold_(scene.shiftThreshold()),
       options_(options),
-      halfVector_(options.forceHalfVector || needsHalfVector(scene)),
+      halfVector_(options.forceHalfVector || gptNeedsHalfVector(scene)),
       splitBounce_(splitBounceFor(ctx.info(), options.splitBounce)),
       checked_(ctx, width_, height_, pixelBuffers(options)),
       counters_(ctx, sizeof(gpu::Counters), "gpt counters"),

@@ -61,6 +61,10 @@ std::vector<std::uint32_t> demodulationMask(const std::vector<std::uint32_t>& ed
                                             const std::vector<gpu::EdgeProbe>& probes, std::uint32_t width,
                                             std::uint32_t height);
 
+// Whether the shift needs its half-vector branch on this scene: some vertex can be glossy at
+// the spec's shift threshold (gpt.comp's kHasGlossy; mlt.comp traces the same sample).
+bool gptNeedsHalfVector(const SceneSpec& scene);
+
 // Whether the split bounce loop pays on this device: lavapipe with Mesa before 23, which runs
 // every branch under lane masks (15-25 % faster samples there); elsewhere the single loop,
 // as on Mesa 25's lavapipe, where the split measured no faster and only costs pipeline

@@ -1,0 +1,100 @@
+// gpt_trace.glsl — one camera sample of gradient-domain path tracing: the base path and its
+// four offset paths through the shift mapping (Kettunen et al. 2015, §4), the estimator of
+// gpt.comp (see there), shared with mlt.comp, whose Markov chains evaluate the same sample at a
+// film position of their own. GLSL only: the including kernel has declared the scene buffers,
+// `frame` (with shiftThreshold), kOffsetDelta, kDemodulate and firstHitModulation, and
+// included gpt_path.glsl, gpt_light.glsl, shift.glsl, surface_rules.glsl and gpt_steps.glsl.
+#ifndef GDPT_LIB_GPT_TRACE
+#define GDPT_LIB_GPT_TRACE
+
+// Split bounce loop (GDPT_GPT_SPLIT_BOUNCE: a second build of this kernel, gpt_split; the
+// host picks one per device, splitBounceDefault in gpt_pass.cpp). Once every live offset
+// shares the base's vertices (in a scene without glossy vertices: every bounce after the
+// first), the remaining bounces run in a second loop compiled without the code for offsets
+// with vertices of their own. Lavapipe with Mesa 22.3 runs every branch under lane masks,
+// also one that no lane takes, so that code costs its time at every bounce there: the split
+// loop is 15-25 % faster on it, neutral on Mesa 25 (which skips such branches), and its
+// pipeline takes about 0.37 s longer to create. A second build rather than a specialisation
+// constant, because lavapipe spends that time on the dead loop too. The image is the same
+// bit for bit either way (bench/RESULTS.md).
+
+// Offset i has a vertex of its own (NOT_CONNECTED); never in the fast form (general false).
+bool ownVertex(OffsetPath o, bool general) { return general && o.state == kShiftNotConnected; }
+
+// Base + 4 offsets for one camera sample at pixelPos (continuous pixel coordinates).
+// countDirect false: the emission seen by the camera ray is left to emitter-silhouette
+// supersampling (visible_emission.glsl) and `direct` stays zero.
+// baseModulation: the base's first-hit modulation (1 unless kDemodulate; offs[i].modulation
+// the offsets').
+void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, bool countDirect, inout uint rays,
+                 out vec3 direct, out vec3 baseModulation, inout OffsetPath offs[kGptNumOffsets]) {
+    direct = vec3(0.0);
+    baseModulation = vec3(1.0);
+    for (uint i = 0u; i < kGptNumOffsets; ++i) {
+        offs[i].modulation = vec3(1.0);
+        offs[i].alive = gptPairExists(px, py, i);
+        offs[i].shifted = false;
+        offs[i].baseSum = vec3(0.0);
+        offs[i].offSum = vec3(0.0);
+        offs[i].beta = vec3(1.0);  // pinhole, box filter: camera weight 1 for every pixel
+        offs[i].r = 1.0;           // image-plane translation: Jacobian 1, same pixel pdf
+        offs[i].rLight = 1.0;
+        offs[i].state = kShiftNotConnected;
+    }
+
+    // Primary rays. Emission at the base's first hit is "very direct": direct buffer only.
+    vec3 o = scene.camPosition;
+    vec3 d = cameraRay(pixelPos);
+    Hit hit = traceClosest(o, d, 0.0, kInf);
+    rays++;
+    if (hit.triangle == kInvalidIndex) {
+        if (kHasEnv && countDirect) direct += scene.envRadiance;
+        return;  // nothing is shifted: the environment seen directly is very direct
+    }
+    SurfaceHit sh = makeSurfaceHit(hit.triangle, hit.u, hit.v, d);
+    if (kHasLightTris && countDirect) direct += surfaceEmission(sh);
+    if (kDemodulate) baseModulation = firstHitModulation(sh, py * scene.width + px);
+    for (uint i = 0u; i < kGptNumOffsets; ++i) {
+        offs[i].shifted = offs[i].alive;
+        if (!offs[i].alive) continue;
+        vec3 di = cameraRay(pixelPos + vec2(kOffsetDelta[i]));
+        Hit hi = traceClosest(o, di, 0.0, kInf);
+        rays++;
+        if (hi.triangle == kInvalidIndex) {
+            offs[i].alive = false;  // base hit, offset missed: no shift
+            continue;
+        }
+        offs[i].hit = makeSurfaceHit(hi.triangle, hi.u, hi.v, di);
+        offs[i].woWorld = -di;
+        if (kDemodulate) {
+            ivec2 q = ivec2(px, py) + kOffsetDelta[i];  // inside the image: the pair exists
+            offs[i].modulation = firstHitModulation(offs[i].hit, uint(q.y) * scene.width + uint(q.x));
+        }
+    }
+
+    vec3 beta = vec3(1.0);  // base f/p
+    uint depth = 0u;
+    bool pathEnded = false;
+    // General bounces; in the split build only while some live offset has a vertex of its
+    // own (the first bounce always, if any offset hit), then the fast form.
+    for (; depth < kMaxDepth && depth < scene.maxDepth; ++depth) {
+#ifdef GDPT_GPT_SPLIT_BOUNCE
+        bool own = false;
+        for (uint i = 0u; i < kGptNumOffsets; ++i) own = own || (offs[i].alive && ownVertex(offs[i], true));
+        if (!own) break;
+#endif
+#define GDPT_GPT_GENERAL true
+#include "lib/gpt_bounce.glsl"
+#undef GDPT_GPT_GENERAL
+    }
+#ifdef GDPT_GPT_SPLIT_BOUNCE
+    if (pathEnded) return;
+    for (; depth < kMaxDepth && depth < scene.maxDepth; ++depth) {
+#define GDPT_GPT_GENERAL false
+#include "lib/gpt_bounce.glsl"
+#undef GDPT_GPT_GENERAL
+    }
+#endif
+}
+
+#endif  // GDPT_LIB_GPT_TRACE

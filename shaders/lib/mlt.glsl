@@ -1,0 +1,61 @@
+// mlt.glsl — the Metropolis-Hastings steps of primary-sample-space MLT (mlt.comp), shared by
+// the kernel and the CPU tests (detailed balance on an analytic target,
+// tests/unit/sampling/test_mlt_chain.cpp).
+//
+// A chain walks the unit hypercube of the path's decisions (Kelemen, Szirmay-Kalos, Antal,
+// Csonka 2002, "A Simple and Robust Mutation Strategy for the Metropolis Light Transport
+// Algorithm", Computer Graphics Forum 21(3)):
+//   large step  every coordinate drawn afresh, uniform;
+//   small step  every coordinate moved by ±s2·exp(−ln(s2/s1)·ξ), wrapped into [0, 1) (§3.1,
+//               s1 = 1/1024, s2 = 1/64);
+// both proposals are symmetric (q(x→y) = q(y→x)), so the acceptance probability is
+// a = min(1, T(y)/T(x)) for the target T. The contribution is splatted with the expected
+// values of Kelemen et al. §4: the current state with weight (1 − a)/T(x), the proposal with
+// a/T(y); their image estimate is b/N Σ weight·f, with b = ∫ T over the hypercube.
+#ifndef GDPT_LIB_MLT
+#define GDPT_LIB_MLT
+
+#include "common.glsl"
+
+GDPT_NAMESPACE_BEGIN
+
+GDPT_CONST float kMltSmallStepMin = 1.0f / 1024.0f;  // s1
+GDPT_CONST float kMltSmallStepMax = 1.0f / 64.0f;    // s2
+
+// Kelemen's small step of one coordinate u in [0, 1), driven by two uniforms: xiSign picks
+// the direction, xiSize the size (log-uniform between s1 and s2). Result in [0, 1).
+GDPT_INLINE float mltSmallStep(float u, float xiSign, float xiSize) {
+    float dv = kMltSmallStepMax * exp(-log(kMltSmallStepMax / kMltSmallStepMin) * xiSize);
+    float v = xiSign < 0.5f ? u + dv : u - dv;
+    v = v - floor(v);                   // wrap: the hypercube is a torus for the small step
+    return min(v, kOneMinusEpsilon);    // v - floor(v) may round to 1 for v just below 0
+}
+
+// Metropolis-Hastings acceptance probability of a symmetric proposal from target tCurrent
+// to tProposed. A current state of target 0 (never the case for a chain started by the
+// bootstrap) accepts anything.
+GDPT_INLINE float mltAcceptance(float tCurrent, float tProposed) {
+    if (!(tCurrent > 0.0f)) return 1.0f;
+    return min(1.0f, tProposed / tCurrent);
+}
+
+// Splat weight of a state with target t and acceptance share w (a for the proposal, 1 − a
+// for the current state): w / t, 0 for a state the target does not see.
+GDPT_INLINE float mltSplatWeight(float w, float t) {
+    return t > 0.0f ? w / t : 0.0f;
+}
+
+// The target of gradient-domain MLT (Lehtinen et al. 2013, §4: the sum of the absolute
+// finite differences plus α times the image) for one G-PT sample: the luminance of the four
+// gradients' absolute values (per channel) plus alpha times the luminance of the sample's
+// radiance, (central + Σ neighbor_i) / 4, which for a sample whose offsets see what the base
+// sees is the path's own contribution (the pair weights of each pixel pair sum to one).
+// Every quantity the sample carries is non-zero only where this is (radiance is non-negative
+// and alpha > 0), so the chain misses nothing that it splats.
+GDPT_INLINE float gmltTarget(float gradientAbsLuminance, vec3 central, vec3 neighborSum, float alpha) {
+    return gradientAbsLuminance + alpha * 0.25f * luminance(central + neighborSum);
+}
+
+GDPT_NAMESPACE_END
+
+#endif  // GDPT_LIB_MLT

@@ -1,0 +1,113 @@
+#include "integrator/mlt_estimate.h"
+
+#include <cmath>
+
+#include "lib/rng.glsl"
+
+namespace gdpt {
+
+MltNormalisation mltNormalisation(const std::vector<float>& targets) {
+    MltNormalisation n;
+    n.samples = targets.size();
+    if (targets.empty()) return n;
+    double sum = 0.0, sumSq = 0.0;
+    for (float t : targets) {
+        const double v = std::isfinite(t) && t > 0.0f ? double(t) : 0.0;
+        sum += v;
+        sumSq += v * v;
+    }
+    const double count = double(targets.size());
+    n.b = sum / count;
+    if (targets.size() > 1) {
+        const double variance = std::max(0.0, (sumSq - sum * n.b) / (count - 1.0));
+        n.standardError = std::sqrt(variance / count);
+    }
+    return n;
+}
+
+std::vector<std::uint32_t> mltChainStarts(const std::vector<float>& targets, std::uint32_t chains,
+                                          std::uint32_t seed) {
+    double total = 0.0;
+    for (float t : targets) total += std::isfinite(t) && t > 0.0f ? double(t) : 0.0;
+    std::vector<std::uint32_t> starts;
+    if (!(total > 0.0) || chains == 0) return starts;
+    starts.reserve(chains);
+    // Systematic resampling: chain c takes the sample whose cumulative interval holds
+    // (c + u) · total / chains.
+    const double u = double(gpu::pcgHash(seed ^ 0x5354u) >> 8) / 16777216.0;
+    const double step = total / double(chains);
+    double cumulative = 0.0;
+    std::size_t i = 0;
+    for (std::uint32_t c = 0; c < chains; ++c) {
+        const double at = (double(c) + u) * step;
+        while (i + 1 < targets.size()) {
+            const double t = std::isfinite(targets[i]) && targets[i] > 0.0f ? double(targets[i]) : 0.0;
+            if (cumulative + t > at) break;
+            cumulative += t;
+            ++i;
+        }
+        // Rounding may leave `at` past the last positive sample: step back to it.
+        std::size_t j = i;
+        while (j > 0 && !(std::isfinite(targets[j]) && targets[j] > 0.0f)) --j;
+        starts.push_back(static_cast<std::uint32_t>(j));
+    }
+    return starts;
+}
+
+MltAccumulator::MltAccumulator(int width, int height)
+    : width_(width), height_(height), sums_(std::size_t(width) * std::size_t(height) * gpu::kMltValues * 3, 0.0) {}
+
+void MltAccumulator::add(const gpu::MltRecord* records, std::size_t count) {
+    const std::size_t pixels = std::size_t(width_) * std::size_t(height_);
+    for (std::size_t r = 0; r < count; ++r) {
+        const gpu::MltRecord& rec = records[r];
+        if (!(rec.weight > 0.0f) || rec.pixel >= pixels) continue;
+        double* s = &sums_[std::size_t(rec.pixel) * gpu::kMltValues * 3];
+        const double w = rec.weight;
+        for (std::uint32_t k = 0; k < gpu::kMltValues; ++k)
+            for (int c = 0; c < 3; ++c) s[k * 3 + std::uint32_t(c)] += w * double(rec.value[k][c]);
+    }
+}
+
+Image MltAccumulator::quantity(std::uint32_t k, double scale) const {
+    Image out(width_, height_);
+    const std::size_t pixels = std::size_t(width_) * std::size_t(height_);
+    for (std::size_t p = 0; p < pixels; ++p)
+        for (int c = 0; c < 3; ++c)
+            out.plane(c)[p] = static_cast<float>(scale * sums_[(p * gpu::kMltValues + k) * 3 + std::size_t(c)]);
+    return out;
+}
+
+MltImages resolveGradientSamples(const MltAccumulator& acc, double scale) {
+    const Image central = acc.quantity(gpu::kMltCentral, scale);
+    Image neighbor[4], gradient[4];
+    for (std::uint32_t i = 0; i < 4; ++i) {
+        neighbor[i] = acc.quantity(gpu::kMltNeighbor + i, scale);
+        gradient[i] = acc.quantity(gpu::kMltGradient + i, scale);
+    }
+    const int w = central.width(), h = central.height();
+    MltImages out{Image(w, h), Image(w, h), Image(w, h)};
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const std::size_t p = std::size_t(y) * std::size_t(w) + std::size_t(x);
+            for (int c = 0; c < 3; ++c) {
+                // Neighbour q = p − δ_i sent its offset i to p (right, down, left, up).
+                double sum = central.plane(c)[p];
+                double k = 0.0;
+                if (x > 0) sum += neighbor[gpu::kGptRight].plane(c)[p - 1], k += 1.0;
+                if (y > 0) sum += neighbor[gpu::kGptDown].plane(c)[p - std::size_t(w)], k += 1.0;
+                if (x + 1 < w) sum += neighbor[gpu::kGptLeft].plane(c)[p + 1], k += 1.0;
+                if (y + 1 < h) sum += neighbor[gpu::kGptUp].plane(c)[p + std::size_t(w)], k += 1.0;
+                out.primal.plane(c)[p] = static_cast<float>(sum / std::max(k, 1.0));
+                if (x + 1 < w)
+                    out.dx.plane(c)[p] =
+                        gradient[gpu::kGptRight].plane(c)[p] - gradient[gpu::kGptLeft].plane(c)[p + 1];
+                if (y + 1 < h)
+                    out.dy.plane(c)[p] = gradient[gpu::kGptDown].plane(c)[p] -
+                                         gradient[gpu::kGptUp].plane(c)[p + std::size_t(w)];
+            }
+        }
+    return out;
+}
+
+}  // namespace gdpt

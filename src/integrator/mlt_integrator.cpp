@@ -1,0 +1,307 @@
+#include "integrator/mlt_integrator.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <utility>
+
+#include "integrator/mlt_estimate.h"
+#include "integrator/recon_reserve.h"
+#include "integrator/render_identity.h"
+#include "integrator/gpt_sampler.h"
+#include "render/device_scene/scene_gpu.h"
+#include "scene/radiance_range.h"
+#include "util/error.h"
+#include "util/interrupt.h"
+#include "util/progress.h"
+#include "util/timer.h"
+#include "vk/commands.h"
+#include "vk/context.h"
+#include "vk/timing.h"
+
+namespace gdpt {
+namespace {
+// Mutation steps a batch records: 2 records per chain and step (mlt_shared.h MltRecord).
+constexpr std::uint32_t kStepsPerBatch = 8;
+// Bootstrap samples per dispatch.
+constexpr std::uint32_t kBootstrapPerDispatch = 1u << 16;
+// Bootstrap samples per chain at least, so that the starts are drawn from many more states.
+constexpr std::uint32_t kBootstrapPerChain = 16;
+}  // namespace
+
+std::uint32_t defaultMltChains(int width, int height) {
+    const std::uint64_t pixels = std::uint64_t(std::max(width, 1)) * std::uint64_t(std::max(height, 1));
+    return static_cast<std::uint32_t>(std::clamp<std::uint64_t>(pixels / 16, 1024, 65536));
+}
+
+MltIntegrator::MltIntegrator(std::string name, MltOptions options)
+    : name_(std::move(name)), options_(std::move(options)) {}
+
+MltIntegrator::~MltIntegrator() = default;
+
+std::uint32_t MltIntegrator::maxBatchSpp(int, int) const {
+    return 1;
+}
+
+ExrAttributes MltIntegrator::identity(const Scene&, const RenderOptions& options) const {
+    return {{"chains", std::to_string(options_.chains ? options_.chains
+                                                      : defaultMltChains(options.scene.width, options.scene.height))},
+            {"large_step", exactFloat(options_.largeStep)},
+            {"target_alpha", exactFloat(options_.targetAlpha)},
+            {"shift_threshold", exactFloat(options.scene.shiftThreshold)}};
+}
+
+std::vector<SolveOptions> MltIntegrator::solves() const {
+    std::vector<SolveOptions> out;
+    if (!gradients()) return out;
+    for (Reconstruction r : options_.reconstructions) {
+        SolveOptions so;
+        so.method = r;
+        so.alpha = options_.alpha;
+        so.tolerance = options_.tolerance;
+        out.push_back(so);
+    }
+    return out;
+}
+
+PoissonSolverGpu& MltIntegrator::solver(const vk::Context& ctx, int width, int height) {
+    if (!solver_ || solverCtx_ != &ctx || solverWidth_ != width || solverHeight_ != height) {
+        solver_ = std::make_unique<PoissonSolverGpu>(ctx, width, height);
+        solverCtx_ = &ctx;
+        solverWidth_ = width;
+        solverHeight_ = height;
+        calibratedSeconds_ = -1.0;
+    }
+    return *solver_;
+}
+
+double MltIntegrator::reserveAfterSampling(const vk::Context& ctx, int width, int height) {
+    const std::vector<SolveOptions> s = solves();
+    if (s.empty()) return 0.0;
+    if (calibratedSeconds_ < 0.0) {
+        calibratedSeconds_ = 0.0;
+        for (const SolveOptions& so : s)
+            calibratedSeconds_ += calibrateReconSeconds(solver(ctx, width, height), so, /*warmUp=*/true);
+    }
+    return calibratedSeconds_;
+}
+
+RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, const RenderOptions& options) {
+    if (options.resume || options.checkpoint || options.share.split() || options.combine)
+        throw UsageError("--method " + name_ +
+                         " keeps its state in its Markov chains: checkpoints, --resume, --shard and mpirun "
+                         "are for pt and gpt");
+    checkRadianceRange(scene, options.scene.envRadiance);
+    Timer total;
+    RenderOutput out;
+    RenderStats& stats = out.stats;
+    const int width = options.scene.width, height = options.scene.height;
+    const std::uint64_t pixels = std::uint64_t(width) * std::uint64_t(height);
+
+    // Set-up: the kernel compiles on a worker thread while the scene is built and uploaded.
+    MltPassOptions po;
+    po.baseOnly = !gradients();
+    po.chains = options_.chains ? options_.chains : defaultMltChains(width, height);
+    po.stepsPerBatch = kStepsPerBatch;
+    po.largeStep = options_.largeStep;
+    po.targetAlpha = options_.targetAlpha;
+    SceneSpec spec(scene, options.scene);
+    MltPass pass(ctx, spec, options.workgroup, po, vk::PipelineCreation::Background);
+    SceneGpu sceneGpu(ctx, scene, options.scene, std::move(spec));
+    pass.attach(sceneGpu);
+    stats.bvhBuildMs = sceneGpu.bvhInfo().buildMs;
+    stats.bvhRegisterStack = sceneGpu.spec().bvhRegisterStack();
+    stats.features = sceneGpu.features();
+    const std::vector<SolveOptions> solveList = solves();
+    if (options.whileCompiling) options.whileCompiling();
+    if (!solveList.empty()) solver(ctx, width, height).preparePipelines(solveList);
+    stats.pipelineWaitMs = 1e3 * pass.waitForPipelines();
+    stats.uploadMs = total.ms() - stats.bvhBuildMs;
+
+    vk::GpuTimer gpuTimer(ctx);
+    vk::GpuTimer* timer = options.profile ? &gpuTimer : nullptr;
+    vk::CommandStream stream(ctx, name_);
+    const auto submit = [&](const std::string& what, const std::function<void(VkCommandBuffer)>& work) {
+        VkCommandBuffer cmd = stream.begin();
+        if (timer) timer->reset(cmd);
+        work(cmd);
+        stream.setWhat(what);
+        stream.submit();
+        stream.waitAll();
+        if (timer) timer->collect();
+        const gpu::Counters c = pass.takeCounters();
+        stats.raysTraced += c.raysTraced;
+        stats.pathsCompleted += c.pathsCompleted;
+        stats.nanSamples += c.nanSamples;
+    };
+    const auto cancelled = [&] { return options.cancel && options.cancel->load(); };
+    Timer sampling;
+
+    // Stage 1: the very-direct light, and the bootstrap: b and the chains' starts.
+    submit(name_ + " direct light", [&](VkCommandBuffer cmd) {
+        pass.recordDirect(cmd, options_.directSamples, options.seed, timer);
+    });
+    const std::uint64_t bootstrapCount =
+        std::max<std::uint64_t>(pixels * options_.bootstrapPerPixel, std::uint64_t{po.chains} * kBootstrapPerChain);
+    if (bootstrapCount > std::uint64_t{1} << 31)
+        throw UsageError("--method " + name_ + ": " + std::to_string(bootstrapCount) +
+                         " bootstrap samples are more than this renderer counts; use a smaller image");
+    std::vector<float> targets;
+    targets.reserve(bootstrapCount);
+    for (std::uint64_t first = 0; first < bootstrapCount && !cancelled(); first += kBootstrapPerDispatch) {
+        const auto n = static_cast<std::uint32_t>(std::min<std::uint64_t>(kBootstrapPerDispatch, bootstrapCount - first));
+        submit(name_ + " bootstrap from sample " + std::to_string(first), [&](VkCommandBuffer cmd) {
+            pass.recordBootstrap(cmd, static_cast<std::uint32_t>(first), n, options.seed, timer);
+        });
+        const std::vector<float> part = pass.bootstrapTargets(n);
+        targets.insert(targets.end(), part.begin(), part.end());
+    }
+    const MltNormalisation norm = mltNormalisation(targets);
+    stats.mlt.chains = po.chains;
+    stats.mlt.bootstrapSamples = targets.size();
+    stats.mlt.normalisation = norm.b;
+    stats.mlt.normalisationStdErr = norm.standardError;
+    const std::vector<std::uint32_t> starts = mltChainStarts(targets, po.chains, options.seed);
+    targets = {};
+
+    // Stage 2: the chains. Mutation steps in batches; the host splats each batch's records
+    // in record order while nothing else runs (the same order on every run).
+    MltAccumulator acc(width, height);
+    const bool timed = options.timeBudget > 0.0;
+    const double budget = options.timeBudget - options.elapsedBefore;
+    const std::uint64_t wantedMutations = std::uint64_t{options.spp} * pixels;
+    const std::uint64_t wantedSteps = (wantedMutations + po.chains - 1) / po.chains;
+    std::uint64_t steps = 0;
+    if (!starts.empty() && !cancelled()) {
+        submit(name_ + " chain start", [&](VkCommandBuffer cmd) { pass.recordStart(cmd, starts, options.seed, timer); });
+        Progress progress("render " + name_, timed ? budget : double(wantedSteps), options.quiet);
+        double secondsPerStep = 0.0;
+        while (!cancelled()) {
+            std::uint32_t n = kStepsPerBatch;
+            if (!timed) {
+                if (steps >= wantedSteps) break;
+                n = static_cast<std::uint32_t>(std::min<std::uint64_t>(n, wantedSteps - steps));
+            } else if (steps > 0) {
+                const double left = budget - total.seconds();
+                const auto fits = static_cast<std::uint64_t>(std::max(0.0, left / std::max(secondsPerStep, 1e-9)));
+                if (fits == 0) break;
+                n = static_cast<std::uint32_t>(std::min<std::uint64_t>(n, fits));
+            }
+            if (steps + n > UINT32_MAX) break;  // step indices are 32-bit
+            Timer batch;
+            submit(name_ + " mutation steps " + std::to_string(steps) + ".." + std::to_string(steps + n - 1) +
+                       " (seed " + std::to_string(options.seed) + ")",
+                   [&](VkCommandBuffer cmd) {
+                       pass.recordMutations(cmd, static_cast<std::uint32_t>(steps), n, options.seed, timer);
+                   });
+            acc.add(pass.records(n), std::size_t{2} * po.chains * n);
+            steps += n;
+            ++stats.batches;
+            secondsPerStep = batch.seconds() / n;
+            char rate[64];
+            std::snprintf(rate, sizeof rate, "%.1f mutations/pixel",
+                          double(steps) * double(po.chains) / double(pixels));
+            progress.update(timed ? total.seconds() : double(steps), rate);
+        }
+        progress.finish();
+        const MltAcceptance a = pass.acceptance();
+        stats.mlt.proposedSmall = a.proposedSmall;
+        stats.mlt.acceptedSmall = a.acceptedSmall;
+        stats.mlt.proposedLarge = a.proposedLarge;
+        stats.mlt.acceptedLarge = a.acceptedLarge;
+    }
+    stats.mlt.mutations = steps * po.chains;
+    stats.spp = static_cast<std::uint32_t>(stats.mlt.mutations / pixels);
+    stats.samplingMs = sampling.ms();
+    stats.kernels = gpuTimer.totals();
+    if (cancelled()) {
+        stats.cancelled = true;
+        return out;
+    }
+    if (stats.nanSamples > 0 && !options.quiet)
+        std::fprintf(stderr, "gdpt: warning: %s: %llu samples were NaN/Inf and were counted as zero\n",
+                     name_.c_str(), static_cast<unsigned long long>(stats.nanSamples));
+
+    // Stage 3: the estimate, X(p) = W·H·b/N Σ weight·X (mlt_estimate.h); gmlt reconstructs.
+    Timer readback;
+    const double scale = stats.mlt.mutations ? double(pixels) * norm.b / double(stats.mlt.mutations) : 0.0;
+    Image direct = pass.directImage();
+    stats.readbackMs = readback.ms();
+    if (!gradients()) {
+        Image primal = acc.quantity(gpu::kMltCentral, scale);
+        out.layers.push_back({"", gptFinal(primal, nullptr, &direct)});
+        out.layers.push_back({"primal", std::move(primal)});
+        out.layers.push_back({"direct", std::move(direct)});
+        return out;
+    }
+    MltImages g = resolveGradientSamples(acc, scale);
+    PoissonInput input;
+    input.primal = &g.primal;
+    input.dx = &g.dx;
+    input.dy = &g.dy;
+    std::vector<NamedLayer> recons;
+    enterPhase("reconstruction");
+    for (SolveOptions so : solveList) {
+        so.progress = [&](int, int, int) {
+            if (cancelled()) throw Interrupted("reconstructing");
+        };
+        Image recon;
+        const SolveReport report = solver_->solve(input, so, recon);
+        if (!options.quiet)
+            std::fprintf(stderr, "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g%s, %.1f ms\n",
+                         toString(so.method), report.iterations, report.irlsIterations, report.residual,
+                         report.converged ? "" : " NOT converged", report.ms);
+        stats.reconstructions.push_back({toString(so.method), report.iterations, report.irlsIterations,
+                                         report.residual, so.tolerance, report.converged, report.ms});
+        stats.reconstructionMs += report.ms;
+        recons.push_back({std::string("recon_") + toString(so.method), std::move(recon)});
+    }
+    out.layers.push_back({"", gptFinal(recons.empty() ? g.primal : recons.front().image, nullptr, &direct)});
+    for (NamedLayer& r : recons) out.layers.push_back(std::move(r));
+    Image primalPlusDirect = gptFinal(g.primal, nullptr, &direct);
+    out.layers.push_back({"primal", std::move(g.primal)});
+    out.layers.push_back({"dx", std::move(g.dx)});
+    out.layers.push_back({"dy", std::move(g.dy)});
+    out.layers.push_back({"direct", std::move(direct)});
+    out.layers.push_back({"primal_plus_direct", std::move(primalPlusDirect)});
+    return out;
+}
+
+void MltIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
+    const MltStats& m = s.mlt;
+    const auto rate = [](std::uint64_t accepted, std::uint64_t proposed) {
+        return proposed ? double(accepted) / double(proposed) : 0.0;
+    };
+    j["mlt"] = {{"chains", m.chains},
+                {"mutations", m.mutations},
+                {"large_step_probability", options_.largeStep},
+                {"acceptance_small", rate(m.acceptedSmall, m.proposedSmall)},
+                {"acceptance_large", rate(m.acceptedLarge, m.proposedLarge)},
+                {"proposed_small", m.proposedSmall},
+                {"proposed_large", m.proposedLarge},
+                {"bootstrap_samples", m.bootstrapSamples},
+                {"normalisation", m.normalisation},
+                {"normalisation_stderr", m.normalisationStdErr}};
+    if (gradients()) j["mlt"]["target_alpha"] = options_.targetAlpha;
+    nlohmann::json recons = nlohmann::json::array();
+    for (const ReconstructionStats& r : s.reconstructions)
+        recons.push_back({{"method", r.method},
+                          {"iterations", r.iterations},
+                          {"irls_iterations", r.irlsIterations},
+                          {"residual", r.residual},
+                          {"tolerance", r.tolerance},
+                          {"converged", r.converged},
+                          {"ms", r.ms}});
+    j["reconstructions"] = recons;
+}
+
+std::string MltIntegrator::summary(const RenderStats& s) const {
+    const MltStats& m = s.mlt;
+    char text[160];
+    std::snprintf(text, sizeof text, ", %u chains, acceptance %.0f %% small / %.0f %% large", m.chains,
+                  m.proposedSmall ? 100.0 * double(m.acceptedSmall) / double(m.proposedSmall) : 0.0,
+                  m.proposedLarge ? 100.0 * double(m.acceptedLarge) / double(m.proposedLarge) : 0.0);
+    return text;
+}
+
+}  // namespace gdpt

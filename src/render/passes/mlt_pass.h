@@ -1,0 +1,81 @@
+// mlt_pass.h — the Metropolis pass: owns mlt.comp (bootstrap, chain start, mutation steps and
+// the very-direct image; see the kernel for the phases) and the buffers it writes. The
+// integrator (integrator/mlt_integrator.h) drives the phases and splats the records.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "image/image.h"
+#include "mlt_shared.h"
+#include "render/device_scene/scene_gpu.h"
+#include "vk/buffer.h"
+#include "vk/kernel.h"
+
+namespace gdpt {
+
+namespace vk {
+class Context;
+class CommandStream;
+class GpuTimer;
+}  // namespace vk
+
+struct MltPassOptions {
+    bool baseOnly = false;            // PSSMLT: the base path alone; else G-MLT (base + offsets)
+    std::uint32_t chains = 4096;      // Markov chains run at once
+    std::uint32_t stepsPerBatch = 8;  // mutation steps a batch records (records buffer size)
+    float largeStep = 0.3f;           // probability of a large step
+    float targetAlpha = 0.25f;        // G-MLT: weight of the primal term of the target
+};
+
+// Counters of the chains (summed over chains, from their MltChain).
+struct MltAcceptance {
+    std::uint64_t proposedSmall = 0, acceptedSmall = 0, proposedLarge = 0, acceptedLarge = 0;
+};
+
+class MltPass {
+public:
+    // Pipelines created as `creation` says (Background: while the caller builds the SceneGpu);
+    // attach() binds the scene's buffers.
+    MltPass(const vk::Context& ctx, const SceneSpec& spec, WorkgroupSize wg, MltPassOptions options,
+            vk::PipelineCreation creation);
+    void attach(const SceneGpu& scene);
+    double waitForPipelines() const;
+
+    // Records `count` bootstrap samples from sample index `first` into the bootstrap buffer
+    // (capacity: the count of the first call, which allocates it).
+    void recordBootstrap(VkCommandBuffer cmd, std::uint32_t first, std::uint32_t count, std::uint32_t seed,
+                         vk::GpuTimer* timer);
+    // Their targets (after the fence).
+    [[nodiscard]] std::vector<float> bootstrapTargets(std::uint32_t count) const;
+    // Starts chain c at bootstrap sample starts[c] (starts.size() == chains).
+    void recordStart(VkCommandBuffer cmd, const std::vector<std::uint32_t>& starts, std::uint32_t seed,
+                     vk::GpuTimer* timer);
+    // Records `steps` (≤ stepsPerBatch) mutation steps of every chain, step indices from `first`.
+    void recordMutations(VkCommandBuffer cmd, std::uint32_t first, std::uint32_t steps, std::uint32_t seed,
+                         vk::GpuTimer* timer);
+    // The records of the last batch of `steps` steps, in step then chain order (after the fence).
+    [[nodiscard]] const gpu::MltRecord* records(std::uint32_t steps);
+    // The very-direct image, `samples` stratified camera samples per pixel.
+    void recordDirect(VkCommandBuffer cmd, std::uint32_t samples, std::uint32_t seed, vk::GpuTimer* timer);
+    [[nodiscard]] Image directImage() const;
+    [[nodiscard]] MltAcceptance acceptance() const;
+    // Reads the counters written since the last call and clears them (after the fence).
+    gpu::Counters takeCounters();
+    [[nodiscard]] const MltPassOptions& options() const { return options_; }
+
+private:
+    [[nodiscard]] gpu::MltParams params(std::uint32_t phase, std::uint32_t count, std::uint32_t seed) const;
+    void dispatchChains(VkCommandBuffer cmd, const gpu::MltParams& p, vk::GpuTimer* timer) const;
+
+    const vk::Context& ctx_;
+    std::uint32_t width_, height_;
+    float shiftThreshold_;
+    MltPassOptions options_;
+    vk::Buffer counters_, chains_, pss_, records_, starts_, direct_;
+    vk::Buffer bootstrap_;
+    std::vector<gpu::MltRecord> host_;
+    vk::Kernel kernel_;
+};
+
+}  // namespace gdpt
