@@ -1,0 +1,182 @@
+// The Metropolis steps of mlt.glsl and the host's estimate (integrator/mlt_estimate.h).
+//
+// Detailed balance: a chain that starts in its target's distribution stays in it. Many
+// independent chains start from exact samples of an analytic target on the unit square
+// (rejection sampling), each takes kSteps mutations with mlt.glsl's small and large steps and
+// acceptance; their final states are independent samples, whose histogram is chi-square
+// tested against the target's cell integrals. The same test with a wrong acceptance ratio
+// (min(1, sqrt(T'/T)): its chain targets sqrt(T)) must fail, and does by a wide margin: the
+// test has the power to catch a broken Metropolis-Hastings ratio.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+#include <vector>
+
+#include "integrator/mlt_estimate.h"
+#include "lib/mlt.glsl"
+#include "stats.h"
+
+namespace gdpt {
+namespace {
+
+// A smooth bump on a floor, with a hole of zero target (the chain must never enter it).
+double target(double u, double v) {
+    if (u > 0.8 && v < 0.2) return 0.0;
+    return 0.1 + std::exp(-((u - 0.3) * (u - 0.3) + (v - 0.6) * (v - 0.6)) / 0.02);
+}
+
+constexpr int kCells = 10;         // 10 x 10 histogram
+constexpr int kSteps = 64;         // mutations per chain
+constexpr int kChains = 40000;     // independent chains (final states)
+constexpr float kLargeStep = 0.3f;
+
+using Acceptance = std::function<float(float, float)>;
+
+std::vector<double> finalStateHistogram(const Acceptance& accept, std::uint32_t seed) {
+    std::mt19937 gen(seed);
+    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+    std::vector<double> counts(kCells * kCells, 0.0);
+    for (int c = 0; c < kChains; ++c) {
+        float u, v;
+        do {  // rejection sampling: the start is distributed by the target exactly
+            u = uni(gen);
+            v = uni(gen);
+        } while (uni(gen) * 1.1f >= target(u, v));
+        float t = static_cast<float>(target(u, v));
+        for (int s = 0; s < kSteps; ++s) {
+            float pu, pv;
+            if (uni(gen) < kLargeStep) {
+                pu = uni(gen);
+                pv = uni(gen);
+            } else {
+                pu = gpu::mltSmallStep(u, uni(gen), uni(gen));
+                pv = gpu::mltSmallStep(v, uni(gen), uni(gen));
+            }
+            const float tp = static_cast<float>(target(pu, pv));
+            if (uni(gen) < accept(t, tp)) u = pu, v = pv, t = tp;
+        }
+        counts[std::size_t(std::min(int(v * kCells), kCells - 1) * kCells + std::min(int(u * kCells), kCells - 1))] +=
+            1.0;
+    }
+    return counts;
+}
+
+std::vector<double> expectedCounts() {
+    // Cell integrals by a 40 x 40 midpoint rule per cell, normalised to kChains.
+    std::vector<double> e(kCells * kCells, 0.0);
+    double total = 0.0;
+    constexpr int kSub = 40;
+    for (int cy = 0; cy < kCells; ++cy)
+        for (int cx = 0; cx < kCells; ++cx) {
+            double s = 0.0;
+            for (int j = 0; j < kSub; ++j)
+                for (int i = 0; i < kSub; ++i)
+                    s += target((cx + (i + 0.5) / kSub) / kCells, (cy + (j + 0.5) / kSub) / kCells);
+            e[std::size_t(cy * kCells + cx)] = s;
+            total += s;
+        }
+    for (double& x : e) x *= kChains / total;
+    return e;
+}
+
+TEST(MltChain, SmallStepStaysInTheUnitIntervalAndWraps) {
+    EXPECT_FLOAT_EQ(gpu::mltSmallStep(0.5f, 0.0f, 0.0f), 0.5f + gpu::kMltSmallStepMax);
+    EXPECT_NEAR(gpu::mltSmallStep(0.5f, 0.9f, 1.0f), 0.5f - gpu::kMltSmallStepMin, 1e-7f);
+    EXPECT_NEAR(gpu::mltSmallStep(0.999f, 0.0f, 0.0f), 0.999f + gpu::kMltSmallStepMax - 1.0f, 1e-6f);
+    EXPECT_NEAR(gpu::mltSmallStep(0.001f, 0.9f, 0.0f), 0.001f - gpu::kMltSmallStepMax + 1.0f, 1e-6f);
+    std::mt19937 gen(7);
+    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+    for (int i = 0; i < 100000; ++i) {
+        const float v = gpu::mltSmallStep(uni(gen), uni(gen), uni(gen));
+        ASSERT_GE(v, 0.0f);
+        ASSERT_LT(v, 1.0f);
+    }
+}
+
+TEST(MltChain, AcceptanceIsTheMetropolisRatio) {
+    EXPECT_FLOAT_EQ(gpu::mltAcceptance(2.0f, 1.0f), 0.5f);
+    EXPECT_FLOAT_EQ(gpu::mltAcceptance(1.0f, 3.0f), 1.0f);
+    EXPECT_FLOAT_EQ(gpu::mltAcceptance(1.0f, 0.0f), 0.0f);
+    EXPECT_FLOAT_EQ(gpu::mltAcceptance(0.0f, 0.0f), 1.0f);
+    EXPECT_FLOAT_EQ(gpu::mltSplatWeight(0.25f, 2.0f), 0.125f);
+    EXPECT_FLOAT_EQ(gpu::mltSplatWeight(1.0f, 0.0f), 0.0f);
+}
+
+TEST(MltChain, DetailedBalanceKeepsTheTargetDistribution) {
+    const std::vector<double> expected = expectedCounts();
+    const std::vector<double> right = finalStateHistogram(gpu::mltAcceptance, 11);
+    const stats::Chi2Result ok = stats::chi2Test(right, expected);
+    ASSERT_TRUE(ok.error.empty()) << ok.error;
+    EXPECT_GT(ok.pValue, 1e-3) << "chi2 " << ok.statistic << " dof " << ok.dof;
+    // The hole: no chain may be found where the target is zero (cells of u > 0.8, v < 0.2).
+    for (int cy = 0; cy < 2; ++cy)
+        for (int cx = 8; cx < kCells; ++cx) EXPECT_EQ(right[std::size_t(cy * kCells + cx)], 0.0);
+
+    // Power: a chain whose ratio is sqrt(T'/T) targets sqrt(T); 64 steps from the right
+    // distribution move it far enough to be rejected.
+    const Acceptance wrong = [](float t, float tp) {
+        return t > 0.0f ? std::min(1.0f, std::sqrt(tp / t)) : 1.0f;
+    };
+    const stats::Chi2Result bad = stats::chi2Test(finalStateHistogram(wrong, 11), expected);
+    EXPECT_LT(bad.pValue, 1e-9) << "chi2 " << bad.statistic << " dof " << bad.dof;
+}
+
+TEST(MltEstimate, NormalisationIsTheMeanTargetWithItsStandardError) {
+    const std::vector<float> t = {1.0f, 2.0f, 3.0f, 6.0f, 0.0f, -1.0f, NAN};
+    const MltNormalisation n = mltNormalisation(t);
+    // Negative and non-finite targets count as 0: values 1, 2, 3, 6, 0, 0, 0.
+    EXPECT_EQ(n.samples, 7u);
+    EXPECT_DOUBLE_EQ(n.b, 12.0 / 7.0);
+    double ss = 0.0;
+    for (double v : {1.0, 2.0, 3.0, 6.0, 0.0, 0.0, 0.0}) ss += (v - 12.0 / 7.0) * (v - 12.0 / 7.0);
+    EXPECT_NEAR(n.standardError, std::sqrt(ss / 6.0 / 7.0), 1e-12);
+    EXPECT_EQ(mltNormalisation({}).b, 0.0);
+}
+
+TEST(MltEstimate, ChainsStartInProportionToTheTarget) {
+    const std::vector<float> t = {0.0f, 1.0f, 3.0f, 0.0f, 4.0f, 0.5f};
+    const std::uint32_t chains = 8500;
+    const std::vector<std::uint32_t> starts = mltChainStarts(t, chains, 5);
+    ASSERT_EQ(starts.size(), chains);
+    std::vector<double> count(t.size(), 0.0);
+    for (std::uint32_t s : starts) count.at(s) += 1.0;
+    // Systematic resampling: each sample is chosen floor or ceil of chains · T_i / Σ T times.
+    for (std::size_t i = 0; i < t.size(); ++i)
+        EXPECT_LE(std::abs(count[i] - chains * t[i] / 8.5), 1.0) << "sample " << i;
+    EXPECT_TRUE(std::is_sorted(starts.begin(), starts.end()));
+    EXPECT_TRUE(mltChainStarts({0.0f, 0.0f}, 10, 1).empty());
+    EXPECT_EQ(mltChainStarts({0.0f, 2.0f, 0.0f}, 3, 9), (std::vector<std::uint32_t>{1, 1, 1}));
+}
+
+TEST(MltEstimate, RecordsResolveLikeGptResolve) {
+    // A 3 x 2 image; one record at pixel (1, 0) with central c and an offset to the right n
+    // and a gradient to the right g, one at (2, 0) with a gradient to the left g2.
+    MltAccumulator acc(3, 2);
+    gpu::MltRecord r[2]{};
+    r[0].pixel = 1;
+    r[0].weight = 0.5f;
+    r[0].value[gpu::kMltCentral] = {2.0f, 4.0f, 6.0f};
+    r[0].value[gpu::kMltNeighbor + gpu::kGptRight] = {1.0f, 1.0f, 1.0f};
+    r[0].value[gpu::kMltGradient + gpu::kGptRight] = {0.5f, 0.5f, 0.5f};
+    r[1].pixel = 2;
+    r[1].weight = 2.0f;
+    r[1].value[gpu::kMltGradient + gpu::kGptLeft] = {0.25f, 0.0f, 0.0f};
+    acc.add(r, 2);
+    const double scale = 3.0;
+    const MltImages m = resolveGradientSamples(acc, scale);
+    // (1, 0) has neighbours left, right, down: k = 3. (2, 0) has left and down: k = 2.
+    EXPECT_FLOAT_EQ(m.primal.at(1, 0, 0), float(3.0 * 0.5 * 2.0 / 3.0));
+    EXPECT_FLOAT_EQ(m.primal.at(1, 0, 2), float(3.0 * 0.5 * 6.0 / 3.0));
+    EXPECT_FLOAT_EQ(m.primal.at(2, 0, 0), float(3.0 * 0.5 * 1.0 / 2.0));
+    EXPECT_FLOAT_EQ(m.primal.at(0, 0, 0), 0.0f);
+    // dx(1, 0) = gradient_right(1, 0) − gradient_left(2, 0).
+    EXPECT_FLOAT_EQ(m.dx.at(1, 0, 0), float(3.0 * (0.5 * 0.5 - 2.0 * 0.25)));
+    EXPECT_FLOAT_EQ(m.dx.at(1, 0, 1), float(3.0 * 0.5 * 0.5));
+    EXPECT_FLOAT_EQ(m.dx.at(2, 0, 0), 0.0f);  // last column
+    EXPECT_FLOAT_EQ(m.dy.at(1, 0, 0), 0.0f);
+}
+
+}  // namespace
+}  // namespace gdpt
