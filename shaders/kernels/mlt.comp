@@ -160,8 +160,9 @@ void writeRecord(uint at, uint pixel, float weight, vec3 value[kMltValues]) {
     for (uint k = 0u; k < kMltValues; ++k) records[at].value[k] = weight > 0.0 ? value[k] : vec3(0.0);
 }
 
-void mutate(uint c, inout uint rays, inout uint nan) {
-    Rng m = rngInit(c, frame.index, frame.seed ^ kTagMutation);
+// Draws chain c's proposal into gPss: a large step (fresh decisions) or a small step of
+// every decision, from the chain's stream of mutation choices `m`.
+bool propose(uint c, inout Rng m) {
     bool large = rngNext(m) < frame.largeStep;
     for (uint k = 0u; k < kMltPssDims; ++k) {
         float u = pss[c * kMltPssDims + k];
@@ -169,14 +170,15 @@ void mutate(uint c, inout uint rays, inout uint nan) {
         float b = rngNext(m);
         gPss[k] = large ? a : mltSmallStep(u, a, b);
     }
-    // Decisions beyond the state: their own stream per chain and step (the chain index is
-    // offset past every bootstrap sample's by the tag).
-    Evaluated e = evaluate(c ^ kTagMutation, frame.index, rays, nan);
-    float tCurrent = chains[c].target;
-    float a = mltAcceptance(tCurrent, e.target);
-    uint at = frame.recordOffset + 2u * c;
+    return large;
+}
+
+// Chain c has evaluated its proposal e: two records, then accept with probability a.
+void finishMutation(uint c, Evaluated e, bool large, inout Rng m) {
     MltChain cur = chains[c];
-    writeRecord(at, cur.pixel, mltSplatWeight(1.0 - a, tCurrent), cur.value);
+    float a = mltAcceptance(cur.target, e.target);
+    uint at = frame.recordOffset + 2u * c;
+    writeRecord(at, cur.pixel, mltSplatWeight(1.0 - a, cur.target), cur.value);
     writeRecord(at + 1u, e.pixel, mltSplatWeight(a, e.target), e.value);
     bool accept = rngNext(m) < a;
     if (large) {
@@ -221,21 +223,35 @@ void main() {
     } else {
         if (item >= frame.count) return;
         paths = 1u;
+        // One call of evaluate (the whole G-PT sample) for every phase: the kernel holds one
+        // copy of the path code, which lavapipe compiles in a third of the time of three.
+        uint stream = 0u, fresh = 0u;
+        bool large = false;
+        Rng m = rngInit(item, frame.index, frame.seed ^ kTagMutation);
         if (frame.phase == kMltPhaseBootstrap) {
-            uint s = frame.index + item;
-            freshState(s);
-            bootstrapTarget[item] = evaluate(s, 0u, rays, nan).target;
+            stream = frame.index + item;
+            freshState(stream);
         } else if (frame.phase == kMltPhaseStart) {
-            uint s = starts[item];
-            freshState(s);
-            Evaluated e = evaluate(s, 0u, rays, nan);
+            stream = starts[item];
+            freshState(stream);
+        } else {
+            large = propose(item, m);
+            // Decisions beyond the state: a stream per chain and step (the chain index is
+            // moved past every bootstrap sample's by the tag).
+            stream = item ^ kTagMutation;
+            fresh = frame.index;
+        }
+        Evaluated e = evaluate(stream, fresh, rays, nan);
+        if (frame.phase == kMltPhaseBootstrap) {
+            bootstrapTarget[item] = e.target;
+        } else if (frame.phase == kMltPhaseStart) {
             storeChain(item, e);
             chains[item].proposedSmall = 0u;
             chains[item].acceptedSmall = 0u;
             chains[item].proposedLarge = 0u;
             chains[item].acceptedLarge = 0u;
         } else {
-            mutate(item, rays, nan);
+            finishMutation(item, e, large, m);
         }
     }
     atomicAdd(counters.raysTraced, rays);

@@ -1,0 +1,163 @@
+// Metropolis light transport (pssmlt, gmlt) against answers it did not make: the white
+// furnace, whose every pixel is exactly 1, and the path tracer's image of the Cornell box.
+//
+// Statistics. A render's pixels are correlated (its chains splat across the image), so the
+// tests compare region means over independent renders (seeds): with n seeds, the mean of the
+// region means and its standard error (sample sd / sqrt(n)) give a Student t statistic with
+// n − 1 degrees of freedom, against the expected value (plus, for the path tracer, its own
+// standard error from its per-pixel variances). The threshold is the t quantile of a Šidák-
+// corrected family level of 1e-3. Each test checks its power: the same statistic against an
+// expectation 5 % off must be rejected, so a test that could not fail would fail.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "gpu_fixture.h"
+#include "integrator/integrator.h"
+#include "integrator/mlt_integrator.h"
+#include "scene/gltf_loader.h"
+#include "stats_normal.h"
+
+namespace gdpt {
+namespace {
+
+class MltRender : public test::GpuTest {};
+
+constexpr int kSeeds = 10;
+
+// Two-sided Student t quantile with `dof` degrees of freedom at level alpha: bisection on
+// the tail probability, integrated from the density by Simpson's rule.
+double twoSidedT(double alpha, int dof) {
+    const double nu = dof;
+    const double c = std::exp(std::lgamma((nu + 1) / 2) - std::lgamma(nu / 2)) / std::sqrt(nu * M_PI);
+    const auto pdf = [&](double t) { return c * std::pow(1.0 + t * t / nu, -(nu + 1) / 2); };
+    const auto centralMass = [&](double t) {  // P(|T| < t)
+        const int n = 4000;
+        const double h = t / n;
+        double s = pdf(0) + pdf(t);
+        for (int i = 1; i < n; ++i) s += (i % 2 ? 4.0 : 2.0) * pdf(i * h);
+        return 2.0 * s * h / 3.0;
+    };
+    double lo = 0.0, hi = 200.0;
+    for (int i = 0; i < 100; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (1.0 - centralMass(mid) > alpha ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+RenderOptions options(int size, std::uint32_t spp, std::uint32_t seed) {
+    RenderOptions o;
+    o.scene.width = o.scene.height = size;
+    o.spp = spp;
+    o.seed = seed;
+    o.quiet = true;
+    return o;
+}
+
+const Image& layer(const RenderOutput& out, const std::string& name) {
+    for (const NamedLayer& l : out.layers)
+        if (l.name == name) return l.image;
+    throw std::runtime_error("no layer " + name);
+}
+
+// Mean of channel c over the pixels [x0, x1) x [y0, y1).
+double regionMean(const Image& im, int c, int x0, int y0, int x1, int y1) {
+    double s = 0.0;
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) s += im.at(x, y, c);
+    return s / double((x1 - x0) * (y1 - y0));
+}
+
+// The t statistic of `samples` (one per seed) against `expected` ± expectedSe.
+double tStatistic(const std::vector<double>& samples, double expected, double expectedSe) {
+    double mean = 0.0;
+    for (double s : samples) mean += s;
+    mean /= double(samples.size());
+    double var = 0.0;
+    for (double s : samples) var += (s - mean) * (s - mean);
+    var /= double(samples.size() - 1);
+    return (mean - expected) / std::sqrt(var / double(samples.size()) + expectedSe * expectedSe);
+}
+
+// The layer that holds the method's splatted estimate: pssmlt's final image, gmlt's primal
+// plus direct (the reconstruction has its own tests; its L1 bias at low counts is G-PT's).
+const char* estimateLayer(const std::string& method) {
+    return method == "gmlt" ? "primal_plus_direct" : "";
+}
+
+TEST_F(MltRender, FurnaceMeanIsOneForBothTargets) {
+    const Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/furnace.gltf");
+    const double threshold = twoSidedT(test::sidakAlpha(1e-3, 2), kSeeds - 1);
+    for (const std::string method : {"pssmlt", "gmlt"}) {
+        std::unique_ptr<Integrator> integrator = makeIntegrator(method);
+        std::vector<double> means;
+        for (int s = 0; s < kSeeds; ++s) {
+            const RenderOutput out = integrator->render(ctx(), scene, options(16, 16, 100 + s));
+            const Image& im = layer(out, estimateLayer(method));
+            means.push_back(regionMean(im, 1, 0, 0, 16, 16));
+            // The very-direct light of the furnace is its emission, 0.5, exactly.
+            EXPECT_FLOAT_EQ(layer(out, "direct").at(5, 7, 0), 0.5f);
+            EXPECT_GT(out.stats.mlt.acceptedSmall, 0u);
+            EXPECT_GT(out.stats.mlt.acceptedLarge, 0u);
+        }
+        const double t = tStatistic(means, 1.0, 0.0);
+        EXPECT_LT(std::abs(t), threshold) << method << ": mean of " << kSeeds << " image means is off 1";
+        EXPECT_GT(std::abs(tStatistic(means, 1.05, 0.0)), threshold) << method << ": the test has no power";
+    }
+}
+
+TEST_F(MltRender, CornellBoxQuadrantsMatchThePathTracer) {
+    const Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.gltf");
+    constexpr int kSize = 32, kHalf = kSize / 2;
+    const RenderOutput pt = makeIntegrator("pt")->render(ctx(), scene, options(kSize, 1024, 7));
+    const Image& ptImage = pt.image();
+    const Image& ptVar = layer(pt, "variance");
+    const double threshold = twoSidedT(test::sidakAlpha(1e-3, 2 * 4 * 3), kSeeds - 1);
+    for (const std::string method : {"pssmlt", "gmlt"}) {
+        std::unique_ptr<Integrator> integrator = makeIntegrator(method);
+        std::vector<std::vector<double>> quadrant(12);
+        for (int s = 0; s < kSeeds; ++s) {
+            const RenderOutput out = integrator->render(ctx(), scene, options(kSize, 32, 200 + s));
+            const Image& im = layer(out, estimateLayer(method));
+            for (int q = 0; q < 4; ++q)
+                for (int c = 0; c < 3; ++c)
+                    quadrant[std::size_t(q * 3 + c)].push_back(
+                        regionMean(im, c, (q % 2) * kHalf, (q / 2) * kHalf, (q % 2 + 1) * kHalf, (q / 2 + 1) * kHalf));
+        }
+        double worstWrong = 0.0;
+        for (int q = 0; q < 4; ++q)
+            for (int c = 0; c < 3; ++c) {
+                const int x0 = (q % 2) * kHalf, y0 = (q / 2) * kHalf;
+                const double expected = regionMean(ptImage, c, x0, y0, x0 + kHalf, y0 + kHalf);
+                // Pixels of a PT render are independent: the variance of the region mean is
+                // the sum of the per-pixel variances of the mean over the pixel count squared.
+                const double se = std::sqrt(regionMean(ptVar, c, x0, y0, x0 + kHalf, y0 + kHalf) / (kHalf * kHalf));
+                const std::vector<double>& v = quadrant[std::size_t(q * 3 + c)];
+                EXPECT_LT(std::abs(tStatistic(v, expected, se)), threshold)
+                    << method << " quadrant " << q << " channel " << c << ": PT " << expected;
+                worstWrong = std::max(worstWrong, std::abs(tStatistic(v, 1.05 * expected, 1.05 * se)));
+            }
+        EXPECT_GT(worstWrong, threshold) << method << ": the test has no power";
+    }
+}
+
+TEST_F(MltRender, DeterministicPerSeed) {
+    const Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/glossy_cornell.gltf");
+    std::unique_ptr<Integrator> gmlt = makeIntegrator("gmlt");
+    const RenderOutput a = gmlt->render(ctx(), scene, options(24, 8, 3));
+    const RenderOutput b = gmlt->render(ctx(), scene, options(24, 8, 3));
+    const RenderOutput c = gmlt->render(ctx(), scene, options(24, 8, 4));
+    ASSERT_EQ(a.layers.size(), b.layers.size());
+    for (std::size_t i = 0; i < a.layers.size(); ++i)
+        for (int ch = 0; ch < 3; ++ch) ASSERT_EQ(a.layers[i].image.plane(ch), b.layers[i].image.plane(ch)) << i;
+    EXPECT_NE(a.image().plane(0), c.image().plane(0));
+    EXPECT_EQ(a.stats.mlt.acceptedSmall, b.stats.mlt.acceptedSmall);
+}
+
+}  // namespace
+}  // namespace gdpt
