@@ -1,0 +1,78 @@
+// `gdpt render --method pssmlt|gmlt`: the JSON reports the chains, both acceptance rates and
+// the bootstrap's normalisation with its standard error; the options that need per-pixel
+// statistics (checkpoints, shards, the variance-weighted reconstructions) are usage errors
+// that leave no output behind.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "cli_runner.h"
+#include "temp_dir.h"
+
+namespace gdpt {
+namespace {
+
+using test::runGdpt;
+using test::RunResult;
+
+const std::string kScene = std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.gltf";
+
+class MltCli : public test::TempDirTest {};
+
+TEST_F(MltCli, JsonReportsChainsAcceptanceAndNormalisation) {
+    for (const std::string method : {"pssmlt", "gmlt"}) {
+        const RunResult r = runGdpt("render " + kScene + " --method " + method +
+                                    " --width 24 --height 16 --spp 8 --chains 512 --large-step 0.25 -o " +
+                                    path(method + ".exr") + " --json " + path(method + ".json"));
+        ASSERT_EQ(r.code, 0) << r.output;
+        EXPECT_NE(r.output.find("512 chains, acceptance"), std::string::npos) << r.output;
+        EXPECT_TRUE(std::filesystem::exists(path(method + ".png")));
+        std::ifstream in(path(method + ".json"));
+        const nlohmann::json j = nlohmann::json::parse(in);
+        EXPECT_EQ(j["method"], method);
+        const nlohmann::json& m = j.at("mlt");
+        EXPECT_EQ(m["chains"], 512);
+        EXPECT_FLOAT_EQ(m["large_step_probability"].get<float>(), 0.25f);
+        // 8 mutations per pixel of 384 pixels on 512 chains: 6 steps of every chain.
+        EXPECT_EQ(m["mutations"], 6 * 512);
+        EXPECT_EQ(m["proposed_small"].get<int>() + m["proposed_large"].get<int>(), 6 * 512);
+        for (const char* rate : {"acceptance_small", "acceptance_large"}) {
+            EXPECT_GT(m[rate].get<double>(), 0.0) << rate;
+            EXPECT_LT(m[rate].get<double>(), 1.0) << rate;
+        }
+        EXPECT_GE(m["bootstrap_samples"], 512 * 16);
+        EXPECT_GT(m["normalisation"].get<double>(), 0.0);
+        EXPECT_GT(m["normalisation_stderr"].get<double>(), 0.0);
+        EXPECT_LT(m["normalisation_stderr"].get<double>(), 0.1 * m["normalisation"].get<double>());
+        EXPECT_EQ(j["reconstructions"].size(), method == "gmlt" ? 1u : 0u);
+    }
+}
+
+TEST_F(MltCli, OptionsThatNeedPerPixelStatisticsAreUsageErrors) {
+    const std::string base = "render " + kScene + " --width 8 --height 8 --spp 2 -o " + path("x.exr") + " ";
+    const struct {
+        std::string flags, says;
+    } cases[] = {
+        {"--method gmlt --checkpoint " + path("c.exr"), "Markov chains"},
+        {"--method pssmlt --shard 0/2", "Markov chains"},
+        {"--method gmlt --recon wl1", "l1 or l2"},
+        {"--method gmlt --recon wl2", "l1 or l2"},
+        {"--method gmlt --alpha 0", "--alpha"},
+    };
+    for (const auto& c : cases) {
+        const RunResult r = runGdpt(base + c.flags);
+        EXPECT_EQ(r.code, 2) << c.flags << "\n" << r.output;
+        EXPECT_NE(r.output.find(c.says), std::string::npos) << c.flags << "\n" << r.output;
+        EXPECT_FALSE(std::filesystem::exists(path("x.exr"))) << c.flags;
+        EXPECT_FALSE(std::filesystem::exists(path("c.exr"))) << c.flags;
+    }
+    // The same render with --recon l2 is fine (the power of the check above).
+    const RunResult ok = runGdpt(base + "--method gmlt --recon l2");
+    EXPECT_EQ(ok.code, 0) << ok.output;
+}
+
+}  // namespace
+}  // namespace gdpt
