@@ -78,10 +78,10 @@ PoissonSolverGpu& MltIntegrator::solver(const vk::Context& ctx, int width, int h
 double MltIntegrator::reserveAfterSampling(const vk::Context& ctx, int width, int height) {
     const std::vector<SolveOptions> s = solves();
     if (s.empty()) return 0.0;
+    PoissonSolverGpu& solverGpu = solver(ctx, width, height);  // (re)made first: it resets the calibration
     if (calibratedSeconds_ < 0.0) {
         calibratedSeconds_ = 0.0;
-        for (const SolveOptions& so : s)
-            calibratedSeconds_ += calibrateReconSeconds(solver(ctx, width, height), so, /*warmUp=*/true);
+        for (const SolveOptions& so : s) calibratedSeconds_ += calibrateReconSeconds(solverGpu, so, /*warmUp=*/true);
     }
     return calibratedSeconds_;
 }
@@ -181,7 +181,9 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
             if (!timed) {
                 if (steps >= wantedSteps) break;
                 n = static_cast<std::uint32_t>(std::min<std::uint64_t>(n, wantedSteps - steps));
-            } else if (steps > 0) {
+            } else if (steps == 0) {
+                n = 1;  // measures a step; the set-up may have used the budget already
+            } else {
                 const double left = budget - total.seconds();
                 const auto fits = static_cast<std::uint64_t>(std::max(0.0, left / std::max(secondsPerStep, 1e-9)));
                 if (fits == 0) break;
