@@ -53,14 +53,14 @@ struct MltParams {
 
 // A chain's current state besides its decisions (kBindMltPss). 144 bytes.
 struct MltChain {
-    vec2 film;                  // film position of the current sample, pixels
-    float target;               // its target value (> 0: chains start where the target is)
-    uint pixel;                 // y·width + x of the film position
-    vec3 value[kMltValues];     // its quantities
-    uint proposedSmall;         // small steps proposed so far
-    uint acceptedSmall;         // of which accepted
-    uint proposedLarge;         // large steps proposed so far
-    uint acceptedLarge;         // of which accepted
+    vec2 film;               // film position of the current sample, pixels
+    float target;            // its target value (> 0: chains start where the target is)
+    uint pixel;              // y·width + x of the film position
+    vec3 value[kMltValues];  // its quantities
+    uint proposedSmall;      // small steps proposed so far
+    uint acceptedSmall;      // of which accepted
+    uint proposedLarge;      // large steps proposed so far
+    uint acceptedLarge;      // of which accepted
     uint pad;
 };
 
@@ -75,9 +75,9 @@ struct MltRecord {
 
 // Descriptor bindings of mlt.comp (set 0), above gpt_shared.h's.
 GDPT_ENUM_BEGIN(MltBinding)
-kBindMltChains = 60u,      // MltChain per chain
-    kBindMltPss = 61u,     // float per chain and decision: chain c's decision k at c·kMltPssDims + k
-    kBindMltRecords = 62u, // MltRecord, 2 per chain and mutation step of a batch
+kBindMltChains = 60u,         // MltChain per chain
+    kBindMltPss = 61u,        // float per chain and decision: chain c's decision k at c·kMltPssDims + k
+    kBindMltRecords = 62u,    // MltRecord, 2 per chain and mutation step of a batch
     kBindMltBootstrap = 63u,  // float per bootstrap sample: its target value
     kBindMltStarts = 64u,     // uint per chain: the bootstrap sample it starts from
     kBindMltDirect = 65u      // vec4 per pixel: mean very-direct emission (rgb)

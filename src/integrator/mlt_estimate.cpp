@@ -55,7 +55,9 @@ std::vector<std::uint32_t> mltChainStarts(const std::vector<float>& targets, std
 }
 
 MltAccumulator::MltAccumulator(int width, int height)
-    : width_(width), height_(height), sums_(std::size_t(width) * std::size_t(height) * gpu::kMltValues * 3, 0.0) {}
+    : width_(width),
+      height_(height),
+      sums_(std::size_t(width) * std::size_t(height) * gpu::kMltValues * 3, 0.0) {}
 
 void MltAccumulator::add(const gpu::MltRecord* records, std::size_t count) {
     const std::size_t pixels = std::size_t(width_) * std::size_t(height_);
@@ -74,7 +76,8 @@ Image MltAccumulator::quantity(std::uint32_t k, double scale) const {
     const std::size_t pixels = std::size_t(width_) * std::size_t(height_);
     for (std::size_t p = 0; p < pixels; ++p)
         for (int c = 0; c < 3; ++c)
-            out.plane(c)[p] = static_cast<float>(scale * sums_[(p * gpu::kMltValues + k) * 3 + std::size_t(c)]);
+            out.plane(c)[p] =
+                static_cast<float>(scale * sums_[(p * gpu::kMltValues + k) * 3 + std::size_t(c)]);
     return out;
 }
 

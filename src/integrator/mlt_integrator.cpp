@@ -5,10 +5,10 @@
 #include <nlohmann/json.hpp>
 #include <utility>
 
+#include "integrator/gpt_sampler.h"
 #include "integrator/mlt_estimate.h"
 #include "integrator/recon_reserve.h"
 #include "integrator/render_identity.h"
-#include "integrator/gpt_sampler.h"
 #include "render/device_scene/scene_gpu.h"
 #include "scene/radiance_range.h"
 #include "util/error.h"
@@ -44,8 +44,9 @@ std::uint32_t MltIntegrator::maxBatchSpp(int, int) const {
 }
 
 ExrAttributes MltIntegrator::identity(const Scene&, const RenderOptions& options) const {
-    return {{"chains", std::to_string(options_.chains ? options_.chains
-                                                      : defaultMltChains(options.scene.width, options.scene.height))},
+    return {{"chains",
+             std::to_string(options_.chains ? options_.chains
+                                            : defaultMltChains(options.scene.width, options.scene.height))},
             {"large_step", exactFloat(options_.largeStep)},
             {"target_alpha", exactFloat(options_.targetAlpha)},
             {"shift_threshold", exactFloat(options.scene.shiftThreshold)}};
@@ -81,7 +82,8 @@ double MltIntegrator::reserveAfterSampling(const vk::Context& ctx, int width, in
     PoissonSolverGpu& solverGpu = solver(ctx, width, height);  // (re)made first: it resets the calibration
     if (calibratedSeconds_ < 0.0) {
         calibratedSeconds_ = 0.0;
-        for (const SolveOptions& so : s) calibratedSeconds_ += calibrateReconSeconds(solverGpu, so, /*warmUp=*/true);
+        for (const SolveOptions& so : s)
+            calibratedSeconds_ += calibrateReconSeconds(solverGpu, so, /*warmUp=*/true);
     }
     return calibratedSeconds_;
 }
@@ -138,18 +140,18 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     Timer sampling;
 
     // Stage 1: the very-direct light, and the bootstrap: b and the chains' starts.
-    submit(name_ + " direct light", [&](VkCommandBuffer cmd) {
-        pass.recordDirect(cmd, options_.directSamples, options.seed, timer);
-    });
-    const std::uint64_t bootstrapCount =
-        std::max<std::uint64_t>(pixels * options_.bootstrapPerPixel, std::uint64_t{po.chains} * kBootstrapPerChain);
+    submit(name_ + " direct light",
+           [&](VkCommandBuffer cmd) { pass.recordDirect(cmd, options_.directSamples, options.seed, timer); });
+    const std::uint64_t bootstrapCount = std::max<std::uint64_t>(
+        pixels * options_.bootstrapPerPixel, std::uint64_t{po.chains} * kBootstrapPerChain);
     if (bootstrapCount > std::uint64_t{1} << 31)
         throw UsageError("--method " + name_ + ": " + std::to_string(bootstrapCount) +
                          " bootstrap samples are more than this renderer counts; use a smaller image");
     std::vector<float> targets;
     targets.reserve(bootstrapCount);
     for (std::uint64_t first = 0; first < bootstrapCount && !cancelled(); first += kBootstrapPerDispatch) {
-        const auto n = static_cast<std::uint32_t>(std::min<std::uint64_t>(kBootstrapPerDispatch, bootstrapCount - first));
+        const auto n = static_cast<std::uint32_t>(
+            std::min<std::uint64_t>(kBootstrapPerDispatch, bootstrapCount - first));
         submit(name_ + " bootstrap from sample " + std::to_string(first), [&](VkCommandBuffer cmd) {
             pass.recordBootstrap(cmd, static_cast<std::uint32_t>(first), n, options.seed, timer);
         });
@@ -173,7 +175,8 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     const std::uint64_t wantedSteps = (wantedMutations + po.chains - 1) / po.chains;
     std::uint64_t steps = 0;
     if (!starts.empty() && !cancelled()) {
-        submit(name_ + " chain start", [&](VkCommandBuffer cmd) { pass.recordStart(cmd, starts, options.seed, timer); });
+        submit(name_ + " chain start",
+               [&](VkCommandBuffer cmd) { pass.recordStart(cmd, starts, options.seed, timer); });
         Progress progress("render " + name_, timed ? budget : double(wantedSteps), options.quiet);
         double secondsPerStep = 0.0;
         while (!cancelled()) {
@@ -185,7 +188,8 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
                 n = 1;  // measures a step; the set-up may have used the budget already
             } else {
                 const double left = budget - total.seconds();
-                const auto fits = static_cast<std::uint64_t>(std::max(0.0, left / std::max(secondsPerStep, 1e-9)));
+                const auto fits =
+                    static_cast<std::uint64_t>(std::max(0.0, left / std::max(secondsPerStep, 1e-9)));
                 if (fits == 0) break;
                 n = static_cast<std::uint32_t>(std::min<std::uint64_t>(n, fits));
             }
@@ -250,7 +254,8 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
         Image recon;
         const SolveReport report = solver_->solve(input, so, recon);
         if (!options.quiet)
-            std::fprintf(stderr, "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g%s, %.1f ms\n",
+            std::fprintf(stderr,
+                         "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g%s, %.1f ms\n",
                          toString(so.method), report.iterations, report.irlsIterations, report.residual,
                          report.converged ? "" : " NOT converged", report.ms);
         stats.reconstructions.push_back({toString(so.method), report.iterations, report.irlsIterations,

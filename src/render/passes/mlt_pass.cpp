@@ -15,9 +15,9 @@ namespace {
 constexpr std::uint32_t kItemsPerRow = 256;
 
 vk::KernelDesc mltDesc(const SceneSpec& scene, WorkgroupSize wg, bool baseOnly) {
-    const std::vector<std::uint32_t> extra = {gpu::kBindCounters,    gpu::kBindMltChains,    gpu::kBindMltPss,
-                                              gpu::kBindMltRecords,  gpu::kBindMltBootstrap, gpu::kBindMltStarts,
-                                              gpu::kBindMltDirect};
+    const std::vector<std::uint32_t> extra = {
+        gpu::kBindCounters,     gpu::kBindMltChains, gpu::kBindMltPss,   gpu::kBindMltRecords,
+        gpu::kBindMltBootstrap, gpu::kBindMltStarts, gpu::kBindMltDirect};
     vk::KernelDesc d =
         scene.kernelDesc(vk::kernelDesc("mlt", GDPT_KERNEL_SPIRV(mlt)), wg, extra, sizeof(gpu::MltParams));
     for (auto& [id, value] : d.specConstants)
@@ -85,8 +85,8 @@ void MltPass::dispatchChains(VkCommandBuffer cmd, const gpu::MltParams& p, vk::G
     vk::computeBarrier(cmd);
 }
 
-void MltPass::recordBootstrap(VkCommandBuffer cmd, std::uint32_t first, std::uint32_t count, std::uint32_t seed,
-                              vk::GpuTimer* timer) {
+void MltPass::recordBootstrap(VkCommandBuffer cmd, std::uint32_t first, std::uint32_t count,
+                              std::uint32_t seed, vk::GpuTimer* timer) {
     if (bootstrap_.size() < std::uint64_t{count} * sizeof(float)) {
         bootstrap_ = vk::Buffer(ctx_, std::uint64_t{count} * sizeof(float), "mlt bootstrap");
         kernel_.bind(gpu::kBindMltBootstrap, bootstrap_);
@@ -107,8 +107,8 @@ void MltPass::recordStart(VkCommandBuffer cmd, const std::vector<std::uint32_t>&
     dispatchChains(cmd, params(gpu::kMltPhaseStart, options_.chains, seed), timer);
 }
 
-void MltPass::recordMutations(VkCommandBuffer cmd, std::uint32_t first, std::uint32_t steps, std::uint32_t seed,
-                              vk::GpuTimer* timer) {
+void MltPass::recordMutations(VkCommandBuffer cmd, std::uint32_t first, std::uint32_t steps,
+                              std::uint32_t seed, vk::GpuTimer* timer) {
     GDPT_CHECK(steps <= options_.stepsPerBatch);
     for (std::uint32_t s = 0; s < steps; ++s) {
         gpu::MltParams p = params(gpu::kMltPhaseMutate, options_.chains, seed);
@@ -125,10 +125,12 @@ const gpu::MltRecord* MltPass::records(std::uint32_t steps) {
     return host_.data();
 }
 
-void MltPass::recordDirect(VkCommandBuffer cmd, std::uint32_t samples, std::uint32_t seed, vk::GpuTimer* timer) {
+void MltPass::recordDirect(VkCommandBuffer cmd, std::uint32_t samples, std::uint32_t seed,
+                           vk::GpuTimer* timer) {
     // Rows per dispatch: about 2^18 pixel-samples each (no dispatch long enough for a watchdog).
     const std::uint64_t perRow = std::uint64_t{width_} * std::max(samples, 1u);
-    const auto rowsPer = static_cast<std::uint32_t>(std::clamp<std::uint64_t>((1u << 18) / perRow, 1, height_));
+    const auto rowsPer =
+        static_cast<std::uint32_t>(std::clamp<std::uint64_t>((1u << 18) / perRow, 1, height_));
     for (std::uint32_t row = 0; row < height_; row += rowsPer) {
         gpu::MltParams p = params(gpu::kMltPhaseDirect, std::min(rowsPer, height_ - row), seed);
         p.directSamples = samples;

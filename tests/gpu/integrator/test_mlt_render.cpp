@@ -126,8 +126,8 @@ TEST_F(MltRender, CornellBoxQuadrantsMatchThePathTracer) {
             const Image& im = layer(out, estimateLayer(method));
             for (int q = 0; q < 4; ++q)
                 for (int c = 0; c < 3; ++c)
-                    quadrant[std::size_t(q * 3 + c)].push_back(
-                        regionMean(im, c, (q % 2) * kHalf, (q / 2) * kHalf, (q % 2 + 1) * kHalf, (q / 2 + 1) * kHalf));
+                    quadrant[std::size_t(q * 3 + c)].push_back(regionMean(
+                        im, c, (q % 2) * kHalf, (q / 2) * kHalf, (q % 2 + 1) * kHalf, (q / 2 + 1) * kHalf));
         }
         double worstWrong = 0.0;
         for (int q = 0; q < 4; ++q)
@@ -136,7 +136,8 @@ TEST_F(MltRender, CornellBoxQuadrantsMatchThePathTracer) {
                 const double expected = regionMean(ptImage, c, x0, y0, x0 + kHalf, y0 + kHalf);
                 // Pixels of a PT render are independent: the variance of the region mean is
                 // the sum of the per-pixel variances of the mean over the pixel count squared.
-                const double se = std::sqrt(regionMean(ptVar, c, x0, y0, x0 + kHalf, y0 + kHalf) / (kHalf * kHalf));
+                const double se =
+                    std::sqrt(regionMean(ptVar, c, x0, y0, x0 + kHalf, y0 + kHalf) / (kHalf * kHalf));
                 const std::vector<double>& v = quadrant[std::size_t(q * 3 + c)];
                 EXPECT_LT(std::abs(tStatistic(v, expected, se)), threshold)
                     << method << " quadrant " << q << " channel " << c << ": PT " << expected;
@@ -154,7 +155,8 @@ TEST_F(MltRender, DeterministicPerSeed) {
     const RenderOutput c = gmlt->render(ctx(), scene, options(24, 8, 4));
     ASSERT_EQ(a.layers.size(), b.layers.size());
     for (std::size_t i = 0; i < a.layers.size(); ++i)
-        for (int ch = 0; ch < 3; ++ch) ASSERT_EQ(a.layers[i].image.plane(ch), b.layers[i].image.plane(ch)) << i;
+        for (int ch = 0; ch < 3; ++ch)
+            ASSERT_EQ(a.layers[i].image.plane(ch), b.layers[i].image.plane(ch)) << i;
     EXPECT_NE(a.image().plane(0), c.image().plane(0));
     EXPECT_EQ(a.stats.mlt.acceptedSmall, b.stats.mlt.acceptedSmall);
 }

@@ -27,9 +27,9 @@ double target(double u, double v) {
     return 0.1 + std::exp(-((u - 0.3) * (u - 0.3) + (v - 0.6) * (v - 0.6)) / 0.02);
 }
 
-constexpr int kCells = 10;         // 10 x 10 histogram
-constexpr int kSteps = 64;         // mutations per chain
-constexpr int kChains = 40000;     // independent chains (final states)
+constexpr int kCells = 10;      // 10 x 10 histogram
+constexpr int kSteps = 64;      // mutations per chain
+constexpr int kChains = 40000;  // independent chains (final states)
 constexpr float kLargeStep = 0.3f;
 
 using Acceptance = std::function<float(float, float)>;
@@ -57,8 +57,8 @@ std::vector<double> finalStateHistogram(const Acceptance& accept, std::uint32_t 
             const float tp = static_cast<float>(target(pu, pv));
             if (uni(gen) < accept(t, tp)) u = pu, v = pv, t = tp;
         }
-        counts[std::size_t(std::min(int(v * kCells), kCells - 1) * kCells + std::min(int(u * kCells), kCells - 1))] +=
-            1.0;
+        counts[std::size_t(std::min(int(v * kCells), kCells - 1) * kCells +
+                           std::min(int(u * kCells), kCells - 1))] += 1.0;
     }
     return counts;
 }
