@@ -589,7 +589,7 @@ Subcommand addRenderCommand(CLI::App& app) {
     const char* mlt = "Metropolis (pssmlt, gmlt; docs/mlt.md)";
     r->add_option("--chains", a.chains, "Markov chains run at once (0 = one per 16 pixels, 1024 to 65536)")
         ->capture_default_str()
-        ->check(CLI::Range(0u, 1u << 20))
+        ->check(CLI::Range(0u, 65536u))
         ->group(mlt);
     r->add_option("--large-step", a.largeStep, "Probability of a large step (a fresh path) per mutation")
         ->capture_default_str()

@@ -14,7 +14,9 @@
 namespace gdpt {
 
 GptIntegrator::GptIntegrator(std::string name, GptOptions options)
-    : name_(std::move(name)), options_(std::move(options)) {}
+    : name_(std::move(name)),
+      options_(std::move(options)),
+      stage_(options_.reconstructions, options_.alpha, options_.tolerance) {}
 
 GptIntegrator::~GptIntegrator() = default;
 
@@ -28,59 +30,21 @@ ExrAttributes GptIntegrator::identity(const Scene& scene, const RenderOptions& o
             {"demodulate", demodulates(scene, options_.sampling.demodulate) ? "on" : "off"}};
 }
 
-std::vector<SolveOptions> GptIntegrator::solves() const {
-    std::vector<SolveOptions> out;
-    for (Reconstruction r : options_.reconstructions) {
-        SolveOptions so;
-        so.method = r;
-        so.alpha = options_.alpha;
-        so.tolerance = options_.tolerance;
-        out.push_back(so);
-    }
-    return out;
-}
-
-PoissonSolverGpu& GptIntegrator::solver(const vk::Context& ctx, int width, int height) {
-    if (!solver_ || solverCtx_ != &ctx || solverWidth_ != width || solverHeight_ != height) {
-        solver_ = std::make_unique<PoissonSolverGpu>(ctx, width, height);
-        solverCtx_ = &ctx;
-        solverWidth_ = width;
-        solverHeight_ = height;
-        calibratedSeconds_ = -1.0;
-        longestSeconds_ = 0.0;
-    }
-    return *solver_;
-}
-
 double GptIntegrator::reserveAfterSampling(const vk::Context& ctx, int width, int height) {
-    const std::vector<SolveOptions> s = solves();
-    if (s.empty()) return 0.0;
-    PoissonSolverGpu& solverGpu = solver(ctx, width, height);
-    if (options_.reconCache) {
-        const ReconReservation r = reserveReconstruction(ctx, solverGpu, s, *options_.reconCache);
-        reserveKey_ = r.key;
-        return r.seconds;
-    }
-    if (calibratedSeconds_ < 0.0) {
-        calibratedSeconds_ = 0.0;
-        for (const SolveOptions& so : s)
-            calibratedSeconds_ += calibrateReconSeconds(solverGpu, so, /*warmUp=*/true);
-    }
-    return std::max(calibratedSeconds_, longestSeconds_);
+    return stage_.reserve(ctx, width, height, options_.reconCache);
 }
 
 RenderOutput GptIntegrator::render(const vk::Context& ctx, const Scene& scene, const RenderOptions& options) {
-    const std::vector<SolveOptions> solveList = solves();
     const int width = options.scene.width, height = options.scene.height;
     // Stage 1, sampling. The reconstruction's pipelines are created while the path kernels
     // compile.
     RenderOptions sampling = options;
-    if (!solveList.empty()) {
+    if (!stage_.empty()) {
         // The solver's fields are allocated here, after the sampling pass has checked that the
         // image's per-pixel buffers fit the device (an image too large is refused at once).
         sampling.whileCompiling = [&] {
             if (options.whileCompiling) options.whileCompiling();
-            solver(ctx, width, height).preparePipelines(solveList);
+            stage_.solver(ctx, width, height).preparePipelines(stage_.solves());
         };
     }
     RenderResultGpt g = renderGpt(ctx, scene, sampling, options_.sampling);
@@ -96,38 +60,7 @@ RenderOutput GptIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     input.varPrimal = &g.varPrimal;
     input.varDx = &g.varDx;
     input.varDy = &g.varDy;
-    std::vector<NamedLayer> recons;
-    Timer reconTimer;
-    enterPhase("reconstruction");
-    // An interrupt stops the reconstruction after the solver's current batch of iterations.
-    const auto stopIfCancelled = [&options] {
-        if (options.cancel && options.cancel->load()) throw Interrupted("reconstructing");
-    };
-    for (SolveOptions so : solveList) {
-        stopIfCancelled();
-        so.progress = [&](int, int, int) { stopIfCancelled(); };
-        Image recon;
-        const SolveReport report = solver_->solve(input, so, recon);
-        // Not converged (the iteration cap, or a tolerance below what float32 residuals
-        // reach) is said as `gdpt solve` says it, and recorded for the JSON summary.
-        if (!options.quiet) {
-            const std::string scaled =
-                report.scaleExponent ? ", inputs scaled by 2^-" + std::to_string(report.scaleExponent) : "";
-            std::fprintf(stderr,
-                         "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g%s%s, %.1f ms\n",
-                         toString(so.method), report.iterations, report.irlsIterations, report.residual,
-                         report.converged ? "" : " NOT converged", scaled.c_str(), report.ms);
-        }
-        out.stats.reconstructions.push_back({toString(so.method), report.iterations, report.irlsIterations,
-                                             report.residual, so.tolerance, report.converged, report.ms});
-        out.stats.reconstructionMs += report.ms;
-        recons.push_back({std::string("recon_") + toString(so.method), std::move(recon)});
-    }
-    if (!solveList.empty()) {
-        if (options_.reconCache && !reserveKey_.empty())
-            options_.reconCache->put(reserveKey_, out.stats.reconstructionMs * 1e-3);
-        longestSeconds_ = std::max(longestSeconds_, reconTimer.seconds());
-    }
+    std::vector<NamedLayer> recons = stage_.run(input, options, out.stats, options_.reconCache);
 
     // Stage 3, compose: final = reconstruction (x modulation) + direct (Kettunen et al. 2015,
     // §5: the very-direct light is not reconstructed). Without a reconstruction, the primal.
@@ -152,16 +85,7 @@ void GptIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
     j["gpt_split_bounce"] = s.gptSplitBounce;
     j["edge_samples"] = {{"factor", s.edgeSamples}, {"pixels", s.edgePixels}};
     j["demodulation"] = {{"on", s.demodulated}, {"pixels", s.demodulatedPixels}};
-    nlohmann::json recons = nlohmann::json::array();
-    for (const ReconstructionStats& r : s.reconstructions)
-        recons.push_back({{"method", r.method},
-                          {"iterations", r.iterations},
-                          {"irls_iterations", r.irlsIterations},
-                          {"residual", r.residual},
-                          {"tolerance", r.tolerance},
-                          {"converged", r.converged},
-                          {"ms", r.ms}});
-    j["reconstructions"] = recons;
+    j["reconstructions"] = reconstructionsJson(s);
 }
 
 std::string GptIntegrator::summary(const RenderStats& s) const {

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "integrator/integrator.h"
-#include "integrator/recon_reserve.h"
+#include "integrator/reconstruction_stage.h"
 
 namespace gdpt {
 
@@ -39,19 +39,9 @@ public:
     [[nodiscard]] std::string summary(const RenderStats& stats) const override;
 
 private:
-    [[nodiscard]] std::vector<SolveOptions> solves() const;
-    // The solver for this device and size (made on first use, kept for later renders so that
-    // its pipelines are compiled once).
-    PoissonSolverGpu& solver(const vk::Context& ctx, int width, int height);
-
     std::string name_;
     GptOptions options_;
-    std::unique_ptr<PoissonSolverGpu> solver_;
-    const vk::Context* solverCtx_ = nullptr;
-    int solverWidth_ = 0, solverHeight_ = 0;
-    std::string reserveKey_;           // the cache key of the last reservation (with a cache)
-    double calibratedSeconds_ = -1.0;  // without a cache: the warm calibration (< 0: not yet)
-    double longestSeconds_ = 0.0;      // without a cache: the longest reconstruction so far
+    ReconstructionStage stage_;
 };
 
 }  // namespace gdpt

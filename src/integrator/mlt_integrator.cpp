@@ -7,7 +7,6 @@
 
 #include "integrator/gpt_sampler.h"
 #include "integrator/mlt_estimate.h"
-#include "integrator/recon_reserve.h"
 #include "integrator/render_identity.h"
 #include "render/device_scene/scene_gpu.h"
 #include "scene/radiance_range.h"
@@ -35,7 +34,11 @@ std::uint32_t defaultMltChains(int width, int height) {
 }
 
 MltIntegrator::MltIntegrator(std::string name, MltOptions options)
-    : name_(std::move(name)), options_(std::move(options)) {}
+    : name_(std::move(name)),
+      options_(std::move(options)),
+      // pssmlt has no gradients to reconstruct: its image is the splatted primal.
+      stage_(name_ == "gmlt" ? options_.reconstructions : std::vector<Reconstruction>{}, options_.alpha,
+             options_.tolerance) {}
 
 MltIntegrator::~MltIntegrator() = default;
 
@@ -52,40 +55,8 @@ ExrAttributes MltIntegrator::identity(const Scene&, const RenderOptions& options
             {"shift_threshold", exactFloat(options.scene.shiftThreshold)}};
 }
 
-std::vector<SolveOptions> MltIntegrator::solves() const {
-    std::vector<SolveOptions> out;
-    if (!gradients()) return out;
-    for (Reconstruction r : options_.reconstructions) {
-        SolveOptions so;
-        so.method = r;
-        so.alpha = options_.alpha;
-        so.tolerance = options_.tolerance;
-        out.push_back(so);
-    }
-    return out;
-}
-
-PoissonSolverGpu& MltIntegrator::solver(const vk::Context& ctx, int width, int height) {
-    if (!solver_ || solverCtx_ != &ctx || solverWidth_ != width || solverHeight_ != height) {
-        solver_ = std::make_unique<PoissonSolverGpu>(ctx, width, height);
-        solverCtx_ = &ctx;
-        solverWidth_ = width;
-        solverHeight_ = height;
-        calibratedSeconds_ = -1.0;
-    }
-    return *solver_;
-}
-
 double MltIntegrator::reserveAfterSampling(const vk::Context& ctx, int width, int height) {
-    const std::vector<SolveOptions> s = solves();
-    if (s.empty()) return 0.0;
-    PoissonSolverGpu& solverGpu = solver(ctx, width, height);  // (re)made first: it resets the calibration
-    if (calibratedSeconds_ < 0.0) {
-        calibratedSeconds_ = 0.0;
-        for (const SolveOptions& so : s)
-            calibratedSeconds_ += calibrateReconSeconds(solverGpu, so, /*warmUp=*/true);
-    }
-    return calibratedSeconds_;
+    return stage_.reserve(ctx, width, height, nullptr);
 }
 
 RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, const RenderOptions& options) {
@@ -114,9 +85,8 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     stats.bvhBuildMs = sceneGpu.bvhInfo().buildMs;
     stats.bvhRegisterStack = sceneGpu.spec().bvhRegisterStack();
     stats.features = sceneGpu.features();
-    const std::vector<SolveOptions> solveList = solves();
     if (options.whileCompiling) options.whileCompiling();
-    if (!solveList.empty()) solver(ctx, width, height).preparePipelines(solveList);
+    if (!stage_.empty()) stage_.solver(ctx, width, height).preparePipelines(stage_.solves());
     stats.pipelineWaitMs = 1e3 * pass.waitForPipelines();
     stats.uploadMs = total.ms() - stats.bvhBuildMs;
 
@@ -245,24 +215,7 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     input.primal = &g.primal;
     input.dx = &g.dx;
     input.dy = &g.dy;
-    std::vector<NamedLayer> recons;
-    enterPhase("reconstruction");
-    for (SolveOptions so : solveList) {
-        so.progress = [&](int, int, int) {
-            if (cancelled()) throw Interrupted("reconstructing");
-        };
-        Image recon;
-        const SolveReport report = solver_->solve(input, so, recon);
-        if (!options.quiet)
-            std::fprintf(stderr,
-                         "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g%s, %.1f ms\n",
-                         toString(so.method), report.iterations, report.irlsIterations, report.residual,
-                         report.converged ? "" : " NOT converged", report.ms);
-        stats.reconstructions.push_back({toString(so.method), report.iterations, report.irlsIterations,
-                                         report.residual, so.tolerance, report.converged, report.ms});
-        stats.reconstructionMs += report.ms;
-        recons.push_back({std::string("recon_") + toString(so.method), std::move(recon)});
-    }
+    std::vector<NamedLayer> recons = stage_.run(input, options, stats, nullptr);
     out.layers.push_back({"", gptFinal(recons.empty() ? g.primal : recons.front().image, nullptr, &direct)});
     for (NamedLayer& r : recons) out.layers.push_back(std::move(r));
     Image primalPlusDirect = gptFinal(g.primal, nullptr, &direct);
@@ -290,16 +243,7 @@ void MltIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
                 {"normalisation", m.normalisation},
                 {"normalisation_stderr", m.normalisationStdErr}};
     if (gradients()) j["mlt"]["target_alpha"] = options_.targetAlpha;
-    nlohmann::json recons = nlohmann::json::array();
-    for (const ReconstructionStats& r : s.reconstructions)
-        recons.push_back({{"method", r.method},
-                          {"iterations", r.iterations},
-                          {"irls_iterations", r.irlsIterations},
-                          {"residual", r.residual},
-                          {"tolerance", r.tolerance},
-                          {"converged", r.converged},
-                          {"ms", r.ms}});
-    j["reconstructions"] = recons;
+    j["reconstructions"] = reconstructionsJson(s);
 }
 
 std::string MltIntegrator::summary(const RenderStats& s) const {

@@ -19,6 +19,7 @@
 #include <string>
 
 #include "integrator/integrator.h"
+#include "integrator/reconstruction_stage.h"
 #include "render/passes/mlt_pass.h"
 
 namespace gdpt {
@@ -39,15 +40,10 @@ public:
 
 private:
     [[nodiscard]] bool gradients() const { return name_ == "gmlt"; }
-    [[nodiscard]] std::vector<SolveOptions> solves() const;
-    PoissonSolverGpu& solver(const vk::Context& ctx, int width, int height);
 
     std::string name_;
     MltOptions options_;
-    std::unique_ptr<PoissonSolverGpu> solver_;
-    const vk::Context* solverCtx_ = nullptr;
-    int solverWidth_ = 0, solverHeight_ = 0;
-    double calibratedSeconds_ = -1.0;
+    ReconstructionStage stage_;
 };
 
 // Chains of a width x height render when MltOptions::chains is 0: one per 16 pixels, at least

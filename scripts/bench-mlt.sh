@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# Metropolis light transport against PT and G-PT at equal time (docs/mlt.md), in one command:
+#   1. the door scene (scenes/indirect_gap.gltf, lit only through a gap) at 256², against a PT
+#      reference of REFSPP samples per pixel (rendered once into OUT/, seed 99; its noise
+#      floor, the mean relative variance of its pixels, is printed);
+#   2. the Cornell box of ../shared/scenes/cbox against its independent reference;
+#   3. the throughput: mutations per second of gmlt and pssmlt against camera samples per
+#      second of G-PT and PT (the same scene and size, --json samples_per_s, 3 interleaved rounds,
+#      medians).
+# Each converge run writes OUT/<scene>/results.{json,csv} and error_vs_time.png; the tables go
+# to stdout. Not a test: about 30 minutes on 2 cores with the defaults (plus the reference).
+#
+#   scripts/bench-mlt.sh [-o OUT] [--times 16,64] [--repeats 2] [--reference-spp 16384]
+#                        [--methods pt,gpt,pssmlt,gmlt] [--reference DOOR_REF.exr]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=bench-mlt times=16,64 repeats=2 refspp=16384 methods=pt,gpt,pssmlt,gmlt doorref=
+while (($#)); do
+  case "$1" in
+    -o) out=$2; shift 2 ;;
+    --times) times=$2; shift 2 ;;
+    --repeats) repeats=$2; shift 2 ;;
+    --reference-spp) refspp=$2; shift 2 ;;
+    --methods) methods=$2; shift 2 ;;
+    --reference) doorref=$2; shift 2 ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    *) echo "bench-mlt.sh: unknown option '$1' (try --help)" >&2; exit 2 ;;
+  esac
+done
+[ -x build/gdpt ] || { echo "bench-mlt.sh: build/gdpt missing; run scripts/build.sh first" >&2; exit 1; }
+mkdir -p "$out"
+door=scenes/indirect_gap.gltf
+if [ -z "$doorref" ]; then
+  doorref=$out/indirect_gap_pt_${refspp}spp.exr
+  [ -f "$doorref" ] || build/gdpt render "$door" --method pt --spp "$refspp" --seed 99 -o "$doorref"
+fi
+common=(--methods "$methods" --times "$times" --repeats "$repeats")
+build/gdpt converge "$door" --reference "$doorref" "${common[@]}" -o "$out/indirect_gap"
+if [ -f ../shared/scenes/cbox/cbox.gltf ]; then
+  build/gdpt converge ../shared/scenes/cbox/cbox.gltf --reference ../shared/scenes/cbox/reference.exr \
+    --methods "$methods" --times "${times%%,*}" --repeats "$repeats" -o "$out/cbox"
+fi
+for s in indirect_gap cbox; do
+  [ -f "$out/$s/results.json" ] || continue
+  echo "== $s (relMSE medians; gain = PT's relMSE / the method's)"
+  python3 - "$out/$s/results.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+rows = d["summary"]
+methods = list(dict.fromkeys(r["method"] for r in rows))
+budgets = sorted({r["budget_s"] for r in rows})
+print("budget_s " + " ".join(f"{m:>10}" for m in methods) + "".join(f" {m + ' gain':>12}" for m in methods if m != "pt"))
+for b in budgets:
+    cells = {r["method"]: r["relmse_median"] for r in rows if r["budget_s"] == b}
+    gains = [cells["pt"] / cells[m] if cells.get("pt") and cells.get(m) else float("nan") for m in methods if m != "pt"]
+    print(f"{b:8g} " + " ".join(f"{cells.get(m, float('nan')):10.4g}" for m in methods) + "".join(f" {g:11.2f}x" for g in gains))
+PY
+done
+echo "== throughput on $door at 256x256 (medians of 3 rounds; samples_per_s: camera samples or mutations)"
+for round in 1 2 3; do
+  for m in pt gpt pssmlt gmlt; do
+    build/gdpt render "$door" --method "$m" --spp 16 --quiet -o "$out/throughput_$m.exr" --json - |
+      python3 -c "import json,sys; j=json.load(sys.stdin); print('$m', j['samples_per_s'], j['time_s']['sampling'])"
+  done
+done | python3 -c "
+import sys, statistics
+rows = {}
+for line in sys.stdin:
+    m, rate, t = line.split(); rows.setdefault(m, []).append(float(rate))
+med = {m: statistics.median(v) for m, v in rows.items()}
+for m, v in med.items():
+    print(f'{m:8s} {v:12.0f} per s   {v / med[\"gpt\"]:.2f}x G-PT')
+"
+python3 - "$doorref" <<'PY' || true
+import sys
+print("reference:", sys.argv[1], "(its noise floor: see docs/mlt.md)")
+PY

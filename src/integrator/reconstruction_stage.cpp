@@ -1,0 +1,100 @@
+#include "integrator/reconstruction_stage.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "integrator/recon_reserve.h"
+#include "util/interrupt.h"
+#include "util/timer.h"
+
+namespace gdpt {
+
+ReconstructionStage::ReconstructionStage(std::vector<Reconstruction> reconstructions, double alpha,
+                                         double tolerance) {
+    for (Reconstruction r : reconstructions) {
+        SolveOptions so;
+        so.method = r;
+        so.alpha = alpha;
+        so.tolerance = tolerance;
+        solves_.push_back(so);
+    }
+}
+
+ReconstructionStage::~ReconstructionStage() = default;
+
+PoissonSolverGpu& ReconstructionStage::solver(const vk::Context& ctx, int width, int height) {
+    if (!solver_ || solverCtx_ != &ctx || solverWidth_ != width || solverHeight_ != height) {
+        solver_ = std::make_unique<PoissonSolverGpu>(ctx, width, height);
+        solverCtx_ = &ctx;
+        solverWidth_ = width;
+        solverHeight_ = height;
+        calibratedSeconds_ = -1.0;
+        longestSeconds_ = 0.0;
+    }
+    return *solver_;
+}
+
+double ReconstructionStage::reserve(const vk::Context& ctx, int width, int height, const ReconTimeCache* cache) {
+    if (solves_.empty()) return 0.0;
+    PoissonSolverGpu& solverGpu = solver(ctx, width, height);  // first: a new solver resets the calibration
+    if (cache) {
+        const ReconReservation r = reserveReconstruction(ctx, solverGpu, solves_, *cache);
+        reserveKey_ = r.key;
+        return r.seconds;
+    }
+    if (calibratedSeconds_ < 0.0) {
+        calibratedSeconds_ = 0.0;
+        for (const SolveOptions& so : solves_) calibratedSeconds_ += calibrateReconSeconds(solverGpu, so, true);
+    }
+    return std::max(calibratedSeconds_, longestSeconds_);
+}
+
+std::vector<NamedLayer> ReconstructionStage::run(const PoissonInput& input, const RenderOptions& options,
+                                                 RenderStats& stats, const ReconTimeCache* cache) {
+    std::vector<NamedLayer> recons;
+    if (solves_.empty()) return recons;
+    Timer reconTimer;
+    enterPhase("reconstruction");
+    // An interrupt stops the reconstruction after the solver's current batch of iterations.
+    const auto stopIfCancelled = [&options] {
+        if (options.cancel && options.cancel->load()) throw Interrupted("reconstructing");
+    };
+    for (SolveOptions so : solves_) {
+        stopIfCancelled();
+        so.progress = [&](int, int, int) { stopIfCancelled(); };
+        Image recon;
+        const SolveReport report = solver_->solve(input, so, recon);
+        // Not converged (the iteration cap, or a tolerance below what float32 residuals
+        // reach) is said as `gdpt solve` says it, and recorded for the JSON summary.
+        if (!options.quiet) {
+            const std::string scaled =
+                report.scaleExponent ? ", inputs scaled by 2^-" + std::to_string(report.scaleExponent) : "";
+            std::fprintf(stderr, "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g%s%s, %.1f ms\n",
+                         toString(so.method), report.iterations, report.irlsIterations, report.residual,
+                         report.converged ? "" : " NOT converged", scaled.c_str(), report.ms);
+        }
+        stats.reconstructions.push_back({toString(so.method), report.iterations, report.irlsIterations,
+                                         report.residual, so.tolerance, report.converged, report.ms});
+        stats.reconstructionMs += report.ms;
+        recons.push_back({std::string("recon_") + toString(so.method), std::move(recon)});
+    }
+    if (cache && !reserveKey_.empty()) cache->put(reserveKey_, stats.reconstructionMs * 1e-3);
+    longestSeconds_ = std::max(longestSeconds_, reconTimer.seconds());
+    return recons;
+}
+
+nlohmann::json reconstructionsJson(const RenderStats& s) {
+    nlohmann::json recons = nlohmann::json::array();
+    for (const ReconstructionStats& r : s.reconstructions)
+        recons.push_back({{"method", r.method},
+                          {"iterations", r.iterations},
+                          {"irls_iterations", r.irlsIterations},
+                          {"residual", r.residual},
+                          {"tolerance", r.tolerance},
+                          {"converged", r.converged},
+                          {"ms", r.ms}});
+    return recons;
+}
+
+}  // namespace gdpt

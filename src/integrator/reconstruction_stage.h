@@ -1,0 +1,61 @@
+// reconstruction_stage.h — the screened Poisson stage that the gradient-domain methods share
+// (G-PT, gmlt): the solver for the device and image size (made once, its pipelines compiled
+// once), the time a timed render reserves for it, the solves themselves with progress,
+// cancellation and their report, and the report's JSON.
+#pragma once
+
+#include <memory>
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+#include <vector>
+
+#include "image/exr_io.h"
+#include "integrator/render_options.h"
+#include "poisson/poisson_gpu.h"
+
+namespace gdpt {
+
+namespace vk {
+class Context;
+}
+class ReconTimeCache;
+
+class ReconstructionStage {
+public:
+    // The reconstructions in order (the first gives the final image), with the primal weight
+    // alpha and the relative residual at which each solve stops.
+    ReconstructionStage(std::vector<Reconstruction> reconstructions, double alpha, double tolerance);
+    ~ReconstructionStage();
+
+    [[nodiscard]] const std::vector<SolveOptions>& solves() const { return solves_; }
+    [[nodiscard]] bool empty() const { return solves_.empty(); }
+    // The solver for this device and size (made on first use, kept for later renders so that
+    // its pipelines are compiled once).
+    PoissonSolverGpu& solver(const vk::Context& ctx, int width, int height);
+    // Seconds a timed render reserves for the solves. With a cache: the remembered time of
+    // this device, size and solves, else one calibration solve per reconstruction (cold, as
+    // a single render pays it). Without: one warm calibration per stage, raised to the
+    // longest reconstruction it has run (the steady state of a benchmark that renders many
+    // times).
+    double reserve(const vk::Context& ctx, int width, int height, const ReconTimeCache* cache);
+    // Runs every solve of `input` (after solver() for the input's size): the layers
+    // recon_<name> in order; adds each solve's report to stats (and says it unless
+    // options.quiet); an interrupt (options.cancel) stops it after the solver's current batch
+    // (throws Interrupted). With a cache, remembers the time for reserve().
+    std::vector<NamedLayer> run(const PoissonInput& input, const RenderOptions& options, RenderStats& stats,
+                                const ReconTimeCache* cache);
+
+private:
+    std::vector<SolveOptions> solves_;
+    std::unique_ptr<PoissonSolverGpu> solver_;
+    const vk::Context* solverCtx_ = nullptr;
+    int solverWidth_ = 0, solverHeight_ = 0;
+    std::string reserveKey_;           // the cache key of the last reservation (with a cache)
+    double calibratedSeconds_ = -1.0;  // without a cache: the warm calibration (< 0: not yet)
+    double longestSeconds_ = 0.0;      // without a cache: the longest reconstruction so far
+};
+
+// The reports of a render's reconstructions as `render --json` writes them.
+nlohmann::json reconstructionsJson(const RenderStats& stats);
+
+}  // namespace gdpt
