@@ -170,7 +170,9 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
                    [&](VkCommandBuffer cmd) {
                        pass.recordMutations(cmd, static_cast<std::uint32_t>(steps), n, options.seed, timer);
                    });
+            Timer splat;
             acc.add(pass.records(n), std::size_t{2} * po.chains * n);
+            stats.mlt.splatMs += splat.ms();
             steps += n;
             ++stats.batches;
             secondsPerStep = batch.seconds() / n;
@@ -241,7 +243,8 @@ void MltIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
                 {"proposed_large", m.proposedLarge},
                 {"bootstrap_samples", m.bootstrapSamples},
                 {"normalisation", m.normalisation},
-                {"normalisation_stderr", m.normalisationStdErr}};
+                {"normalisation_stderr", m.normalisationStdErr},
+                {"splat_s", m.splatMs * 1e-3}};
     if (gradients()) j["mlt"]["target_alpha"] = options_.targetAlpha;
     j["reconstructions"] = reconstructionsJson(s);
 }

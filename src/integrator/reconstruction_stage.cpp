@@ -35,7 +35,8 @@ PoissonSolverGpu& ReconstructionStage::solver(const vk::Context& ctx, int width,
     return *solver_;
 }
 
-double ReconstructionStage::reserve(const vk::Context& ctx, int width, int height, const ReconTimeCache* cache) {
+double ReconstructionStage::reserve(const vk::Context& ctx, int width, int height,
+                                    const ReconTimeCache* cache) {
     if (solves_.empty()) return 0.0;
     PoissonSolverGpu& solverGpu = solver(ctx, width, height);  // first: a new solver resets the calibration
     if (cache) {
@@ -45,7 +46,8 @@ double ReconstructionStage::reserve(const vk::Context& ctx, int width, int heigh
     }
     if (calibratedSeconds_ < 0.0) {
         calibratedSeconds_ = 0.0;
-        for (const SolveOptions& so : solves_) calibratedSeconds_ += calibrateReconSeconds(solverGpu, so, true);
+        for (const SolveOptions& so : solves_)
+            calibratedSeconds_ += calibrateReconSeconds(solverGpu, so, true);
     }
     return std::max(calibratedSeconds_, longestSeconds_);
 }
@@ -70,7 +72,8 @@ std::vector<NamedLayer> ReconstructionStage::run(const PoissonInput& input, cons
         if (!options.quiet) {
             const std::string scaled =
                 report.scaleExponent ? ", inputs scaled by 2^-" + std::to_string(report.scaleExponent) : "";
-            std::fprintf(stderr, "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g%s%s, %.1f ms\n",
+            std::fprintf(stderr,
+                         "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g%s%s, %.1f ms\n",
                          toString(so.method), report.iterations, report.irlsIterations, report.residual,
                          report.converged ? "" : " NOT converged", scaled.c_str(), report.ms);
         }

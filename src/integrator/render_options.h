@@ -100,6 +100,7 @@ struct MltStats {
     std::uint64_t bootstrapSamples = 0;
     double normalisation = 0.0;        // b = ∫ T, the bootstrap's mean target
     double normalisationStdErr = 0.0;  // its standard error
+    double splatMs = 0.0;              // reading the records back and adding them up (host)
 };
 
 struct RenderStats {

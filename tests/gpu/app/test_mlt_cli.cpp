@@ -47,6 +47,8 @@ TEST_F(MltCli, JsonReportsChainsAcceptanceAndNormalisation) {
         EXPECT_GT(m["normalisation"].get<double>(), 0.0);
         EXPECT_GT(m["normalisation_stderr"].get<double>(), 0.0);
         EXPECT_LT(m["normalisation_stderr"].get<double>(), 0.1 * m["normalisation"].get<double>());
+        EXPECT_GE(m["splat_s"].get<double>(), 0.0);
+        EXPECT_LT(m["splat_s"].get<double>(), j["time_s"]["sampling"].get<double>());
         EXPECT_EQ(j["reconstructions"].size(), method == "gmlt" ? 1u : 0u);
     }
 }
