@@ -15,10 +15,10 @@
 //              chains' target nor reconstructed).
 // A state is the vector of a sample's first kMltPssDims decisions (mlt_shared.h): the film
 // position over the whole image, then the light and BSDF samples of the first bounces;
-// sampler.glsl reads them through pssLookup instead of its Sobol' points. The sample is
-// gpt.comp's (gpt_trace.glsl): G-MLT (kBaseOnly false) traces the base path and its four
-// offsets and its target is Lehtinen et al. 2013's gradient target (gmltTarget); PSSMLT
-// (kBaseOnly true) traces the base path alone and its target is its luminance.
+// sampler.glsl reads them through pssLookup instead of its Sobol' points. G-MLT (kBaseOnly
+// false) evaluates gpt.comp's sample (gpt_trace.glsl): the base path and its four offsets,
+// with Lehtinen et al. 2013's gradient target (gmltTarget); PSSMLT (kBaseOnly true) traces
+// the path tracer's path (pt_core.glsl) and its target is its luminance.
 // No float atomics: every invocation writes only its own chain, records and pixel; the
 // integer counters are order-independent sums. Deterministic per seed and device.
 #version 460
@@ -30,7 +30,6 @@
 #include "lib/rng.glsl"
 
 layout(constant_id = kSpecMltBaseOnly) const bool kBaseOnly = false;
-#define GDPT_GPT_BASE_ONLY kBaseOnly
 
 // The chain's decisions being evaluated (gPssActive), read by sampler.glsl.
 float gPss[kMltPssDims];
@@ -89,6 +88,38 @@ vec3 firstHitModulation(SurfaceHit h, uint pixel) { return vec3(1.0); }
 
 #include "lib/gpt_trace.glsl"
 
+// PSSMLT traces the path tracer's path (pt_core.glsl), not G-PT's base path: the same
+// estimator for one path, without the offsets' code, which lavapipe 22.3 would run under
+// lane masks at every bounce. The emission the camera sees directly is the direct phase's:
+// pt_core's "estimated elsewhere" hook says so for every pixel.
+#define GDPT_LIB_VISIBLE_EMISSION
+bool emissionSupersampled(uint pixel) { return true; }
+#include "lib/pt_core.glsl"
+
+// The path tracer's radiance of a camera sample at `film` (decisions through pssLookup).
+vec3 tracePath(LdSample lds, Rng rng, vec2 film, uint pixel, inout uint rays) {
+    PathState s;
+    s.pixel = pixel;
+    s.origin = scene.camPosition;
+    s.dir = cameraRay(film);
+    s.prevPdf = 0.0;
+    s.beta = vec3(1.0);
+    s.flags = kPathFlagAlive | kPathFlagPrevSpecular;
+    s.radiance = vec3(0.0);
+    s.rng = rng.state;
+    s.prevP = s.origin;
+    s.depth = 0u;
+    s.rays = 0u;
+    s.ldSeed = lds.seed;
+    s.sampleIndex = lds.index;
+    while ((s.flags & kPathFlagAlive) != 0u) {
+        Hit hit = traceClosest(s.origin, s.dir, 0.0, kInf);
+        ptProcessHit(s, hit);
+    }
+    rays += s.rays;
+    return s.radiance;
+}
+
 // Stream tags: the numbers of one sample index in one phase never repeat another's.
 const uint kTagState = 0x53544154u;     // a fresh state's decisions
 const uint kTagMutation = 0x4d555441u;  // a mutation's choices (large or small, sizes, accept)
@@ -112,22 +143,28 @@ Evaluated evaluate(uint stream, uint fresh, inout uint rays, inout uint nan) {
     e.pixel = py * frame.width + px;
     Rng rng = rngInit(stream, fresh, frame.seed);
     LdSample lds = ldSampleInit(stream, fresh, frame.seed ^ kTagState);
-    OffsetPath offs[kGptNumOffsets];
-    vec3 direct, baseModulation;
-    gPssActive = true;
-    traceSample(lds, rng, e.film, px, py, false, rays, direct, baseModulation, offs);
-    gPssActive = false;
     vec3 central = vec3(0.0), neighborSum = vec3(0.0);
     float gradientAbs = 0.0;
     bool finite = true;
-    for (uint i = 0u; i < kGptNumOffsets; ++i) {
-        central += offs[i].baseSum;
-        neighborSum += offs[i].offSum;
-        e.value[kMltNeighbor + i] = offs[i].offSum;
-        e.value[kMltGradient + i] = offs[i].offSum - offs[i].baseSum;
-        gradientAbs += luminance(abs(offs[i].offSum - offs[i].baseSum));
-        finite = finite && isFinite(offs[i].baseSum) && isFinite(offs[i].offSum);
+    for (uint k = 0u; k < kMltValues; ++k) e.value[k] = vec3(0.0);
+    gPssActive = true;
+    if (kBaseOnly) {
+        central = tracePath(lds, rng, e.film, e.pixel, rays);
+        finite = isFinite(central);
+    } else {
+        OffsetPath offs[kGptNumOffsets];
+        vec3 direct, baseModulation;
+        traceSample(lds, rng, e.film, px, py, false, rays, direct, baseModulation, offs);
+        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+            central += offs[i].baseSum;
+            neighborSum += offs[i].offSum;
+            e.value[kMltNeighbor + i] = offs[i].offSum;
+            e.value[kMltGradient + i] = offs[i].offSum - offs[i].baseSum;
+            gradientAbs += luminance(abs(offs[i].offSum - offs[i].baseSum));
+            finite = finite && isFinite(offs[i].baseSum) && isFinite(offs[i].offSum);
+        }
     }
+    gPssActive = false;
     e.value[kMltCentral] = central;
     e.target = kBaseOnly ? luminance(central) : gmltTarget(gradientAbs, central, neighborSum, frame.targetAlpha);
     // pixel_stats.glsl's policy: a non-finite sample counts as zero, in every quantity.
@@ -154,9 +191,10 @@ void storeChain(uint c, Evaluated e) {
     for (uint k = 0u; k < kMltPssDims; ++k) pss[c * kMltPssDims + k] = gPss[k];
 }
 
-void writeRecord(uint at, uint pixel, float weight, vec3 value[kMltValues]) {
+void writeRecord(uint at, uint pixel, float weight, float largeTarget, vec3 value[kMltValues]) {
     records[at].pixel = pixel;
     records[at].weight = weight;
+    records[at].largeTarget = largeTarget;
     for (uint k = 0u; k < kMltValues; ++k) records[at].value[k] = weight > 0.0 ? value[k] : vec3(0.0);
 }
 
@@ -178,8 +216,8 @@ void finishMutation(uint c, Evaluated e, bool large, inout Rng m) {
     MltChain cur = chains[c];
     float a = mltAcceptance(cur.target, e.target);
     uint at = frame.recordOffset + 2u * c;
-    writeRecord(at, cur.pixel, mltSplatWeight(1.0 - a, cur.target), cur.value);
-    writeRecord(at + 1u, e.pixel, mltSplatWeight(a, e.target), e.value);
+    writeRecord(at, cur.pixel, mltSplatWeight(1.0 - a, cur.target), -1.0, cur.value);
+    writeRecord(at + 1u, e.pixel, mltSplatWeight(a, e.target), large ? e.target : -1.0, e.value);
     bool accept = rngNext(m) < a;
     if (large) {
         chains[c].proposedLarge++;

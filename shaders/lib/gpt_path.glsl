@@ -24,16 +24,8 @@ struct OffsetPath {
     vec3 modulation;  // first-hit demodulation factor of the offset (1 = none; gpt.comp)
 };
 
-// A kernel that traces the base path alone defines GDPT_GPT_BASE_ONLY to a true constant
-// (mlt.comp for primary-sample-space MLT): no pair exists, and every path counts as the lone
-// pair of a 1x1 image below, whose weights are the path tracer's.
-#ifndef GDPT_GPT_BASE_ONLY
-#define GDPT_GPT_BASE_ONLY false
-#endif
-
 // The pair (p, p + δ_i) exists only inside the image; at borders p has fewer pairs.
 bool gptPairExists(uint px, uint py, uint i) {
-    if (GDPT_GPT_BASE_ONLY) return false;
     ivec2 q = ivec2(px, py) + kOffsetDelta[i];
     return q.x >= 0 && q.y >= 0 && q.x < int(scene.width) && q.y < int(scene.height);
 }
@@ -45,8 +37,7 @@ bool gptPairExists(uint px, uint py, uint i) {
 // is unbiased there too; without it a 1x1 primal is zero. Images one pixel wide or high need
 // no such pair: each pixel has one or two real ones.
 bool gptPairCounted(uint px, uint py, uint i) {
-    bool lone = GDPT_GPT_BASE_ONLY || (scene.width == 1u && scene.height == 1u);
-    return gptPairExists(px, py, i) || (lone && i == kGptRight);
+    return gptPairExists(px, py, i) || (scene.width == 1u && scene.height == 1u && i == kGptRight);
 }
 
 // Vertex classification; a scene without glossy/specular vertices (kHasGlossy false) has

@@ -66,10 +66,13 @@ struct MltChain {
 
 // One splat: `weight` times `value` goes to pixel `pixel` (Kelemen et al. 2002, §4: the
 // current sample with weight (1 − a)/T, the proposal with a/T, a the acceptance
-// probability). The host sums them in record order. 116 bytes.
+// probability). The host sums them in record order. A large step's proposal is a fresh
+// uniform state, so its target is one more sample of b = ∫ T (Kelemen et al. §4 estimate b
+// from the large steps): the host pools them with the bootstrap's. 120 bytes.
 struct MltRecord {
     uint pixel;
-    float weight;  // 0: nothing to splat
+    float weight;       // 0: nothing to splat
+    float largeTarget;  // the proposal of a large step: its target (≥ 0); otherwise −1
     vec3 value[kMltValues];
 };
 
@@ -90,7 +93,7 @@ kSpecMltBaseOnly = 20u  // 1: trace the base path alone (PSSMLT), 0: base + offs
 #ifdef __cplusplus
 static_assert(sizeof(MltParams) == 48, "MltParams layout");
 static_assert(sizeof(MltChain) == 144, "MltChain layout (scalar)");
-static_assert(sizeof(MltRecord) == 116, "MltRecord layout (scalar)");
+static_assert(sizeof(MltRecord) == 120, "MltRecord layout (scalar)");
 static_assert(std::uint32_t{kBindMltChains} > std::uint32_t{kBindGptEdgeProbe},
               "MLT bindings must not collide with gpt_shared.h's");
 }  // namespace gdpt::gpu

@@ -1,28 +1,39 @@
 #include "integrator/mlt_estimate.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "lib/rng.glsl"
 
 namespace gdpt {
 
-MltNormalisation mltNormalisation(const std::vector<float>& targets) {
+void TargetSums::add(float target) {
+    const double v = std::isfinite(target) && target > 0.0f ? double(target) : 0.0;
+    sum += v;
+    sumSquares += v * v;
+    ++count;
+}
+
+void TargetSums::add(const TargetSums& other) {
+    sum += other.sum;
+    sumSquares += other.sumSquares;
+    count += other.count;
+}
+
+MltNormalisation TargetSums::normalisation() const {
     MltNormalisation n;
-    n.samples = targets.size();
-    if (targets.empty()) return n;
-    double sum = 0.0, sumSq = 0.0;
-    for (float t : targets) {
-        const double v = std::isfinite(t) && t > 0.0f ? double(t) : 0.0;
-        sum += v;
-        sumSq += v * v;
-    }
-    const double count = double(targets.size());
-    n.b = sum / count;
-    if (targets.size() > 1) {
-        const double variance = std::max(0.0, (sumSq - sum * n.b) / (count - 1.0));
-        n.standardError = std::sqrt(variance / count);
-    }
+    n.samples = count;
+    if (count == 0) return n;
+    const double c = double(count);
+    n.b = sum / c;
+    if (count > 1) n.standardError = std::sqrt(std::max(0.0, (sumSquares - sum * n.b) / (c - 1.0)) / c);
     return n;
+}
+
+MltNormalisation mltNormalisation(const std::vector<float>& targets) {
+    TargetSums s;
+    for (float t : targets) s.add(t);
+    return s.normalisation();
 }
 
 std::vector<std::uint32_t> mltChainStarts(const std::vector<float>& targets, std::uint32_t chains,
@@ -63,6 +74,7 @@ void MltAccumulator::add(const gpu::MltRecord* records, std::size_t count) {
     const std::size_t pixels = std::size_t(width_) * std::size_t(height_);
     for (std::size_t r = 0; r < count; ++r) {
         const gpu::MltRecord& rec = records[r];
+        if (rec.largeTarget >= 0.0f) largeSteps_.add(rec.largeTarget);
         if (!(rec.weight > 0.0f) || rec.pixel >= pixels) continue;
         double* s = &sums_[std::size_t(rec.pixel) * gpu::kMltValues * 3];
         const double w = rec.weight;

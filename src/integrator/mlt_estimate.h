@@ -18,11 +18,22 @@
 
 namespace gdpt {
 
-// b = the mean of the bootstrap's targets and its standard error (sd / √n), in double.
+// b̂ = the mean of targets of fresh uniform states (the bootstrap's and the large steps'
+// proposals) and its standard error (sd / √n), in double.
 struct MltNormalisation {
     double b = 0.0;
     double standardError = 0.0;
     std::uint64_t samples = 0;
+};
+
+// Running sums of such targets; a negative or non-finite target counts as 0 (the kernel's
+// policy for a non-finite sample).
+struct TargetSums {
+    double sum = 0.0, sumSquares = 0.0;
+    std::uint64_t count = 0;
+    void add(float target);
+    void add(const TargetSums& other);
+    [[nodiscard]] MltNormalisation normalisation() const;
 };
 MltNormalisation mltNormalisation(const std::vector<float>& targets);
 
@@ -36,7 +47,9 @@ std::vector<std::uint32_t> mltChainStarts(const std::vector<float>& targets, std
 class MltAccumulator {
 public:
     MltAccumulator(int width, int height);
+    // Adds the records' splats, and the targets of the large steps' proposals to largeSteps().
     void add(const gpu::MltRecord* records, std::size_t count);
+    [[nodiscard]] const TargetSums& largeSteps() const { return largeSteps_; }
     // The mean of quantity k (kMltCentral, kMltNeighbor + i, kMltGradient + i) per pixel,
     // scaled by `scale` (= W·H·b/N).
     [[nodiscard]] Image quantity(std::uint32_t k, double scale) const;
@@ -44,6 +57,7 @@ public:
 private:
     int width_, height_;
     std::vector<double> sums_;  // [pixel][k][channel]
+    TargetSums largeSteps_;
 };
 
 // G-PT's resolve (gpt_resolve.comp) of per-pixel means: primal = the average of the pair

@@ -128,11 +128,10 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
         const std::vector<float> part = pass.bootstrapTargets(n);
         targets.insert(targets.end(), part.begin(), part.end());
     }
-    const MltNormalisation norm = mltNormalisation(targets);
+    TargetSums fresh;  // the targets of fresh states: the bootstrap's, then the large steps'
+    for (float t : targets) fresh.add(t);
     stats.mlt.chains = po.chains;
     stats.mlt.bootstrapSamples = targets.size();
-    stats.mlt.normalisation = norm.b;
-    stats.mlt.normalisationStdErr = norm.standardError;
     const std::vector<std::uint32_t> starts = mltChainStarts(targets, po.chains, options.seed);
     targets = {};
 
@@ -200,7 +199,13 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
         std::fprintf(stderr, "gdpt: warning: %s: %llu samples were NaN/Inf and were counted as zero\n",
                      name_.c_str(), static_cast<unsigned long long>(stats.nanSamples));
 
-    // Stage 3: the estimate, X(p) = W·H·b/N Σ weight·X (mlt_estimate.h); gmlt reconstructs.
+    // Stage 3: the estimate, X(p) = W·H·b/N Σ weight·X (mlt_estimate.h), with b̂ from every
+    // fresh state (Kelemen et al. 2002, §4); gmlt reconstructs.
+    fresh.add(acc.largeSteps());
+    const MltNormalisation norm = fresh.normalisation();
+    stats.mlt.normalisation = norm.b;
+    stats.mlt.normalisationStdErr = norm.standardError;
+    stats.mlt.normalisationSamples = norm.samples;
     Timer readback;
     const double scale = stats.mlt.mutations ? double(pixels) * norm.b / double(stats.mlt.mutations) : 0.0;
     Image direct = pass.directImage();
@@ -244,6 +249,7 @@ void MltIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
                 {"bootstrap_samples", m.bootstrapSamples},
                 {"normalisation", m.normalisation},
                 {"normalisation_stderr", m.normalisationStdErr},
+                {"normalisation_samples", m.normalisationSamples},
                 {"splat_s", m.splatMs * 1e-3}};
     if (gradients()) j["mlt"]["target_alpha"] = options_.targetAlpha;
     j["reconstructions"] = reconstructionsJson(s);

@@ -135,6 +135,18 @@ TEST(MltEstimate, NormalisationIsTheMeanTargetWithItsStandardError) {
     EXPECT_EQ(mltNormalisation({}).b, 0.0);
 }
 
+TEST(MltEstimate, PooledTargetsAreTheMeanOfAllSamples) {
+    // The bootstrap's and the large steps' sums pooled give the mean of all their targets.
+    TargetSums boot, large;
+    for (float t : {1.0f, 3.0f}) boot.add(t);
+    for (float t : {2.0f, 6.0f, 0.0f}) large.add(t);
+    boot.add(large);
+    const MltNormalisation n = boot.normalisation();
+    EXPECT_EQ(n.samples, 5u);
+    EXPECT_DOUBLE_EQ(n.b, 12.0 / 5.0);
+    EXPECT_NEAR(n.standardError, mltNormalisation({1.0f, 3.0f, 2.0f, 6.0f, 0.0f}).standardError, 1e-12);
+}
+
 TEST(MltEstimate, ChainsStartInProportionToTheTarget) {
     const std::vector<float> t = {0.0f, 1.0f, 3.0f, 0.0f, 4.0f, 0.5f};
     const std::uint32_t chains = 8500;
@@ -163,7 +175,11 @@ TEST(MltEstimate, RecordsResolveLikeGptResolve) {
     r[1].pixel = 2;
     r[1].weight = 2.0f;
     r[1].value[gpu::kMltGradient + gpu::kGptLeft] = {0.25f, 0.0f, 0.0f};
+    r[0].largeTarget = -1.0f;  // not a large step
+    r[1].largeTarget = 4.0f;   // a large step's proposal: one more sample of b
     acc.add(r, 2);
+    EXPECT_EQ(acc.largeSteps().count, 1u);
+    EXPECT_DOUBLE_EQ(acc.largeSteps().sum, 4.0);
     const double scale = 3.0;
     const MltImages m = resolveGradientSamples(acc, scale);
     // (1, 0) has neighbours left, right, down: k = 3. (2, 0) has left and down: k = 2.
