@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Metropolis light transport against PT and G-PT at equal time (docs/mlt.md), in one command:
 #   1. the door scene (scenes/indirect_gap.gltf, lit only through a gap) at 256², against a PT
-#      reference of REFSPP samples per pixel (rendered once into OUT/, seed 99; its noise
-#      floor, the mean relative variance of its pixels, is printed);
+#      reference of REFSPP samples per pixel (rendered once into OUT/, seed 99, or given with
+#      --reference, then of --reference-spp samples); its noise floor is printed;
 #   2. the Cornell box of ../shared/scenes/cbox against its independent reference;
 #   3. the throughput: mutations per second of gmlt and pssmlt against camera samples per
 #      second of G-PT and PT (the same scene and size, --json samples_per_s, 3 interleaved rounds,
@@ -71,7 +71,15 @@ med = {m: statistics.median(v) for m, v in rows.items()}
 for m, v in med.items():
     print(f'{m:8s} {v:12.0f} per s   {v / med[\"gpt\"]:.2f}x G-PT')
 "
-python3 - "$doorref" <<'PY' || true
-import sys
-print("reference:", sys.argv[1], "(its noise floor: see docs/mlt.md)")
+# The reference's own noise, from PT's error at the largest budget: PT's relMSE falls as 1/spp,
+# so a PT reference of REFSPP samples sits about relMSE · spp / REFSPP from the truth, and every
+# relMSE against it carries that much on top.
+python3 - "$out/indirect_gap/results.json" "$refspp" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+pt = [r for r in d["summary"] if r["method"] == "pt"]
+if pt:
+    last = max(pt, key=lambda r: r["budget_s"])
+    floor = last["relmse_median"] * last["spp_median"] / float(sys.argv[2])
+    print(f"door reference ({sys.argv[2]} spp): noise floor about {floor:.3g} in relMSE")
 PY
