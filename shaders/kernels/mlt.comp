@@ -96,30 +96,6 @@ vec3 firstHitModulation(SurfaceHit h, uint pixel) { return vec3(1.0); }
 bool emissionSupersampled(uint pixel) { return true; }
 #include "lib/pt_core.glsl"
 
-// The path tracer's radiance of a camera sample at `film` (decisions through pssLookup).
-vec3 tracePath(LdSample lds, Rng rng, vec2 film, uint pixel, inout uint rays) {
-    PathState s;
-    s.pixel = pixel;
-    s.origin = scene.camPosition;
-    s.dir = cameraRay(film);
-    s.prevPdf = 0.0;
-    s.beta = vec3(1.0);
-    s.flags = kPathFlagAlive | kPathFlagPrevSpecular;
-    s.radiance = vec3(0.0);
-    s.rng = rng.state;
-    s.prevP = s.origin;
-    s.depth = 0u;
-    s.rays = 0u;
-    s.ldSeed = lds.seed;
-    s.sampleIndex = lds.index;
-    while ((s.flags & kPathFlagAlive) != 0u) {
-        Hit hit = traceClosest(s.origin, s.dir, 0.0, kInf);
-        ptProcessHit(s, hit);
-    }
-    rays += s.rays;
-    return s.radiance;
-}
-
 // Stream tags: the numbers of one sample index in one phase never repeat another's.
 const uint kTagState = 0x53544154u;     // a fresh state's decisions
 const uint kTagMutation = 0x4d555441u;  // a mutation's choices (large or small, sizes, accept)
@@ -149,7 +125,10 @@ Evaluated evaluate(uint stream, uint fresh, inout uint rays, inout uint nan) {
     for (uint k = 0u; k < kMltValues; ++k) e.value[k] = vec3(0.0);
     gPssActive = true;
     if (kBaseOnly) {
-        central = tracePath(lds, rng, e.film, e.pixel, rays);
+        PathState path = ptBeginAt(e.pixel, e.film, rng, lds);
+        ptTrace(path);
+        rays += path.rays;
+        central = path.radiance;
         finite = isFinite(central);
     } else {
         OffsetPath offs[kGptNumOffsets];

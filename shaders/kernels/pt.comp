@@ -39,10 +39,7 @@ void main() {
     uint rays = 0u;
     for (uint i = 0u; i < frame.samplesPerPixel; ++i) {
         PathState s = ptBegin(x, y, frame.sampleBase + i, frame.seed);
-        while ((s.flags & kPathFlagAlive) != 0u) {
-            Hit hit = traceClosest(s.origin, s.dir, 0.0, 1.0 / 0.0);
-            ptProcessHit(s, hit);
-        }
+        ptTrace(s);
         rays += s.rays;
         bool finite = isFinite(s.radiance);
         if (!finite) nan++;

@@ -18,16 +18,13 @@
 #include "lib/sampler.glsl"
 #include "lib/visible_emission.glsl"
 
-// Starts the path of sample `sampleIndex` of pixel (x, y): box filter, so the sample
-// position is uniform over the pixel square.
-PathState ptBegin(uint x, uint y, uint sampleIndex, uint seed) {
+// Starts a camera path through the continuous pixel position `pixelPos` of pixel `pixel`,
+// with the random numbers of `rng` and the sampler's decisions of `lds`.
+PathState ptBeginAt(uint pixel, vec2 pixelPos, Rng rng, LdSample lds) {
     PathState s;
-    s.pixel = y * scene.width + x;
-    Rng rng = rngInit(s.pixel, sampleIndex, seed);
-    LdSample lds = ldSampleInit(s.pixel, sampleIndex, seed);
-    vec2 jitter = ldGet2(lds, kLdDimPixel);
+    s.pixel = pixel;
     s.origin = scene.camPosition;
-    s.dir = cameraRay(vec2(x, y) + jitter);
+    s.dir = cameraRay(pixelPos);
     s.prevPdf = 0.0;
     s.beta = vec3(1.0);
     s.flags = kPathFlagAlive | kPathFlagPrevSpecular;
@@ -37,8 +34,16 @@ PathState ptBegin(uint x, uint y, uint sampleIndex, uint seed) {
     s.depth = 0u;
     s.rays = 0u;
     s.ldSeed = lds.seed;
-    s.sampleIndex = sampleIndex;
+    s.sampleIndex = lds.index;
     return s;
+}
+
+// Starts the path of sample `sampleIndex` of pixel (x, y): box filter, so the sample
+// position is uniform over the pixel square.
+PathState ptBegin(uint x, uint y, uint sampleIndex, uint seed) {
+    uint pixel = y * scene.width + x;
+    LdSample lds = ldSampleInit(pixel, sampleIndex, seed);
+    return ptBeginAt(pixel, vec2(x, y) + ldGet2(lds, kLdDimPixel), rngInit(pixel, sampleIndex, seed), lds);
 }
 
 // Consumes the closest hit of the current segment; updates the state to the next segment
@@ -122,6 +127,14 @@ void ptProcessHit(inout PathState s, Hit hit) {
         if (survive) s.flags |= kPathFlagAlive;
     }
     s.rng = rng.state;
+}
+
+// Traces the path to its end (s.radiance, s.rays).
+void ptTrace(inout PathState s) {
+    while ((s.flags & kPathFlagAlive) != 0u) {
+        Hit hit = traceClosest(s.origin, s.dir, 0.0, 1.0 / 0.0);
+        ptProcessHit(s, hit);
+    }
 }
 
 #endif  // GDPT_LIB_PT_CORE
