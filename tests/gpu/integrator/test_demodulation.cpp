@@ -74,19 +74,10 @@ TEST(DemodulationMask, KeepsOnlyPixelsWhoseNeighbourhoodShowsOneSurface) {
 
 class Demodulation : public test::GpuTest {};
 
-RenderOptions options(int size, std::uint32_t spp, std::uint32_t seed) {
-    RenderOptions o;
-    o.scene.width = o.scene.height = size;
-    o.spp = spp;
-    o.seed = seed;
-    o.quiet = true;
-    return o;
-}
-
 TEST_F(Demodulation, LeavesAnUntexturedSceneBitForBitAlone) {
     const Scene scene = makeCornellBox();
     ASSERT_FALSE(demodulationApplies(scene));
-    RenderOptions o = options(24, 2, 3);
+    RenderOptions o = renderOptions(24, 24, 2, 3);
     GptSamplingOptions g;
     g.demodulate = gdpt::Demodulation::Off;
     const RenderResultGpt off = renderGpt(ctx(), scene, o, g);
@@ -137,7 +128,7 @@ Scene checkerUnderSky() {
 TEST_F(Demodulation, ModulatedPrimalOfATexturedPlaneUnderASkyMatchesThePathTracer) {
     const Scene scene = checkerUnderSky();
     ASSERT_TRUE(demodulationApplies(scene));
-    RenderOptions o = options(48, 32, 11);
+    RenderOptions o = renderOptions(48, 48, 32, 11);
     o.scene.envRadiance = glm::vec3(1.0f);
     const RenderResultGpt g = renderGpt(ctx(), scene, o);  // Auto: on
     ASSERT_TRUE(g.stats.demodulated);

@@ -50,15 +50,6 @@ double twoSidedT(double alpha, int dof) {
     return 0.5 * (lo + hi);
 }
 
-RenderOptions options(int size, std::uint32_t spp, std::uint32_t seed) {
-    RenderOptions o;
-    o.scene.width = o.scene.height = size;
-    o.spp = spp;
-    o.seed = seed;
-    o.quiet = true;
-    return o;
-}
-
 const Image& layer(const RenderOutput& out, const std::string& name) {
     for (const NamedLayer& l : out.layers)
         if (l.name == name) return l.image;
@@ -97,7 +88,7 @@ TEST_F(MltRender, FurnaceMeanIsOneForBothTargets) {
         std::unique_ptr<Integrator> integrator = makeIntegrator(method);
         std::vector<double> means;
         for (int s = 0; s < kSeeds; ++s) {
-            const RenderOutput out = integrator->render(ctx(), scene, options(16, 16, 100 + s));
+            const RenderOutput out = integrator->render(ctx(), scene, renderOptions(16, 16, 16, 100 + s));
             const Image& im = layer(out, estimateLayer(method));
             means.push_back(regionMean(im, 1, 0, 0, 16, 16));
             // The very-direct light of the furnace is its emission, 0.5, exactly.
@@ -114,7 +105,7 @@ TEST_F(MltRender, FurnaceMeanIsOneForBothTargets) {
 TEST_F(MltRender, CornellBoxQuadrantsMatchThePathTracer) {
     const Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.gltf");
     constexpr int kSize = 32, kHalf = kSize / 2;
-    const RenderOutput pt = makeIntegrator("pt")->render(ctx(), scene, options(kSize, 1024, 7));
+    const RenderOutput pt = makeIntegrator("pt")->render(ctx(), scene, renderOptions(kSize, kSize, 1024, 7));
     const Image& ptImage = pt.image();
     const Image& ptVar = layer(pt, "variance");
     const double threshold = twoSidedT(test::sidakAlpha(1e-3, 2 * 4 * 3), kSeeds - 1);
@@ -122,7 +113,8 @@ TEST_F(MltRender, CornellBoxQuadrantsMatchThePathTracer) {
         std::unique_ptr<Integrator> integrator = makeIntegrator(method);
         std::vector<std::vector<double>> quadrant(12);
         for (int s = 0; s < kSeeds; ++s) {
-            const RenderOutput out = integrator->render(ctx(), scene, options(kSize, 32, 200 + s));
+            const RenderOutput out =
+                integrator->render(ctx(), scene, renderOptions(kSize, kSize, 32, 200 + s));
             const Image& im = layer(out, estimateLayer(method));
             for (int q = 0; q < 4; ++q)
                 for (int c = 0; c < 3; ++c)
@@ -150,9 +142,9 @@ TEST_F(MltRender, CornellBoxQuadrantsMatchThePathTracer) {
 TEST_F(MltRender, DeterministicPerSeed) {
     const Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/glossy_cornell.gltf");
     std::unique_ptr<Integrator> gmlt = makeIntegrator("gmlt");
-    const RenderOutput a = gmlt->render(ctx(), scene, options(24, 8, 3));
-    const RenderOutput b = gmlt->render(ctx(), scene, options(24, 8, 3));
-    const RenderOutput c = gmlt->render(ctx(), scene, options(24, 8, 4));
+    const RenderOutput a = gmlt->render(ctx(), scene, renderOptions(24, 24, 8, 3));
+    const RenderOutput b = gmlt->render(ctx(), scene, renderOptions(24, 24, 8, 3));
+    const RenderOutput c = gmlt->render(ctx(), scene, renderOptions(24, 24, 8, 4));
     ASSERT_EQ(a.layers.size(), b.layers.size());
     for (std::size_t i = 0; i < a.layers.size(); ++i)
         for (int ch = 0; ch < 3; ++ch)
