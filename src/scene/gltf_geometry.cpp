@@ -362,6 +362,22 @@ std::vector<glm::vec2> readTexcoords(const tinygltf::Model& model, int accessor,
     return out;
 }
 
+std::vector<glm::dvec4> readKeyValues(const tinygltf::Model& model, int accessor, const char* role, int type,
+                                      bool normalizedIntegers) {
+    const std::initializer_list<int> floatOnly = {TINYGLTF_COMPONENT_TYPE_FLOAT};
+    const std::initializer_list<int> withIntegers = {
+        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+        TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT};
+    const CheckedAccessor a =
+        checkAccessor(model, accessor, role, type, normalizedIntegers ? withIntegers : floatOnly);
+    if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT && !a.normalized)
+        throw Error(a.label + " has integer components that are not normalized (glTF 2.0 §3.11 allows "
+                              "only normalized integers for rotations)");
+    std::vector<glm::dvec4> out(a.count, glm::dvec4(0.0));
+    readElements(a, [&](std::size_t i, int c, double v) { out[i][c] = v; });
+    return out;
+}
+
 std::vector<std::uint32_t> readIndices(const tinygltf::Model& model, int accessor) {
     const CheckedAccessor a =
         checkAccessor(model, accessor, "indices", TINYGLTF_TYPE_SCALAR,

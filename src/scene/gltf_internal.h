@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "scene/animation.h"
 #include "scene/gltf_loader.h"
 #include "scene/scene.h"
 #include "util/error.h"
@@ -92,6 +93,17 @@ std::optional<SceneEstimate> precheckJson(std::string_view text);
 std::vector<glm::vec3> readVec3(const tinygltf::Model& model, int accessor, const char* role);
 std::vector<glm::vec2> readTexcoords(const tinygltf::Model& model, int accessor, const char* role);
 std::vector<std::uint32_t> readIndices(const tinygltf::Model& model, int accessor);
+// A SCALAR, VEC3 or VEC4 accessor (`type`) as (x, y, z, w) doubles, missing components 0, the
+// values unchecked (animation keys; animation.h checks them): float components, or with
+// `normalizedIntegers` also normalized (unsigned) bytes and shorts (rotations, glTF 2.0 §3.11).
+std::vector<glm::dvec4> readKeyValues(const tinygltf::Model& model, int accessor, const char* role, int type,
+                                      bool normalizedIntegers);
+
+// The file's animations (gltf_animation.cpp), every channel checked (animation.h
+// checkChannel) and named; channels gdpt does not apply (morph target weights, channels
+// without a node) are noted as unsupported. Throws gdpt::Error naming the animation and
+// channel.
+std::vector<Animation> readAnimations(Context& ctx);
 
 // Appends all triangle primitives of one mesh instance (gltf_geometry.cpp).
 void addMeshInstance(Context& ctx, const MeshInstance& inst, bool sceneHasNormals, bool sceneHasUvs);

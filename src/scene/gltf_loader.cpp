@@ -17,6 +17,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <string_view>
@@ -154,7 +155,6 @@ void checkExtensions(gltf::Context& ctx) {
     for (const auto& ext : model.extensionsUsed)
         if (!gltf::supportedExtension(ext)) ctx.unsupported("extension " + ext);
     if (!model.skins.empty()) ctx.unsupported("skins (meshes rendered in their bind pose)");
-    if (!model.animations.empty()) ctx.unsupported("animations (the static pose is rendered)");
 }
 
 // Checks the node graph: child indices in range, at most one parent per node (glTF 2.0
@@ -364,29 +364,56 @@ void checkSceneExtent(const Scene& scene) {
     throw Error(text);
 }
 
-Scene loadImpl(const std::string& path, const LoadOptions& opts) {
+// A node's local transform in the pose: the animated parts replace the node's own.
+glm::dmat4 posedMatrix(const tinygltf::Node& node, const NodePose& pose) {
+    tinygltf::Node posed = node;  // animated nodes have no matrix (readAnimations checks)
+    if (pose.translation) posed.translation = {pose.translation->x, pose.translation->y, pose.translation->z};
+    if (pose.rotation) posed.rotation = {pose.rotation->x, pose.rotation->y, pose.rotation->z, pose.rotation->w};
+    if (pose.scale) posed.scale = {pose.scale->x, pose.scale->y, pose.scale->z};
+    return localMatrix(posed);
+}
+
+}  // namespace
+}  // namespace gltf
+
+struct GltfAsset::Impl {
+    std::string path;
+    LoadOptions opts;
+    SceneEstimate estimate;
+    tinygltf::Model model;
+    // What every instance shares: materials, textures, the unsupported-feature notes.
+    Scene base;
+    std::map<std::pair<int, bool>, int> textureCache;
+    int defaultMaterial = -1;
+    std::vector<int> roots;
+    std::vector<Animation> animations;
+
+    void parse();
+    [[nodiscard]] Scene instance(int animation, double time) const;
+};
+
+void GltfAsset::Impl::parse() {
     // The JSON alone first: its checks and the estimate come before the parser, a .glb's BIN
     // chunk and any external buffer are read, and before anything is allocated per element.
-    std::vector<unsigned char> bytes = readFile(path, /*jsonOnly=*/true);
-    const SceneEstimate estimate = precheck(bytes);
-    refuseBeyondLimits(estimate, opts);
+    std::vector<unsigned char> bytes = gltf::readFile(path, /*jsonOnly=*/true);
+    estimate = gltf::precheck(bytes);
+    gltf::refuseBeyondLimits(estimate, opts);
     std::optional<Progress> progress;
     if (!opts.quiet && estimate.triangles >= opts.progressTriangles) {
-        progress.emplace("loading " + path, static_cast<double>(estimate.triangles), false);
+        progress.emplace("reading " + path, 1.0, false);
         progress->update(0.0, "reading buffers");
     }
-    const bool binary = isGlb(bytes);
-    if (binary) bytes = readFile(path, /*jsonOnly=*/false);
+    const bool binary = gltf::isGlb(bytes);
+    if (binary) bytes = gltf::readFile(path, /*jsonOnly=*/false);
 
-    tinygltf::Model model;
     tinygltf::TinyGLTF parser;
     // Images get the memory budget that the geometry leaves (see ImageDecodeContext).
-    const std::uint64_t budget = memoryBudget(opts);
+    const std::uint64_t budget = gltf::memoryBudget(opts);
     gltf::ImageDecodeContext imageDecode{&model, budget == 0               ? ~std::uint64_t{0}
                                                  : budget > estimate.bytes ? budget - estimate.bytes
                                                                            : 0};
     parser.SetImageLoader(&gltf::decodeImage, &imageDecode);
-    parser.SetFsCallbacks({&tinygltf::FileExists, &tinygltf::ExpandFilePath, &readExternalFile,
+    parser.SetFsCallbacks({&tinygltf::FileExists, &tinygltf::ExpandFilePath, &gltf::readExternalFile,
                            &tinygltf::WriteWholeFile, nullptr});
     std::string err, warn;
     std::string baseDir = std::filesystem::path(path).parent_path().string();
@@ -396,42 +423,57 @@ Scene loadImpl(const std::string& path, const LoadOptions& opts) {
                                              static_cast<unsigned int>(bytes.size()), baseDir)
                : parser.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
                                             static_cast<unsigned int>(bytes.size()), baseDir);
-    if (!ok) throw Error("glTF parse error: " + oneLine(err.empty() ? "unknown error" : err));
+    if (!ok) throw Error("glTF parse error: " + gltf::oneLine(err.empty() ? "unknown error" : err));
     bytes = {};
     throwIfInterrupted("loading");  // SIGINT/SIGTERM (util/interrupt.h): between the stages
 
-    Scene scene;
-    scene.sourcePath = path;
-    gltf::Context ctx{model, scene, {}, -1};
-    if (!warn.empty()) ctx.unsupported("tinygltf warning: " + oneLine(warn));
-    checkExtensions(ctx);
+    base.sourcePath = path;
+    gltf::Context ctx{model, base, {}, -1};
+    if (!warn.empty()) ctx.unsupported("tinygltf warning: " + gltf::oneLine(warn));
+    gltf::checkExtensions(ctx);
     gltf::convertMaterials(ctx);
-    const std::vector<int> parent = checkNodeGraph(model);
+    textureCache = ctx.textureCache;
+    defaultMaterial = ctx.defaultMaterial;
+    roots = gltf::sceneRoots(model, gltf::checkNodeGraph(model));
+    animations = gltf::readAnimations(ctx);
+    if (progress) progress->finish("parsed");
+}
+
+Scene GltfAsset::Impl::instance(int animation, double time) const {
+    std::map<int, NodePose> pose;
+    if (animation >= 0) pose = poseAt(animations.at(static_cast<std::size_t>(animation)), time);
+    Scene scene = base;
+    gltf::Context ctx{model, scene, textureCache, defaultMaterial};
+    std::optional<Progress> progress;
+    if (!opts.quiet && estimate.triangles >= opts.progressTriangles)
+        progress.emplace("loading " + path, static_cast<double>(estimate.triangles), false);
 
     // Depth-first traversal with an explicit stack (deep hierarchies must not overflow
     // the call stack); children are pushed in reverse so the order matches recursion.
     std::vector<gltf::MeshInstance> instances;
     std::vector<std::pair<int, glm::dmat4>> stack;
-    const std::vector<int> roots = sceneRoots(model, parent);
     for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.emplace_back(*it, glm::dmat4(1.0));
     while (!stack.empty()) {
         const auto [index, parentWorld] = stack.back();
         stack.pop_back();
         const tinygltf::Node& node = model.nodes[static_cast<std::size_t>(index)];
         try {
-            const glm::dmat4 world = parentWorld * localMatrix(node);
+            const auto posed = pose.find(index);
+            const glm::dmat4 local =
+                posed == pose.end() ? gltf::localMatrix(node) : gltf::posedMatrix(node, posed->second);
+            const glm::dmat4 world = parentWorld * local;
             if (node.mesh >= 0) {
                 if (static_cast<std::size_t>(node.mesh) >= model.meshes.size())
                     throw Error("mesh " + std::to_string(node.mesh) + " out of range (file has " +
                                 std::to_string(model.meshes.size()) + " meshes)");
                 instances.push_back({node.mesh, index, world});
             }
-            if (node.camera >= 0) addCamera(ctx, node, world);
+            if (node.camera >= 0) gltf::addCamera(ctx, node, world);
             if (node.skin >= 0) ctx.unsupported("skins (meshes rendered in their bind pose)");
             if (!node.weights.empty()) ctx.unsupported("morph target weights");
             for (const auto& [name, value] : node.extensions) {
                 if (name == "KHR_lights_punctual")
-                    addLight(ctx, value, world);
+                    gltf::addLight(ctx, value, world);
                 else
                     ctx.unsupported("node extension " + name);
             }
@@ -463,18 +505,21 @@ Scene loadImpl(const std::string& path, const LoadOptions& opts) {
                              std::to_string(scene.triangles.size()) + " triangles");
     }
     if (progress) progress->finish(std::to_string(scene.triangles.size()) + " triangles");
-    checkSceneExtent(scene);
+    gltf::checkSceneExtent(scene);
     return scene;
 }
 
-}  // namespace
-}  // namespace gltf
+namespace {
 
-Scene loadGltf(const std::string& path, const LoadOptions& opts) {
+// Runs `f`, giving every error the file's name (and turning foreign exceptions into ours).
+template <typename F>
+auto withFileContext(const std::string& path, F&& f) -> decltype(f()) {
     try {
-        return gltf::loadImpl(path, opts);
+        return f();
     } catch (const Interrupted&) {
         throw;  // not a problem of the file
+    } catch (const UsageError&) {
+        throw;
     } catch (const Error& e) {
         throw e.withContext(path);
     } catch (const std::bad_alloc&) {
@@ -484,6 +529,50 @@ Scene loadGltf(const std::string& path, const LoadOptions& opts) {
         throw Error(path + ": " + e.what());
     }
 }
+
+}  // namespace
+
+GltfAsset::GltfAsset(const std::string& path, const LoadOptions& opts) : impl_(std::make_unique<Impl>()) {
+    impl_->path = path;
+    impl_->opts = opts;
+    withFileContext(path, [&] { impl_->parse(); });
+}
+
+GltfAsset::~GltfAsset() = default;
+GltfAsset::GltfAsset(GltfAsset&&) noexcept = default;
+GltfAsset& GltfAsset::operator=(GltfAsset&&) noexcept = default;
+
+const std::string& GltfAsset::path() const {
+    return impl_->path;
+}
+
+const std::vector<Animation>& GltfAsset::animations() const {
+    return impl_->animations;
+}
+
+int GltfAsset::findAnimation(const std::string& nameOrIndex) const {
+    const auto& list = impl_->animations;
+    for (std::size_t i = 0; i < list.size(); ++i)
+        if (list[i].name == nameOrIndex) return static_cast<int>(i);
+    const bool digits =
+        !nameOrIndex.empty() && nameOrIndex.size() < 10 &&
+        std::all_of(nameOrIndex.begin(), nameOrIndex.end(), [](char c) { return c >= '0' && c <= '9'; });
+    if (digits && std::stoul(nameOrIndex) < list.size()) return std::stoi(nameOrIndex);
+    std::string known;
+    for (std::size_t i = 0; i < list.size(); ++i)
+        known += (i ? ", " : "") + std::to_string(i) + (list[i].name.empty() ? "" : " '" + list[i].name + "'");
+    throw UsageError("--animation " + nameOrIndex + ": " + impl_->path +
+                     (list.empty() ? " has no animations" : " has no such animation (it has " + known + ")"));
+}
+
+Scene GltfAsset::instance(int animation, double time) const {
+    return withFileContext(impl_->path, [&] { return impl_->instance(animation, time); });
+}
+
+Scene loadGltf(const std::string& path, const LoadOptions& opts) {
+    return GltfAsset(path, opts).instance();
+}
+
 
 SceneEstimate estimateGltf(const std::string& path) {
     try {
@@ -521,6 +610,21 @@ std::string describeScene(const Scene& scene) {
         os << "\n  bounds (" << b.min.x << ", " << b.min.y << ", " << b.min.z << ") - (" << b.max.x << ", "
            << b.max.y << ", " << b.max.z << ")";
     for (const auto& u : scene.unsupported) os << "\n  unsupported: " << u;
+    return os.str();
+}
+
+std::string describeAnimations(const std::vector<Animation>& animations) {
+    std::ostringstream os;
+    for (std::size_t i = 0; i < animations.size(); ++i) {
+        const Animation& a = animations[i];
+        char duration[32];
+        std::snprintf(duration, sizeof duration, "%.4g s", a.duration());
+        os << (i ? "\n" : "") << "animation " << i << (a.name.empty() ? "" : " '" + a.name + "'") << ": "
+           << duration << ", " << a.channels.size() << " channel" << (a.channels.size() == 1 ? "" : "s");
+        for (const auto& c : a.channels)
+            os << "\n  " << c.target << " (" << interpolationName(c.interpolation) << ", " << c.times.size()
+               << " keys, " << c.times.front() << " to " << c.times.back() << " s)";
+    }
     return os.str();
 }
 

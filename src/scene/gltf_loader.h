@@ -23,8 +23,10 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 
+#include "scene/animation.h"
 #include "scene/scene.h"
 
 namespace gdpt {
@@ -49,7 +51,35 @@ struct LoadOptions {
     bool quiet = false;
 };
 
-// Loads `path` (.gltf or .glb, detected from the file's magic bytes). Throws gdpt::Error.
+// A glTF file parsed and checked once (its materials and textures converted), from which
+// scenes are instanced: the rest pose, or any time of one of its animations (animation.h),
+// the animated nodes' transforms composed through the hierarchy as for a static scene
+// (cameras and punctual lights included). A sequence of frames parses the file once.
+class GltfAsset {
+public:
+    // Reads and parses `path` (.gltf or .glb, detected from the file's magic bytes) and checks
+    // its animations. Throws gdpt::Error naming the file.
+    explicit GltfAsset(const std::string& path, const LoadOptions& opts = {});
+    ~GltfAsset();
+    GltfAsset(GltfAsset&&) noexcept;
+    GltfAsset& operator=(GltfAsset&&) noexcept;
+
+    [[nodiscard]] const std::string& path() const;
+    [[nodiscard]] const std::vector<Animation>& animations() const;
+    // The index of the animation named `nameOrIndex` (its name, else a decimal index). Throws
+    // gdpt::UsageError listing the animations if there is none such.
+    [[nodiscard]] int findAnimation(const std::string& nameOrIndex) const;
+    // The scene in its rest pose (animation < 0), or with animation `animation` at `time`
+    // seconds (before 0 or after its duration the channels hold their first or last keys).
+    // Throws gdpt::Error naming the file.
+    [[nodiscard]] Scene instance(int animation = -1, double time = 0.0) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+// Loads `path` in its rest pose: GltfAsset(path, opts).instance(). Throws gdpt::Error.
 [[nodiscard]] Scene loadGltf(const std::string& path, const LoadOptions& opts = {});
 
 // The estimate of `path` from its JSON alone (a .glb's BIN chunk and external buffers are not
@@ -62,5 +92,8 @@ struct LoadOptions {
 
 // A few lines summarising the scene (counts, bounds, cameras, unsupported features).
 [[nodiscard]] std::string describeScene(const Scene& scene);
+
+// One line per animation: index, name, duration, what it drives.
+[[nodiscard]] std::string describeAnimations(const std::vector<Animation>& animations);
 
 }  // namespace gdpt

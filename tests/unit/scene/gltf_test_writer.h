@@ -75,6 +75,33 @@ public:
     int addVec3(const std::vector<glm::vec3>& v) {
         return addAccessor(addView(v.data(), v.size() * 12), kFloat, v.size(), "VEC3");
     }
+    int addScalars(const std::vector<float>& v) {
+        return addAccessor(addView(v.data(), v.size() * 4), kFloat, v.size(), "SCALAR");
+    }
+    int addVec4(const std::vector<glm::vec4>& v) {
+        return addAccessor(addView(v.data(), v.size() * 16), kFloat, v.size(), "VEC4");
+    }
+    // An animation with one sampler per channel: (node, path, interpolation, key times,
+    // output accessor); returns its index.
+    struct ChannelSpec {
+        int node;
+        std::string path;
+        std::string interpolation;
+        std::vector<float> times;
+        int output;
+    };
+    int addAnimation(const std::string& name, const std::vector<ChannelSpec>& channels) {
+        nlohmann::json a = {{"channels", nlohmann::json::array()}, {"samplers", nlohmann::json::array()}};
+        if (!name.empty()) a["name"] = name;
+        for (const ChannelSpec& c : channels) {
+            a["samplers"].push_back(
+                {{"input", addScalars(c.times)}, {"output", c.output}, {"interpolation", c.interpolation}});
+            a["channels"].push_back({{"sampler", a["samplers"].size() - 1},
+                                     {"target", {{"node", c.node}, {"path", c.path}}}});
+        }
+        doc["animations"].push_back(a);
+        return static_cast<int>(doc["animations"].size() - 1);
+    }
     int addVec2(const std::vector<glm::vec2>& v) {
         return addAccessor(addView(v.data(), v.size() * 8), kFloat, v.size(), "VEC2");
     }
