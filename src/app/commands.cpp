@@ -97,7 +97,8 @@ int runDiff(const DiffArgs& args) {
 }
 
 int runInfo(const InfoArgs& args) {
-    const Scene scene = loadGltf(args.scene);
+    const GltfAsset asset(args.scene);
+    const Scene scene = asset.instance();
     // The features the kernels are specialised for (SceneSpec: the light count is the light
     // table's, without emitters of zero area or power); a scene without triangles has none.
     SceneGpuOptions so;
@@ -106,6 +107,8 @@ int runInfo(const InfoArgs& args) {
     if (!scene.triangles.empty()) spec = std::make_unique<const SceneSpec>(scene, so);
     const SceneFeatures f = spec ? spec->features() : analyzeScene(scene, so.envRadiance);
     std::printf("%s\n", describeScene(scene).c_str());
+    // Animations (render them with gdpt render --frames; a plain render shows the rest pose).
+    if (!asset.animations().empty()) std::printf("%s\n", describeAnimations(asset.animations()).c_str());
     for (const auto& [k, v] : describeFeatures(f)) std::printf("  %-26s %s\n", k.c_str(), v.c_str());
     // bvhRegisterStack: entries of the register traversal stack when the tree was built before
     // the pipelines (small scenes) and its traversals hold at most kBvhRegisterStackMax

@@ -1,0 +1,185 @@
+// render_setup.cpp — see render_setup.h.
+#include "app/render_setup.h"
+
+#include <sys/resource.h>
+
+#include <cstdio>
+
+#include "app/bench_util.h"
+#include "integrator/recon_reserve.h"
+#include "util/error.h"
+#include "util/interrupt.h"
+#include "vk/context.h"
+
+namespace gdpt {
+namespace {
+
+using nlohmann::json;
+
+json kernelJson(const std::map<std::string, vk::KernelTime>& kernels, double frameMs) {
+    json k = json::object();
+    for (const auto& [name, t] : kernels)
+        k[name] = {{"count", t.count},
+                   {"total_ms", t.totalMs},
+                   {"ms_per_call", t.count ? t.totalMs / double(t.count) : 0.0},
+                   {"share", frameMs > 0 ? t.totalMs / frameMs : 0.0}};
+    return k;
+}
+
+// Peak memory: the process's resident set (getrusage) and gdpt's device allocations; per
+// megapixel of the image, which is how they grow (fixed costs, e.g. the scene, included).
+json memoryJson(const vk::Context& ctx, int width, int height) {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    const double host = double(usage.ru_maxrss) * 1024.0;  // Linux reports KiB
+    const double device = double(ctx.deviceBytesPeak());
+    const double megapixels = double(width) * double(height) * 1e-6;
+    return {{"host_peak_bytes", host},
+            {"device_peak_bytes", device},
+            {"megapixels", megapixels},
+            {"host_peak_bytes_per_megapixel", host / megapixels},
+            {"device_peak_bytes_per_megapixel", device / megapixels}};
+}
+
+}  // namespace
+
+std::string previewPath(const std::string& exrPath) {
+    const auto dot = exrPath.rfind('.');
+    const auto slash = exrPath.rfind('/');
+    const bool hasExt = dot != std::string::npos && (slash == std::string::npos || dot > slash);
+    return (hasExt ? exrPath.substr(0, dot) : exrPath) + ".png";
+}
+
+
+void printProfile(const std::map<std::string, vk::KernelTime>& kernels) {
+    double total = 0.0;
+    for (const auto& [name, t] : kernels) total += t.totalMs;
+    std::fprintf(stderr, "%-24s %8s %12s %12s %7s\n", "kernel", "count", "total ms", "ms/call", "share");
+    for (const auto& [name, t] : kernels)
+        std::fprintf(stderr, "%-24s %8llu %12.3f %12.3f %6.1f%%\n", name.c_str(),
+                     static_cast<unsigned long long>(t.count), t.totalMs,
+                     t.count ? t.totalMs / double(t.count) : 0.0,
+                     total > 0 ? 100.0 * t.totalMs / total : 0.0);
+}
+
+// The integrator of args.method with the method options from the command line.
+std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTimeCache* cache) {
+    MethodOptions m;
+    GptOptions& g = m.gpt;
+    g.sampling.splitBounce = args.splitBounce == "on"    ? GptPassOptions::SplitBounce::On
+                             : args.splitBounce == "off" ? GptPassOptions::SplitBounce::Off
+                                                         : GptPassOptions::SplitBounce::Auto;
+    g.sampling.edgeSamples = args.edgeSamples;
+    g.sampling.demodulate = parseDemodulation(args.demodulate);
+    g.reconstructions = {parseReconstruction(args.recon)};
+    if (args.allRecon)
+        for (const char* other : {"l1", "l2", "wl2", "wl1"})
+            if (args.recon != other) g.reconstructions.push_back(parseReconstruction(other));
+    g.alpha = args.alpha;
+    g.tolerance = args.tolerance;
+    MltOptions& mlt = m.mlt;
+    mlt.chains = args.chains;
+    mlt.largeStep = args.largeStep;
+    mlt.targetAlpha = args.targetAlpha;
+    mlt.reconstructions = {parseReconstruction(args.recon)};
+    if (args.allRecon && args.recon != "l2") mlt.reconstructions.push_back(Reconstruction::L2);
+    if (args.allRecon && args.recon != "l1") mlt.reconstructions.push_back(Reconstruction::L1);
+    mlt.alpha = args.alpha;
+    mlt.tolerance = args.tolerance;
+    // Timed renders remember each configuration's reconstruction time.
+    if (args.time > 0.0) g.reconCache = cache;
+    return makeIntegrator(args.method, m);
+}
+
+RenderOptions renderOptionsFor(const RenderArgs& args) {
+    RenderOptions o;
+    o.scene.width = args.width;
+    o.scene.height = args.height;
+    o.scene.maxDepth = args.maxDepth;
+    o.scene.envRadiance = parseColor(args.env, "--env");
+    o.scene.camera = args.camera;
+    o.scene.shiftThreshold = args.shiftThreshold;
+    o.spp = args.spp;
+    o.timeBudget = args.time;
+    o.seed = args.seed;
+    o.profile = args.profile;
+    o.quiet = args.quiet;
+    o.scene.quiet = args.quiet;
+    o.workgroup = parseWorkgroup(args.workgroup);
+    o.emitterSupersampling = args.emitterSupersampling;
+    o.cancel = &interruptFlag();
+    return o;
+}
+
+
+json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrator& integrator,
+                 const RenderStats& s, double seconds, double reserved, double finishReserved,
+                 double writeMs) {
+    json j = {{"scene", args.scene},
+              {"output", args.output},
+              {"method", args.method},
+              {"device", ctx.info().name},
+              {"driver", ctx.info().driverInfo},
+              {"width", args.width},
+              {"height", args.height},
+              {"spp", s.spp},
+              {"partial_pass_rows", s.partialPassRows},
+              {"seed", args.seed},
+              {"batches", s.batches},
+              {"bvh_register_stack", s.bvhRegisterStack},
+              {"time_s",
+               {{"total", seconds},
+                {"bvh_build", s.bvhBuildMs * 1e-3},
+                {"upload", s.uploadMs * 1e-3},
+                {"pipeline_wait", s.pipelineWaitMs * 1e-3},
+                {"sampling", s.samplingMs * 1e-3},
+                {"readback", s.readbackMs * 1e-3},
+                {"reconstruction", s.reconstructionMs * 1e-3},
+                {"reconstruction_reserved", reserved},
+                {"finish_reserved", finishReserved},
+                {"write", writeMs * 1e-3}}},
+              {"rays_traced", s.raysTraced},
+              {"paths_completed", s.pathsCompleted},
+              {"nan_samples", s.nanSamples},
+              {"shift_pairs", s.shiftPairs},
+              {"shift_failures", s.shiftFailures},
+              {"shift_failure_rate", s.shiftPairs ? double(s.shiftFailures) / double(s.shiftPairs) : 0.0},
+              {"rays_per_s", double(s.raysTraced) / (s.samplingMs * 1e-3)},
+              {"samples_per_s", double(s.pathsCompleted) / (s.samplingMs * 1e-3)},
+              {"kernels", kernelJson(s.kernels, s.samplingMs)},
+              {"validation_errors", ctx.validationErrors()},
+              {"memory", memoryJson(ctx, args.width, args.height)}};
+    if (s.distributed.parts > 1)
+        j["distributed"] = {{"parts", s.distributed.parts},
+                            {"part_spp", s.distributed.partSpp},
+                            {"bytes_per_part", s.distributed.bytesPerPart},
+                            {"merge_s", s.distributed.mergeMs * 1e-3},
+                            {"wait_s", s.distributed.waitMs * 1e-3}};
+    integrator.describe(j, s);
+    j["emitter_supersampling"] = {{"factor", s.emitterSupersampling},
+                                  {"rays_per_sample", s.emitterRaysPerSample},
+                                  {"pixels", s.emitterSupersampledPixels}};
+    return j;
+}
+
+// Usage errors that the option checks alone cannot see (exit 2 before any work).
+void checkArgs(const RenderArgs& args) {
+    const bool l1 = args.recon == "l1" || args.recon == "wl1" || args.allRecon;
+    const bool mlt = args.method == "pssmlt" || args.method == "gmlt";
+    if (mlt && (!args.checkpoint.empty() || !args.resume.empty() || !args.shard.empty()))
+        throw UsageError(
+            "--method " + args.method +
+            " keeps its state in its Markov chains: --checkpoint, --resume and --shard are for pt "
+            "and gpt");
+    if (args.method == "gmlt" && (args.recon == "wl1" || args.recon == "wl2"))
+        throw UsageError(
+            "--recon " + args.recon +
+            " weights by per-pixel variances, which the correlated samples of Markov chains do not "
+            "give; --method gmlt reconstructs with l1 or l2");
+    if ((args.method == "gpt" || args.method == "gmlt") && l1 && !(args.alpha > 0.0))
+        throw UsageError("--alpha " + std::to_string(args.alpha) +
+                         ": the L1 reconstructions (--recon l1 or wl1, or --all-recon) need --alpha > 0 (the "
+                         "primal term anchors each reweighted solve); use --recon l2 for alpha 0");
+}
+
+}  // namespace gdpt

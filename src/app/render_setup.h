@@ -1,0 +1,45 @@
+// render_setup.h — what `gdpt render` needs for every image it renders, whether one or a
+// sequence of frames (render_command.cpp, sequence_command.cpp): the integrator and render
+// options from the command line, the usage checks, the output names and the JSON summary.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "app/cli.h"
+#include "integrator/integrator.h"
+#include "vk/timing.h"
+
+namespace gdpt {
+
+class ReconTimeCache;
+namespace vk {
+class Context;
+}
+
+// The PNG preview beside an EXR: its path with the extension replaced by .png.
+std::string previewPath(const std::string& exrPath);
+
+// --profile: GPU time per kernel on stderr.
+void printProfile(const std::map<std::string, vk::KernelTime>& kernels);
+
+// The integrator of args.method with the method options from the command line; timed renders
+// remember reconstruction times in `cache`.
+std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTimeCache* cache);
+
+// The render options of the command line (image, sampling, budget, cancellation by SIGINT).
+RenderOptions renderOptionsFor(const RenderArgs& args);
+
+// A render's JSON summary (--json): settings, times, counters, kernels, memory, the method's
+// own keys.
+nlohmann::json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrator& integrator,
+                           const RenderStats& s, double seconds, double reserved, double finishReserved,
+                           double writeMs);
+
+// Usage errors that the option checks alone cannot see (throws gdpt::UsageError, exit 2,
+// before any work).
+void checkArgs(const RenderArgs& args);
+
+}  // namespace gdpt
