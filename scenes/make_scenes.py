@@ -14,6 +14,10 @@ Outputs (see scenes/README.md):
                       hidden light in a compartment behind it ("Veach ajar door")
   textured.gltf       the Cornell box with a fine sRGB checker/noise PNG texture on the floor
                       and back wall (texels ~1.2-1.6 pixels at 256x256)
+  moving_box.gltf     the Cornell box whose short box slides and turns on the floor (3 s
+                      animation: an object moving under a fixed camera)
+  camera_move.gltf    the Cornell box seen by a camera that moves in and pans (2 s animation,
+                      CUBICSPLINE)
 
 Python standard library only, so that anyone can regenerate the files. Conventions follow
 ../shared/scenes/README.md: Y up, metres, radiance = emissiveFactor x emissive_strength,
@@ -61,6 +65,14 @@ class GltfWriter:
             if kind == "VEC3":  # min/max are required for POSITION only
                 acc["min"] = [min(v[i] for v in values) for i in range(n)]
                 acc["max"] = [max(v[i] for v in values) for i in range(n)]
+        elif kind in ("TIME", "OUT3", "OUT4"):  # animation sampler input / outputs
+            n = {"TIME": 1, "OUT3": 3, "OUT4": 4}[kind]
+            flat = list(values) if n == 1 else [c for v in values for c in v]
+            view = self._view(struct.pack("<%df" % len(flat), *flat))
+            acc = {"bufferView": view, "componentType": FLOAT, "count": len(flat) // n,
+                   "type": {1: "SCALAR", 3: "VEC3", 4: "VEC4"}[n]}
+            if n == 1:  # glTF 2.0 §3.11: an input accessor MUST have min and max
+                acc["min"], acc["max"] = [min(flat)], [max(flat)]
         else:
             view = self._view(struct.pack("<%dI" % len(values), *values), ELEMENT_ARRAY_BUFFER)
             acc = {"bufferView": view, "componentType": UINT, "count": len(values), "type": "SCALAR"}
@@ -106,6 +118,18 @@ class GltfWriter:
         self.doc["materials"].append(m)
         return len(self.doc["materials"]) - 1
 
+    def animation(self, name, channels):
+        """channels: (node index, path, interpolation, key times, output values)."""
+        anim = {"name": name, "channels": [], "samplers": []}
+        for node, path, interpolation, times, values in channels:
+            anim["samplers"].append({"input": self._accessor(times, "TIME"),
+                                     "output": self._accessor(values,
+                                                              "OUT4" if path == "rotation" else "OUT3"),
+                                     "interpolation": interpolation})
+            anim["channels"].append({"sampler": len(anim["samplers"]) - 1,
+                                     "target": {"node": node, "path": path}})
+        self.doc.setdefault("animations", []).append(anim)
+
     def mesh(self, name, positions, normals, indices, material, uvs=None):
         prim = {"attributes": {"POSITION": self._accessor(positions, "VEC3"),
                                "NORMAL": self._accessor(normals, "VEC3")},
@@ -113,18 +137,22 @@ class GltfWriter:
         if uvs is not None:
             prim["attributes"]["TEXCOORD_0"] = self._accessor(uvs, "VEC2")
         self.doc["meshes"].append({"name": name, "primitives": [prim]})
-        self.node({"name": name, "mesh": len(self.doc["meshes"]) - 1})
+        return self.node({"name": name, "mesh": len(self.doc["meshes"]) - 1})
 
-    def node(self, node):
+    def node(self, node, root=True):
+        """Adds a node (a root of the scene unless root=False); returns its index."""
         self.doc["nodes"].append(node)
-        self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
+        index = len(self.doc["nodes"]) - 1
+        if root:
+            self.doc["scenes"][0]["nodes"].append(index)
+        return index
 
     def camera(self, name, position, yfov, aspect=1.0, rotation=(0.0, 0.0, 0.0, 1.0)):
         self.doc["cameras"].append({"name": name, "type": "perspective",
                                     "perspective": {"yfov": yfov, "aspectRatio": aspect,
                                                     "znear": 0.01}})
-        self.node({"name": name, "camera": len(self.doc["cameras"]) - 1,
-                   "translation": list(position), "rotation": list(rotation)})
+        return self.node({"name": name, "camera": len(self.doc["cameras"]) - 1,
+                          "translation": list(position), "rotation": list(rotation)})
 
     def write(self, path):
         while len(self.blob) % 4:
@@ -266,7 +294,7 @@ CORNELL_LIGHT = [(-0.235, 1.98, -0.22), (0.235, 1.98, -0.22), (0.235, 1.98, 0.16
 CORNELL_RADIANCE = (17.0, 12.0, 4.0)
 
 
-def cornell(glossy, light_area=1.0, textured=False):
+def cornell(glossy, light_area=1.0, textured=False, short_box=True):
     """light_area: fraction of the original light's area; the light shrinks about its centre
     and its radiance grows by 1 / light_area, so its power stays the same.
     textured: floor and back wall get detail_texture() (white factor) instead of white."""
@@ -308,7 +336,8 @@ def cornell(glossy, light_area=1.0, textured=False):
         w.mesh("mirror_sphere", pos, verts, [i for t in tris for i in t], mirror)
         w.mesh("tallbox", *box(TALL_BOX), metal)
     else:
-        w.mesh("shortbox", *box(SHORT_BOX), white)
+        if short_box:
+            w.mesh("shortbox", *box(SHORT_BOX), white)
         w.mesh("tallbox", *box(TALL_BOX), white)
     s = math.sqrt(light_area)
     centre = [sum(p[i] for p in CORNELL_LIGHT) / 4.0 for i in range(3)]
@@ -377,6 +406,45 @@ def indirect_gap():
     return w
 
 
+def yaw(degrees):
+    """The quaternion (x, y, z, w) of a rotation about +Y."""
+    h = math.radians(degrees) / 2.0
+    return (0.0, math.sin(h), 0.0, math.cos(h))
+
+
+def moving_box():
+    """The Cornell box whose short box slides across the floor and turns: its mesh is stored
+    about its centre under a node whose translation (LINEAR) and rotation (LINEAR, slerp) are
+    animated over 3 s; at time 0 the box is where cornell_box.gltf has it."""
+    w = cornell(False, short_box=False)
+    white = w.doc["materials"].index(next(m for m in w.doc["materials"] if m["name"] == "white"))
+    centre = [sum(p[i] for p in SHORT_BOX) / 8.0 for i in range(3)]
+    pos, nrm, idx = box([[p[i] - centre[i] for i in range(3)] for p in SHORT_BOX])
+    child = w.mesh("shortbox", pos, nrm, idx, white)
+    w.doc["scenes"][0]["nodes"].remove(child)
+    mover = w.node({"name": "shortbox_motion", "translation": centre, "children": [child]})
+    c = centre
+    w.animation("slide", [
+        (mover, "translation", "LINEAR", [0.0, 1.0, 2.0, 3.0],
+         [c, (c[0] - 0.35, c[1], c[2] - 0.1), (c[0] - 0.5, c[1], c[2] + 0.15), (c[0] - 0.2, c[1], c[2] + 0.2)]),
+        (mover, "rotation", "LINEAR", [0.0, 1.5, 3.0], [yaw(0.0), yaw(45.0), yaw(90.0)])])
+    return w
+
+
+def camera_move():
+    """The Cornell box seen by a camera that moves in and to the right while it turns left
+    (CUBICSPLINE translation and rotation over 2 s, zero tangents at both ends: it starts and
+    stops smoothly); at time 0 the view is cornell_box.gltf's."""
+    w = cornell(False)
+    cam = next(i for i, n in enumerate(w.doc["nodes"]) if n.get("name") == "camera")
+    zero3, zero4 = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0)
+    start, end = (0.0, 1.0, 6.8), (0.45, 1.05, 5.6)
+    w.animation("move_in", [
+        (cam, "translation", "CUBICSPLINE", [0.0, 2.0], [zero3, start, zero3, zero3, end, zero3]),
+        (cam, "rotation", "CUBICSPLINE", [0.0, 2.0], [zero4, yaw(0.0), zero4, zero4, yaw(6.0), zero4])])
+    return w
+
+
 def furnace():
     w = GltfWriter()
     mat = w.material("furnace", (0.5, 0.5, 0.5), emission=(0.5, 0.5, 0.5))
@@ -396,6 +464,8 @@ def main():
     cornell(False, light_area=0.05).write(os.path.join(out, "small_light.gltf"))
     indirect_gap().write(os.path.join(out, "indirect_gap.gltf"))
     cornell(False, textured=True).write(os.path.join(out, "textured.gltf"))
+    moving_box().write(os.path.join(out, "moving_box.gltf"))
+    camera_move().write(os.path.join(out, "camera_move.gltf"))
 
 
 if __name__ == "__main__":

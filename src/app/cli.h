@@ -47,6 +47,10 @@ struct RenderArgs {
     std::uint32_t chains = 0;   // pssmlt, gmlt: Markov chains (0 = per image size)
     float largeStep = 0.3f;     // pssmlt, gmlt: probability of a large step
     float targetAlpha = 0.25f;  // gmlt: weight of the radiance in the target
+    std::string frames;         // "A:B": render frames A..B of an animation (sequence_command.cpp)
+    double fps = 24.0;          // frames per second: frame k is the scene at time k / fps
+    std::string animation;      // the animation's name or index ("" = the first)
+    bool noVideo = false;       // no MP4 of the sequence even when ffmpeg is installed
 };
 
 struct DiffArgs {

@@ -12,6 +12,8 @@ struct MergedShards;
 int runRender(const RenderArgs& args);
 // The render of `args` continued from shards' merged statistics (gdpt merge), or a plain one.
 int runRender(const RenderArgs& args, const MergedShards* merged);
+// The frames args.frames of an animation (gdpt render --frames; runRender calls it).
+int runSequence(const RenderArgs& args);
 // A render's settings as a shard records them (gdpt.info.render_args), and back; `where`
 // names the file in errors.
 std::string renderArgsJson(const RenderArgs& args);

@@ -157,8 +157,12 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
     try {
         enterPhase("loading");
         if (world) world->testFault("loading");
-        loaded.emplace(loadGltf(args.scene, deviceLoadOptions(args.device, quiet)));
+        const GltfAsset asset(args.scene, deviceLoadOptions(args.device, quiet));
+        loaded.emplace(asset.instance());
         const Scene& scene = *loaded;
+        if (!asset.animations().empty() && !quiet)
+            std::fprintf(stderr, "gdpt: note: %s has %zu animation(s); the rest pose is rendered (--frames renders them)\n",
+                         args.scene.c_str(), asset.animations().size());
         throwIfInterrupted("loading");
         if (!scene.unsupported.empty() && !quiet) {
             std::string list;
@@ -328,6 +332,7 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
 }
 
 int runRender(const RenderArgs& args) {
+    if (!args.frames.empty()) return runSequence(args);
     return runRender(args, nullptr);
 }
 
@@ -439,6 +444,25 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(1e-4f, 1e3f))
         ->group(mlt);
+
+    const char* animation = "Animation (docs/animation.md)";
+    CLI::Option* frames =
+        r->add_option("--frames", a.frames,
+                      "A:B: render frames A to B of an animation, frame k at time k/fps; -o takes a frame number "
+                      "(e.g. out/frame_%04d.exr, directory created); each frame's EXR + PNG is written when it is "
+                      "done, and an MP4 of the PNGs when ffmpeg is installed. --time is the whole sequence's")
+            ->group(animation);
+    r->add_option("--fps", a.fps, "Frames per second of --frames")
+        ->capture_default_str()
+        ->check(CLI::Range(1e-3, 1e4))
+        ->needs(frames)
+        ->group(animation);
+    r->add_option("--animation", a.animation, "The animation to render, by name or index (default: the first)")
+        ->needs(frames)
+        ->group(animation);
+    r->add_flag("--no-video", a.noVideo, "No MP4 of the sequence even when ffmpeg is installed")
+        ->needs(frames)
+        ->group(animation);
 
     const char* budget = "Time budget and checkpoints";
     r->add_option("--time", a.time, "Seconds for the whole render, reconstruction included; overrides --spp")

@@ -1,0 +1,241 @@
+// sequence_command.cpp — `gdpt render SCENE --frames A:B`: the frames of an animation, each
+// rendered like a single image (render_setup.h) at time frame / fps of the chosen animation
+// and written, EXR + PNG, as soon as it is done; then a video of the PNGs when ffmpeg is
+// installed, and the sequence's JSON summary. The file is parsed once (GltfAsset); the device,
+// the integrator and its reconstruction solver are made once for the whole sequence.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "app/bench_util.h"
+#include "app/commands.h"
+#include "app/render_setup.h"
+#include "app/video_preview.h"
+#include "distributed/mpi_world.h"
+#include "image/exr_io.h"
+#include "image/finite_check.h"
+#include "image/png_preview.h"
+#include "integrator/recon_reserve.h"
+#include "render/device_scene/scene_gpu.h"
+#include "scene/gltf_loader.h"
+#include "scene/light_sources.h"
+#include "util/error.h"
+#include "util/frame_pattern.h"
+#include "util/interrupt.h"
+#include "util/output_files.h"
+#include "util/timer.h"
+#include "vk/context.h"
+
+namespace gdpt {
+namespace {
+
+using nlohmann::json;
+
+// Usage errors of a sequence (exit 2 before any work).
+void checkSequenceArgs(const RenderArgs& args, const FrameRange& range) {
+    if (!args.checkpoint.empty() || !args.resume.empty())
+        throw UsageError(
+            "--checkpoint and --resume are for one image; a sequence writes each frame when it is done, so "
+            "an interrupted sequence continues with --frames FROM:" +
+            std::to_string(range.last) + " from the first frame missing");
+    if (!args.shard.empty())
+        throw UsageError("--shard splits one image; split a sequence by its frames (--frames A:B per job)");
+    if (MpiWorld::get())
+        throw UsageError("a sequence under mpirun is not supported; run one gdpt per range of --frames instead");
+    if (!hasFrameNumber(args.output, "-o") && range.count() > 1)
+        throw UsageError("-o " + args.output + ": " + std::to_string(range.count()) +
+                         " frames need a frame number in the output name, e.g. -o frames/frame_%04d.exr");
+}
+
+// Creates the directory of the frames (a sequence usually goes to a fresh one).
+void makeOutputDirectory(const std::string& path) {
+    const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+    if (dir.empty()) return;
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) throw Error(path + ": cannot create the directory " + dir.string() + ": " + ec.message());
+}
+
+std::string seconds(double s) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f s", s);
+    return text;
+}
+
+}  // namespace
+
+int runSequence(const RenderArgs& args) {
+    installInterruptHandlers();
+    checkArgs(args);
+    const FrameRange range = parseFrameRange(args.frames, "--frames");
+    checkSequenceArgs(args, range);
+    Timer total;
+    RenderOptions options = renderOptionsFor(args);
+    const bool quiet = options.quiet;
+    const bool timed = args.time > 0.0;
+    const ReconTimeCache cache(ReconTimeCache::defaultPath());
+
+    // The outputs that exist once per sequence are checked before anything is loaded; each
+    // frame's EXR and PNG are staged when it starts and committed when it is whole, so an
+    // interrupted sequence leaves only complete frames.
+    makeOutputDirectory(args.output);
+    OutputSet sequenceOutputs({{"scene", args.scene}});
+    const TextOutput jsonOutput(sequenceOutputs, args.json, "--json");
+    {
+        OutputSet probe({{"scene", args.scene}});
+        probe.add(framePath(args.output, range.first), "-o");
+        probe.add(previewPath(framePath(args.output, range.first)), "PNG preview of -o");
+    }
+    const std::optional<std::string> ffmpeg = args.noVideo || range.count() < 2 ? std::nullopt : findFfmpeg();
+    const std::string video = ffmpeg ? sequenceVideoPath(args.output, ".mp4") : "";
+    if (ffmpeg) sequenceOutputs.checkSeparate(video, "the sequence's video");
+
+    enterPhase("loading");
+    const GltfAsset asset(args.scene, deviceLoadOptions(args.device, quiet));
+    int animation = -1;
+    if (!args.animation.empty())
+        animation = asset.findAnimation(args.animation);
+    else if (!asset.animations().empty())
+        animation = 0;
+    if (animation < 0 && !quiet)
+        std::fprintf(stderr, "gdpt: note: %s has no animations; every frame is the same still scene\n",
+                     args.scene.c_str());
+    const double duration = animation >= 0 ? asset.animations()[static_cast<std::size_t>(animation)].duration() : 0.0;
+    throwIfInterrupted("loading");
+
+    vk::ContextOptions ctxOptions;
+    ctxOptions.device = args.device;
+    ctxOptions.validation = args.validate;
+    const vk::Context ctx(ctxOptions);
+    if (!quiet)
+        std::fprintf(stderr, "gdpt: device '%s' (%s, %s); %d frames at %g fps%s\n", ctx.info().name.c_str(),
+                     ctx.info().type.c_str(), ctx.info().driverInfo.c_str(), range.count(), args.fps,
+                     animation >= 0 ? (", animation " + std::to_string(animation) + " (" + seconds(duration) + ")").c_str()
+                                    : "");
+    std::unique_ptr<Integrator> integrator = integratorFor(args, &cache);
+    const double reserved = timed ? integrator->reserveAfterSampling(ctx, args.width, args.height) : 0.0;
+
+    json frames = json::array();
+    double afterSamplingSeconds = 0.0;  // the last frame's time after its sampling (reconstruction aside)
+    bool warned = false;
+    for (int frame = range.first; frame <= range.last; ++frame) {
+        Timer frameTimer;
+        const int done = frame - range.first, left = range.last - frame + 1;
+        const double time = double(frame) / args.fps;
+        const std::string exrPath = framePath(args.output, frame);
+        enterPhase("loading");
+        const Scene scene = asset.instance(animation, time);
+        if (!warned && !quiet) {
+            warned = true;
+            if (!scene.unsupported.empty()) {
+                std::string list;
+                for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
+                std::fprintf(stderr, "gdpt: warning: %s: not rendered: %s\n", args.scene.c_str(), list.c_str());
+            }
+            if (const auto black = blackImageWarning(scene, options.scene.envRadiance))
+                std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
+        }
+        OutputSet outputs({{"scene", args.scene}});
+        const StagedFile& exrFile = outputs.add(exrPath, "-o (frame " + std::to_string(frame) + ")");
+        const StagedFile& pngFile = outputs.add(previewPath(exrPath), "PNG preview of -o");
+
+        // --time is the whole sequence's: each frame gets an equal share of what is left, less
+        // what the method and the last frame needed after sampling.
+        RenderOptions frameOptions = options;
+        if (timed) {
+            const double share = std::max(0.0, args.time - total.seconds()) / double(left);
+            frameOptions.timeBudget = std::max(0.05 * args.time / double(range.count()),
+                                               share - reserved - afterSamplingSeconds);
+        }
+        frameOptions.elapsedBefore = frameTimer.seconds();
+        enterPhase("sampling");
+        RenderOutput out = integrator->render(ctx, scene, frameOptions);
+        RenderStats& s = out.stats;
+        if (s.cancelled) {
+            if (!quiet)
+                std::fprintf(stderr,
+                             "gdpt: interrupted in frame %d; %s (continue with --frames %d:%d)\n", frame,
+                             done == 0 ? "no frame written"
+                                       : ("frames " + std::to_string(range.first) + " to " +
+                                          std::to_string(frame - 1) + " written")
+                                             .c_str(),
+                             frame, range.last);
+            return 130;
+        }
+        const double sampledAt = frameTimer.seconds() - (s.readbackMs + s.reconstructionMs) * 1e-3;
+        enterPhase("writing");
+        Timer writeTimer;
+        checkFinite(out.layers, exrPath);
+        writeExr(exrFile, out.layers);
+        throwIfInterrupted("writing");
+        writePngPreview(pngFile, out.image());
+        throwIfInterrupted("writing");
+        outputs.commit();
+        const double writeMs = writeTimer.ms();
+        const double frameSeconds = frameTimer.seconds();
+        afterSamplingSeconds = std::max(0.0, frameSeconds - sampledAt - s.reconstructionMs * 1e-3);
+        if (jsonOutput.wanted()) {
+            RenderArgs frameArgs = args;
+            frameArgs.output = exrPath;
+            json j = summaryJson(frameArgs, ctx, *integrator, s, frameSeconds, reserved, afterSamplingSeconds, writeMs);
+            j["frame"] = frame;
+            j["time"] = time;
+            frames.push_back(std::move(j));
+        }
+        if (!quiet) {
+            const double elapsed = total.seconds();
+            const double remaining = elapsed / double(done + 1) * double(left - 1);
+            std::fprintf(stderr, "gdpt: frame %d (%d/%d, t = %.4g s): wrote %s (%u spp%s, %s); sequence %s, %s\n",
+                         frame, done + 1, range.count(), time, exrPath.c_str(), s.spp,
+                         integrator->summary(s).c_str(), seconds(frameSeconds).c_str(), seconds(elapsed).c_str(),
+                         left > 1 ? ("about " + seconds(remaining) + " left").c_str() : "done");
+        }
+        if (args.profile) printProfile(s.kernels);
+    }
+
+    std::string videoNote;
+    if (ffmpeg) {
+        enterPhase("writing");
+        const std::string pngPattern = previewPath(args.output);
+        const std::string failure = encodeVideo(*ffmpeg, pngPattern, range.first, range.count(), args.fps, video);
+        throwIfInterrupted("writing");
+        if (!failure.empty()) {
+            if (!quiet) std::fprintf(stderr, "gdpt: warning: no video of the sequence: %s\n", failure.c_str());
+        } else {
+            videoNote = ", video " + video;
+        }
+    }
+    if (jsonOutput.wanted()) {
+        json summary = {{"scene", args.scene},
+                        {"output", args.output},
+                        {"method", args.method},
+                        {"device", ctx.info().name},
+                        {"frames", {{"first", range.first}, {"last", range.last}, {"count", range.count()}}},
+                        {"fps", args.fps},
+                        {"animation",
+                         animation >= 0 ? json{{"index", animation},
+                                               {"name", asset.animations()[static_cast<std::size_t>(animation)].name},
+                                               {"duration", duration}}
+                                        : json(nullptr)},
+                        {"time_budget", args.time},
+                        {"time_s", total.seconds()},
+                        {"video", videoNote.empty() ? json(nullptr) : json(video)},
+                        {"validation_errors", ctx.validationErrors()},
+                        {"frame_summaries", std::move(frames)}};
+        jsonOutput.write(summary.dump(2) + "\n");
+        throwIfInterrupted("writing");
+    }
+    sequenceOutputs.commit();
+    if (!quiet)
+        std::fprintf(stderr, "gdpt: wrote %d frames %s%s in %s\n", range.count(), args.output.c_str(), videoNote.c_str(),
+                     seconds(total.seconds()).c_str());
+    if (ctx.validationErrors() > 0) {
+        std::fprintf(stderr, "gdpt: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
+        return 1;
+    }
+    return 0;
+}
+
+}  // namespace gdpt
