@@ -120,79 +120,95 @@ int runSequence(const RenderArgs& args) {
     json frames = json::array();
     double afterSamplingSeconds = 0.0;  // the last frame's time after its sampling (reconstruction aside)
     bool warned = false;
-    for (int frame = range.first; frame <= range.last; ++frame) {
-        Timer frameTimer;
-        const int done = frame - range.first, left = range.last - frame + 1;
-        const double time = double(frame) / args.fps;
-        const std::string exrPath = framePath(args.output, frame);
-        enterPhase("loading");
-        const Scene scene = asset.instance(animation, time);
-        if (!warned && !quiet) {
-            warned = true;
-            if (!scene.unsupported.empty()) {
-                std::string list;
-                for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
-                std::fprintf(stderr, "gdpt: warning: %s: not rendered: %s\n", args.scene.c_str(), list.c_str());
+    int frame = range.first;
+    // An interrupt ends the sequence with exit 130; the frames before the current one are
+    // written whole, the current one not at all.
+    const auto interrupted = [&](const std::string& phase) {
+        const std::string written = frame == range.first       ? "no frame written"
+                                    : frame == range.first + 1 ? "frame " + std::to_string(range.first) + " written"
+                                                               : "frames " + std::to_string(range.first) + " to " +
+                                                                     std::to_string(frame - 1) + " written";
+        if (frame > range.last)
+            std::fprintf(stderr, "gdpt: interrupted while %s; all %d frames written\n", phase.c_str(), range.count());
+        else
+            std::fprintf(stderr, "gdpt: interrupted while %s frame %d; %s (continue with --frames %d:%d)\n",
+                         phase.c_str(), frame, written.c_str(), frame, range.last);
+        return 130;
+    };
+    for (; frame <= range.last; ++frame) {
+        try {
+            Timer frameTimer;
+            const int done = frame - range.first, left = range.last - frame + 1;
+            const double time = double(frame) / args.fps;
+            const std::string exrPath = framePath(args.output, frame);
+            enterPhase("loading");
+            const Scene scene = asset.instance(animation, time);
+            if (!warned && !quiet) {
+                warned = true;
+                if (!scene.unsupported.empty()) {
+                    std::string list;
+                    for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
+                    std::fprintf(stderr, "gdpt: warning: %s: not rendered: %s\n", args.scene.c_str(), list.c_str());
+                }
+                if (const auto black = blackImageWarning(scene, options.scene.envRadiance))
+                    std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
             }
-            if (const auto black = blackImageWarning(scene, options.scene.envRadiance))
-                std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
-        }
-        OutputSet outputs({{"scene", args.scene}});
-        const StagedFile& exrFile = outputs.add(exrPath, "-o (frame " + std::to_string(frame) + ")");
-        const StagedFile& pngFile = outputs.add(previewPath(exrPath), "PNG preview of -o");
+            OutputSet outputs({{"scene", args.scene}});
+            const StagedFile& exrFile = outputs.add(exrPath, "-o (frame " + std::to_string(frame) + ")");
+            const StagedFile& pngFile = outputs.add(previewPath(exrPath), "PNG preview of -o");
 
-        // --time is the whole sequence's: each frame gets an equal share of what is left, less
-        // what the method and the last frame needed after sampling.
-        RenderOptions frameOptions = options;
-        if (timed) {
-            const double share = std::max(0.0, args.time - total.seconds()) / double(left);
-            frameOptions.timeBudget = std::max(0.05 * args.time / double(range.count()),
-                                               share - reserved - afterSamplingSeconds);
-        }
-        frameOptions.elapsedBefore = frameTimer.seconds();
-        enterPhase("sampling");
-        RenderOutput out = integrator->render(ctx, scene, frameOptions);
-        RenderStats& s = out.stats;
-        if (s.cancelled) {
-            if (!quiet)
+            // --time is the whole sequence's: each frame gets an equal share of what is left, less
+            // what the method and the last frame needed after sampling.
+            RenderOptions frameOptions = options;
+            frameOptions.seed = sequenceFrameSeed(args.seed, frame);
+            if (timed) {
+                const double share = std::max(0.0, args.time - total.seconds()) / double(left);
+                frameOptions.timeBudget =
+                    std::max(0.05 * args.time / double(range.count()), share - reserved - afterSamplingSeconds);
+            }
+            frameOptions.elapsedBefore = frameTimer.seconds();
+            enterPhase("sampling");
+            RenderOutput out = integrator->render(ctx, scene, frameOptions);
+            RenderStats& s = out.stats;
+            if (s.cancelled) return interrupted("sampling");
+            const double sampledAt = frameTimer.seconds() - (s.readbackMs + s.reconstructionMs) * 1e-3;
+            enterPhase("writing");
+            Timer writeTimer;
+            checkFinite(out.layers, exrPath);
+            writeExr(exrFile, out.layers);
+            throwIfInterrupted("writing");
+            writePngPreview(pngFile, out.image());
+            throwIfInterrupted("writing");
+            outputs.commit();
+            const double writeMs = writeTimer.ms();
+            const double frameSeconds = frameTimer.seconds();
+            afterSamplingSeconds = std::max(0.0, frameSeconds - sampledAt - s.reconstructionMs * 1e-3);
+            if (jsonOutput.wanted()) {
+                RenderArgs frameArgs = args;
+                frameArgs.output = exrPath;
+                frameArgs.seed = frameOptions.seed;
+                json j = summaryJson(frameArgs, ctx, *integrator, s, frameSeconds, reserved, afterSamplingSeconds,
+                                     writeMs);
+                j["frame"] = frame;
+                j["time"] = time;
+                frames.push_back(std::move(j));
+            }
+            if (!quiet) {
+                const double elapsed = total.seconds();
+                const double remaining = elapsed / double(done + 1) * double(left - 1);
                 std::fprintf(stderr,
-                             "gdpt: interrupted in frame %d; %s (continue with --frames %d:%d)\n", frame,
-                             done == 0 ? "no frame written"
-                                       : ("frames " + std::to_string(range.first) + " to " +
-                                          std::to_string(frame - 1) + " written")
-                                             .c_str(),
-                             frame, range.last);
-            return 130;
+                             "gdpt: frame %d (%d/%d, t = %.4g s): wrote %s (%u spp%s, %s); sequence %s, %s\n", frame,
+                             done + 1, range.count(), time, exrPath.c_str(), s.spp, integrator->summary(s).c_str(),
+                             seconds(frameSeconds).c_str(), seconds(elapsed).c_str(),
+                             left > 1 ? ("about " + seconds(remaining) + " left").c_str() : "done");
+            }
+            if (args.profile) printProfile(s.kernels);
+        } catch (const Interrupted& e) {
+            return interrupted(e.phase());
+        } catch (const std::exception&) {
+            if (interruptRequested()) return interrupted("rendering");  // a layer re-wrapped it
+            throw;
         }
-        const double sampledAt = frameTimer.seconds() - (s.readbackMs + s.reconstructionMs) * 1e-3;
-        enterPhase("writing");
-        Timer writeTimer;
-        checkFinite(out.layers, exrPath);
-        writeExr(exrFile, out.layers);
-        throwIfInterrupted("writing");
-        writePngPreview(pngFile, out.image());
-        throwIfInterrupted("writing");
-        outputs.commit();
-        const double writeMs = writeTimer.ms();
-        const double frameSeconds = frameTimer.seconds();
-        afterSamplingSeconds = std::max(0.0, frameSeconds - sampledAt - s.reconstructionMs * 1e-3);
-        if (jsonOutput.wanted()) {
-            RenderArgs frameArgs = args;
-            frameArgs.output = exrPath;
-            json j = summaryJson(frameArgs, ctx, *integrator, s, frameSeconds, reserved, afterSamplingSeconds, writeMs);
-            j["frame"] = frame;
-            j["time"] = time;
-            frames.push_back(std::move(j));
-        }
-        if (!quiet) {
-            const double elapsed = total.seconds();
-            const double remaining = elapsed / double(done + 1) * double(left - 1);
-            std::fprintf(stderr, "gdpt: frame %d (%d/%d, t = %.4g s): wrote %s (%u spp%s, %s); sequence %s, %s\n",
-                         frame, done + 1, range.count(), time, exrPath.c_str(), s.spp,
-                         integrator->summary(s).c_str(), seconds(frameSeconds).c_str(), seconds(elapsed).c_str(),
-                         left > 1 ? ("about " + seconds(remaining) + " left").c_str() : "done");
-        }
-        if (args.profile) printProfile(s.kernels);
     }
 
     std::string videoNote;
@@ -200,7 +216,7 @@ int runSequence(const RenderArgs& args) {
         enterPhase("writing");
         const std::string pngPattern = previewPath(args.output);
         const std::string failure = encodeVideo(*ffmpeg, pngPattern, range.first, range.count(), args.fps, video);
-        throwIfInterrupted("writing");
+        if (interruptRequested()) return interrupted("writing the video");
         if (!failure.empty()) {
             if (!quiet) std::fprintf(stderr, "gdpt: warning: no video of the sequence: %s\n", failure.c_str());
         } else {
@@ -225,7 +241,7 @@ int runSequence(const RenderArgs& args) {
                         {"validation_errors", ctx.validationErrors()},
                         {"frame_summaries", std::move(frames)}};
         jsonOutput.write(summary.dump(2) + "\n");
-        throwIfInterrupted("writing");
+        if (interruptRequested()) return interrupted("writing the summary");
     }
     sequenceOutputs.commit();
     if (!quiet)

@@ -122,6 +122,9 @@ glm::dvec4 sampleChannel(const AnimationChannel& c, double time) {
     // Key k with times[k] <= time < times[k + 1].
     const std::size_t k = static_cast<std::size_t>(
         std::upper_bound(c.times.begin(), c.times.end(), time) - c.times.begin() - 1);
+    // On a key, its value as stored (no interpolation arithmetic), so that a pose at a key
+    // time equals the static node with that key's transform bit for bit.
+    if (time == c.times[k]) return c.values[valueIndex(c, k)];
     const double t0 = c.times[k], t1 = c.times[k + 1];
     const double td = t1 - t0;
     const double s = (time - t0) / td;

@@ -25,6 +25,14 @@ bool hasFrameNumber(const std::string& pattern, const std::string& flag);
 // has no frame number. The pattern must pass hasFrameNumber.
 std::string framePath(const std::string& pattern, int frame);
 
+// The seed of frame `frame` of a sequence rendered with `seed`: seed + frame * 0x9E3779B9
+// (mod 2^32; the golden-ratio increment), so that frame 0 is the single image of that seed and
+// every frame's noise is independent of its neighbours', as independent renders of the frames
+// would be (temporal methods correlate frames on purpose, and say so).
+[[nodiscard]] constexpr unsigned sequenceFrameSeed(unsigned seed, int frame) {
+    return seed + static_cast<unsigned>(frame) * 0x9E3779B9u;
+}
+
 // The sequence's video beside its frames: the pattern without its frame number (and the
 // separator before it) and with `extension`: "out/frame_%04d.exr" -> "out/frame.mp4";
 // "out/%04d.exr" -> "out/sequence.mp4".

@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <string>
 
 namespace gdpt {
@@ -71,7 +72,13 @@ void enterPhase(const char* phase) {
     if (!at) return;
     const std::string want(at);
     const std::size_t colon = want.find(':');
-    if (want.substr(0, colon) != phase) return;
+    const std::string target = want.substr(0, colon);
+    const std::size_t hash = target.find('#');
+    if (target.substr(0, hash) != phase) return;
+    // Starts of the phase so far (phases are entered from the main thread only).
+    static std::map<std::string, int> starts;
+    const int nth = hash == std::string::npos ? 1 : std::atoi(target.c_str() + hash + 1);
+    if (++starts[phase] != nth) return;
     const bool term = colon != std::string::npos && want.substr(colon + 1) == "TERM";
     std::raise(term ? SIGTERM : SIGINT);
 }

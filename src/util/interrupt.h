@@ -47,8 +47,9 @@ void throwIfInterrupted(const char* phase);
 
 // Marks the start of a phase of a command ("loading", "sampling", "reconstruction",
 // "writing"). For tests of the handling of each phase: if the environment variable
-// GDPT_TEST_SIGNAL_AT names this phase (optionally ":TERM"), the process sends itself SIGINT
-// (or SIGTERM) here, exactly as a user's Ctrl-C at that moment would.
+// GDPT_TEST_SIGNAL_AT names this phase (optionally "#N": its Nth start, e.g. the second
+// frame's sampling of a sequence; optionally ":TERM"), the process sends itself SIGINT (or
+// SIGTERM) here, exactly as a user's Ctrl-C at that moment would.
 void enterPhase(const char* phase);
 
 }  // namespace gdpt

@@ -1,0 +1,184 @@
+// `gdpt render --frames A:B`: every frame written (EXR + PNG) with its own seed and a JSON
+// summary; a frame of an animated scene is, bit for bit, the render of the static scene of its
+// pose (computed here by hand from the keys scenes/make_scenes.py writes), after other frames
+// were rendered by the same process; an interrupt leaves exactly the complete frames; usage
+// errors leave nothing.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "cli_runner.h"
+#include "same_bits.h"
+#include "temp_dir.h"
+
+namespace gdpt {
+namespace {
+
+namespace fs = std::filesystem;
+using test::runGdpt;
+using test::RunResult;
+
+const std::string kMovingBox = std::string(GDPT_SOURCE_DIR) + "/scenes/moving_box.gltf";
+const std::string kCornell = std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.gltf";
+
+class SequenceCli : public test::TempDirTest {
+protected:
+    std::vector<std::string> files() const {
+        std::vector<std::string> names;
+        for (const auto& e : fs::directory_iterator(dir_)) names.push_back(e.path().filename().string());
+        std::sort(names.begin(), names.end());
+        return names;
+    }
+};
+
+nlohmann::json readJson(const std::string& path) {
+    std::ifstream in(path);
+    return nlohmann::json::parse(in);
+}
+
+TEST_F(SequenceCli, EveryFrameIsWrittenWithItsSeedAndSummarised) {
+    const RunResult r = runGdpt("render " + kMovingBox + " --frames 2:4 --fps 2 --spp 2 --width 16 --height 16 " +
+                                "--method pt --seed 5 --no-video -o " + path("seq/f_%03d.exr") + " --json " +
+                                path("seq.json"));
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("frame 3 (2/3, t = 1.5 s): wrote"), std::string::npos) << r.output;
+    for (int f = 2; f <= 4; ++f) {
+        EXPECT_TRUE(fs::exists(path("seq/f_00" + std::to_string(f) + ".exr"))) << f;
+        EXPECT_TRUE(fs::exists(path("seq/f_00" + std::to_string(f) + ".png"))) << f;
+    }
+    EXPECT_EQ(std::distance(fs::directory_iterator(path("seq")), fs::directory_iterator{}), 6);
+    const nlohmann::json j = readJson(path("seq.json"));
+    EXPECT_EQ(j["frames"]["count"], 3);
+    EXPECT_EQ(j["animation"]["name"], "slide");
+    EXPECT_DOUBLE_EQ(j["animation"]["duration"].get<double>(), 3.0);
+    EXPECT_TRUE(j["video"].is_null());
+    ASSERT_EQ(j["frame_summaries"].size(), 3u);
+    for (int i = 0; i < 3; ++i) {
+        const nlohmann::json& f = j["frame_summaries"][i];
+        EXPECT_EQ(f["frame"], 2 + i);
+        EXPECT_DOUBLE_EQ(f["time"].get<double>(), (2 + i) / 2.0);
+        EXPECT_EQ(f["spp"], 2);
+        EXPECT_EQ(f["seed"].get<unsigned>(), 5u + unsigned(2 + i) * 0x9E3779B9u);
+        EXPECT_EQ(f["output"], path("seq/f_00" + std::to_string(2 + i) + ".exr"));
+    }
+    // The box moves: consecutive frames differ.
+    EXPECT_NE(readExrLayer(path("seq/f_002.exr")).plane(0)[8 * 16 + 9],
+              readExrLayer(path("seq/f_004.exr")).plane(0)[8 * 16 + 9]);
+}
+
+// moving_box's short box hangs under node "shortbox_motion" at the box's centre c; its keys are
+// float32: translation c, (c - 0.35 x - 0.1 z), (c - 0.5 x + 0.15 z), ... at 0, 1, 2, 3 s;
+// rotation about +Y by 0, 45 and 90 degrees at 0, 1.5 and 3 s. Frame 36 at 24 fps is t = 1.5:
+// the translation halfway between keys 1 and 2, the rotation key 1 itself.
+nlohmann::json staticPoseAt1_5(nlohmann::json scene) {
+    scene.erase("animations");
+    for (auto& node : scene["nodes"]) {
+        if (node.value("name", "") != "shortbox_motion") continue;
+        const auto c = node["translation"].get<std::vector<double>>();
+        const auto f = [](double v) { return double(static_cast<float>(v)); };
+        const double k1[3] = {f(c[0] - 0.35), f(c[1]), f(c[2] - 0.1)};
+        const double k2[3] = {f(c[0] - 0.5), f(c[1]), f(c[2] + 0.15)};
+        node["translation"] = {0.5 * k1[0] + 0.5 * k2[0], 0.5 * k1[1] + 0.5 * k2[1], 0.5 * k1[2] + 0.5 * k2[2]};
+        const double half = 45.0 * (M_PI / 180.0) / 2.0;
+        node["rotation"] = {0.0, f(std::sin(half)), 0.0, f(std::cos(half))};
+        return scene;
+    }
+    ADD_FAILURE() << "no node shortbox_motion";
+    return scene;
+}
+
+TEST_F(SequenceCli, AFrameIsTheStaticSceneOfItsPoseBitForBit) {
+    std::ifstream in(kMovingBox);
+    const nlohmann::json animated = nlohmann::json::parse(in);
+    {
+        std::ofstream out(path("still.gltf"));
+        out << staticPoseAt1_5(animated).dump();
+    }
+    const std::string common = " --spp 3 --width 24 --height 20 --method gpt --recon l1 ";
+    // Frames 35 and 36: the integrator renders frame 36 after another frame.
+    const RunResult seq = runGdpt("render " + kMovingBox + " --frames 35:36 --no-video" + common + "-o " +
+                                  path("f_%02d.exr"));
+    ASSERT_EQ(seq.code, 0) << seq.output;
+    const unsigned seed = 36u * 0x9E3779B9u;
+    const RunResult still =
+        runGdpt("render " + path("still.gltf") + common + "--seed " + std::to_string(seed) + " -o " + path("still.exr"));
+    ASSERT_EQ(still.code, 0) << still.output;
+    test::expectSameExrLayers(path("f_36.exr"), path("still.exr"));
+    // Control: the neighbouring frame is a different pose, not the same bits.
+    EXPECT_NE(readExrLayer(path("f_35.exr")).plane(1), readExrLayer(path("still.exr")).plane(1));
+}
+
+TEST_F(SequenceCli, AStillSceneRendersAsASequenceWithANote) {
+    const RunResult r = runGdpt("render " + kCornell + " --frames 0:1 --spp 1 --width 8 --height 8 --method pt -o " +
+                                path("c_%d.exr"));
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("has no animations; every frame is the same still scene"), std::string::npos) << r.output;
+    EXPECT_TRUE(fs::exists(path("c_0.exr")));
+    EXPECT_TRUE(fs::exists(path("c_1.exr")));
+    // Frame 0 is the single image of the same seed.
+    ASSERT_EQ(runGdpt("render " + kCornell + " --spp 1 --width 8 --height 8 --method pt -o " + path("one.exr")).code, 0);
+    test::expectSameExrLayers(path("c_0.exr"), path("one.exr"));
+}
+
+TEST_F(SequenceCli, AnInterruptLeavesTheCompleteFramesAndSaysWhereToContinue) {
+    const std::string args = "render " + kMovingBox + " --frames 0:3 --fps 1 --spp 2 --width 16 --height 16 --no-video " +
+                             "-o " + path("f_%04d.exr") + " --json " + path("s.json");
+    for (const char* at : {"sampling#2", "writing#2", "loading#3"}) {
+        SCOPED_TRACE(at);
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+        const RunResult r = runGdpt(args, std::string("GDPT_TEST_SIGNAL_AT=") + at);
+        EXPECT_EQ(r.code, 130) << r.output;
+        EXPECT_NE(r.output.find("frame 1; frame 0 written (continue with --frames 1:3)"), std::string::npos)
+            << r.output;
+        EXPECT_EQ(files(), (std::vector<std::string>{"f_0000.exr", "f_0000.png"}));
+    }
+    // Continuing from the first missing frame completes the sequence.
+    const RunResult rest = runGdpt("render " + kMovingBox + " --frames 1:3 --fps 1 --spp 2 --width 16 --height 16 " +
+                                   "--no-video -o " + path("f_%04d.exr"));
+    ASSERT_EQ(rest.code, 0) << rest.output;
+    EXPECT_EQ(files().size(), 8u);
+}
+
+TEST_F(SequenceCli, UsageErrorsLeaveNothing) {
+    const std::string base = "render " + kMovingBox + " --spp 1 --width 8 --height 8 ";
+    const struct {
+        std::string flags, says;
+    } cases[] = {
+        {"--frames 0:3 -o " + path("plain.exr"), "4 frames need a frame number in the output name"},
+        {"--frames 3:1 -o " + path("f_%d.exr"), "the last frame comes before the first"},
+        {"--frames x -o " + path("f_%d.exr"), "--frames x: expected A:B"},
+        {"--frames 0:1 -o " + path("f_%s.exr"), "'%' must start the frame number"},
+        {"--frames 0:1 --animation walk -o " + path("f_%d.exr"), "has no such animation (it has 0 'slide')"},
+        {"--frames 0:1 --animation 1 -o " + path("f_%d.exr"), "has no such animation"},
+        {"--frames 0:1 --checkpoint " + path("c.exr") + " -o " + path("f_%d.exr"), "continues with --frames"},
+        {"--frames 0:1 --shard 0/2 -o " + path("f_%d.exr"), "split a sequence by its frames"},
+        {"--fps 30 -o " + path("x.exr"), "--fps requires --frames"},
+        {"--frames 0:1 --fps 0 -o " + path("f_%d.exr"), "--fps"},
+    };
+    for (const auto& c : cases) {
+        const RunResult r = runGdpt(base + c.flags);
+        EXPECT_EQ(r.code, 2) << c.flags << "\n" << r.output;
+        EXPECT_NE(r.output.find(c.says), std::string::npos) << c.flags << "\n" << r.output;
+        EXPECT_TRUE(files().empty()) << c.flags << ": left " << files().front();
+    }
+}
+
+TEST_F(SequenceCli, InfoListsTheAnimations) {
+    const RunResult r = runGdpt("info " + kMovingBox);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("animation 0 'slide': 3 s, 2 channels"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("node 'shortbox_motion' rotation (LINEAR, 3 keys, 0 to 3 s)"), std::string::npos)
+        << r.output;
+    const RunResult still = runGdpt("render " + kMovingBox + " --spp 1 --width 8 --height 8 -o " + path("x.exr"));
+    ASSERT_EQ(still.code, 0) << still.output;
+    EXPECT_NE(still.output.find("has 1 animation(s); the rest pose is rendered"), std::string::npos) << still.output;
+}
+
+}  // namespace
+}  // namespace gdpt
