@@ -28,6 +28,7 @@ packages=(
   gnuplot-nox python3 clang libclang-rt-dev clang-format-14
   assimp-testmodels
   libopenmpi-dev openmpi-bin
+  ffmpeg
 )
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"

@@ -180,5 +180,29 @@ TEST_F(SequenceCli, InfoListsTheAnimations) {
     EXPECT_NE(still.output.find("has 1 animation(s); the rest pose is rendered"), std::string::npos) << still.output;
 }
 
+// With ffmpeg installed (scripts/install-deps.sh installs it), a sequence gets an MP4 of its
+// PNGs with one video frame per frame (counted by ffprobe); without ffmpeg on PATH, none,
+// and the frames are written all the same.
+TEST_F(SequenceCli, AVideoOfTheFramesWhenFfmpegIsInstalled) {
+    if (test::runShell("command -v ffmpeg && command -v ffprobe").code != 0)
+        GTEST_SKIP() << "ffmpeg is not installed (scripts/install-deps.sh installs it)";
+    const std::string args = "render " + kMovingBox + " --frames 0:4 --fps 12 --spp 1 --width 17 --height 9 " +
+                             "--method pt -o " + path("v/clip_%04d.exr") + " --json " + path("v.json");
+    const RunResult r = runGdpt(args);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("video " + path("v/clip.mp4")), std::string::npos) << r.output;
+    EXPECT_EQ(readJson(path("v.json"))["video"], path("v/clip.mp4"));
+    const RunResult probe = test::runShell("ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+                                           "stream=nb_read_frames,codec_name,width,height -of csv=p=0 " +
+                                           path("v/clip.mp4"));
+    ASSERT_EQ(probe.code, 0) << probe.output;
+    EXPECT_EQ(probe.output, "h264,18,10,5\n");  // odd sizes padded to even
+    // No ffmpeg on PATH: no video, the frames all the same.
+    const RunResult none = runGdpt(args + " --quiet", "PATH=" + dir_.string());
+    ASSERT_EQ(none.code, 0) << none.output;
+    EXPECT_TRUE(readJson(path("v.json"))["video"].is_null());
+    EXPECT_TRUE(fs::exists(path("v/clip_0004.png")));
+}
+
 }  // namespace
 }  // namespace gdpt
