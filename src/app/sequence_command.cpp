@@ -108,6 +108,7 @@ int runSequence(const RenderArgs& args) {
     vk::ContextOptions ctxOptions;
     ctxOptions.device = args.device;
     ctxOptions.validation = args.validate;
+    ctxOptions.keepPipelines = true;  // every frame's kernels compile once (vk/pipeline_cache.h)
     const vk::Context ctx(ctxOptions);
     if (!quiet)
         std::fprintf(stderr, "gdpt: device '%s' (%s, %s); %d frames at %g fps%s\n", ctx.info().name.c_str(),

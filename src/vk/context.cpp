@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "util/error.h"
+#include "vk/pipeline_cache.h"
 #include "vk/vk_check.h"
 
 namespace gdpt::vk {
@@ -274,9 +275,10 @@ Context::Context(const ContextOptions& options)
         vkDestroyDevice(d, nullptr);
     });
     vkGetDeviceQueue(device, queueFamily_, 0, &queue_);
+    if (options.keepPipelines) pipelineCache_ = std::make_unique<PipelineCache>();
 }
 
-Context::~Context() = default;
+Context::~Context() = default;  // pipelineCache_ before device_
 
 VkBool32 Context::messengerCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                     VkDebugUtilsMessageTypeFlagsEXT /*types*/,

@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,10 @@ struct ContextOptions {
     std::string device;           // "" = default choice; else a device index or name substring
     bool validation = false;      // enable VK_LAYER_KHRONOS_validation + error-counting messenger
     bool printValidation = true;  // print validation messages to stderr
+    // Keep every compute pipeline for the context's life and share it among kernels of the
+    // same description (pipeline_cache.h): for many renders in one process, e.g. the frames
+    // of a sequence. Off: each Kernel creates and owns its pipeline.
+    bool keepPipelines = false;
 };
 
 // What `gdpt devices` prints and what the limits check reads.
@@ -55,6 +60,8 @@ struct DeviceInfo {
 // version there, but 25.0 reports driverVersion 1, so the string is read first.
 std::uint32_t mesaMajorVersion(const std::string& driverInfo, std::uint32_t driverVersion);
 
+class PipelineCache;
+
 class Context {
 public:
     explicit Context(const ContextOptions& options = {});
@@ -86,6 +93,9 @@ public:
     void noteAllocation(std::uint64_t bytes) const;
     void noteFree(std::uint64_t bytes) const;
 
+    // The pipelines kept for the context's life (ContextOptions::keepPipelines), else null.
+    [[nodiscard]] PipelineCache* pipelineCache() const { return pipelineCache_.get(); }
+
     // Throws gdpt::Error naming the limit if a single storage buffer of `bytes` bytes
     // (what: "triangle geometry") exceeds the device's maxStorageBufferRange.
     void checkStorageBufferSize(std::uint64_t bytes, const std::string& what) const;
@@ -115,6 +125,8 @@ private:
     VkQueue queue_ = VK_NULL_HANDLE;
     std::uint32_t queueFamily_ = 0;
     PFN_vkSetDebugUtilsObjectNameEXT setObjectName_ = nullptr;
+    // After device_: destroyed (its pipelines released) before the device.
+    std::unique_ptr<PipelineCache> pipelineCache_;
 };
 
 }  // namespace gdpt::vk

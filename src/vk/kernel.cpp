@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <memory>
 #include <string>
 #include <utility>
 
 #include "vk/buffer.h"
 #include "vk/context.h"
+#include "vk/pipeline_cache.h"
 #include "vk/timing.h"
 #include "vk/vk_check.h"
 
@@ -45,6 +47,95 @@ VkPipeline createPipeline(const PipelineJob& job) {
         throw e.withContext("creating pipeline '" + job.name + "'");
     }
     return pipeline;
+}
+
+// What creating a kernel's pipeline uses, and what binding its descriptor set needs: the
+// shader module and the layouts (each Kernel has its own; a kept pipeline has its own too).
+struct PipelineObjects {
+    Handle<VkShaderModule> module;
+    Handle<VkDescriptorSetLayout> setLayout;
+    Handle<VkPipelineLayout> pipelineLayout;
+    std::uint32_t texelCount = 0;  // texel bindings of the set layout
+    std::size_t bindingCount = 0;
+};
+
+PipelineObjects makeObjects(const Context& ctx, const KernelDesc& desc) {
+    const VkDevice device = ctx.device();
+    PipelineObjects o;
+    VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    const bool optimized = desc.spirvOptimized != nullptr && useOptimizedSpirv(ctx.info());
+    moduleInfo.codeSize = optimized ? desc.spirvOptimizedBytes : desc.spirvBytes;
+    moduleInfo.pCode = optimized ? desc.spirvOptimized : desc.spirv;
+    VkShaderModule module = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateShaderModule(device, &moduleInfo, nullptr, &module));
+    o.module = Handle<VkShaderModule>(module,
+                                      [device](VkShaderModule m) { vkDestroyShaderModule(device, m, nullptr); });
+    ctx.setName(VK_OBJECT_TYPE_SHADER_MODULE, reinterpret_cast<std::uint64_t>(module), desc.name);
+
+    std::vector<VkDescriptorSetLayoutBinding> bindings;
+    for (const auto& [b, format] : desc.texelBindings)
+        GDPT_CHECK(std::find(desc.bindings.begin(), desc.bindings.end(), b) != desc.bindings.end());
+    for (std::uint32_t b : desc.bindings) {
+        VkDescriptorSetLayoutBinding lb{};
+        lb.binding = b;
+        const bool texel = texelFormat(desc.texelBindings, b) != VK_FORMAT_UNDEFINED;
+        lb.descriptorType = texel ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        o.texelCount += texel ? 1u : 0u;
+        lb.descriptorCount = 1;
+        lb.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+        bindings.push_back(lb);
+    }
+    o.bindingCount = bindings.size();
+    VkDescriptorSetLayoutCreateInfo setInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    setInfo.bindingCount = static_cast<std::uint32_t>(bindings.size());
+    setInfo.pBindings = bindings.data();
+    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &setLayout));
+    o.setLayout = Handle<VkDescriptorSetLayout>(
+        setLayout, [device](VkDescriptorSetLayout l) { vkDestroyDescriptorSetLayout(device, l, nullptr); });
+
+    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, desc.pushConstantBytes};
+    VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    layoutInfo.setLayoutCount = 1;
+    layoutInfo.pSetLayouts = &setLayout;
+    layoutInfo.pushConstantRangeCount = desc.pushConstantBytes ? 1u : 0u;
+    layoutInfo.pPushConstantRanges = &range;
+    VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
+    VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &pipelineLayout));
+    o.pipelineLayout = Handle<VkPipelineLayout>(
+        pipelineLayout, [device](VkPipelineLayout l) { vkDestroyPipelineLayout(device, l, nullptr); });
+    return o;
+}
+
+// The job that creates a pipeline of `desc` with `module` and `layout`.
+PipelineJob pipelineJob(VkDevice device, const KernelDesc& desc, VkShaderModule module, VkPipelineLayout layout) {
+    PipelineJob job;
+    job.device = device;
+    job.module = module;
+    job.layout = layout;
+    job.name = desc.name;
+    for (const auto& [id, value] : desc.specConstants) {
+        VkSpecializationMapEntry e{};
+        e.constantID = id;
+        e.offset = static_cast<std::uint32_t>(job.values.size() * sizeof(std::uint32_t));
+        e.size = sizeof(std::uint32_t);
+        job.entries.push_back(e);
+        job.values.push_back(value);
+    }
+    return job;
+}
+
+// What makes two kernels' pipelines interchangeable: the SPIR-V (by its embedded array and the
+// form used), the set layout, the push constants and the specialisation constants.
+std::string pipelineKey(const Context& ctx, const KernelDesc& desc) {
+    const bool optimized = desc.spirvOptimized != nullptr && useOptimizedSpirv(ctx.info());
+    std::string key = desc.name + "|" + std::to_string(reinterpret_cast<std::uintptr_t>(desc.spirv)) +
+                      (optimized ? "|opt|" : "|raw|") + std::to_string(desc.pushConstantBytes) + "|b";
+    for (std::uint32_t b : desc.bindings)
+        key += "," + std::to_string(b) + ":" + std::to_string(static_cast<int>(texelFormat(desc.texelBindings, b)));
+    key += "|s";
+    for (const auto& [id, value] : desc.specConstants) key += "," + std::to_string(id) + "=" + std::to_string(value);
+    return key;
 }
 
 }  // namespace
@@ -86,66 +177,17 @@ Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation crea
                     " bytes of push constants; device limit maxPushConstantsSize = " +
                     std::to_string(ctx.info().maxPushConstantsSize));
 
-    VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    const bool optimized = desc.spirvOptimized != nullptr && useOptimizedSpirv(ctx.info());
-    moduleInfo.codeSize = optimized ? desc.spirvOptimizedBytes : desc.spirvBytes;
-    moduleInfo.pCode = optimized ? desc.spirvOptimized : desc.spirv;
-    VkShaderModule module = VK_NULL_HANDLE;
-    VK_CHECK(vkCreateShaderModule(device, &moduleInfo, nullptr, &module));
-    module_ = Handle<VkShaderModule>(
-        module, [device](VkShaderModule m) { vkDestroyShaderModule(device, m, nullptr); });
-    ctx.setName(VK_OBJECT_TYPE_SHADER_MODULE, reinterpret_cast<std::uint64_t>(module), desc.name);
+    PipelineObjects objects = makeObjects(ctx, desc);
+    module_ = std::move(objects.module);
+    setLayout_ = std::move(objects.setLayout);
+    pipelineLayout_ = std::move(objects.pipelineLayout);
+    const VkDescriptorSetLayout setLayout = setLayout_.get();
+    const std::uint32_t texelCount = objects.texelCount;
+    const std::size_t bindingCount = objects.bindingCount;
 
-    std::vector<VkDescriptorSetLayoutBinding> bindings;
-    std::uint32_t texelCount = 0;
-    for (const auto& [b, format] : desc.texelBindings)
-        GDPT_CHECK(std::find(desc.bindings.begin(), desc.bindings.end(), b) != desc.bindings.end());
-    for (std::uint32_t b : desc.bindings) {
-        VkDescriptorSetLayoutBinding lb{};
-        lb.binding = b;
-        const bool texel = texelFormat(desc.texelBindings, b) != VK_FORMAT_UNDEFINED;
-        lb.descriptorType =
-            texel ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        texelCount += texel ? 1u : 0u;
-        lb.descriptorCount = 1;
-        lb.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-        bindings.push_back(lb);
-    }
-    VkDescriptorSetLayoutCreateInfo setInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-    setInfo.bindingCount = static_cast<std::uint32_t>(bindings.size());
-    setInfo.pBindings = bindings.data();
-    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
-    VK_CHECK(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &setLayout));
-    setLayout_ = Handle<VkDescriptorSetLayout>(
-        setLayout, [device](VkDescriptorSetLayout l) { vkDestroyDescriptorSetLayout(device, l, nullptr); });
-
-    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, desc.pushConstantBytes};
-    VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-    layoutInfo.setLayoutCount = 1;
-    layoutInfo.pSetLayouts = &setLayout;
-    layoutInfo.pushConstantRangeCount = desc.pushConstantBytes ? 1u : 0u;
-    layoutInfo.pPushConstantRanges = &range;
-    VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
-    VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &pipelineLayout));
-    pipelineLayout_ = Handle<VkPipelineLayout>(
-        pipelineLayout, [device](VkPipelineLayout l) { vkDestroyPipelineLayout(device, l, nullptr); });
-
-    PipelineJob job;
-    job.device = device;
-    job.module = module;
-    job.layout = pipelineLayout;
-    job.name = desc.name;
-    for (const auto& [id, value] : desc.specConstants) {
-        VkSpecializationMapEntry e{};
-        e.constantID = id;
-        e.offset = static_cast<std::uint32_t>(job.values.size() * sizeof(std::uint32_t));
-        e.size = sizeof(std::uint32_t);
-        job.entries.push_back(e);
-        job.values.push_back(value);
-    }
-    if (!bindings.empty()) {
+    if (bindingCount > 0) {
         std::vector<VkDescriptorPoolSize> sizes;
-        const auto storageCount = static_cast<std::uint32_t>(bindings.size()) - texelCount;
+        const auto storageCount = static_cast<std::uint32_t>(bindingCount) - texelCount;
         if (storageCount) sizes.push_back({VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, storageCount});
         if (texelCount) sizes.push_back({VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, texelCount});
         VkDescriptorPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
@@ -164,6 +206,23 @@ Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation crea
     }
 
     // Last, so that nothing after it can throw while a worker is running.
+    if (PipelineCache* cache = ctx.pipelineCache()) {
+        // A kept pipeline: created once per description, with objects of its own that live as
+        // long as it (the kernel binds its set with its own, identical, layout).
+        shared_ = cache->get(pipelineKey(ctx, desc), [&] {
+            auto owned = std::make_shared<PipelineObjects>(makeObjects(ctx, desc));
+            PipelineJob job = pipelineJob(device, desc, owned->module.get(), owned->pipelineLayout.get());
+            std::shared_future<VkPipeline> pipeline =
+                creation == PipelineCreation::Background
+                    ? std::async(std::launch::async, [job = std::move(job)] { return createPipeline(job); }).share()
+                    : std::async(std::launch::deferred, [job = std::move(job)] { return createPipeline(job); }).share();
+            return PipelineCache::Creation{
+                pipeline, [device, owned](VkPipeline p) { vkDestroyPipeline(device, p, nullptr); }};
+        });
+        if (creation == PipelineCreation::Now) (void)wait();
+        return;
+    }
+    PipelineJob job = pipelineJob(device, desc, module_.get(), pipelineLayout_.get());
     if (creation == PipelineCreation::Background) {
         pending_ = std::async(std::launch::async, [job = std::move(job)] { return createPipeline(job); });
     } else {
@@ -190,6 +249,12 @@ void Kernel::adopt(VkPipeline pipeline) const {
 }
 
 double Kernel::wait() const {
+    if (shared_.valid()) {
+        if (keptPipeline_ != VK_NULL_HANDLE) return 0.0;
+        const auto start = std::chrono::steady_clock::now();
+        keptPipeline_ = shared_.get();  // rethrows the creation's error
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
     if (!pending_.valid()) return 0.0;
     const auto start = std::chrono::steady_clock::now();
     adopt(pending_.get());  // rethrows the worker's error
@@ -262,7 +327,7 @@ VkBufferView Kernel::texelView(std::uint32_t binding, const Buffer& buffer, VkFo
 
 void Kernel::bindState(VkCommandBuffer cmd, const void* push) const {
     (void)wait();
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.get());
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, shared_.valid() ? keptPipeline_ : pipeline_.get());
     if (set_ != VK_NULL_HANDLE)
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelineLayout_.get(), 0, 1, &set_, 0,
                                 nullptr);

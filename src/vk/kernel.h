@@ -131,6 +131,9 @@ private:
     // it (both mutable: resolving it does not change what the kernel is).
     mutable Handle<VkPipeline> pipeline_;
     mutable std::future<VkPipeline> pending_;
+    // Or a pipeline the context keeps (ContextOptions::keepPipelines), not owned.
+    std::shared_future<VkPipeline> shared_;
+    mutable VkPipeline keptPipeline_ = VK_NULL_HANDLE;
     Handle<VkDescriptorPool> pool_;
     VkDescriptorSet set_ = VK_NULL_HANDLE;
     std::vector<std::pair<std::uint32_t, Handle<VkBufferView>>> views_;  // texel bindings' views
