@@ -1,0 +1,78 @@
+// poisson_spacetime.h — the space-time screened Poisson reconstruction of temporal
+// gradient-domain path tracing (Manzi, Kettunen, Durand, Zwicker, Lehtinen 2016, "Temporal
+// Gradient-Domain Path Tracing", §4): a window of F frames of W x H pixels is reconstructed at
+// once from every frame's primal and spatial gradients and the temporal differences between
+// consecutive frames. Per channel, the unknown frames I_0..I_{F-1} minimise
+//     E(I) = Σ_f [ α² Σ_i wp (I_f,i − t_f,i)²                     primal rows
+//                + Σ_i wdx (I_f,i+1 − I_f,i − dx_f,i)²             (x < W−1)
+//                + Σ_i wdy (I_f,i+W − I_f,i − dy_f,i)² ]           (y < H−1)
+//          + β² Σ_{f<F−1} Σ_i wdt (I_f+1,i − I_f,i − dt_f,i)²      temporal rows
+// which is poisson_problem.h's energy of each frame plus the temporal rows: a weighted
+// 7-point graph Laplacian in (x, y, f) plus the screening diagonal. One frame (F = 1) is
+// exactly the 2D problem (tested against poisson_cpu.h).
+//
+// L2: the weights are 1. L1 (the default of G-PT): iteratively reweighted least squares as the
+// 2D device solver does it (poisson_irls.h, poisson_gpu.h's schedule): round 0 is the L2
+// solve, round k ≥ 1 weights every row by 1 / (‖RGB residual‖ + ε_k), ε_k = regInit ·
+// regIter^(k−1), renormalised to mean 1, each round warm-started from the last.
+//
+// Solver: conjugate gradients preconditioned by the diagonal (Jacobi), in double precision on
+// the CPU, the channels in parallel. Why not the device's multigrid-PCG (poisson_gpu.h): it is
+// 2D; a window is F times the pixels of a frame and, warm-started from the frames' own 2D
+// reconstructions, needs few iterations (docs/animation.md has the measurements).
+#pragma once
+
+#include <array>
+#include <cstddef>
+
+#include "poisson/poisson_cpu.h"
+
+namespace gdpt {
+
+struct SpaceTimeProblem {
+    int width = 0;
+    int height = 0;
+    int frames = 0;
+    double alpha = 0.2;  // primal rows α (I − t), as poisson_problem.h
+    double beta = 1.0;   // temporal rows β (I_f+1 − I_f − dt)
+    // Frame-major planar fields: frame f's pixel i at f·W·H + i. dt has F − 1 frames (the
+    // target of I_f+1 − I_f at each pixel).
+    std::array<Field, 3> primal, dx, dy, dt;
+    // Warm start (F·W·H per channel), e.g. each frame's own 2D reconstruction; empty: the
+    // primal.
+    std::array<Field, 3> initial;
+
+    [[nodiscard]] std::size_t pixels() const { return std::size_t(width) * std::size_t(height); }
+    [[nodiscard]] std::size_t size() const { return pixels() * std::size_t(frames); }
+};
+
+struct SpaceTimeOptions {
+    bool l1 = true;  // else L2
+    // IRLS (L1): the 2D device solver's schedule (poisson_gpu.h SolveOptions).
+    int irlsIterations = 6;
+    double regInit = 0.05;
+    double regIter = 0.4;
+    double innerTolerance = 0.02;  // relative residual of the rounds before the last
+    double tolerance = 1e-4;       // relative residual of the last round (and of L2)
+    int maxIterations = 4000;      // per solve
+    int threads = 0;               // channels solved at once; 0 = the machine's cores (at most 3)
+};
+
+struct SpaceTimeStats {
+    int iterations = 0;      // PCG iterations, summed over rounds, max over channels
+    int irlsIterations = 0;  // 1 for L2
+    double residual = 0.0;   // relative residual of the last solve, max over channels
+    bool converged = false;  // every channel's last solve reached the tolerance
+    double ms = 0.0;
+};
+
+// The reconstruction of the window, three channels of F·W·H values. Throws gdpt::Error if the
+// sizes disagree, a value is not finite, α ≤ 0 (the primal rows anchor the solve) or β < 0.
+std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const SpaceTimeOptions& options = {},
+                                    SpaceTimeStats* stats = nullptr);
+
+// The exact L2 minimiser of one channel (Eigen's sparse LDLT on the normal equations): the
+// reference of the iterative solver in tests, for small windows.
+Field solveSpaceTimeExactL2(const SpaceTimeProblem& problem, int channel);
+
+}  // namespace gdpt
