@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
@@ -32,6 +33,16 @@ struct RenderOutput {
     std::vector<NamedLayer> layers;
     RenderStats stats;
     [[nodiscard]] const Image& image() const { return layers.front().image; }
+};
+
+// Consecutive frames of an animation, as a temporal method renders them at once
+// (Integrator::renderWindow).
+struct FrameWindow {
+    int first = 0;  // frames first .. first + count - 1
+    int count = 0;
+    std::function<Scene(int frame)> scene;            // the scene at a frame's time
+    std::function<std::uint32_t(int frame)> seed;     // a frame's seed (frame_pattern.h sequenceFrameSeed)
+    bool startsSequence = true;                       // no frame before it (else the method's last window)
 };
 
 class Integrator {
@@ -60,6 +71,15 @@ public:
     virtual void describe(nlohmann::json& summary, const RenderStats& stats) const {
         (void)summary, (void)stats;
     }
+    // Temporal methods: frames per window (renderWindow renders them at once); 0 for the
+    // methods that render one image at a time (render), which a sequence calls per frame.
+    [[nodiscard]] virtual int windowFrames() const { return 0; }
+    // Renders the frames of `window` (windowFrames() > 0 only): one output per frame in order,
+    // or, if sampling was cancelled, what was rendered before (the last stats.cancelled, no
+    // layers). `options` is for the whole window (its time budget included). Windows of one
+    // sequence come in order: a method may carry state from one to the next.
+    virtual std::vector<RenderOutput> renderWindow(const vk::Context& ctx, const FrameWindow& window,
+                                                   const RenderOptions& options);
     // A phrase for the render's one-line summary ("" if none): what the method adapted.
     [[nodiscard]] virtual std::string summary(const RenderStats& stats) const {
         (void)stats;
@@ -95,13 +115,24 @@ struct MltOptions {
     double tolerance = 1e-4;  // relative residual at which each solve stops
 };
 
+// The settings of temporal G-PT (tgpt; tgpt_integrator.h).
+struct TgptOptions {
+    GptSamplingOptions sampling;  // of each frame's two half renders (demodulation off)
+    int window = 10;              // frames reconstructed at once (Manzi et al. 2016 use about 10)
+    bool l1 = true;               // the space-time reconstruction: L1 (IRLS) or L2
+    double alpha = 0.2;           // weight of the primal rows
+    double beta = 1.0;            // weight of the temporal rows
+    double tolerance = 1e-4;      // relative residual of the last solve
+};
+
 // Every method's own settings; each integrator reads its part.
 struct MethodOptions {
     GptOptions gpt;
     MltOptions mlt;
+    TgptOptions tgpt;
 };
 
-// Makes the integrator of `name`: a method name ("pt", "gpt", "pssmlt", "gmlt"), or "gpt-<reconstruction>"
+// Makes the integrator of `name`: a method name ("pt", "gpt", "pssmlt", "gmlt", "tgpt"), or "gpt-<reconstruction>"
 // (gpt-l1, gpt-l2, gpt-wl1, gpt-wl2: G-PT with that reconstruction alone, as `converge`
 // names its methods). Throws gdpt::UsageError naming the known methods otherwise.
 std::unique_ptr<Integrator> makeIntegrator(const std::string& name, const MethodOptions& options = {});

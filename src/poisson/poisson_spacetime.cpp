@@ -19,13 +19,14 @@ namespace {
 struct Operator {
     int width = 0, height = 0, frames = 0;
     Field cx, cy, ct, cp;  // edge i–(i+1), i–(i+W), i–(i+W·H); screening
+    Field cb;              // frame 0's rows to the fixed previous frame (W·H; empty: none)
     [[nodiscard]] std::size_t pixels() const { return std::size_t(width) * std::size_t(height); }
     [[nodiscard]] std::size_t size() const { return pixels() * std::size_t(frames); }
 };
 
 // Row weights shared by the channels (IRLS; all 1 for L2). Dropped rows are 0.
 struct Weights {
-    Field primal, dx, dy, dt;
+    Field primal, dx, dy, dt, boundary;  // boundary: W·H rows to the previous frame, or empty
 };
 
 void check(const SpaceTimeProblem& p) {
@@ -46,12 +47,19 @@ void check(const SpaceTimeProblem& p) {
         sized(p.dy[c], n, "dy");
         sized(p.dt[c], nt, "dt");
         if (!p.initial[c].empty()) sized(p.initial[c], n, "initial");
+        if (!p.previous[c].empty() || !p.dtPrevious[c].empty()) {
+            sized(p.previous[c], p.pixels(), "previous");
+            sized(p.dtPrevious[c], p.pixels(), "dtPrevious");
+        }
     }
+    if (p.previous[0].empty() != p.previous[1].empty() || p.previous[0].empty() != p.previous[2].empty())
+        throw Error("space-time Poisson: previous is given for some channels only");
 }
 
 Weights unitWeights(const SpaceTimeProblem& p) {
     const std::size_t n = p.size(), np = p.pixels(), w = std::size_t(p.width);
-    Weights wt{Field(n, 1.0), Field(n, 1.0), Field(n, 1.0), Field(np * std::size_t(p.frames - 1), 1.0)};
+    Weights wt{Field(n, 1.0), Field(n, 1.0), Field(n, 1.0), Field(np * std::size_t(p.frames - 1), 1.0),
+               p.previous[0].empty() ? Field() : Field(np, 1.0)};
     for (std::size_t i = 0; i < n; ++i) {
         if ((i % np) % w + 1 == w) wt.dx[i] = 0.0;
         if ((i % np) + w >= np) wt.dy[i] = 0.0;
@@ -71,6 +79,8 @@ Operator makeOperator(const SpaceTimeProblem& p, const Weights& wt) {
     for (std::size_t i = 0; i + np < n; ++i) op.ct[i] = p.beta * p.beta * wt.dt[i];
     op.cp.resize(n);
     for (std::size_t i = 0; i < n; ++i) op.cp[i] = p.alpha * p.alpha * wt.primal[i];
+    op.cb = wt.boundary;
+    for (double& v : op.cb) v *= p.beta * p.beta;
     return op;
 }
 
@@ -79,6 +89,7 @@ Field rhs(const SpaceTimeProblem& p, const Operator& op, int c) {
     const std::size_t n = op.size(), np = op.pixels(), w = std::size_t(op.width);
     Field b(n);
     for (std::size_t i = 0; i < n; ++i) b[i] = op.cp[i] * p.primal[c][i];
+    for (std::size_t i = 0; i < op.cb.size(); ++i) b[i] += op.cb[i] * (p.previous[c][i] + p.dtPrevious[c][i]);
     for (std::size_t i = 0; i < n; ++i) {
         if (op.cx[i] != 0.0) {
             b[i] -= op.cx[i] * p.dx[c][i];
@@ -99,6 +110,7 @@ Field rhs(const SpaceTimeProblem& p, const Operator& op, int c) {
 void apply(const Operator& op, const Field& x, Field& y) {
     const std::size_t n = op.size(), np = op.pixels(), w = std::size_t(op.width);
     for (std::size_t i = 0; i < n; ++i) y[i] = op.cp[i] * x[i];
+    for (std::size_t i = 0; i < op.cb.size(); ++i) y[i] += op.cb[i] * x[i];
     for (std::size_t i = 0; i < n; ++i) {
         const double xi = x[i];
         if (op.cx[i] != 0.0) {
@@ -122,6 +134,7 @@ void apply(const Operator& op, const Field& x, Field& y) {
 Field diagonalOf(const Operator& op) {
     const std::size_t n = op.size(), np = op.pixels(), w = std::size_t(op.width);
     Field d = op.cp;
+    for (std::size_t i = 0; i < op.cb.size(); ++i) d[i] += op.cb[i];
     for (std::size_t i = 0; i < n; ++i) {
         if (op.cx[i] != 0.0) d[i] += op.cx[i], d[i + 1] += op.cx[i];
         if (op.cy[i] != 0.0) d[i] += op.cy[i], d[i + w] += op.cy[i];
@@ -205,8 +218,12 @@ Weights irlsWeights(const SpaceTimeProblem& p, const std::array<Field, 3>& x, do
             wt.dt[i] = weightOf(e);
         }
     }
+    for (std::size_t i = 0; i < wt.boundary.size(); ++i) {
+        for (int c = 0; c < 3; ++c) e[c] = p.beta * (x[c][i] - p.previous[c][i] - p.dtPrevious[c][i]);
+        wt.boundary[i] = weightOf(e);
+    }
     const double scale = double(rows) / sum;
-    for (Field* f : {&wt.primal, &wt.dx, &wt.dy, &wt.dt})
+    for (Field* f : {&wt.primal, &wt.dx, &wt.dy, &wt.dt, &wt.boundary})
         for (double& v : *f) v *= scale;
     return wt;
 }

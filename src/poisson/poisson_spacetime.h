@@ -7,6 +7,7 @@
 //                + Σ_i wdx (I_f,i+1 − I_f,i − dx_f,i)²             (x < W−1)
 //                + Σ_i wdy (I_f,i+W − I_f,i − dy_f,i)² ]           (y < H−1)
 //          + β² Σ_{f<F−1} Σ_i wdt (I_f+1,i − I_f,i − dt_f,i)²      temporal rows
+//          [+ β² Σ_i wdb (I_0,i − previous_i − dtPrevious_i)²       the frame before, fixed]
 // which is poisson_problem.h's energy of each frame plus the temporal rows: a weighted
 // 7-point graph Laplacian in (x, y, f) plus the screening diagonal. One frame (F = 1) is
 // exactly the 2D problem (tested against poisson_cpu.h).
@@ -41,6 +42,10 @@ struct SpaceTimeProblem {
     // Warm start (F·W·H per channel), e.g. each frame's own 2D reconstruction; empty: the
     // primal.
     std::array<Field, 3> initial;
+    // Optional: the frame before the window, already reconstructed (W·H per channel), and the
+    // target of I_0 − previous: temporal rows β (I_0 − previous − dtPrevious) that tie the
+    // window to the one before it (a sequence reconstructed window by window has no seam).
+    std::array<Field, 3> previous, dtPrevious;
 
     [[nodiscard]] std::size_t pixels() const { return std::size_t(width) * std::size_t(height); }
     [[nodiscard]] std::size_t size() const { return pixels() * std::size_t(frames); }

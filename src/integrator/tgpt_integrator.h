@@ -1,0 +1,61 @@
+// tgpt_integrator.h — temporal gradient-domain path tracing (Manzi, Kettunen, Durand, Zwicker,
+// Lehtinen, "Temporal Gradient-Domain Path Tracing", ACM TOG 35(6), 2016) as an integrator of
+// windows of frames:
+//   1. sample: every frame f as two G-PT renders of half the samples each (gpt_sampler.h),
+//      the first with frame f's seed σ(f), the second with frame f+1's seed σ(f+1) (§3, as the
+//      published code seeds them). Frame f+1's first half then replays, sample for sample,
+//      the random numbers of frame f's second half in the next frame's scene: the temporal
+//      difference dt_f = primal(f+1, first half) − primal(f, second half) is the mean of
+//      paired differences, unbiased for I_f+1 − I_f, and exactly 0 where nothing moved;
+//   2. reconstruct: a space-time screened Poisson solve of the window from every frame's
+//      primal, dx, dy and the dt between its frames (poisson_spacetime.h; L1 by IRLS by
+//      default), coupled to the previous window's last reconstructed frame through the dt
+//      between the windows, so that a sequence has no seam at window boundaries;
+//   3. compose: final = reconstruction + very-direct light, per frame (as G-PT, §5 of
+//      Kettunen et al. 2015).
+// The temporal shift is random replay at the same pixel (primary-sample space): the path of
+// frame f+1 starts through the same point of the same pixel with the same decisions. The
+// published method also carries the primary hit along the scene's motion (motion vectors);
+// that refinement is not built (docs/animation.md). Texture demodulation is off (a frame's
+// modulation differs from the next one's where something moves).
+// Layers per frame: final, recon_spacetime_<l1|l2>, primal, dx, dy, dt (to the next frame;
+// 0 in the sequence's last frame), direct, var_primal, var_dx, var_dy, var_direct,
+// primal_plus_direct.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "integrator/integrator.h"
+
+namespace gdpt {
+
+class TgptIntegrator final : public Integrator {
+public:
+    explicit TgptIntegrator(TgptOptions options);
+
+    [[nodiscard]] std::string name() const override { return "tgpt"; }
+    [[nodiscard]] std::uint32_t maxBatchSpp(int width, int height) const override;
+    [[nodiscard]] ExrAttributes identity(const Scene& scene, const RenderOptions& options) const override;
+    // One image is not a sequence: throws gdpt::UsageError (tgpt renders --frames).
+    RenderOutput render(const vk::Context& ctx, const Scene& scene, const RenderOptions& options) override;
+    [[nodiscard]] int windowFrames() const override { return options_.window; }
+    std::vector<RenderOutput> renderWindow(const vk::Context& ctx, const FrameWindow& window,
+                                           const RenderOptions& options) override;
+    void describe(nlohmann::json& summary, const RenderStats& stats) const override;
+    [[nodiscard]] std::string summary(const RenderStats& stats) const override;
+
+private:
+    TgptOptions options_;
+    // From the last window: its last frame's reconstruction and its second half's primal
+    // (seeded like the next window's first frame's first half).
+    struct Carry {
+        int frame = -1;
+        std::array<std::vector<double>, 3> recon;
+        Image secondHalfPrimal;
+    };
+    std::optional<Carry> carry_;
+};
+
+}  // namespace gdpt
