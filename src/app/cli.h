@@ -51,6 +51,8 @@ struct RenderArgs {
     double fps = 24.0;          // frames per second: frame k is the scene at time k / fps
     std::string animation;      // the animation's name or index ("" = the first)
     bool noVideo = false;       // no MP4 of the sequence even when ffmpeg is installed
+    int window = 10;            // tgpt: frames reconstructed together
+    double beta = 1.0;          // tgpt: weight of the temporal rows
 };
 
 struct DiffArgs {

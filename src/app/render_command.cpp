@@ -370,7 +370,8 @@ Subcommand addRenderCommand(CLI::App& app) {
     const char* sampling = "Sampling";
     r->add_option("--method", a.method,
                   "gpt: gradient-domain path tracing; pt: path tracing (docs/gpt.md); gmlt: gradient-domain "
-                  "Metropolis; pssmlt: primary-sample-space Metropolis (docs/mlt.md)")
+                  "Metropolis; pssmlt: primary-sample-space Metropolis (docs/mlt.md); tgpt: temporal G-PT of a "
+                  "sequence (--frames; docs/animation.md)")
         ->capture_default_str()
         ->check(CLI::IsMember(methodNames()))
         ->group(sampling);
@@ -461,6 +462,18 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->needs(frames)
         ->group(animation);
     r->add_flag("--no-video", a.noVideo, "No MP4 of the sequence even when ffmpeg is installed")
+        ->needs(frames)
+        ->group(animation);
+    r->add_option("--window", a.window,
+                  "tgpt: frames reconstructed together by one space-time solve (each window tied to the one "
+                  "before)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 256))
+        ->needs(frames)
+        ->group(animation);
+    r->add_option("--beta", a.beta, "tgpt: weight of the temporal rows of the space-time solve")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1e3))
         ->needs(frames)
         ->group(animation);
 

@@ -86,6 +86,13 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
     if (args.allRecon && args.recon != "l1") mlt.reconstructions.push_back(Reconstruction::L1);
     mlt.alpha = args.alpha;
     mlt.tolerance = args.tolerance;
+    TgptOptions& t = m.tgpt;
+    t.sampling = g.sampling;
+    t.window = args.window;
+    t.l1 = args.recon == "l1";
+    t.alpha = args.alpha;
+    t.beta = args.beta;
+    t.tolerance = args.tolerance;
     // Timed renders remember each configuration's reconstruction time.
     if (args.time > 0.0) g.reconCache = cache;
     return makeIntegrator(args.method, m);
@@ -176,7 +183,17 @@ void checkArgs(const RenderArgs& args) {
             "--recon " + args.recon +
             " weights by per-pixel variances, which the correlated samples of Markov chains do not "
             "give; --method gmlt reconstructs with l1 or l2");
-    if ((args.method == "gpt" || args.method == "gmlt") && l1 && !(args.alpha > 0.0))
+    if (args.method == "tgpt") {
+        if (args.frames.empty())
+            throw UsageError("--method tgpt renders a sequence (temporal differences between frames): add --frames A:B");
+        if (args.recon == "wl1" || args.recon == "wl2" || args.allRecon)
+            throw UsageError("--method tgpt reconstructs with --recon l1 or l2 (one space-time solve per window)");
+        if (args.demodulate == "on")
+            throw UsageError(
+                "--method tgpt does not demodulate (a frame's texture modulation differs from the next one's "
+                "where something moves)");
+    }
+    if ((args.method == "gpt" || args.method == "gmlt" || args.method == "tgpt") && l1 && !(args.alpha > 0.0))
         throw UsageError("--alpha " + std::to_string(args.alpha) +
                          ": the L1 reconstructions (--recon l1 or wl1, or --all-recon) need --alpha > 0 (the "
                          "primal term anchors each reweighted solve); use --recon l2 for alpha 0");

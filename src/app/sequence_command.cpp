@@ -136,74 +136,108 @@ int runSequence(const RenderArgs& args) {
                          phase.c_str(), frame, written.c_str(), frame, range.last);
         return 130;
     };
-    for (; frame <= range.last; ++frame) {
-        try {
-            Timer frameTimer;
-            const int done = frame - range.first, left = range.last - frame + 1;
-            const double time = double(frame) / args.fps;
-            const std::string exrPath = framePath(args.output, frame);
-            enterPhase("loading");
-            const Scene scene = asset.instance(animation, time);
-            if (!warned && !quiet) {
-                warned = true;
-                if (!scene.unsupported.empty()) {
-                    std::string list;
-                    for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
-                    std::fprintf(stderr, "gdpt: warning: %s: not rendered: %s\n", args.scene.c_str(), list.c_str());
-                }
-                if (const auto black = blackImageWarning(scene, options.scene.envRadiance))
-                    std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
+    // The scene of a frame (the first one also says what the scene cannot show).
+    const auto sceneAt = [&](int f) {
+        enterPhase("loading");
+        Scene scene = asset.instance(animation, double(f) / args.fps);
+        if (!warned && !quiet) {
+            warned = true;
+            if (!scene.unsupported.empty()) {
+                std::string list;
+                for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
+                std::fprintf(stderr, "gdpt: warning: %s: not rendered: %s\n", args.scene.c_str(), list.c_str());
             }
-            OutputSet outputs({{"scene", args.scene}});
-            const StagedFile& exrFile = outputs.add(exrPath, "-o (frame " + std::to_string(frame) + ")");
-            const StagedFile& pngFile = outputs.add(previewPath(exrPath), "PNG preview of -o");
-
-            // --time is the whole sequence's: each frame gets an equal share of what is left, less
-            // what the method and the last frame needed after sampling.
+            if (const auto black = blackImageWarning(scene, options.scene.envRadiance))
+                std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
+        }
+        return scene;
+    };
+    // Writes frame f's EXR and PNG (together, whole or not at all), its summary and progress.
+    // `seconds` is what the frame cost (a window's frames share its time).
+    const auto writeFrame = [&](RenderOutput& out, double frameSeconds, double sampledAt) {
+        enterPhase("writing");
+        const RenderStats& s = out.stats;
+        const std::string exrPath = framePath(args.output, frame);
+        const double time = double(frame) / args.fps;
+        Timer writeTimer;
+        OutputSet outputs({{"scene", args.scene}});
+        const StagedFile& exrFile = outputs.add(exrPath, "-o (frame " + std::to_string(frame) + ")");
+        const StagedFile& pngFile = outputs.add(previewPath(exrPath), "PNG preview of -o");
+        checkFinite(out.layers, exrPath);
+        writeExr(exrFile, out.layers);
+        throwIfInterrupted("writing");
+        writePngPreview(pngFile, out.image());
+        throwIfInterrupted("writing");
+        outputs.commit();
+        const double writeMs = writeTimer.ms();
+        frameSeconds += writeMs * 1e-3;
+        afterSamplingSeconds = std::max(0.0, frameSeconds - sampledAt - s.reconstructionMs * 1e-3);
+        if (jsonOutput.wanted()) {
+            RenderArgs frameArgs = args;
+            frameArgs.output = exrPath;
+            frameArgs.seed = sequenceFrameSeed(args.seed, frame);
+            json j = summaryJson(frameArgs, ctx, *integrator, s, frameSeconds, reserved, afterSamplingSeconds, writeMs);
+            j["frame"] = frame;
+            j["time"] = time;
+            frames.push_back(std::move(j));
+        }
+        if (!quiet) {
+            const int done = frame - range.first + 1, left = range.last - frame;
+            const double elapsed = total.seconds();
+            const double remaining = elapsed / double(done) * double(left);
+            std::fprintf(stderr, "gdpt: frame %d (%d/%d, t = %.4g s): wrote %s (%u spp%s, %s); sequence %s, %s\n",
+                         frame, done, range.count(), time, exrPath.c_str(), s.spp, integrator->summary(s).c_str(),
+                         seconds(frameSeconds).c_str(), seconds(elapsed).c_str(),
+                         left > 0 ? ("about " + seconds(remaining) + " left").c_str() : "done");
+        }
+        if (args.profile) printProfile(s.kernels);
+    };
+    // --time is the whole sequence's: each frame gets an equal share of what is left, less what
+    // the method reserves after sampling and the last frame needed to be written; a window of
+    // `count` frames gets their shares.
+    const auto budgetFor = [&](int count) {
+        const int left = range.last - frame + 1;
+        const double share = std::max(0.0, args.time - total.seconds()) / double(left);
+        return std::max(0.05 * args.time / double(range.count()),
+                        double(count) * (share - afterSamplingSeconds) - reserved);
+    };
+    const int window = integrator->windowFrames();
+    while (frame <= range.last) {
+        try {
+            if (window > 0) {
+                // A temporal method: a window of frames sampled and reconstructed together.
+                Timer windowTimer;
+                FrameWindow w;
+                w.first = frame;
+                w.count = std::min(window, range.last - frame + 1);
+                w.scene = sceneAt;
+                w.seed = [&](int f) { return sequenceFrameSeed(args.seed, f); };
+                w.startsSequence = frame == range.first;
+                RenderOptions windowOptions = options;
+                if (timed) windowOptions.timeBudget = budgetFor(w.count);
+                enterPhase("sampling");
+                std::vector<RenderOutput> outs = integrator->renderWindow(ctx, w, windowOptions);
+                if (outs.empty() || outs.back().stats.cancelled) return interrupted("sampling");
+                const double each = windowTimer.seconds() / double(outs.size());
+                for (RenderOutput& out : outs) {
+                    writeFrame(out, each, each - out.stats.reconstructionMs * 1e-3);
+                    ++frame;
+                }
+                continue;
+            }
+            Timer frameTimer;
+            const Scene scene = sceneAt(frame);
             RenderOptions frameOptions = options;
             frameOptions.seed = sequenceFrameSeed(args.seed, frame);
-            if (timed) {
-                const double share = std::max(0.0, args.time - total.seconds()) / double(left);
-                frameOptions.timeBudget =
-                    std::max(0.05 * args.time / double(range.count()), share - reserved - afterSamplingSeconds);
-            }
+            if (timed) frameOptions.timeBudget = budgetFor(1);
             frameOptions.elapsedBefore = frameTimer.seconds();
             enterPhase("sampling");
             RenderOutput out = integrator->render(ctx, scene, frameOptions);
-            RenderStats& s = out.stats;
-            if (s.cancelled) return interrupted("sampling");
-            const double sampledAt = frameTimer.seconds() - (s.readbackMs + s.reconstructionMs) * 1e-3;
-            enterPhase("writing");
-            Timer writeTimer;
-            checkFinite(out.layers, exrPath);
-            writeExr(exrFile, out.layers);
-            throwIfInterrupted("writing");
-            writePngPreview(pngFile, out.image());
-            throwIfInterrupted("writing");
-            outputs.commit();
-            const double writeMs = writeTimer.ms();
-            const double frameSeconds = frameTimer.seconds();
-            afterSamplingSeconds = std::max(0.0, frameSeconds - sampledAt - s.reconstructionMs * 1e-3);
-            if (jsonOutput.wanted()) {
-                RenderArgs frameArgs = args;
-                frameArgs.output = exrPath;
-                frameArgs.seed = frameOptions.seed;
-                json j = summaryJson(frameArgs, ctx, *integrator, s, frameSeconds, reserved, afterSamplingSeconds,
-                                     writeMs);
-                j["frame"] = frame;
-                j["time"] = time;
-                frames.push_back(std::move(j));
-            }
-            if (!quiet) {
-                const double elapsed = total.seconds();
-                const double remaining = elapsed / double(done + 1) * double(left - 1);
-                std::fprintf(stderr,
-                             "gdpt: frame %d (%d/%d, t = %.4g s): wrote %s (%u spp%s, %s); sequence %s, %s\n", frame,
-                             done + 1, range.count(), time, exrPath.c_str(), s.spp, integrator->summary(s).c_str(),
-                             seconds(frameSeconds).c_str(), seconds(elapsed).c_str(),
-                             left > 1 ? ("about " + seconds(remaining) + " left").c_str() : "done");
-            }
-            if (args.profile) printProfile(s.kernels);
+            if (out.stats.cancelled) return interrupted("sampling");
+            const double sampledAt =
+                frameTimer.seconds() - (out.stats.readbackMs + out.stats.reconstructionMs) * 1e-3;
+            writeFrame(out, frameTimer.seconds(), sampledAt);
+            ++frame;
         } catch (const Interrupted& e) {
             return interrupted(e.phase());
         } catch (const std::exception&) {

@@ -104,6 +104,16 @@ struct MltStats {
     double splatMs = 0.0;                    // reading the records back and adding them up (host)
 };
 
+// Temporal G-PT (tgpt): the window a frame was reconstructed in, and its two half renders.
+struct TgptStats {
+    int windowFirst = 0;                 // first frame of the window
+    int windowFrames = 0;                // frames reconstructed together
+    std::uint32_t firstHalfSpp = 0;      // samples per pixel seeded with the frame's own seed
+    std::uint32_t secondHalfSpp = 0;     // ... with the next frame's seed (paired with it)
+    bool temporalToPrevious = false;     // the frame has a dt to the frame before it
+    bool joinedPreviousWindow = false;   // the window's solve was tied to the window before
+};
+
 struct RenderStats {
     std::uint32_t spp = 0;              // samples in every pixel
     std::uint32_t partialPassRows = 0;  // timed renders: rows (from the top) with one sample more
@@ -135,6 +145,7 @@ struct RenderStats {
     bool handedOff = false;
     DistributedStats distributed;
     MltStats mlt;
+    TgptStats tgpt;
     std::map<std::string, vk::KernelTime> kernels;
     SceneFeatures features;
 };

@@ -23,6 +23,7 @@
 // primal_plus_direct.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -56,6 +57,9 @@ private:
         Image secondHalfPrimal;
     };
     std::optional<Carry> carry_;
+    // The last window's solve, reserved (per frame) from the next window's budget.
+    double lastSolveSeconds_ = 0.0;
+    int lastSolveFrames_ = 1;
 };
 
 }  // namespace gdpt

@@ -29,27 +29,6 @@ class MltRender : public test::GpuTest {};
 
 constexpr int kSeeds = 10;
 
-// Two-sided Student t quantile with `dof` degrees of freedom at level alpha: bisection on
-// the tail probability, integrated from the density by Simpson's rule.
-double twoSidedT(double alpha, int dof) {
-    const double nu = dof;
-    const double c = std::exp(std::lgamma((nu + 1) / 2) - std::lgamma(nu / 2)) / std::sqrt(nu * M_PI);
-    const auto pdf = [&](double t) { return c * std::pow(1.0 + t * t / nu, -(nu + 1) / 2); };
-    const auto centralMass = [&](double t) {  // P(|T| < t)
-        const int n = 4000;
-        const double h = t / n;
-        double s = pdf(0) + pdf(t);
-        for (int i = 1; i < n; ++i) s += (i % 2 ? 4.0 : 2.0) * pdf(i * h);
-        return 2.0 * s * h / 3.0;
-    };
-    double lo = 0.0, hi = 200.0;
-    for (int i = 0; i < 100; ++i) {
-        const double mid = 0.5 * (lo + hi);
-        (1.0 - centralMass(mid) > alpha ? lo : hi) = mid;
-    }
-    return 0.5 * (lo + hi);
-}
-
 const Image& layer(const RenderOutput& out, const std::string& name) {
     for (const NamedLayer& l : out.layers)
         if (l.name == name) return l.image;
@@ -83,7 +62,7 @@ const char* estimateLayer(const std::string& method) {
 
 TEST_F(MltRender, FurnaceMeanIsOneForBothTargets) {
     const Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/furnace.gltf");
-    const double threshold = twoSidedT(test::sidakAlpha(1e-3, 2), kSeeds - 1);
+    const double threshold = test::twoSidedT(test::sidakAlpha(1e-3, 2), kSeeds - 1);
     for (const std::string method : {"pssmlt", "gmlt"}) {
         std::unique_ptr<Integrator> integrator = makeIntegrator(method);
         std::vector<double> means;
@@ -108,7 +87,7 @@ TEST_F(MltRender, CornellBoxQuadrantsMatchThePathTracer) {
     const RenderOutput pt = makeIntegrator("pt")->render(ctx(), scene, renderOptions(kSize, kSize, 1024, 7));
     const Image& ptImage = pt.image();
     const Image& ptVar = layer(pt, "variance");
-    const double threshold = twoSidedT(test::sidakAlpha(1e-3, 2 * 4 * 3), kSeeds - 1);
+    const double threshold = test::twoSidedT(test::sidakAlpha(1e-3, 2 * 4 * 3), kSeeds - 1);
     for (const std::string method : {"pssmlt", "gmlt"}) {
         std::unique_ptr<Integrator> integrator = makeIntegrator(method);
         std::vector<std::vector<double>> quadrant(12);

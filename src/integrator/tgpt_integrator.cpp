@@ -1,0 +1,274 @@
+// tgpt_integrator.cpp — temporal G-PT (tgpt_integrator.h).
+#include "integrator/tgpt_integrator.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <utility>
+
+#include "integrator/gpt_sampler.h"
+#include "integrator/reconstruction_stage.h"
+#include "integrator/render_identity.h"
+#include "poisson/poisson_spacetime.h"
+#include "util/error.h"
+#include "util/timer.h"
+
+namespace gdpt {
+namespace {
+
+// One frame's two half renders, combined.
+struct FrameSamples {
+    Image primal, dx, dy, direct, varPrimal, varDx, varDy, varDirect;
+    Image firstHalfPrimal;   // seeded σ(f): pairs with the previous frame's second half
+    Image secondHalfPrimal;  // seeded σ(f+1): pairs with the next frame's first half
+    RenderStats stats;
+};
+
+// The spp-weighted mean of two estimates, and the variance of that mean from theirs.
+Image weightedMean(const Image& a, double na, const Image& b, double nb) {
+    Image out = a;
+    const double wa = na / (na + nb), wb = nb / (na + nb);
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < out.pixelCount(); ++i)
+            out.plane(c)[i] = float(wa * a.plane(c)[i] + wb * b.plane(c)[i]);
+    return out;
+}
+
+Image weightedVariance(const Image& a, double na, const Image& b, double nb) {
+    Image out = a;
+    const double wa = na / (na + nb), wb = nb / (na + nb);
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < out.pixelCount(); ++i)
+            out.plane(c)[i] = float(wa * wa * a.plane(c)[i] + wb * wb * b.plane(c)[i]);
+    return out;
+}
+
+Image difference(const Image& a, const Image& b) {
+    Image out = a;
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < out.pixelCount(); ++i) out.plane(c)[i] = a.plane(c)[i] - b.plane(c)[i];
+    return out;
+}
+
+// The counters and times of two renders of one frame, added.
+RenderStats addStats(const RenderStats& a, const RenderStats& b) {
+    RenderStats s = a;
+    s.spp = a.spp + b.spp;
+    s.partialPassRows = std::max(a.partialPassRows, b.partialPassRows);
+    s.batches = a.batches + b.batches;
+    s.bvhBuildMs += b.bvhBuildMs;
+    s.uploadMs += b.uploadMs;
+    s.pipelineWaitMs += b.pipelineWaitMs;
+    s.samplingMs += b.samplingMs;
+    s.readbackMs += b.readbackMs;
+    s.raysTraced += b.raysTraced;
+    s.pathsCompleted += b.pathsCompleted;
+    s.nanSamples += b.nanSamples;
+    s.shiftPairs += b.shiftPairs;
+    s.shiftFailures += b.shiftFailures;
+    for (const auto& [name, t] : b.kernels) {
+        vk::KernelTime& k = s.kernels[name];
+        k.count += t.count;
+        k.totalMs += t.totalMs;
+    }
+    s.cancelled = a.cancelled || b.cancelled;
+    return s;
+}
+
+std::array<Field, 3> toFields(const Image& image) {
+    std::array<Field, 3> f;
+    for (int c = 0; c < 3; ++c) f[c].assign(image.plane(c).begin(), image.plane(c).end());
+    return f;
+}
+
+// Appends frame `k` of the window's images (W·H per channel) to a frame-major field.
+void append(std::array<Field, 3>& to, const Image& image) {
+    for (int c = 0; c < 3; ++c) to[c].insert(to[c].end(), image.plane(c).begin(), image.plane(c).end());
+}
+
+Image frameOf(const std::array<Field, 3>& x, std::size_t frame, int width, int height) {
+    Image out(width, height);
+    const std::size_t np = out.pixelCount();
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < np; ++i) out.plane(c)[i] = float(x[c][frame * np + i]);
+    return out;
+}
+
+}  // namespace
+
+TgptIntegrator::TgptIntegrator(TgptOptions options) : options_(std::move(options)) {
+    options_.sampling.demodulate = Demodulation::Off;
+    if (options_.window < 1) throw UsageError("--window must be at least 1 frame");
+}
+
+std::uint32_t TgptIntegrator::maxBatchSpp(int width, int height) const {
+    return maxBatchSppFor(width, height, kGptBatchPixelSamples);
+}
+
+ExrAttributes TgptIntegrator::identity(const Scene& scene, const RenderOptions& options) const {
+    (void)scene;
+    return {{"shift_threshold", exactFloat(options.scene.shiftThreshold)},
+            {"edge_samples", std::to_string(options_.sampling.edgeSamples)},
+            {"window", std::to_string(options_.window)}};
+}
+
+RenderOutput TgptIntegrator::render(const vk::Context& ctx, const Scene& scene, const RenderOptions& options) {
+    (void)ctx, (void)scene, (void)options;
+    throw UsageError(
+        "--method tgpt renders a sequence of frames (temporal differences between them): add --frames A:B");
+}
+
+std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, const FrameWindow& window,
+                                                       const RenderOptions& options) {
+    const int width = options.scene.width, height = options.scene.height;
+    const bool timed = options.timeBudget > 0.0;
+    Timer timer;
+    std::vector<RenderOutput> outputs;
+    std::vector<FrameSamples> frames;
+    if (window.startsSequence) carry_.reset();
+    const bool joined = carry_ && carry_->frame == window.first - 1;
+
+    // 1. Sampling: two half renders per frame, seeded σ(f) and σ(f+1).
+    for (int k = 0; k < window.count; ++k) {
+        const int frame = window.first + k;
+        const Scene scene = window.scene(frame);
+        RenderOptions half = options;
+        half.spp = std::max<std::uint32_t>(1, options.spp / 2);
+        half.whileCompiling = nullptr;
+        half.elapsedBefore = 0.0;
+        // Timed: what is left of the window's budget (less the last window's solve time),
+        // shared by the frames still to sample; each half takes half of the frame's share.
+        const double frameStart = timer.seconds();
+        const double share = std::max(1e-3, (options.timeBudget - options.elapsedBefore - frameStart -
+                                             lastSolveSeconds_ * double(window.count) / double(lastSolveFrames_)) /
+                                                double(window.count - k));
+        if (timed) half.timeBudget = 0.5 * share;
+        half.seed = window.seed(frame);
+        RenderResultGpt first = renderGpt(ctx, scene, half, options_.sampling);
+        if (first.stats.cancelled) {
+            outputs.push_back({{}, first.stats});
+            return outputs;
+        }
+        if (timed) half.timeBudget = std::max(1e-3, share - (timer.seconds() - frameStart));
+        half.seed = window.seed(frame + 1);
+        RenderResultGpt second = renderGpt(ctx, scene, half, options_.sampling);
+        if (second.stats.cancelled) {
+            outputs.push_back({{}, addStats(first.stats, second.stats)});
+            return outputs;
+        }
+        FrameSamples f;
+        const double na = first.stats.spp, nb = second.stats.spp;
+        f.primal = weightedMean(first.primal, na, second.primal, nb);
+        f.dx = weightedMean(first.dx, na, second.dx, nb);
+        f.dy = weightedMean(first.dy, na, second.dy, nb);
+        f.direct = weightedMean(first.direct, na, second.direct, nb);
+        f.varPrimal = weightedVariance(first.varPrimal, na, second.varPrimal, nb);
+        f.varDx = weightedVariance(first.varDx, na, second.varDx, nb);
+        f.varDy = weightedVariance(first.varDy, na, second.varDy, nb);
+        f.varDirect = weightedVariance(first.varDirect, na, second.varDirect, nb);
+        f.firstHalfPrimal = std::move(first.primal);
+        f.secondHalfPrimal = std::move(second.primal);
+        f.stats = addStats(first.stats, second.stats);
+        f.stats.tgpt.firstHalfSpp = first.stats.spp;
+        f.stats.tgpt.secondHalfSpp = second.stats.spp;
+        frames.push_back(std::move(f));
+    }
+
+    // 2. The space-time reconstruction of the window: dt_k = first half of k+1 − second
+    // half of k (the same random numbers in consecutive frames).
+    SpaceTimeProblem problem;
+    problem.width = width;
+    problem.height = height;
+    problem.frames = window.count;
+    problem.alpha = options_.alpha;
+    problem.beta = options_.beta;
+    std::vector<Image> dtToPrevious(frames.size());
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+        append(problem.primal, frames[k].primal);
+        append(problem.dx, frames[k].dx);
+        append(problem.dy, frames[k].dy);
+        if (k > 0) {
+            dtToPrevious[k] = difference(frames[k].firstHalfPrimal, frames[k - 1].secondHalfPrimal);
+            append(problem.dt, dtToPrevious[k]);
+        }
+    }
+    if (joined) {
+        dtToPrevious[0] = difference(frames[0].firstHalfPrimal, carry_->secondHalfPrimal);
+        problem.previous = carry_->recon;
+        problem.dtPrevious = toFields(dtToPrevious[0]);
+    }
+    SpaceTimeOptions solve;
+    solve.l1 = options_.l1;
+    solve.tolerance = options_.tolerance;
+    SpaceTimeStats solved;
+    const std::array<Field, 3> x = solveSpaceTime(problem, solve, &solved);
+    lastSolveSeconds_ = solved.ms * 1e-3;
+    lastSolveFrames_ = window.count;
+    if (!options.quiet)
+        std::fprintf(stderr, "gdpt: space-time %s reconstruction of frames %d-%d: %d iterations (%d IRLS), "
+                             "residual %.2g, %.1f ms\n",
+                     options_.l1 ? "l1" : "l2", window.first, window.first + window.count - 1, solved.iterations,
+                     solved.irlsIterations, solved.residual, solved.ms);
+
+    // 3. Compose each frame: reconstruction + very-direct light.
+    const std::string reconName = std::string("recon_spacetime_") + (options_.l1 ? "l1" : "l2");
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+        FrameSamples& f = frames[k];
+        Image recon = frameOf(x, k, width, height);
+        RenderOutput out;
+        out.stats = f.stats;
+        ReconstructionStats r;
+        r.method = "spacetime_" + std::string(options_.l1 ? "l1" : "l2");
+        r.iterations = solved.iterations;
+        r.irlsIterations = solved.irlsIterations;
+        r.residual = solved.residual;
+        r.tolerance = options_.tolerance;
+        r.converged = solved.converged;
+        r.ms = solved.ms / double(frames.size());  // the window's solve, shared by its frames
+        out.stats.reconstructions.push_back(r);
+        out.stats.reconstructionMs = r.ms;
+        out.stats.tgpt.windowFirst = window.first;
+        out.stats.tgpt.windowFrames = window.count;
+        out.stats.tgpt.temporalToPrevious = k > 0 || joined;
+        out.stats.tgpt.joinedPreviousWindow = joined;
+        if (dtToPrevious[k].empty()) dtToPrevious[k] = Image(width, height);
+        out.layers.push_back({"", gptFinal(recon, nullptr, &f.direct)});
+        Image primalPlusDirect = gptFinal(f.primal, nullptr, &f.direct);
+        out.layers.push_back({reconName, std::move(recon)});
+        out.layers.push_back({"primal", std::move(f.primal)});
+        out.layers.push_back({"dx", std::move(f.dx)});
+        out.layers.push_back({"dy", std::move(f.dy)});
+        out.layers.push_back({"dt", std::move(dtToPrevious[k])});
+        out.layers.push_back({"direct", std::move(f.direct)});
+        out.layers.push_back({"var_primal", std::move(f.varPrimal)});
+        out.layers.push_back({"var_dx", std::move(f.varDx)});
+        out.layers.push_back({"var_dy", std::move(f.varDy)});
+        out.layers.push_back({"var_direct", std::move(f.varDirect)});
+        out.layers.push_back({"primal_plus_direct", std::move(primalPlusDirect)});
+        outputs.push_back(std::move(out));
+    }
+    carry_ = Carry{window.first + window.count - 1, {}, std::move(frames.back().secondHalfPrimal)};
+    const std::size_t last = std::size_t(window.count - 1) * std::size_t(width) * std::size_t(height);
+    for (int c = 0; c < 3; ++c)
+        carry_->recon[c].assign(x[c].begin() + std::ptrdiff_t(last), x[c].end());
+    return outputs;
+}
+
+void TgptIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
+    j["edge_samples"] = {{"factor", s.edgeSamples}, {"pixels", s.edgePixels}};
+    j["reconstructions"] = reconstructionsJson(s);
+    j["tgpt"] = {{"window_first", s.tgpt.windowFirst},
+                 {"window_frames", s.tgpt.windowFrames},
+                 {"first_half_spp", s.tgpt.firstHalfSpp},
+                 {"second_half_spp", s.tgpt.secondHalfSpp},
+                 {"temporal_to_previous", s.tgpt.temporalToPrevious},
+                 {"joined_previous_window", s.tgpt.joinedPreviousWindow},
+                 {"alpha", options_.alpha},
+                 {"beta", options_.beta}};
+}
+
+std::string TgptIntegrator::summary(const RenderStats& s) const {
+    return ", window " + std::to_string(s.tgpt.windowFirst) + "+" + std::to_string(s.tgpt.windowFrames);
+}
+
+}  // namespace gdpt
