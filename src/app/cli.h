@@ -61,6 +61,13 @@ struct DiffArgs {
     std::string json;
 };
 
+struct DiffSequenceArgs {
+    std::string test;       // frame pattern, e.g. out/f_%04d.exr
+    std::string reference;  // frame pattern of the reference sequence
+    std::string frames;     // "A:B"
+    std::string json;
+};
+
 struct InfoArgs {
     std::string scene;
     std::string env = "0,0,0";

@@ -1,7 +1,8 @@
-// commands.cpp — the small subcommands: diff, info, devices (render is render_command.cpp).
+// commands.cpp — the small subcommands: diff, diff-sequence, info, devices (render is render_command.cpp).
 #include "app/commands.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -18,6 +19,7 @@
 #include "scene/gltf_loader.h"
 #include "scene/light_sources.h"
 #include "util/error.h"
+#include "util/frame_pattern.h"
 #include "util/output_files.h"
 #include "vk/context.h"
 
@@ -93,6 +95,50 @@ int runDiff(const DiffArgs& args) {
     if (args.json != "-")
         std::printf("relMSE %.6g  MSE %.6g  MAE %.6g  max %.6g  bias %.3g  (%zu pixels, %zu non-finite)\n",
                     e.relMse, e.mse, e.mae, e.maxAbsError, e.meanBias, e.finitePixels, e.nonFinitePixels);
+    return 0;
+}
+
+int runDiffSequence(const DiffSequenceArgs& args) {
+    const FrameRange range = parseFrameRange(args.frames, "--frames");
+    if (!hasFrameNumber(args.test, "test") || !hasFrameNumber(args.reference, "reference"))
+        throw UsageError("diff-sequence compares sequences: both paths take a frame number (e.g. out/f_%04d.exr)");
+    OutputSet outputs;
+    const TextOutput jsonOutput(outputs, args.json, "--json");
+    json frames = json::array();
+    double relSum = 0.0, temporalSum = 0.0;
+    Image testBefore, referenceBefore;
+    for (int f = range.first; f <= range.last; ++f) {
+        const std::string testPath = framePath(args.test, f), referencePath = framePath(args.reference, f);
+        for (const std::string* p : {&testPath, &referencePath})
+            if (!std::filesystem::is_regular_file(*p)) throw Error(*p + ": no such frame");
+        Image test = readExrLayer(testPath), reference = readExrLayer(referencePath);
+        if (!test.sameSize(reference))
+            throw Error("cannot compare " + testPath + " with " + referencePath + ": the sizes differ");
+        json j = {{"frame", f}, {"relmse", relMse(test, reference)}};
+        relSum += j["relmse"].get<double>();
+        if (f > range.first) {
+            const double t = temporalRelMse(testBefore, test, referenceBefore, reference);
+            j["temporal_relmse"] = t;  // of the change from the frame before
+            temporalSum += t;
+        }
+        frames.push_back(std::move(j));
+        testBefore = std::move(test);
+        referenceBefore = std::move(reference);
+    }
+    const double meanRel = relSum / range.count();
+    const double meanTemporal = range.count() > 1 ? temporalSum / (range.count() - 1) : 0.0;
+    jsonOutput.write(json{{"test", args.test},
+                          {"reference", args.reference},
+                          {"frames", {{"first", range.first}, {"last", range.last}}},
+                          {"mean_relmse", meanRel},
+                          {"mean_temporal_relmse", meanTemporal},
+                          {"per_frame", std::move(frames)}}
+                         .dump(2) +
+                     "\n");
+    outputs.commit();
+    if (args.json != "-")
+        std::printf("frames %d-%d: mean relMSE %.6g, mean temporal relMSE %.6g\n", range.first, range.last, meanRel,
+                    meanTemporal);
     return 0;
 }
 
@@ -195,6 +241,20 @@ Subcommand addDiffCommand(CLI::App& app) {
     d->add_option("--json", diff.json, "Write the metrics as JSON to this file ('-' = stdout)");
 
     return {d, [args] { return runDiff(*args); }};
+}
+
+Subcommand addDiffSequenceCommand(CLI::App& app) {
+    auto args = std::make_shared<DiffSequenceArgs>();
+    auto& d = *args;
+    CLI::App* c = app.add_subcommand(
+        "diff-sequence",
+        "Compare two EXR sequences frame by frame: each frame's relMSE and the temporal relMSE (the error of "
+        "the frame-to-frame change; flicker)");
+    c->add_option("test", d.test, "Frames to evaluate, with a frame number (e.g. out/f_%04d.exr)")->required();
+    c->add_option("reference", d.reference, "Reference frames, with a frame number")->required();
+    c->add_option("--frames", d.frames, "A:B: the frames to compare")->required();
+    c->add_option("--json", d.json, "Write the metrics as JSON to this file ('-' = stdout)");
+    return {c, [args] { return runDiffSequence(*args); }};
 }
 
 Subcommand addInfoCommand(CLI::App& app) {

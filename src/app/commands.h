@@ -20,6 +20,7 @@ std::string renderArgsJson(const RenderArgs& args);
 RenderArgs renderArgsFromJson(const std::string& text, const std::string& where);
 int runDiff(const DiffArgs& args);
 int runInfo(const InfoArgs& args);
+int runDiffSequence(const DiffSequenceArgs& args);
 int runDevices(const DevicesArgs& args);
 
 }  // namespace gdpt

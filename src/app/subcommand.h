@@ -17,6 +17,7 @@ struct Subcommand {
 
 Subcommand addRenderCommand(CLI::App& app);
 Subcommand addDiffCommand(CLI::App& app);
+Subcommand addDiffSequenceCommand(CLI::App& app);
 Subcommand addInfoCommand(CLI::App& app);
 Subcommand addDevicesCommand(CLI::App& app);
 Subcommand addBenchCommand(CLI::App& app);

@@ -66,6 +66,28 @@ ImageErrorStats compareImages(const Image& test, const Image& reference) {
     return s;
 }
 
+double temporalRelMse(const Image& test0, const Image& test1, const Image& reference0, const Image& reference1) {
+    for (const Image* im : {&test1, &reference0, &reference1})
+        if (!im->sameSize(test0)) throw Error("cannot compare frames of different sizes");
+    double sum = 0.0;
+    std::size_t pixels = 0;
+    for (std::size_t i = 0; i < test0.pixelCount(); ++i) {
+        double d[3], gray = 0.0;
+        bool finite = true;
+        for (int c = 0; c < 3; ++c) {
+            const double t0 = test0.plane(c)[i], t1 = test1.plane(c)[i];
+            const double r0 = reference0.plane(c)[i], r1 = reference1.plane(c)[i];
+            finite = finite && std::isfinite(t0) && std::isfinite(t1) && std::isfinite(r0) && std::isfinite(r1);
+            d[c] = (t1 - t0) - (r1 - r0);
+            gray += 0.5 * (r0 + r1) / 3.0;
+        }
+        if (!finite) continue;
+        ++pixels;
+        sum += (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) / (kRelMseEpsilon + gray * gray);
+    }
+    return pixels ? sum / double(pixels) : std::numeric_limits<double>::quiet_NaN();
+}
+
 double relMse(const Image& test, const Image& reference) {
     return compareImages(test, reference).relMse;
 }

@@ -35,6 +35,15 @@ struct ImageErrorStats {
 // All metrics of `test` against `reference`. Throws gdpt::Error if the sizes differ.
 ImageErrorStats compareImages(const Image& test, const Image& reference);
 
+// The temporal error of a sequence between two consecutive frames: the relMSE of the test's
+// frame-to-frame change against the reference's change,
+//     mean over pixels of Σ_c ((T1 − T0)_pc − (R1 − R0)_pc)² / (1e-3 + gray((R0 + R1)/2)_p²),
+// the relMSE above applied to the differences (normalised by the reference's mean value at
+// the pixel, as relMSE is). Flicker (independent noise per frame) shows here even where each
+// frame alone is close to its reference. Pixels with a non-finite value in any of the four
+// images are left out. Throws gdpt::Error if the sizes differ.
+double temporalRelMse(const Image& test0, const Image& test1, const Image& reference0, const Image& reference1);
+
 // Shorthands for compareImages(test, reference).<metric>.
 double relMse(const Image& test, const Image& reference);
 double mse(const Image& test, const Image& reference);
