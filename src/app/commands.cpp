@@ -101,7 +101,8 @@ int runDiff(const DiffArgs& args) {
 int runDiffSequence(const DiffSequenceArgs& args) {
     const FrameRange range = parseFrameRange(args.frames, "--frames");
     if (!hasFrameNumber(args.test, "test") || !hasFrameNumber(args.reference, "reference"))
-        throw UsageError("diff-sequence compares sequences: both paths take a frame number (e.g. out/f_%04d.exr)");
+        throw UsageError(
+            "diff-sequence compares sequences: both paths take a frame number (e.g. out/f_%04d.exr)");
     OutputSet outputs;
     const TextOutput jsonOutput(outputs, args.json, "--json");
     json frames = json::array();
@@ -137,8 +138,8 @@ int runDiffSequence(const DiffSequenceArgs& args) {
                      "\n");
     outputs.commit();
     if (args.json != "-")
-        std::printf("frames %d-%d: mean relMSE %.6g, mean temporal relMSE %.6g\n", range.first, range.last, meanRel,
-                    meanTemporal);
+        std::printf("frames %d-%d: mean relMSE %.6g, mean temporal relMSE %.6g\n", range.first, range.last,
+                    meanRel, meanTemporal);
     return 0;
 }
 
@@ -250,7 +251,8 @@ Subcommand addDiffSequenceCommand(CLI::App& app) {
         "diff-sequence",
         "Compare two EXR sequences frame by frame: each frame's relMSE and the temporal relMSE (the error of "
         "the frame-to-frame change; flicker)");
-    c->add_option("test", d.test, "Frames to evaluate, with a frame number (e.g. out/f_%04d.exr)")->required();
+    c->add_option("test", d.test, "Frames to evaluate, with a frame number (e.g. out/f_%04d.exr)")
+        ->required();
     c->add_option("reference", d.reference, "Reference frames, with a frame number")->required();
     c->add_option("--frames", d.frames, "A:B: the frames to compare")->required();
     c->add_option("--json", d.json, "Write the metrics as JSON to this file ('-' = stdout)");

@@ -21,10 +21,11 @@ int run(int argc, char** argv) {
     app.set_help_all_flag("--help-all", "Print help for all subcommands");
 
     const std::vector<Subcommand> commands = {
-        addRenderCommand(app),        addDiffCommand(app), addDiffSequenceCommand(app),  addInfoCommand(app),
-        addDevicesCommand(app),       addBenchCommand(app), addConvergeCommand(app),
-        addSolveCommand(app),         addCloneCommand(app), addBenchPoissonCommand(app),
-        addBenchFeaturesCommand(app), addMergeCommand(app), addBenchMergeCommand(app),
+        addRenderCommand(app),       addDiffCommand(app),          addDiffSequenceCommand(app),
+        addInfoCommand(app),         addDevicesCommand(app),       addBenchCommand(app),
+        addConvergeCommand(app),     addSolveCommand(app),         addCloneCommand(app),
+        addBenchPoissonCommand(app), addBenchFeaturesCommand(app), addMergeCommand(app),
+        addBenchMergeCommand(app),
     };
 
     try {

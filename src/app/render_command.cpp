@@ -161,8 +161,10 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
         loaded.emplace(asset.instance());
         const Scene& scene = *loaded;
         if (!asset.animations().empty() && !quiet)
-            std::fprintf(stderr, "gdpt: note: %s has %zu animation(s); the rest pose is rendered (--frames renders them)\n",
-                         args.scene.c_str(), asset.animations().size());
+            std::fprintf(
+                stderr,
+                "gdpt: note: %s has %zu animation(s); the rest pose is rendered (--frames renders them)\n",
+                args.scene.c_str(), asset.animations().size());
         throwIfInterrupted("loading");
         if (!scene.unsupported.empty() && !quiet) {
             std::string list;
@@ -368,10 +370,11 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->group(image);
 
     const char* sampling = "Sampling";
-    r->add_option("--method", a.method,
-                  "gpt: gradient-domain path tracing; pt: path tracing (docs/gpt.md); gmlt: gradient-domain "
-                  "Metropolis; pssmlt: primary-sample-space Metropolis (docs/mlt.md); tgpt: temporal G-PT of a "
-                  "sequence (--frames; docs/animation.md)")
+    r->add_option(
+         "--method", a.method,
+         "gpt: gradient-domain path tracing; pt: path tracing (docs/gpt.md); gmlt: gradient-domain "
+         "Metropolis; pssmlt: primary-sample-space Metropolis (docs/mlt.md); tgpt: temporal G-PT of a "
+         "sequence (--frames; docs/animation.md)")
         ->capture_default_str()
         ->check(CLI::IsMember(methodNames()))
         ->group(sampling);
@@ -448,17 +451,19 @@ Subcommand addRenderCommand(CLI::App& app) {
 
     const char* animation = "Animation (docs/animation.md)";
     CLI::Option* frames =
-        r->add_option("--frames", a.frames,
-                      "A:B: render frames A to B of an animation, frame k at time k/fps; -o takes a frame number "
-                      "(e.g. out/frame_%04d.exr, directory created); each frame's EXR + PNG is written when it is "
-                      "done, and an MP4 of the PNGs when ffmpeg is installed. --time is the whole sequence's")
+        r->add_option(
+             "--frames", a.frames,
+             "A:B: render frames A to B of an animation, frame k at time k/fps; -o takes a frame number "
+             "(e.g. out/frame_%04d.exr, directory created); each frame's EXR + PNG is written when it is "
+             "done, and an MP4 of the PNGs when ffmpeg is installed. --time is the whole sequence's")
             ->group(animation);
     r->add_option("--fps", a.fps, "Frames per second of --frames")
         ->capture_default_str()
         ->check(CLI::Range(1e-3, 1e4))
         ->needs(frames)
         ->group(animation);
-    r->add_option("--animation", a.animation, "The animation to render, by name or index (default: the first)")
+    r->add_option("--animation", a.animation,
+                  "The animation to render, by name or index (default: the first)")
         ->needs(frames)
         ->group(animation);
     r->add_flag("--no-video", a.noVideo, "No MP4 of the sequence even when ffmpeg is installed")

@@ -50,7 +50,6 @@ std::string previewPath(const std::string& exrPath) {
     return (hasExt ? exrPath.substr(0, dot) : exrPath) + ".png";
 }
 
-
 void printProfile(const std::map<std::string, vk::KernelTime>& kernels) {
     double total = 0.0;
     for (const auto& [name, t] : kernels) total += t.totalMs;
@@ -118,7 +117,6 @@ RenderOptions renderOptionsFor(const RenderArgs& args) {
     return o;
 }
 
-
 json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrator& integrator,
                  const RenderStats& s, double seconds, double reserved, double finishReserved,
                  double writeMs) {
@@ -185,9 +183,11 @@ void checkArgs(const RenderArgs& args) {
             "give; --method gmlt reconstructs with l1 or l2");
     if (args.method == "tgpt") {
         if (args.frames.empty())
-            throw UsageError("--method tgpt renders a sequence (temporal differences between frames): add --frames A:B");
+            throw UsageError(
+                "--method tgpt renders a sequence (temporal differences between frames): add --frames A:B");
         if (args.recon == "wl1" || args.recon == "wl2" || args.allRecon)
-            throw UsageError("--method tgpt reconstructs with --recon l1 or l2 (one space-time solve per window)");
+            throw UsageError(
+                "--method tgpt reconstructs with --recon l1 or l2 (one space-time solve per window)");
         if (args.demodulate == "on")
             throw UsageError(
                 "--method tgpt does not demodulate (a frame's texture modulation differs from the next one's "

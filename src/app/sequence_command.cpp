@@ -43,7 +43,8 @@ void checkSequenceArgs(const RenderArgs& args, const FrameRange& range) {
     if (!args.shard.empty())
         throw UsageError("--shard splits one image; split a sequence by its frames (--frames A:B per job)");
     if (MpiWorld::get())
-        throw UsageError("a sequence under mpirun is not supported; run one gdpt per range of --frames instead");
+        throw UsageError(
+            "a sequence under mpirun is not supported; run one gdpt per range of --frames instead");
     if (!hasFrameNumber(args.output, "-o") && range.count() > 1)
         throw UsageError("-o " + args.output + ": " + std::to_string(range.count()) +
                          " frames need a frame number in the output name, e.g. -o frames/frame_%04d.exr");
@@ -102,7 +103,8 @@ int runSequence(const RenderArgs& args) {
     if (animation < 0 && !quiet)
         std::fprintf(stderr, "gdpt: note: %s has no animations; every frame is the same still scene\n",
                      args.scene.c_str());
-    const double duration = animation >= 0 ? asset.animations()[static_cast<std::size_t>(animation)].duration() : 0.0;
+    const double duration =
+        animation >= 0 ? asset.animations()[static_cast<std::size_t>(animation)].duration() : 0.0;
     throwIfInterrupted("loading");
 
     vk::ContextOptions ctxOptions;
@@ -111,10 +113,12 @@ int runSequence(const RenderArgs& args) {
     ctxOptions.keepPipelines = true;  // every frame's kernels compile once (vk/pipeline_cache.h)
     const vk::Context ctx(ctxOptions);
     if (!quiet)
-        std::fprintf(stderr, "gdpt: device '%s' (%s, %s); %d frames at %g fps%s\n", ctx.info().name.c_str(),
-                     ctx.info().type.c_str(), ctx.info().driverInfo.c_str(), range.count(), args.fps,
-                     animation >= 0 ? (", animation " + std::to_string(animation) + " (" + seconds(duration) + ")").c_str()
-                                    : "");
+        std::fprintf(
+            stderr, "gdpt: device '%s' (%s, %s); %d frames at %g fps%s\n", ctx.info().name.c_str(),
+            ctx.info().type.c_str(), ctx.info().driverInfo.c_str(), range.count(), args.fps,
+            animation >= 0
+                ? (", animation " + std::to_string(animation) + " (" + seconds(duration) + ")").c_str()
+                : "");
     std::unique_ptr<Integrator> integrator = integratorFor(args, &cache);
     const double reserved = timed ? integrator->reserveAfterSampling(ctx, args.width, args.height) : 0.0;
 
@@ -125,12 +129,14 @@ int runSequence(const RenderArgs& args) {
     // An interrupt ends the sequence with exit 130; the frames before the current one are
     // written whole, the current one not at all.
     const auto interrupted = [&](const std::string& phase) {
-        const std::string written = frame == range.first       ? "no frame written"
-                                    : frame == range.first + 1 ? "frame " + std::to_string(range.first) + " written"
-                                                               : "frames " + std::to_string(range.first) + " to " +
-                                                                     std::to_string(frame - 1) + " written";
+        const std::string written =
+            frame == range.first ? "no frame written"
+            : frame == range.first + 1
+                ? "frame " + std::to_string(range.first) + " written"
+                : "frames " + std::to_string(range.first) + " to " + std::to_string(frame - 1) + " written";
         if (frame > range.last)
-            std::fprintf(stderr, "gdpt: interrupted while %s; all %d frames written\n", phase.c_str(), range.count());
+            std::fprintf(stderr, "gdpt: interrupted while %s; all %d frames written\n", phase.c_str(),
+                         range.count());
         else
             std::fprintf(stderr, "gdpt: interrupted while %s frame %d; %s (continue with --frames %d:%d)\n",
                          phase.c_str(), frame, written.c_str(), frame, range.last);
@@ -145,7 +151,8 @@ int runSequence(const RenderArgs& args) {
             if (!scene.unsupported.empty()) {
                 std::string list;
                 for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
-                std::fprintf(stderr, "gdpt: warning: %s: not rendered: %s\n", args.scene.c_str(), list.c_str());
+                std::fprintf(stderr, "gdpt: warning: %s: not rendered: %s\n", args.scene.c_str(),
+                             list.c_str());
             }
             if (const auto black = blackImageWarning(scene, options.scene.envRadiance))
                 std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
@@ -176,7 +183,8 @@ int runSequence(const RenderArgs& args) {
             RenderArgs frameArgs = args;
             frameArgs.output = exrPath;
             frameArgs.seed = sequenceFrameSeed(args.seed, frame);
-            json j = summaryJson(frameArgs, ctx, *integrator, s, frameSeconds, reserved, afterSamplingSeconds, writeMs);
+            json j = summaryJson(frameArgs, ctx, *integrator, s, frameSeconds, reserved, afterSamplingSeconds,
+                                 writeMs);
             j["frame"] = frame;
             j["time"] = time;
             frames.push_back(std::move(j));
@@ -185,10 +193,11 @@ int runSequence(const RenderArgs& args) {
             const int done = frame - range.first + 1, left = range.last - frame;
             const double elapsed = total.seconds();
             const double remaining = elapsed / double(done) * double(left);
-            std::fprintf(stderr, "gdpt: frame %d (%d/%d, t = %.4g s): wrote %s (%u spp%s, %s); sequence %s, %s\n",
-                         frame, done, range.count(), time, exrPath.c_str(), s.spp, integrator->summary(s).c_str(),
-                         seconds(frameSeconds).c_str(), seconds(elapsed).c_str(),
-                         left > 0 ? ("about " + seconds(remaining) + " left").c_str() : "done");
+            std::fprintf(
+                stderr, "gdpt: frame %d (%d/%d, t = %.4g s): wrote %s (%u spp%s, %s); sequence %s, %s\n",
+                frame, done, range.count(), time, exrPath.c_str(), s.spp, integrator->summary(s).c_str(),
+                seconds(frameSeconds).c_str(), seconds(elapsed).c_str(),
+                left > 0 ? ("about " + seconds(remaining) + " left").c_str() : "done");
         }
         if (args.profile) printProfile(s.kernels);
     };
@@ -250,38 +259,41 @@ int runSequence(const RenderArgs& args) {
     if (ffmpeg) {
         enterPhase("writing");
         const std::string pngPattern = previewPath(args.output);
-        const std::string failure = encodeVideo(*ffmpeg, pngPattern, range.first, range.count(), args.fps, video);
+        const std::string failure =
+            encodeVideo(*ffmpeg, pngPattern, range.first, range.count(), args.fps, video);
         if (interruptRequested()) return interrupted("writing the video");
         if (!failure.empty()) {
-            if (!quiet) std::fprintf(stderr, "gdpt: warning: no video of the sequence: %s\n", failure.c_str());
+            if (!quiet)
+                std::fprintf(stderr, "gdpt: warning: no video of the sequence: %s\n", failure.c_str());
         } else {
             videoNote = ", video " + video;
         }
     }
     if (jsonOutput.wanted()) {
-        json summary = {{"scene", args.scene},
-                        {"output", args.output},
-                        {"method", args.method},
-                        {"device", ctx.info().name},
-                        {"frames", {{"first", range.first}, {"last", range.last}, {"count", range.count()}}},
-                        {"fps", args.fps},
-                        {"animation",
-                         animation >= 0 ? json{{"index", animation},
-                                               {"name", asset.animations()[static_cast<std::size_t>(animation)].name},
-                                               {"duration", duration}}
-                                        : json(nullptr)},
-                        {"time_budget", args.time},
-                        {"time_s", total.seconds()},
-                        {"video", videoNote.empty() ? json(nullptr) : json(video)},
-                        {"validation_errors", ctx.validationErrors()},
-                        {"frame_summaries", std::move(frames)}};
+        json summary = {
+            {"scene", args.scene},
+            {"output", args.output},
+            {"method", args.method},
+            {"device", ctx.info().name},
+            {"frames", {{"first", range.first}, {"last", range.last}, {"count", range.count()}}},
+            {"fps", args.fps},
+            {"animation", animation >= 0
+                              ? json{{"index", animation},
+                                     {"name", asset.animations()[static_cast<std::size_t>(animation)].name},
+                                     {"duration", duration}}
+                              : json(nullptr)},
+            {"time_budget", args.time},
+            {"time_s", total.seconds()},
+            {"video", videoNote.empty() ? json(nullptr) : json(video)},
+            {"validation_errors", ctx.validationErrors()},
+            {"frame_summaries", std::move(frames)}};
         jsonOutput.write(summary.dump(2) + "\n");
         if (interruptRequested()) return interrupted("writing the summary");
     }
     sequenceOutputs.commit();
     if (!quiet)
-        std::fprintf(stderr, "gdpt: wrote %d frames %s%s in %s\n", range.count(), args.output.c_str(), videoNote.c_str(),
-                     seconds(total.seconds()).c_str());
+        std::fprintf(stderr, "gdpt: wrote %d frames %s%s in %s\n", range.count(), args.output.c_str(),
+                     videoNote.c_str(), seconds(total.seconds()).c_str());
     if (ctx.validationErrors() > 0) {
         std::fprintf(stderr, "gdpt: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
         return 1;

@@ -32,8 +32,8 @@ std::optional<std::string> findFfmpeg() {
     return std::nullopt;
 }
 
-std::string encodeVideo(const std::string& ffmpeg, const std::string& pngPattern, int first, int count, double fps,
-                        const std::string& videoPath) {
+std::string encodeVideo(const std::string& ffmpeg, const std::string& pngPattern, int first, int count,
+                        double fps, const std::string& videoPath) {
     StagedFile video(videoPath);
     char rate[32];
     std::snprintf(rate, sizeof rate, "%.9g", fps);

@@ -15,7 +15,7 @@ namespace gdpt {
 // at `fps` into `videoPath` (MP4, H.264, yuv420p, odd sizes padded by a pixel), written whole
 // or not at all (util/output_files.h). Returns "" on success, else why not (ffmpeg's exit
 // status); ffmpeg's own messages go to stderr.
-[[nodiscard]] std::string encodeVideo(const std::string& ffmpeg, const std::string& pngPattern, int first, int count,
-                                      double fps, const std::string& videoPath);
+[[nodiscard]] std::string encodeVideo(const std::string& ffmpeg, const std::string& pngPattern, int first,
+                                      int count, double fps, const std::string& videoPath);
 
 }  // namespace gdpt

@@ -66,7 +66,8 @@ ImageErrorStats compareImages(const Image& test, const Image& reference) {
     return s;
 }
 
-double temporalRelMse(const Image& test0, const Image& test1, const Image& reference0, const Image& reference1) {
+double temporalRelMse(const Image& test0, const Image& test1, const Image& reference0,
+                      const Image& reference1) {
     for (const Image* im : {&test1, &reference0, &reference1})
         if (!im->sameSize(test0)) throw Error("cannot compare frames of different sizes");
     double sum = 0.0;
@@ -77,7 +78,8 @@ double temporalRelMse(const Image& test0, const Image& test1, const Image& refer
         for (int c = 0; c < 3; ++c) {
             const double t0 = test0.plane(c)[i], t1 = test1.plane(c)[i];
             const double r0 = reference0.plane(c)[i], r1 = reference1.plane(c)[i];
-            finite = finite && std::isfinite(t0) && std::isfinite(t1) && std::isfinite(r0) && std::isfinite(r1);
+            finite =
+                finite && std::isfinite(t0) && std::isfinite(t1) && std::isfinite(r0) && std::isfinite(r1);
             d[c] = (t1 - t0) - (r1 - r0);
             gray += 0.5 * (r0 + r1) / 3.0;
         }

@@ -42,7 +42,8 @@ ImageErrorStats compareImages(const Image& test, const Image& reference);
 // the pixel, as relMSE is). Flicker (independent noise per frame) shows here even where each
 // frame alone is close to its reference. Pixels with a non-finite value in any of the four
 // images are left out. Throws gdpt::Error if the sizes differ.
-double temporalRelMse(const Image& test0, const Image& test1, const Image& reference0, const Image& reference1);
+double temporalRelMse(const Image& test0, const Image& test1, const Image& reference0,
+                      const Image& reference1);
 
 // Shorthands for compareImages(test, reference).<metric>.
 double relMse(const Image& test, const Image& reference);

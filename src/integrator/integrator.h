@@ -40,9 +40,9 @@ struct RenderOutput {
 struct FrameWindow {
     int first = 0;  // frames first .. first + count - 1
     int count = 0;
-    std::function<Scene(int frame)> scene;            // the scene at a frame's time
-    std::function<std::uint32_t(int frame)> seed;     // a frame's seed (frame_pattern.h sequenceFrameSeed)
-    bool startsSequence = true;                       // no frame before it (else the method's last window)
+    std::function<Scene(int frame)> scene;         // the scene at a frame's time
+    std::function<std::uint32_t(int frame)> seed;  // a frame's seed (frame_pattern.h sequenceFrameSeed)
+    bool startsSequence = true;                    // no frame before it (else the method's last window)
 };
 
 class Integrator {
@@ -132,9 +132,9 @@ struct MethodOptions {
     TgptOptions tgpt;
 };
 
-// Makes the integrator of `name`: a method name ("pt", "gpt", "pssmlt", "gmlt", "tgpt"), or "gpt-<reconstruction>"
-// (gpt-l1, gpt-l2, gpt-wl1, gpt-wl2: G-PT with that reconstruction alone, as `converge`
-// names its methods). Throws gdpt::UsageError naming the known methods otherwise.
+// Makes the integrator of `name`: a method name ("pt", "gpt", "pssmlt", "gmlt", "tgpt"), or
+// "gpt-<reconstruction>" (gpt-l1, gpt-l2, gpt-wl1, gpt-wl2: G-PT with that reconstruction alone, as
+// `converge` names its methods). Throws gdpt::UsageError naming the known methods otherwise.
 std::unique_ptr<Integrator> makeIntegrator(const std::string& name, const MethodOptions& options = {});
 
 // The method names makeIntegrator knows, and with the gpt-<reconstruction> forms.

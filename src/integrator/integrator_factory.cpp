@@ -16,8 +16,8 @@ const std::vector<std::string>& methodNames() {
 }
 
 const std::vector<std::string>& methodVariantNames() {
-    static const std::vector<std::string> names = {"pt",      "gpt",     "gpt-l1", "gpt-l2",
-                                                   "gpt-wl1", "gpt-wl2", "pssmlt", "gmlt", "tgpt"};
+    static const std::vector<std::string> names = {"pt",      "gpt",    "gpt-l1", "gpt-l2", "gpt-wl1",
+                                                   "gpt-wl2", "pssmlt", "gmlt",   "tgpt"};
     return names;
 }
 

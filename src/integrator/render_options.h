@@ -106,12 +106,12 @@ struct MltStats {
 
 // Temporal G-PT (tgpt): the window a frame was reconstructed in, and its two half renders.
 struct TgptStats {
-    int windowFirst = 0;                 // first frame of the window
-    int windowFrames = 0;                // frames reconstructed together
-    std::uint32_t firstHalfSpp = 0;      // samples per pixel seeded with the frame's own seed
-    std::uint32_t secondHalfSpp = 0;     // ... with the next frame's seed (paired with it)
-    bool temporalToPrevious = false;     // the frame has a dt to the frame before it
-    bool joinedPreviousWindow = false;   // the window's solve was tied to the window before
+    int windowFirst = 0;                // first frame of the window
+    int windowFrames = 0;               // frames reconstructed together
+    std::uint32_t firstHalfSpp = 0;     // samples per pixel seeded with the frame's own seed
+    std::uint32_t secondHalfSpp = 0;    // ... with the next frame's seed (paired with it)
+    bool temporalToPrevious = false;    // the frame has a dt to the frame before it
+    bool joinedPreviousWindow = false;  // the window's solve was tied to the window before
 };
 
 struct RenderStats {

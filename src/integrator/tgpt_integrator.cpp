@@ -1,6 +1,8 @@
 // tgpt_integrator.cpp — temporal G-PT (tgpt_integrator.h).
 #include "integrator/tgpt_integrator.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -94,6 +96,34 @@ Image frameOf(const std::array<Field, 3>& x, std::size_t frame, int width, int h
     return out;
 }
 
+// What a window keeps: the solver's fields, and per frame twelve float RGB images (the halves'
+// primals, the combined estimates and variances) until it is written.
+std::uint64_t windowBytes(int width, int height, int frames) {
+    return spaceTimeSolveBytes(width, height, frames) +
+           std::uint64_t(width) * std::uint64_t(height) * std::uint64_t(frames) * 12u * 3u * 4u;
+}
+
+std::string gibibytes(std::uint64_t bytes) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f GiB", double(bytes) / double(1ull << 30));
+    return text;
+}
+
+// Refuses a window larger than the machine's memory, before it is sampled.
+void checkWindowMemory(int width, int height, int frames) {
+    const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || pageSize <= 0) return;
+    const std::uint64_t memory = std::uint64_t(pages) * std::uint64_t(pageSize);
+    const std::uint64_t need = windowBytes(width, height, frames);
+    if (need <= memory) return;
+    const std::uint64_t perFrame = windowBytes(width, height, 1);
+    throw Error("a tgpt window of " + std::to_string(frames) + " frames of " + std::to_string(width) + "x" +
+                std::to_string(height) + " needs about " + gibibytes(need) +
+                " for its space-time reconstruction, more than this machine's " + gibibytes(memory) +
+                "; the largest window that fits is " + std::to_string(memory / perFrame) +
+                " frames (--window), or render smaller frames");
+}
+
 }  // namespace
 
 TgptIntegrator::TgptIntegrator(TgptOptions options) : options_(std::move(options)) {
@@ -112,7 +142,8 @@ ExrAttributes TgptIntegrator::identity(const Scene& scene, const RenderOptions& 
             {"window", std::to_string(options_.window)}};
 }
 
-RenderOutput TgptIntegrator::render(const vk::Context& ctx, const Scene& scene, const RenderOptions& options) {
+RenderOutput TgptIntegrator::render(const vk::Context& ctx, const Scene& scene,
+                                    const RenderOptions& options) {
     (void)ctx, (void)scene, (void)options;
     throw UsageError(
         "--method tgpt renders a sequence of frames (temporal differences between them): add --frames A:B");
@@ -121,6 +152,7 @@ RenderOutput TgptIntegrator::render(const vk::Context& ctx, const Scene& scene, 
 std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, const FrameWindow& window,
                                                        const RenderOptions& options) {
     const int width = options.scene.width, height = options.scene.height;
+    checkWindowMemory(width, height, window.count);
     const bool timed = options.timeBudget > 0.0;
     Timer timer;
     std::vector<RenderOutput> outputs;
@@ -139,9 +171,10 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         // Timed: what is left of the window's budget (less the last window's solve time),
         // shared by the frames still to sample; each half takes half of the frame's share.
         const double frameStart = timer.seconds();
-        const double share = std::max(1e-3, (options.timeBudget - options.elapsedBefore - frameStart -
-                                             lastSolveSeconds_ * double(window.count) / double(lastSolveFrames_)) /
-                                                double(window.count - k));
+        const double share =
+            std::max(1e-3, (options.timeBudget - options.elapsedBefore - frameStart -
+                            lastSolveSeconds_ * double(window.count) / double(lastSolveFrames_)) /
+                               double(window.count - k));
         if (timed) half.timeBudget = 0.5 * share;
         half.seed = window.seed(frame);
         RenderResultGpt first = renderGpt(ctx, scene, half, options_.sampling);
@@ -205,10 +238,11 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
     lastSolveSeconds_ = solved.ms * 1e-3;
     lastSolveFrames_ = window.count;
     if (!options.quiet)
-        std::fprintf(stderr, "gdpt: space-time %s reconstruction of frames %d-%d: %d iterations (%d IRLS), "
-                             "residual %.2g, %.1f ms\n",
-                     options_.l1 ? "l1" : "l2", window.first, window.first + window.count - 1, solved.iterations,
-                     solved.irlsIterations, solved.residual, solved.ms);
+        std::fprintf(stderr,
+                     "gdpt: space-time %s reconstruction of frames %d-%d: %d iterations (%d IRLS), "
+                     "residual %.2g, %.1f ms\n",
+                     options_.l1 ? "l1" : "l2", window.first, window.first + window.count - 1,
+                     solved.iterations, solved.irlsIterations, solved.residual, solved.ms);
 
     // 3. Compose each frame: reconstruction + very-direct light.
     const std::string reconName = std::string("recon_spacetime_") + (options_.l1 ? "l1" : "l2");
@@ -249,8 +283,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
     }
     carry_ = Carry{window.first + window.count - 1, {}, std::move(frames.back().secondHalfPrimal)};
     const std::size_t last = std::size_t(window.count - 1) * std::size_t(width) * std::size_t(height);
-    for (int c = 0; c < 3; ++c)
-        carry_->recon[c].assign(x[c].begin() + std::ptrdiff_t(last), x[c].end());
+    for (int c = 0; c < 3; ++c) carry_->recon[c].assign(x[c].begin() + std::ptrdiff_t(last), x[c].end());
     return outputs;
 }
 

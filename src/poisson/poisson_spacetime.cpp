@@ -40,7 +40,8 @@ void check(const SpaceTimeProblem& p) {
                 throw Error(std::string("space-time Poisson: ") + what + " has " + std::to_string(f.size()) +
                             " values, expected " + std::to_string(want));
             for (double v : f)
-                if (!std::isfinite(v)) throw Error(std::string("space-time Poisson: ") + what + " is not finite");
+                if (!std::isfinite(v))
+                    throw Error(std::string("space-time Poisson: ") + what + " is not finite");
         };
         sized(p.primal[c], n, "primal");
         sized(p.dx[c], n, "dx");
@@ -237,13 +238,15 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
     std::array<Field, 3> x;
     for (int c = 0; c < 3; ++c) x[c] = problem.initial[c].empty() ? problem.primal[c] : problem.initial[c];
     const int rounds = options.l1 ? std::max(1, options.irlsIterations) : 1;
-    const unsigned cores = options.threads > 0 ? unsigned(options.threads) : std::thread::hardware_concurrency();
+    const unsigned cores =
+        options.threads > 0 ? unsigned(options.threads) : std::thread::hardware_concurrency();
     const bool parallel = cores > 1;
     SpaceTimeStats s;
     std::array<int, 3> iterations{};
     for (int round = 0; round < rounds; ++round) {
-        const Weights wt = round == 0 ? unitWeights(problem)
-                                      : irlsWeights(problem, x, options.regInit * std::pow(options.regIter, round - 1));
+        const Weights wt =
+            round == 0 ? unitWeights(problem)
+                       : irlsWeights(problem, x, options.regInit * std::pow(options.regIter, round - 1));
         const Operator op = makeOperator(problem, wt);
         const bool last = round + 1 == rounds;
         const double tolerance = last ? options.tolerance : options.innerTolerance;

@@ -25,6 +25,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 
 #include "poisson/poisson_cpu.h"
 
@@ -75,6 +76,12 @@ struct SpaceTimeStats {
 // sizes disagree, a value is not finite, α ≤ 0 (the primal rows anchor the solve) or β < 0.
 std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const SpaceTimeOptions& options = {},
                                     SpaceTimeStats* stats = nullptr);
+
+// Bytes solveSpaceTime holds for a window: about 17 doubles per pixel, channel and frame (the
+// targets, the iterate, CG's vectors, the operator's weights).
+[[nodiscard]] constexpr std::uint64_t spaceTimeSolveBytes(int width, int height, int frames) {
+    return std::uint64_t(width) * std::uint64_t(height) * std::uint64_t(frames) * 3u * 17u * 8u;
+}
 
 // The exact L2 minimiser of one channel (Eigen's sparse LDLT on the normal equations): the
 // reference of the iterative solver in tests, for small windows.

@@ -77,16 +77,17 @@ void checkChannel(AnimationChannel& c) {
     const std::size_t wanted = cubic ? 3 * keys : keys;
     if (c.values.size() != wanted)
         throw Error("the sampler has " + std::to_string(keys) + " key times but " +
-                    std::to_string(c.values.size()) + " output values (" + interpolationName(c.interpolation) +
-                    " needs " + (cubic ? "3 per key: in-tangent, value, out-tangent" : "one per key") + ", " +
+                    std::to_string(c.values.size()) + " output values (" +
+                    interpolationName(c.interpolation) + " needs " +
+                    (cubic ? "3 per key: in-tangent, value, out-tangent" : "one per key") + ", " +
                     std::to_string(wanted) + ")");
     for (std::size_t k = 0; k < keys; ++k) {
         const double t = c.times[k];
         if (!std::isfinite(t)) throw Error("key time " + std::to_string(k) + " is " + number(t));
         if (t < 0.0) throw Error("key time " + std::to_string(k) + " is " + number(t) + ", before 0");
         if (k > 0 && !(t > c.times[k - 1]))
-            throw Error("key times are not strictly increasing: key " + std::to_string(k) + " at " + number(t) +
-                        " s follows " + number(c.times[k - 1]) + " s");
+            throw Error("key times are not strictly increasing: key " + std::to_string(k) + " at " +
+                        number(t) + " s follows " + number(c.times[k - 1]) + " s");
     }
     for (std::size_t i = 0; i < c.values.size(); ++i) {
         const glm::dvec4& v = c.values[i];
@@ -120,8 +121,8 @@ glm::dvec4 sampleChannel(const AnimationChannel& c, double time) {
     if (time <= c.times.front() || keys == 1) return c.values[valueIndex(c, 0)];
     if (time >= c.times.back()) return c.values[valueIndex(c, keys - 1)];
     // Key k with times[k] <= time < times[k + 1].
-    const std::size_t k = static_cast<std::size_t>(
-        std::upper_bound(c.times.begin(), c.times.end(), time) - c.times.begin() - 1);
+    const std::size_t k = static_cast<std::size_t>(std::upper_bound(c.times.begin(), c.times.end(), time) -
+                                                   c.times.begin() - 1);
     // On a key, its value as stored (no interpolation arithmetic), so that a pose at a key
     // time equals the static node with that key's transform bit for bit.
     if (time == c.times[k]) return c.values[valueIndex(c, k)];

@@ -80,10 +80,10 @@ std::vector<Animation> readAnimations(Context& ctx) {
                     throw Error("target path '" + channel.target_path +
                                 "' is not translation, rotation, scale or weights");
                 if (!targets.emplace(channel.target_node, property).second)
-                    throw Error("targets node " + std::to_string(channel.target_node) + " " +
-                                propertyName(property) +
-                                ", which an earlier channel of the animation targets already (glTF 2.0 §3.11: "
-                                "each target at most once per animation)");
+                    throw Error(
+                        "targets node " + std::to_string(channel.target_node) + " " + propertyName(property) +
+                        ", which an earlier channel of the animation targets already (glTF 2.0 §3.11: "
+                        "each target at most once per animation)");
                 out.channels.push_back(readChannel(model, animation, channel, property));
             } catch (const Error& e) {
                 throw e.withContext(channelLabel);

@@ -371,8 +371,9 @@ std::vector<glm::dvec4> readKeyValues(const tinygltf::Model& model, int accessor
     const CheckedAccessor a =
         checkAccessor(model, accessor, role, type, normalizedIntegers ? withIntegers : floatOnly);
     if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT && !a.normalized)
-        throw Error(a.label + " has integer components that are not normalized (glTF 2.0 §3.11 allows "
-                              "only normalized integers for rotations)");
+        throw Error(a.label +
+                    " has integer components that are not normalized (glTF 2.0 §3.11 allows "
+                    "only normalized integers for rotations)");
     std::vector<glm::dvec4> out(a.count, glm::dvec4(0.0));
     readElements(a, [&](std::size_t i, int c, double v) { out[i][c] = v; });
     return out;

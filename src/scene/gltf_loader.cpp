@@ -368,7 +368,8 @@ void checkSceneExtent(const Scene& scene) {
 glm::dmat4 posedMatrix(const tinygltf::Node& node, const NodePose& pose) {
     tinygltf::Node posed = node;  // animated nodes have no matrix (readAnimations checks)
     if (pose.translation) posed.translation = {pose.translation->x, pose.translation->y, pose.translation->z};
-    if (pose.rotation) posed.rotation = {pose.rotation->x, pose.rotation->y, pose.rotation->z, pose.rotation->w};
+    if (pose.rotation)
+        posed.rotation = {pose.rotation->x, pose.rotation->y, pose.rotation->z, pose.rotation->w};
     if (pose.scale) posed.scale = {pose.scale->x, pose.scale->y, pose.scale->z};
     return localMatrix(posed);
 }
@@ -560,7 +561,8 @@ int GltfAsset::findAnimation(const std::string& nameOrIndex) const {
     if (digits && std::stoul(nameOrIndex) < list.size()) return std::stoi(nameOrIndex);
     std::string known;
     for (std::size_t i = 0; i < list.size(); ++i)
-        known += (i ? ", " : "") + std::to_string(i) + (list[i].name.empty() ? "" : " '" + list[i].name + "'");
+        known +=
+            (i ? ", " : "") + std::to_string(i) + (list[i].name.empty() ? "" : " '" + list[i].name + "'");
     throw UsageError("--animation " + nameOrIndex + ": " + impl_->path +
                      (list.empty() ? " has no animations" : " has no such animation (it has " + known + ")"));
 }
@@ -572,7 +574,6 @@ Scene GltfAsset::instance(int animation, double time) const {
 Scene loadGltf(const std::string& path, const LoadOptions& opts) {
     return GltfAsset(path, opts).instance();
 }
-
 
 SceneEstimate estimateGltf(const std::string& path) {
     try {

@@ -36,7 +36,8 @@ void scan(const std::string& p, const std::string& flag, Number&& onNumber, Lite
         }
         const bool zeroWithoutWidth = j == i + 2 && width == 0;
         if (j >= p.size() || p[j] != 'd' || zeroWithoutWidth)
-            throw UsageError(flag + " " + p + ": '%' must start the frame number (%d or %0Nd, e.g. %04d) or be written %%");
+            throw UsageError(flag + " " + p +
+                             ": '%' must start the frame number (%d or %0Nd, e.g. %04d) or be written %%");
         onNumber(i, j + 1 - i, width);
         i = j;
     }
@@ -53,8 +54,7 @@ FrameRange parseFrameRange(const std::string& text, const std::string& flag) {
     }
     r.first = parseFrame(text.substr(0, colon), text, flag);
     r.last = parseFrame(text.substr(colon + 1), text, flag);
-    if (r.last < r.first)
-        throw UsageError(flag + " " + text + ": the last frame comes before the first");
+    if (r.last < r.first) throw UsageError(flag + " " + text + ": the last frame comes before the first");
     return r;
 }
 
@@ -105,7 +105,8 @@ std::string sequenceVideoPath(const std::string& pattern, const std::string& ext
             copied = at + 2;
         });
     stem += name.substr(copied);
-    while (!stem.empty() && (stem.back() == '_' || stem.back() == '-' || stem.back() == '.' || stem.back() == ' '))
+    while (!stem.empty() &&
+           (stem.back() == '_' || stem.back() == '-' || stem.back() == '.' || stem.back() == ' '))
         stem.pop_back();
     return dir + (stem.empty() ? "sequence" : stem) + extension;
 }

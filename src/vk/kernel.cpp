@@ -68,8 +68,8 @@ PipelineObjects makeObjects(const Context& ctx, const KernelDesc& desc) {
     moduleInfo.pCode = optimized ? desc.spirvOptimized : desc.spirv;
     VkShaderModule module = VK_NULL_HANDLE;
     VK_CHECK(vkCreateShaderModule(device, &moduleInfo, nullptr, &module));
-    o.module = Handle<VkShaderModule>(module,
-                                      [device](VkShaderModule m) { vkDestroyShaderModule(device, m, nullptr); });
+    o.module = Handle<VkShaderModule>(
+        module, [device](VkShaderModule m) { vkDestroyShaderModule(device, m, nullptr); });
     ctx.setName(VK_OBJECT_TYPE_SHADER_MODULE, reinterpret_cast<std::uint64_t>(module), desc.name);
 
     std::vector<VkDescriptorSetLayoutBinding> bindings;
@@ -79,7 +79,8 @@ PipelineObjects makeObjects(const Context& ctx, const KernelDesc& desc) {
         VkDescriptorSetLayoutBinding lb{};
         lb.binding = b;
         const bool texel = texelFormat(desc.texelBindings, b) != VK_FORMAT_UNDEFINED;
-        lb.descriptorType = texel ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        lb.descriptorType =
+            texel ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
         o.texelCount += texel ? 1u : 0u;
         lb.descriptorCount = 1;
         lb.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -108,7 +109,8 @@ PipelineObjects makeObjects(const Context& ctx, const KernelDesc& desc) {
 }
 
 // The job that creates a pipeline of `desc` with `module` and `layout`.
-PipelineJob pipelineJob(VkDevice device, const KernelDesc& desc, VkShaderModule module, VkPipelineLayout layout) {
+PipelineJob pipelineJob(VkDevice device, const KernelDesc& desc, VkShaderModule module,
+                        VkPipelineLayout layout) {
     PipelineJob job;
     job.device = device;
     job.module = module;
@@ -132,9 +134,11 @@ std::string pipelineKey(const Context& ctx, const KernelDesc& desc) {
     std::string key = desc.name + "|" + std::to_string(reinterpret_cast<std::uintptr_t>(desc.spirv)) +
                       (optimized ? "|opt|" : "|raw|") + std::to_string(desc.pushConstantBytes) + "|b";
     for (std::uint32_t b : desc.bindings)
-        key += "," + std::to_string(b) + ":" + std::to_string(static_cast<int>(texelFormat(desc.texelBindings, b)));
+        key += "," + std::to_string(b) + ":" +
+               std::to_string(static_cast<int>(texelFormat(desc.texelBindings, b)));
     key += "|s";
-    for (const auto& [id, value] : desc.specConstants) key += "," + std::to_string(id) + "=" + std::to_string(value);
+    for (const auto& [id, value] : desc.specConstants)
+        key += "," + std::to_string(id) + "=" + std::to_string(value);
     return key;
 }
 
@@ -214,8 +218,11 @@ Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation crea
             PipelineJob job = pipelineJob(device, desc, owned->module.get(), owned->pipelineLayout.get());
             std::shared_future<VkPipeline> pipeline =
                 creation == PipelineCreation::Background
-                    ? std::async(std::launch::async, [job = std::move(job)] { return createPipeline(job); }).share()
-                    : std::async(std::launch::deferred, [job = std::move(job)] { return createPipeline(job); }).share();
+                    ? std::async(std::launch::async, [job = std::move(job)] { return createPipeline(job); })
+                          .share()
+                    : std::async(std::launch::deferred, [job = std::move(job)] {
+                          return createPipeline(job);
+                      }).share();
             return PipelineCache::Creation{
                 pipeline, [device, owned](VkPipeline p) { vkDestroyPipeline(device, p, nullptr); }};
         });

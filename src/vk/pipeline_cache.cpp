@@ -14,7 +14,8 @@ PipelineCache::~PipelineCache() {
     }
 }
 
-std::shared_future<VkPipeline> PipelineCache::get(const std::string& key, const std::function<Creation()>& create) {
+std::shared_future<VkPipeline> PipelineCache::get(const std::string& key,
+                                                  const std::function<Creation()>& create) {
     const std::lock_guard<std::mutex> lock(mutex_);
     const auto it = entries_.find(key);
     if (it != entries_.end()) {

@@ -34,7 +34,8 @@ public:
     };
     // The pipeline of `key`: the one created before (a hit), else the one `create` starts
     // (called under the cache's lock, so it must only start the work).
-    [[nodiscard]] std::shared_future<VkPipeline> get(const std::string& key, const std::function<Creation()>& create);
+    [[nodiscard]] std::shared_future<VkPipeline> get(const std::string& key,
+                                                     const std::function<Creation()>& create);
     [[nodiscard]] std::size_t size() const;
     // Kernels that found their pipeline here instead of creating it.
     [[nodiscard]] std::size_t hits() const;

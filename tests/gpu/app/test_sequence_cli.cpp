@@ -42,9 +42,9 @@ nlohmann::json readJson(const std::string& path) {
 }
 
 TEST_F(SequenceCli, EveryFrameIsWrittenWithItsSeedAndSummarised) {
-    const RunResult r = runGdpt("render " + kMovingBox + " --frames 2:4 --fps 2 --spp 2 --width 16 --height 16 " +
-                                "--method pt --seed 5 --no-video -o " + path("seq/f_%03d.exr") + " --json " +
-                                path("seq.json"));
+    const RunResult r = runGdpt(
+        "render " + kMovingBox + " --frames 2:4 --fps 2 --spp 2 --width 16 --height 16 " +
+        "--method pt --seed 5 --no-video -o " + path("seq/f_%03d.exr") + " --json " + path("seq.json"));
     ASSERT_EQ(r.code, 0) << r.output;
     EXPECT_NE(r.output.find("frame 3 (2/3, t = 1.5 s): wrote"), std::string::npos) << r.output;
     for (int f = 2; f <= 4; ++f) {
@@ -83,7 +83,8 @@ nlohmann::json staticPoseAt1_5(nlohmann::json scene) {
         const auto f = [](double v) { return double(static_cast<float>(v)); };
         const double k1[3] = {f(c[0] - 0.35), f(c[1]), f(c[2] - 0.1)};
         const double k2[3] = {f(c[0] - 0.5), f(c[1]), f(c[2] + 0.15)};
-        node["translation"] = {0.5 * k1[0] + 0.5 * k2[0], 0.5 * k1[1] + 0.5 * k2[1], 0.5 * k1[2] + 0.5 * k2[2]};
+        node["translation"] = {0.5 * k1[0] + 0.5 * k2[0], 0.5 * k1[1] + 0.5 * k2[1],
+                               0.5 * k1[2] + 0.5 * k2[2]};
         const double half = 45.0 * (M_PI / 180.0) / 2.0;
         node["rotation"] = {0.0, f(std::sin(half)), 0.0, f(std::cos(half))};
         return scene;
@@ -101,12 +102,12 @@ TEST_F(SequenceCli, AFrameIsTheStaticSceneOfItsPoseBitForBit) {
     }
     const std::string common = " --spp 3 --width 24 --height 20 --method gpt --recon l1 ";
     // Frames 35 and 36: the integrator renders frame 36 after another frame.
-    const RunResult seq = runGdpt("render " + kMovingBox + " --frames 35:36 --no-video" + common + "-o " +
-                                  path("f_%02d.exr"));
+    const RunResult seq =
+        runGdpt("render " + kMovingBox + " --frames 35:36 --no-video" + common + "-o " + path("f_%02d.exr"));
     ASSERT_EQ(seq.code, 0) << seq.output;
     const unsigned seed = 36u * 0x9E3779B9u;
-    const RunResult still =
-        runGdpt("render " + path("still.gltf") + common + "--seed " + std::to_string(seed) + " -o " + path("still.exr"));
+    const RunResult still = runGdpt("render " + path("still.gltf") + common + "--seed " +
+                                    std::to_string(seed) + " -o " + path("still.exr"));
     ASSERT_EQ(still.code, 0) << still.output;
     test::expectSameExrLayers(path("f_36.exr"), path("still.exr"));
     // Control: the neighbouring frame is a different pose, not the same bits.
@@ -114,20 +115,26 @@ TEST_F(SequenceCli, AFrameIsTheStaticSceneOfItsPoseBitForBit) {
 }
 
 TEST_F(SequenceCli, AStillSceneRendersAsASequenceWithANote) {
-    const RunResult r = runGdpt("render " + kCornell + " --frames 0:1 --spp 1 --width 8 --height 8 --method pt -o " +
-                                path("c_%d.exr"));
+    const RunResult r =
+        runGdpt("render " + kCornell + " --frames 0:1 --spp 1 --width 8 --height 8 --method pt -o " +
+                path("c_%d.exr"));
     ASSERT_EQ(r.code, 0) << r.output;
-    EXPECT_NE(r.output.find("has no animations; every frame is the same still scene"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("has no animations; every frame is the same still scene"), std::string::npos)
+        << r.output;
     EXPECT_TRUE(fs::exists(path("c_0.exr")));
     EXPECT_TRUE(fs::exists(path("c_1.exr")));
     // Frame 0 is the single image of the same seed.
-    ASSERT_EQ(runGdpt("render " + kCornell + " --spp 1 --width 8 --height 8 --method pt -o " + path("one.exr")).code, 0);
+    ASSERT_EQ(
+        runGdpt("render " + kCornell + " --spp 1 --width 8 --height 8 --method pt -o " + path("one.exr"))
+            .code,
+        0);
     test::expectSameExrLayers(path("c_0.exr"), path("one.exr"));
 }
 
 TEST_F(SequenceCli, AnInterruptLeavesTheCompleteFramesAndSaysWhereToContinue) {
-    const std::string args = "render " + kMovingBox + " --frames 0:3 --fps 1 --spp 2 --width 16 --height 16 --no-video " +
-                             "-o " + path("f_%04d.exr") + " --json " + path("s.json");
+    const std::string args = "render " + kMovingBox +
+                             " --frames 0:3 --fps 1 --spp 2 --width 16 --height 16 --no-video " + "-o " +
+                             path("f_%04d.exr") + " --json " + path("s.json");
     for (const char* at : {"sampling#2", "writing#2", "loading#3"}) {
         SCOPED_TRACE(at);
         fs::remove_all(dir_);
@@ -139,8 +146,9 @@ TEST_F(SequenceCli, AnInterruptLeavesTheCompleteFramesAndSaysWhereToContinue) {
         EXPECT_EQ(files(), (std::vector<std::string>{"f_0000.exr", "f_0000.png"}));
     }
     // Continuing from the first missing frame completes the sequence.
-    const RunResult rest = runGdpt("render " + kMovingBox + " --frames 1:3 --fps 1 --spp 2 --width 16 --height 16 " +
-                                   "--no-video -o " + path("f_%04d.exr"));
+    const RunResult rest =
+        runGdpt("render " + kMovingBox + " --frames 1:3 --fps 1 --spp 2 --width 16 --height 16 " +
+                "--no-video -o " + path("f_%04d.exr"));
     ASSERT_EQ(rest.code, 0) << rest.output;
     EXPECT_EQ(files().size(), 8u);
 }
@@ -175,9 +183,60 @@ TEST_F(SequenceCli, InfoListsTheAnimations) {
     EXPECT_NE(r.output.find("animation 0 'slide': 3 s, 2 channels"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("node 'shortbox_motion' rotation (LINEAR, 3 keys, 0 to 3 s)"), std::string::npos)
         << r.output;
-    const RunResult still = runGdpt("render " + kMovingBox + " --spp 1 --width 8 --height 8 -o " + path("x.exr"));
+    const RunResult still =
+        runGdpt("render " + kMovingBox + " --spp 1 --width 8 --height 8 -o " + path("x.exr"));
     ASSERT_EQ(still.code, 0) << still.output;
-    EXPECT_NE(still.output.find("has 1 animation(s); the rest pose is rendered"), std::string::npos) << still.output;
+    EXPECT_NE(still.output.find("has 1 animation(s); the rest pose is rendered"), std::string::npos)
+        << still.output;
+}
+
+// --method tgpt: windows of frames reconstructed together, each tied to the one before; its
+// layers and JSON say so; the options it cannot honour are usage errors; a window larger than
+// the machine's memory is refused before any sampling.
+TEST_F(SequenceCli, TemporalGptRendersWindowsOfFrames) {
+    const RunResult r =
+        runGdpt("render " + kMovingBox + " --method tgpt --frames 0:4 --window 2 --spp 4 " +
+                "--width 16 --height 12 --no-video -o " + path("t/f_%d.exr") + " --json " + path("t.json"));
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("space-time l1 reconstruction of frames 2-3"), std::string::npos) << r.output;
+    const nlohmann::json j = readJson(path("t.json"));
+    ASSERT_EQ(j["frame_summaries"].size(), 5u);
+    const int firsts[] = {0, 0, 2, 2, 4};
+    for (int f = 0; f < 5; ++f) {
+        const nlohmann::json& s = j["frame_summaries"][f];
+        EXPECT_EQ(s["tgpt"]["window_first"], firsts[f]) << f;
+        EXPECT_EQ(s["tgpt"]["joined_previous_window"], f >= 2) << f;
+        EXPECT_EQ(s["tgpt"]["temporal_to_previous"], f >= 1) << f;
+        EXPECT_EQ(s["spp"], 4);
+        EXPECT_EQ(s["reconstructions"][0]["method"], "spacetime_l1");
+    }
+    const auto layers = readExr(path("t/f_3.exr"));
+    std::vector<std::string> names;
+    for (const auto& l : layers) names.push_back(l.name);
+    for (const char* want : {"recon_spacetime_l1", "primal", "dx", "dy", "dt", "direct"})
+        EXPECT_NE(std::find(names.begin(), names.end(), want), names.end()) << want;
+}
+
+TEST_F(SequenceCli, TemporalGptRefusesWhatItCannotDo) {
+    const std::string base = "render " + kMovingBox + " --method tgpt --spp 2 ";
+    const struct {
+        std::string flags, says;
+        int code;
+    } cases[] = {
+        {"-o " + path("x.exr"), "--method tgpt renders a sequence", 2},
+        {"--frames 0:1 --recon wl2 -o " + path("f_%d.exr"), "reconstructs with --recon l1 or l2", 2},
+        {"--frames 0:1 --demodulate on -o " + path("f_%d.exr"), "does not demodulate", 2},
+        {"--frames 0:1 --window 0 -o " + path("f_%d.exr"), "--window", 2},
+        {"--window 3 -o " + path("x.exr"), "--window requires --frames", 2},
+        {"--frames 0:63 --window 64 --width 4096 --height 4096 -o " + path("f_%d.exr"),
+         "needs about 552.0 GiB for its space-time reconstruction", 1},
+    };
+    for (const auto& c : cases) {
+        const RunResult r = runGdpt(base + c.flags);
+        EXPECT_EQ(r.code, c.code) << c.flags << "\n" << r.output;
+        EXPECT_NE(r.output.find(c.says), std::string::npos) << c.flags << "\n" << r.output;
+        EXPECT_TRUE(files().empty()) << c.flags << ": left " << files().front();
+    }
 }
 
 // With ffmpeg installed (scripts/install-deps.sh installs it), a sequence gets an MP4 of its
@@ -186,15 +245,17 @@ TEST_F(SequenceCli, InfoListsTheAnimations) {
 TEST_F(SequenceCli, AVideoOfTheFramesWhenFfmpegIsInstalled) {
     if (test::runShell("command -v ffmpeg && command -v ffprobe").code != 0)
         GTEST_SKIP() << "ffmpeg is not installed (scripts/install-deps.sh installs it)";
-    const std::string args = "render " + kMovingBox + " --frames 0:4 --fps 12 --spp 1 --width 17 --height 9 " +
-                             "--method pt -o " + path("v/clip_%04d.exr") + " --json " + path("v.json");
+    const std::string args = "render " + kMovingBox +
+                             " --frames 0:4 --fps 12 --spp 1 --width 17 --height 9 " + "--method pt -o " +
+                             path("v/clip_%04d.exr") + " --json " + path("v.json");
     const RunResult r = runGdpt(args);
     ASSERT_EQ(r.code, 0) << r.output;
     EXPECT_NE(r.output.find("video " + path("v/clip.mp4")), std::string::npos) << r.output;
     EXPECT_EQ(readJson(path("v.json"))["video"], path("v/clip.mp4"));
-    const RunResult probe = test::runShell("ffprobe -v error -count_frames -select_streams v:0 -show_entries "
-                                           "stream=nb_read_frames,codec_name,width,height -of csv=p=0 " +
-                                           path("v/clip.mp4"));
+    const RunResult probe = test::runShell(
+        "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+        "stream=nb_read_frames,codec_name,width,height -of csv=p=0 " +
+        path("v/clip.mp4"));
     ASSERT_EQ(probe.code, 0) << probe.output;
     EXPECT_EQ(probe.output, "h264,18,10,5\n");  // odd sizes padded to even
     // No ffmpeg on PATH: no video, the frames all the same.

@@ -59,7 +59,8 @@ const Image& layer(const RenderOutput& out, const std::string& name) {
     throw std::runtime_error("no layer " + name);
 }
 
-FrameWindow windowOf(std::function<Scene(int)> scene, int first, int count, unsigned seed, bool starts = true) {
+FrameWindow windowOf(std::function<Scene(int)> scene, int first, int count, unsigned seed,
+                     bool starts = true) {
     FrameWindow w;
     w.first = first;
     w.count = count;
@@ -77,7 +78,8 @@ TEST_F(TgptRender, AStillSceneHasZeroTemporalDifferencesAndJoinsWindows) {
     RenderOptions options = renderOptions(20, 16, 4, 0);
     const auto still = [&](int) { return box; };
     const std::vector<RenderOutput> first = tgpt.renderWindow(keeping(), windowOf(still, 0, 2, 3), options);
-    const std::vector<RenderOutput> second = tgpt.renderWindow(keeping(), windowOf(still, 2, 2, 3, false), options);
+    const std::vector<RenderOutput> second =
+        tgpt.renderWindow(keeping(), windowOf(still, 2, 2, 3, false), options);
     ASSERT_EQ(first.size(), 2u);
     ASSERT_EQ(second.size(), 2u);
     EXPECT_FALSE(first[0].stats.tgpt.temporalToPrevious);
@@ -112,13 +114,15 @@ TEST_F(TgptRender, TemporalDifferencesAreUnbiased) {
     TgptIntegrator tgpt(o);
     std::vector<std::vector<double>> blocks(bx * by * 3);  // per block and channel: one value per seed
     for (int seed = 0; seed < kSeeds; ++seed) {
-        const auto frames = tgpt.renderWindow(keeping(), windowOf(sceneAt, 0, 2, unsigned(seed) * 7919u), renderOptions(w, h, 8, 0));
+        const auto frames = tgpt.renderWindow(keeping(), windowOf(sceneAt, 0, 2, unsigned(seed) * 7919u),
+                                              renderOptions(w, h, 8, 0));
         const Image& dt = layer(frames[1], "dt");
         for (int c = 0; c < 3; ++c)
             for (int b = 0; b < bx * by; ++b) {
                 double sum = 0.0;
                 for (int y = 0; y < block; ++y)
-                    for (int x = 0; x < block; ++x) sum += dt.at((b % bx) * block + x, (b / bx) * block + y, c);
+                    for (int x = 0; x < block; ++x)
+                        sum += dt.at((b % bx) * block + x, (b / bx) * block + y, c);
                 blocks[(b * 3) + c].push_back(sum / (block * block));
             }
     }

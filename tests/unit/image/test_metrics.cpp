@@ -121,8 +121,9 @@ TEST(TemporalRelMse, HandComputedValues) {
     // Reference frames 1 and 3 (grey 1, 3: mean gray 2); a test that follows the change exactly
     // has no temporal error, even if both its frames are off by the same amount.
     const Image r0 = constantImage(2, 2, 1, 1, 1), r1 = constantImage(2, 2, 3, 3, 3);
-    EXPECT_EQ(temporalRelMse(constantImage(2, 2, 1.5f, 1.5f, 1.5f), constantImage(2, 2, 3.5f, 3.5f, 3.5f), r0, r1),
-              0.0);
+    EXPECT_EQ(
+        temporalRelMse(constantImage(2, 2, 1.5f, 1.5f, 1.5f), constantImage(2, 2, 3.5f, 3.5f, 3.5f), r0, r1),
+        0.0);
     // A test that does not change: per pixel Σ_c (0 − 2)² / (1e-3 + 4) = 12 / 4.001.
     EXPECT_NEAR(temporalRelMse(r0, r0, r0, r1), 12.0 / 4.001, 1e-12);
     // Flicker: one pixel off by +1 in frame 0 only: (−1)² · 3 / 4.001 over 4 pixels.

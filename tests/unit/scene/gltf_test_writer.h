@@ -96,8 +96,8 @@ public:
         for (const ChannelSpec& c : channels) {
             a["samplers"].push_back(
                 {{"input", addScalars(c.times)}, {"output", c.output}, {"interpolation", c.interpolation}});
-            a["channels"].push_back({{"sampler", a["samplers"].size() - 1},
-                                     {"target", {{"node", c.node}, {"path", c.path}}}});
+            a["channels"].push_back(
+                {{"sampler", a["samplers"].size() - 1}, {"target", {{"node", c.node}, {"path", c.path}}}});
         }
         doc["animations"].push_back(a);
         return static_cast<int>(doc["animations"].size() - 1);

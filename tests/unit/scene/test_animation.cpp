@@ -54,7 +54,8 @@ TEST(Animation, LinearTranslationAtBetweenBeforeAndAfterKeys) {
 }
 
 TEST(Animation, LinearFirstKeyAfterZeroHoldsItsValueBefore) {
-    const auto c = channel(AnimatedProperty::Scale, Interpolation::Linear, {1.0, 2.0}, {{1, 1, 1, 0}, {3, 1, 1, 0}});
+    const auto c =
+        channel(AnimatedProperty::Scale, Interpolation::Linear, {1.0, 2.0}, {{1, 1, 1, 0}, {3, 1, 1, 0}});
     expectNear(sampleChannel(c, 0.0), {1, 1, 1, 0});
     expectNear(sampleChannel(c, 1.5), {2, 1, 1, 0});
 }
@@ -72,8 +73,9 @@ TEST(Animation, CubicSplineHermiteByHand) {
     // Keys at 0 and 2 (td = 2); values v0 = 0, v1 = (1, 0, 0); out-tangent b0 = (0, 4, 0),
     // in-tangent a1 = (0, 0, 8). At s = 1/2 the Hermite basis is h00 = 1/2, h10 = 1/8,
     // h01 = 1/2, h11 = -1/8: p = 0 + 2 (1/8) b0 + (1/2) v1 + 2 (-1/8) a1 = (0.5, 1, -2).
-    const auto c = channel(AnimatedProperty::Translation, Interpolation::CubicSpline, {0.0, 2.0},
-                           {{9, 9, 9, 0}, {0, 0, 0, 0}, {0, 4, 0, 0}, {0, 0, 8, 0}, {1, 0, 0, 0}, {7, 7, 7, 0}});
+    const auto c =
+        channel(AnimatedProperty::Translation, Interpolation::CubicSpline, {0.0, 2.0},
+                {{9, 9, 9, 0}, {0, 0, 0, 0}, {0, 4, 0, 0}, {0, 0, 8, 0}, {1, 0, 0, 0}, {7, 7, 7, 0}});
     expectNear(sampleChannel(c, 1.0), {0.5, 1.0, -2.0, 0});
     // At s = 1/4: h00 = 27/32, h10 = 9/64, h01 = 5/32, h11 = -3/64.
     expectNear(sampleChannel(c, 0.5), {5.0 / 32, 2 * 9.0 / 64 * 4, 2 * -3.0 / 64 * 8, 0});
@@ -86,8 +88,9 @@ TEST(Animation, CubicSplineHermiteByHand) {
 
 TEST(Animation, CubicSplineWithSecantTangentsIsLinear) {
     // Tangents equal to the secant slope (in units per second) reproduce linear motion.
-    const auto c = channel(AnimatedProperty::Translation, Interpolation::CubicSpline, {0.5, 2.5},
-                           {{0.5, 0, 0, 0}, {1, 2, 3, 0}, {0.5, 0, 0, 0}, {0.5, 0, 0, 0}, {2, 2, 3, 0}, {0.5, 0, 0, 0}});
+    const auto c =
+        channel(AnimatedProperty::Translation, Interpolation::CubicSpline, {0.5, 2.5},
+                {{0.5, 0, 0, 0}, {1, 2, 3, 0}, {0.5, 0, 0, 0}, {0.5, 0, 0, 0}, {2, 2, 3, 0}, {0.5, 0, 0, 0}});
     for (double t = 0.5; t <= 2.5; t += 0.125)
         expectNear(sampleChannel(c, t), {1 + (t - 0.5) * 0.5, 2, 3, 0}, 1e-12);
 }
@@ -133,8 +136,8 @@ TEST(Animation, SlerpHalfTurn) {
 
 TEST(Animation, SlerpOfNearlyEqualKeysIsFiniteAndUnit) {
     const glm::dvec3 x(1, 0, 0);
-    const auto c =
-        channel(AnimatedProperty::Rotation, Interpolation::Linear, {0.0, 1.0}, {axisAngle(x, 0.2), axisAngle(x, 0.2 + 1e-13)});
+    const auto c = channel(AnimatedProperty::Rotation, Interpolation::Linear, {0.0, 1.0},
+                           {axisAngle(x, 0.2), axisAngle(x, 0.2 + 1e-13)});
     const glm::dvec4 v = sampleChannel(c, 0.5);
     EXPECT_NEAR(glm::length(v), 1.0, 1e-12);
     expectNear(v, axisAngle(x, 0.2), 1e-12);
@@ -152,16 +155,18 @@ TEST(Animation, RotationKeysOfAnyLengthInterpolateAsUnitKeys) {
 
 TEST(Animation, CubicSplineRotationIsUnit) {
     const glm::dvec3 y(0, 1, 0);
-    const auto c = channel(AnimatedProperty::Rotation, Interpolation::CubicSpline, {0.0, 1.0},
-                           {{0, 0, 0, 0}, axisAngle(y, 0.0), {0, 0.3, 0, 0}, {0, 0.3, 0, 0}, axisAngle(y, 1.0), {0, 0, 0, 0}});
+    const auto c = channel(
+        AnimatedProperty::Rotation, Interpolation::CubicSpline, {0.0, 1.0},
+        {{0, 0, 0, 0}, axisAngle(y, 0.0), {0, 0.3, 0, 0}, {0, 0.3, 0, 0}, axisAngle(y, 1.0), {0, 0, 0, 0}});
     for (double t = 0.0; t <= 1.0; t += 0.1) EXPECT_NEAR(glm::length(sampleChannel(c, t)), 1.0, 1e-12) << t;
 }
 
 TEST(Animation, PoseCombinesChannelsPerNode) {
     Animation a;
+    a.channels.push_back(channel(AnimatedProperty::Translation, Interpolation::Linear, {0.0, 1.0},
+                                 {{0, 0, 0, 0}, {4, 0, 0, 0}}));
     a.channels.push_back(
-        channel(AnimatedProperty::Translation, Interpolation::Linear, {0.0, 1.0}, {{0, 0, 0, 0}, {4, 0, 0, 0}}));
-    a.channels.push_back(channel(AnimatedProperty::Scale, Interpolation::Step, {0.0, 2.0}, {{1, 1, 1, 0}, {2, 2, 2, 0}}));
+        channel(AnimatedProperty::Scale, Interpolation::Step, {0.0, 2.0}, {{1, 1, 1, 0}, {2, 2, 2, 0}}));
     a.channels[1].node = 3;
     EXPECT_DOUBLE_EQ(a.duration(), 2.0);
     const auto pose = poseAt(a, 0.5);

@@ -9,8 +9,8 @@
 #include <functional>
 #include <limits>
 
-#include "scene/gltf_loader.h"
 #include "gltf_test_writer.h"
+#include "scene/gltf_loader.h"
 
 namespace gdpt::test {
 namespace {
@@ -43,7 +43,8 @@ void addMove(TestGltf& g, int node) {
     const int t = g.addVec3({{0, 0, 0}, {2, 0, 0}});
     const float s = std::sqrt(0.5f);
     const int r = g.addVec4({{0, 0, 0, 1}, {0, 0, s, s}});
-    g.addAnimation("Move", {{node, "translation", "LINEAR", {0.0f, 1.0f}, t}, {node, "rotation", "STEP", {0.0f, 1.0f}, r}});
+    g.addAnimation("Move", {{node, "translation", "LINEAR", {0.0f, 1.0f}, t},
+                            {node, "rotation", "STEP", {0.0f, 1.0f}, r}});
 }
 
 bool sameBits(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
@@ -71,8 +72,9 @@ TEST(GltfAnimation, PoseEqualsTheStaticFileOfThatPose) {
     // At 1 s (and after): translation (2, 0, 0) and the quarter turn about Z.
     const float s = std::sqrt(0.5f);
     const Scene end = asset.instance(0, 1.0);
-    const Scene stillEnd = loadGltf(
-        animatedFile({{"translation", {2.0, 0.0, 0.0}}, {"rotation", {0.0, 0.0, s, s}}}).writeGltf(dir, "end"));
+    const Scene stillEnd =
+        loadGltf(animatedFile({{"translation", {2.0, 0.0, 0.0}}, {"rotation", {0.0, 0.0, s, s}}})
+                     .writeGltf(dir, "end"));
     EXPECT_TRUE(sameBits(end.positions, stillEnd.positions));
     EXPECT_TRUE(sameBits(asset.instance(0, 9.0).positions, stillEnd.positions));
     // The child's (0, 1, 0) turned a quarter about Z is (-1, 0, 0); plus (2, 0, 0).
@@ -111,8 +113,12 @@ TEST(GltfAnimation, AnimationsAreFoundByNameOrIndexAndListed) {
     const std::string dir = testDir();
     TestGltf g = animatedFile();
     addMove(g, 2);
-    g.addAnimation("Scale", {{0, "scale", "CUBICSPLINE", {0.0f, 3.0f},
-                              g.addVec3({{0, 0, 0}, {1, 1, 1}, {0, 0, 0}, {0, 0, 0}, {2, 2, 2}, {0, 0, 0}})}});
+    g.addAnimation("Scale",
+                   {{0,
+                     "scale",
+                     "CUBICSPLINE",
+                     {0.0f, 3.0f},
+                     g.addVec3({{0, 0, 0}, {1, 1, 1}, {0, 0, 0}, {0, 0, 0}, {2, 2, 2}, {0, 0, 0}})}});
     const GltfAsset asset(g.writeGltf(dir, "two"));
     EXPECT_EQ(asset.findAnimation("Move"), 0);
     EXPECT_EQ(asset.findAnimation("Scale"), 1);
@@ -157,28 +163,36 @@ TEST(GltfAnimation, MalformedAnimationsAreRefusedWithTheirPlace) {
     const std::vector<Case> cases = {
         {"repeated_time",
          [](TestGltf& g) {
-             g.addAnimation("Move", {{0, "translation", "LINEAR", {0.0f, 1.0f, 1.0f},
+             g.addAnimation("Move", {{0,
+                                      "translation",
+                                      "LINEAR",
+                                      {0.0f, 1.0f, 1.0f},
                                       g.addVec3({{0, 0, 0}, {1, 0, 0}, {2, 0, 0}})}});
          },
-         "animation 'Move' channel 0: sampler 0: key times are not strictly increasing: key 2 at 1 s follows 1 s"},
+         "animation 'Move' channel 0: sampler 0: key times are not strictly increasing: key 2 at 1 s follows "
+         "1 s"},
         {"nan_key",
          [nan](TestGltf& g) {
-             g.addAnimation("", {{0, "translation", "LINEAR", {0.0f, 1.0f}, g.addVec3({{0, 0, 0}, {nan, 0, 0}})}});
+             g.addAnimation(
+                 "", {{0, "translation", "LINEAR", {0.0f, 1.0f}, g.addVec3({{0, 0, 0}, {nan, 0, 0}})}});
          },
          "animation 0 channel 0: sampler 0: output value 1 has the component nan"},
         {"nan_time",
          [nan](TestGltf& g) {
-             g.addAnimation("", {{0, "translation", "LINEAR", {0.0f, nan}, g.addVec3({{0, 0, 0}, {1, 0, 0}})}});
+             g.addAnimation("",
+                            {{0, "translation", "LINEAR", {0.0f, nan}, g.addVec3({{0, 0, 0}, {1, 0, 0}})}});
          },
          "key time 1 is nan"},
         {"count_mismatch",
          [](TestGltf& g) {
-             g.addAnimation("", {{0, "scale", "LINEAR", {0.0f, 1.0f, 2.0f}, g.addVec3({{1, 1, 1}, {2, 2, 2}})}});
+             g.addAnimation("",
+                            {{0, "scale", "LINEAR", {0.0f, 1.0f, 2.0f}, g.addVec3({{1, 1, 1}, {2, 2, 2}})}});
          },
          "the sampler has 3 key times but 2 output values"},
         {"cubic_count",
          [](TestGltf& g) {
-             g.addAnimation("", {{0, "scale", "CUBICSPLINE", {0.0f, 1.0f}, g.addVec3({{1, 1, 1}, {2, 2, 2}})}});
+             g.addAnimation("",
+                            {{0, "scale", "CUBICSPLINE", {0.0f, 1.0f}, g.addVec3({{1, 1, 1}, {2, 2, 2}})}});
          },
          "CUBICSPLINE needs 3 per key"},
         {"bad_interpolation",
@@ -193,7 +207,8 @@ TEST(GltfAnimation, MalformedAnimationsAreRefusedWithTheirPlace) {
          "(output) has type VEC3, expected VEC4"},
         {"zero_quaternion",
          [](TestGltf& g) {
-             g.addAnimation("", {{0, "rotation", "LINEAR", {0.0f, 1.0f}, g.addVec4({{0, 0, 0, 1}, {0, 0, 0, 0}})}});
+             g.addAnimation(
+                 "", {{0, "rotation", "LINEAR", {0.0f, 1.0f}, g.addVec4({{0, 0, 0, 1}, {0, 0, 0, 0}})}});
          },
          "rotation key 1 is a zero quaternion"},
         {"duplicate_target",
@@ -206,12 +221,14 @@ TEST(GltfAnimation, MalformedAnimationsAreRefusedWithTheirPlace) {
         {"matrix_node",
          [](TestGltf& g) {
              g.doc["nodes"][0]["matrix"] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-             g.addAnimation("", {{0, "translation", "LINEAR", {0.0f, 1.0f}, g.addVec3({{0, 0, 0}, {1, 0, 0}})}});
+             g.addAnimation("",
+                            {{0, "translation", "LINEAR", {0.0f, 1.0f}, g.addVec3({{0, 0, 0}, {1, 0, 0}})}});
          },
          "node 'TriNode' is animated but has a matrix"},
         {"negative_time",
          [](TestGltf& g) {
-             g.addAnimation("", {{0, "translation", "LINEAR", {-1.0f, 1.0f}, g.addVec3({{0, 0, 0}, {1, 0, 0}})}});
+             g.addAnimation("",
+                            {{0, "translation", "LINEAR", {-1.0f, 1.0f}, g.addVec3({{0, 0, 0}, {1, 0, 0}})}});
          },
          "key time 0 is -1, before 0"},
     };

@@ -99,6 +99,7 @@ constexpr Expected kSet[] = {
     {"cornell_box.gltf", 36, 36, 2, 2},       {"glossy_cornell.gltf", 1000, 2000, 2, 2},
     {"furnace.gltf", 1280, 1280, 1280, 1280}, {"small_light.gltf", 36, 36, 2, 2},
     {"indirect_gap.gltf", 40, 200, 2, 2},     {"textured.gltf", 36, 36, 2, 2},
+    {"moving_box.gltf", 36, 36, 2, 2},        {"camera_move.gltf", 36, 36, 2, 2},
 };
 
 TEST(SceneSet, EveryFileIsListedAndLoadsCleanly) {
@@ -210,6 +211,38 @@ TEST(SceneSet, IndirectGapCameraNeverSeesTheLight) {
     // And the light exists and is bright enough to matter.
     EXPECT_EQ(emissiveTriangles(s), 2u);
     EXPECT_GT(emittedPower(s).x, 10.0);
+}
+
+// The animated scenes start from the Cornell box: moving_box's short box at time 0 has the
+// box's corners (up to float rounding of its centre's transform) and has moved by 3 s;
+// camera_move's camera at time 0 is the box's camera and ends where the file says.
+TEST(SceneSet, AnimatedScenesStartFromTheCornellBox) {
+    const Scene cbox = loadClean("cornell_box.gltf");
+    const GltfAsset moving(scenePath("moving_box.gltf"));
+    ASSERT_EQ(moving.animations().size(), 1u);
+    EXPECT_DOUBLE_EQ(moving.animations()[0].duration(), 3.0);
+    const Scene start = moving.instance(0, 0.0), end = moving.instance(0, 3.0);
+    const auto bounds = [](const Scene& s, std::size_t firstTriangle, std::size_t count) {
+        Bounds b;
+        for (std::size_t t = firstTriangle; t < firstTriangle + count; ++t)
+            for (int k = 0; k < 3; ++k) b.extend(s.positions[s.triangles[t][k]]);
+        return b;
+    };
+    // cornell_box lists the short box after the walls (5 quads = 10 triangles), moving_box last.
+    const Bounds box = bounds(cbox, 10, 12), moved0 = bounds(start, 24, 12), moved3 = bounds(end, 24, 12);
+    for (int a = 0; a < 3; ++a) {
+        EXPECT_NEAR(moved0.min[a], box.min[a], 1e-6f);
+        EXPECT_NEAR(moved0.max[a], box.max[a], 1e-6f);
+    }
+    EXPECT_LT(moved3.max.x, box.max.x - 0.1f);  // slid towards -x
+    const GltfAsset camera(scenePath("camera_move.gltf"));
+    ASSERT_EQ(camera.animations().size(), 1u);
+    const Camera c0 = camera.instance(0, 0.0).cameras.at(0), c2 = camera.instance(0, 2.0).cameras.at(0);
+    EXPECT_EQ(c0.position, cbox.cameras[0].position);
+    EXPECT_EQ(c0.forward, cbox.cameras[0].forward);
+    EXPECT_NEAR(c2.position.x, 0.45f, 1e-6f);
+    EXPECT_NEAR(c2.position.z, 5.6f, 1e-6f);
+    EXPECT_LT(c2.forward.x, -0.05f);  // turned left
 }
 
 }  // namespace

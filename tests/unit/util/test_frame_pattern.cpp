@@ -26,10 +26,12 @@ TEST(FramePattern, RangesParse) {
     EXPECT_EQ(parseFrameRange("7", "--frames").count(), 1);
     EXPECT_EQ(parseFrameRange("0:0", "--frames").first, 0);
     for (const char* bad : {"", ":", "3:", ":4", "-1:3", "a:b", "1:2:3", "1.5:3", "99999999:1", " 1:2"})
-        EXPECT_NE(usageError([&] { (void)parseFrameRange(bad, "--frames"); }).find("--frames"), std::string::npos)
+        EXPECT_NE(usageError([&] { (void)parseFrameRange(bad, "--frames"); }).find("--frames"),
+                  std::string::npos)
             << bad;
-    EXPECT_NE(usageError([] { (void)parseFrameRange("5:2", "--frames"); }).find("the last frame comes before"),
-              std::string::npos);
+    EXPECT_NE(
+        usageError([] { (void)parseFrameRange("5:2", "--frames"); }).find("the last frame comes before"),
+        std::string::npos);
 }
 
 TEST(FramePattern, PathsFormatTheFrameNumber) {
@@ -52,9 +54,11 @@ TEST(FramePattern, VideoBesideTheFrames) {
 }
 
 TEST(FramePattern, BadPatternsAreRefused) {
-    for (const char* bad : {"f_%s.exr", "f_%4d.exr", "f_%0d.exr", "f_%.exr", "f_%", "f_%x.exr", "f_%010d.exr"})
-        EXPECT_NE(usageError([&] { (void)hasFrameNumber(bad, "-o"); }).find("'%' must start the frame number"),
-                  std::string::npos)
+    for (const char* bad :
+         {"f_%s.exr", "f_%4d.exr", "f_%0d.exr", "f_%.exr", "f_%", "f_%x.exr", "f_%010d.exr"})
+        EXPECT_NE(
+            usageError([&] { (void)hasFrameNumber(bad, "-o"); }).find("'%' must start the frame number"),
+            std::string::npos)
             << bad;
     EXPECT_NE(usageError([] { (void)hasFrameNumber("%04d/f_%04d.exr", "-o"); }).find("2 frame numbers"),
               std::string::npos);
