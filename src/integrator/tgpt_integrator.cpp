@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <utility>
@@ -26,22 +27,15 @@ struct FrameSamples {
     RenderStats stats;
 };
 
-// The spp-weighted mean of two estimates, and the variance of that mean from theirs.
-Image weightedMean(const Image& a, double na, const Image& b, double nb) {
+// Two estimates of n_a and n_b samples combined with the weights w = n / (n_a + n_b), each
+// value raised to `power`: 1 for the spp-weighted mean of the estimates, 2 for the variance of
+// that mean from theirs.
+Image weighted(const Image& a, double na, const Image& b, double nb, int power) {
     Image out = a;
-    const double wa = na / (na + nb), wb = nb / (na + nb);
+    const double wa = std::pow(na / (na + nb), power), wb = std::pow(nb / (na + nb), power);
     for (int c = 0; c < 3; ++c)
         for (std::size_t i = 0; i < out.pixelCount(); ++i)
             out.plane(c)[i] = float(wa * a.plane(c)[i] + wb * b.plane(c)[i]);
-    return out;
-}
-
-Image weightedVariance(const Image& a, double na, const Image& b, double nb) {
-    Image out = a;
-    const double wa = na / (na + nb), wb = nb / (na + nb);
-    for (int c = 0; c < 3; ++c)
-        for (std::size_t i = 0; i < out.pixelCount(); ++i)
-            out.plane(c)[i] = float(wa * wa * a.plane(c)[i] + wb * wb * b.plane(c)[i]);
     return out;
 }
 
@@ -191,14 +185,14 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         }
         FrameSamples f;
         const double na = first.stats.spp, nb = second.stats.spp;
-        f.primal = weightedMean(first.primal, na, second.primal, nb);
-        f.dx = weightedMean(first.dx, na, second.dx, nb);
-        f.dy = weightedMean(first.dy, na, second.dy, nb);
-        f.direct = weightedMean(first.direct, na, second.direct, nb);
-        f.varPrimal = weightedVariance(first.varPrimal, na, second.varPrimal, nb);
-        f.varDx = weightedVariance(first.varDx, na, second.varDx, nb);
-        f.varDy = weightedVariance(first.varDy, na, second.varDy, nb);
-        f.varDirect = weightedVariance(first.varDirect, na, second.varDirect, nb);
+        f.primal = weighted(first.primal, na, second.primal, nb, 1);
+        f.dx = weighted(first.dx, na, second.dx, nb, 1);
+        f.dy = weighted(first.dy, na, second.dy, nb, 1);
+        f.direct = weighted(first.direct, na, second.direct, nb, 1);
+        f.varPrimal = weighted(first.varPrimal, na, second.varPrimal, nb, 2);
+        f.varDx = weighted(first.varDx, na, second.varDx, nb, 2);
+        f.varDy = weighted(first.varDy, na, second.varDy, nb, 2);
+        f.varDirect = weighted(first.varDirect, na, second.varDirect, nb, 2);
         f.firstHalfPrimal = std::move(first.primal);
         f.secondHalfPrimal = std::move(second.primal);
         f.stats = addStats(first.stats, second.stats);
