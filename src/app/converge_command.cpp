@@ -242,7 +242,10 @@ int runConverge(const ConvergeArgs& a) {
     // The arguments first: a usage error never waits for a scene or a reference.
     const auto methods = splitList(a.methods);
     if (methods.empty()) throw UsageError("--methods: no method given");
-    for (const std::string& m : methods) (void)makeIntegrator(m);  // unknown names fail before any render
+    for (const std::string& m : methods)  // unknown names, and methods of sequences, fail before any render
+        if (makeIntegrator(m)->windowFrames() > 0)
+            throw UsageError("--methods " + m + ": converge renders single images; " + m +
+                             " renders sequences (scripts/bench-temporal.sh compares it)");
     std::vector<double> times;
     for (const auto& t : splitList(a.times)) {
         try {

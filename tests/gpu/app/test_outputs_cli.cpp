@@ -170,6 +170,12 @@ TEST_F(OutputsCli, ConvergeRefusesWhatCannotBeMeasuredAndWritesNothing) {
     r = test::runGdpt("converge " + kScene + " --reference " + path("nan.exr") + " --methods '' -o " + out);
     EXPECT_EQ(r.code, 2) << r.output;
     EXPECT_TRUE(listing("conv").empty());
+
+    // A method of sequences is refused before any render.
+    r = test::runGdpt("converge " + kScene + " --reference " + path("nan.exr") + " --methods pt,tgpt -o " + out);
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_TRUE(says(r, "tgpt renders sequences")) << r.output;
+    EXPECT_TRUE(listing("conv").empty());
 }
 
 // Class: --time 0 silently rendered 64 spp; --alpha 0 with an L1 reconstruction failed with
