@@ -172,7 +172,8 @@ TEST_F(OutputsCli, ConvergeRefusesWhatCannotBeMeasuredAndWritesNothing) {
     EXPECT_TRUE(listing("conv").empty());
 
     // A method of sequences is refused before any render.
-    r = test::runGdpt("converge " + kScene + " --reference " + path("nan.exr") + " --methods pt,tgpt -o " + out);
+    r = test::runGdpt("converge " + kScene + " --reference " + path("nan.exr") + " --methods pt,tgpt -o " +
+                      out);
     EXPECT_EQ(r.code, 2) << r.output;
     EXPECT_TRUE(says(r, "tgpt renders sequences")) << r.output;
     EXPECT_TRUE(listing("conv").empty());
