@@ -78,9 +78,9 @@ int runSequence(const RenderArgs& args) {
     const bool timed = args.time > 0.0;
     const ReconTimeCache cache(ReconTimeCache::defaultPath());
 
-    // The outputs that exist once per sequence are checked before anything is loaded; each
-    // frame's EXR and PNG are staged when it starts and committed when it is whole, so an
-    // interrupted sequence leaves only complete frames.
+    // The outputs that exist once per sequence, and the first frame's, are checked before
+    // anything is loaded; each frame's EXR and PNG are staged when the frame is rendered and
+    // committed together, so an interrupted sequence leaves only complete frames.
     makeOutputDirectory(args.output);
     OutputSet sequenceOutputs({{"scene", args.scene}});
     const TextOutput jsonOutput(sequenceOutputs, args.json, "--json");
