@@ -28,7 +28,6 @@
 #include "integrator/render_identity.h"
 #include "render/device_scene/scene_gpu.h"
 #include "scene/gltf_loader.h"
-#include "scene/light_sources.h"
 #include "util/error.h"
 #include "util/interrupt.h"
 #include "util/output_files.h"
@@ -166,13 +165,7 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
                 "gdpt: note: %s has %zu animation(s); the rest pose is rendered (--frames renders them)\n",
                 args.scene.c_str(), asset.animations().size());
         throwIfInterrupted("loading");
-        if (!scene.unsupported.empty() && !quiet) {
-            std::string list;
-            for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
-            std::fprintf(stderr, "gdpt: warning: %s: not rendered: %s\n", args.scene.c_str(), list.c_str());
-        }
-        if (const auto black = blackImageWarning(scene, options.scene.envRadiance); black && !quiet)
-            std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
+        if (!quiet) warnAboutScene(args.scene, scene, options.scene.envRadiance);
         vk::ContextOptions ctxOptions;
         ctxOptions.device = args.device;
         ctxOptions.validation = args.validate;
@@ -326,11 +319,7 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
                      args.output.c_str(), s.spp, partial.c_str(), parts.c_str(),
                      integrator->summary(s).c_str(), seconds, sampling);
     }
-    if (ctx.validationErrors() > 0) {
-        std::fprintf(stderr, "gdpt: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
-        return 1;
-    }
-    return 0;
+    return validationExitStatus(ctx);
 }
 
 int runRender(const RenderArgs& args) {

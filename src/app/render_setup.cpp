@@ -7,6 +7,7 @@
 
 #include "app/bench_util.h"
 #include "integrator/recon_reserve.h"
+#include "scene/light_sources.h"
 #include "util/error.h"
 #include "util/interrupt.h"
 #include "vk/context.h"
@@ -165,6 +166,22 @@ json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrato
                                   {"rays_per_sample", s.emitterRaysPerSample},
                                   {"pixels", s.emitterSupersampledPixels}};
     return j;
+}
+
+void warnAboutScene(const std::string& path, const Scene& scene, glm::vec3 envRadiance) {
+    if (!scene.unsupported.empty()) {
+        std::string list;
+        for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
+        std::fprintf(stderr, "gdpt: warning: %s: not rendered: %s\n", path.c_str(), list.c_str());
+    }
+    if (const auto black = blackImageWarning(scene, envRadiance))
+        std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
+}
+
+int validationExitStatus(const vk::Context& ctx) {
+    if (ctx.validationErrors() == 0) return 0;
+    std::fprintf(stderr, "gdpt: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
+    return 1;
 }
 
 // Usage errors that the option checks alone cannot see (exit 2 before any work).

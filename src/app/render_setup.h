@@ -38,6 +38,14 @@ nlohmann::json summaryJson(const RenderArgs& args, const vk::Context& ctx, const
                            const RenderStats& s, double seconds, double reserved, double finishReserved,
                            double writeMs);
 
+// The warnings about a loaded scene, on stderr: what the file holds that is not rendered, and
+// that the image would be black (nothing emits).
+void warnAboutScene(const std::string& path, const Scene& scene, glm::vec3 envRadiance);
+
+// A render's exit status once its outputs are written: 1 (said on stderr) if Vulkan validation
+// reported errors, else 0.
+int validationExitStatus(const vk::Context& ctx);
+
 // Usage errors that the option checks alone cannot see (throws gdpt::UsageError, exit 2,
 // before any work).
 void checkArgs(const RenderArgs& args);

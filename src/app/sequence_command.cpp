@@ -20,7 +20,6 @@
 #include "integrator/recon_reserve.h"
 #include "render/device_scene/scene_gpu.h"
 #include "scene/gltf_loader.h"
-#include "scene/light_sources.h"
 #include "util/error.h"
 #include "util/frame_pattern.h"
 #include "util/interrupt.h"
@@ -146,17 +145,8 @@ int runSequence(const RenderArgs& args) {
     const auto sceneAt = [&](int f) {
         enterPhase("loading");
         Scene scene = asset.instance(animation, double(f) / args.fps);
-        if (!warned && !quiet) {
-            warned = true;
-            if (!scene.unsupported.empty()) {
-                std::string list;
-                for (const auto& u : scene.unsupported) list += (list.empty() ? "" : "; ") + u;
-                std::fprintf(stderr, "gdpt: warning: %s: not rendered: %s\n", args.scene.c_str(),
-                             list.c_str());
-            }
-            if (const auto black = blackImageWarning(scene, options.scene.envRadiance))
-                std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
-        }
+        if (!warned && !quiet) warnAboutScene(args.scene, scene, options.scene.envRadiance);
+        warned = true;
         return scene;
     };
     // Writes frame f's EXR and PNG (together, whole or not at all), its summary and progress.
@@ -294,11 +284,7 @@ int runSequence(const RenderArgs& args) {
     if (!quiet)
         std::fprintf(stderr, "gdpt: wrote %d frames %s%s in %s\n", range.count(), args.output.c_str(),
                      videoNote.c_str(), seconds(total.seconds()).c_str());
-    if (ctx.validationErrors() > 0) {
-        std::fprintf(stderr, "gdpt: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
-        return 1;
-    }
-    return 0;
+    return validationExitStatus(ctx);
 }
 
 }  // namespace gdpt

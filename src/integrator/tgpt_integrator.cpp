@@ -1,8 +1,6 @@
 // tgpt_integrator.cpp — temporal G-PT (tgpt_integrator.h).
 #include "integrator/tgpt_integrator.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -14,6 +12,7 @@
 #include "integrator/render_identity.h"
 #include "poisson/poisson_spacetime.h"
 #include "util/error.h"
+#include "util/memory.h"
 #include "util/timer.h"
 
 namespace gdpt {
@@ -71,13 +70,7 @@ RenderStats addStats(const RenderStats& a, const RenderStats& b) {
     return s;
 }
 
-std::array<Field, 3> toFields(const Image& image) {
-    std::array<Field, 3> f;
-    for (int c = 0; c < 3; ++c) f[c].assign(image.plane(c).begin(), image.plane(c).end());
-    return f;
-}
-
-// Appends frame `k` of the window's images (W·H per channel) to a frame-major field.
+// Appends an image (W·H per channel) to a frame-major field.
 void append(std::array<Field, 3>& to, const Image& image) {
     for (int c = 0; c < 3; ++c) to[c].insert(to[c].end(), image.plane(c).begin(), image.plane(c).end());
 }
@@ -97,17 +90,10 @@ std::uint64_t windowBytes(int width, int height, int frames) {
            std::uint64_t(width) * std::uint64_t(height) * std::uint64_t(frames) * 12u * 3u * 4u;
 }
 
-std::string gibibytes(std::uint64_t bytes) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.1f GiB", double(bytes) / double(1ull << 30));
-    return text;
-}
-
 // Refuses a window larger than the machine's memory, before it is sampled.
 void checkWindowMemory(int width, int height, int frames) {
-    const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
-    if (pages <= 0 || pageSize <= 0) return;
-    const std::uint64_t memory = std::uint64_t(pages) * std::uint64_t(pageSize);
+    const std::uint64_t memory = physicalMemory();
+    if (memory == 0) return;
     const std::uint64_t need = windowBytes(width, height, frames);
     if (need <= memory) return;
     const std::uint64_t perFrame = windowBytes(width, height, 1);
@@ -222,7 +208,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
     if (joined) {
         dtToPrevious[0] = difference(frames[0].firstHalfPrimal, carry_->secondHalfPrimal);
         problem.previous = carry_->recon;
-        problem.dtPrevious = toFields(dtToPrevious[0]);
+        append(problem.dtPrevious, dtToPrevious[0]);
     }
     SpaceTimeOptions solve;
     solve.l1 = options_.l1;
@@ -239,14 +225,14 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
                      solved.iterations, solved.irlsIterations, solved.residual, solved.ms);
 
     // 3. Compose each frame: reconstruction + very-direct light.
-    const std::string reconName = std::string("recon_spacetime_") + (options_.l1 ? "l1" : "l2");
+    const std::string solveName = std::string("spacetime_") + (options_.l1 ? "l1" : "l2");
     for (std::size_t k = 0; k < frames.size(); ++k) {
         FrameSamples& f = frames[k];
         Image recon = frameOf(x, k, width, height);
         RenderOutput out;
         out.stats = f.stats;
         ReconstructionStats r;
-        r.method = "spacetime_" + std::string(options_.l1 ? "l1" : "l2");
+        r.method = solveName;
         r.iterations = solved.iterations;
         r.irlsIterations = solved.irlsIterations;
         r.residual = solved.residual;
@@ -262,7 +248,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         if (dtToPrevious[k].empty()) dtToPrevious[k] = Image(width, height);
         out.layers.push_back({"", gptFinal(recon, nullptr, &f.direct)});
         Image primalPlusDirect = gptFinal(f.primal, nullptr, &f.direct);
-        out.layers.push_back({reconName, std::move(recon)});
+        out.layers.push_back({"recon_" + solveName, std::move(recon)});
         out.layers.push_back({"primal", std::move(f.primal)});
         out.layers.push_back({"dx", std::move(f.dx)});
         out.layers.push_back({"dy", std::move(f.dy)});

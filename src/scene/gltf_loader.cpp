@@ -4,8 +4,6 @@
 // materials are converted in gltf_geometry.cpp and gltf_materials.cpp.
 #include "scene/gltf_loader.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -24,6 +22,7 @@
 
 #include "scene/gltf_internal.h"
 #include "util/interrupt.h"
+#include "util/memory.h"
 #include "util/progress.h"
 
 namespace gdpt {
@@ -106,33 +105,42 @@ void checkFinite(const std::vector<double>& v, const std::string& what) {
         if (!std::isfinite(x)) throw Error(what + " is not finite");
 }
 
-// Local transform of a node: `matrix` (column-major) or T * R * S (glTF 2.0 §3.5.3).
-glm::dmat4 localMatrix(const tinygltf::Node& node) {
+// Local transform of a node: `matrix` (column-major) or T * R * S (glTF 2.0 §3.5.3), where an
+// animation's pose (if any) replaces the node's own translation, rotation or scale (animated
+// nodes have no matrix: readAnimations refuses them).
+glm::dmat4 localMatrix(const tinygltf::Node& node, const NodePose* pose = nullptr) {
     if (!node.matrix.empty()) {
         if (node.matrix.size() != 16) throw Error("matrix must have 16 numbers");
         checkFinite(node.matrix, "matrix");
         return glm::make_mat4(node.matrix.data());
     }
     glm::dmat4 t(1.0), r(1.0), s(1.0);
-    if (!node.translation.empty()) {
+    std::optional<glm::dvec3> translation = pose ? pose->translation : std::nullopt;
+    if (!translation && !node.translation.empty()) {
         if (node.translation.size() != 3) throw Error("translation must have 3 numbers");
         checkFinite(node.translation, "translation");
-        t[3] = glm::dvec4(node.translation[0], node.translation[1], node.translation[2], 1.0);
+        translation = glm::dvec3(node.translation[0], node.translation[1], node.translation[2]);
     }
-    if (!node.rotation.empty()) {
+    if (translation) t[3] = glm::dvec4(*translation, 1.0);
+    std::optional<glm::dquat> rotation = pose ? pose->rotation : std::nullopt;
+    if (!rotation && !node.rotation.empty()) {
         if (node.rotation.size() != 4) throw Error("rotation must have 4 numbers");
         checkFinite(node.rotation, "rotation");
         // glTF stores (x, y, z, w); glm's constructor takes (w, x, y, z).
-        glm::dquat q(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]);
-        const double len = glm::length(q);
-        if (!(len > 1e-12)) throw Error("rotation is a zero quaternion");
-        r = glm::mat4_cast(q / len);
+        rotation = glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]);
     }
-    if (!node.scale.empty()) {
+    if (rotation) {
+        const double len = glm::length(*rotation);
+        if (!(len > 1e-12)) throw Error("rotation is a zero quaternion");
+        r = glm::mat4_cast(*rotation / len);
+    }
+    std::optional<glm::dvec3> scale = pose ? pose->scale : std::nullopt;
+    if (!scale && !node.scale.empty()) {
         if (node.scale.size() != 3) throw Error("scale must have 3 numbers");
         checkFinite(node.scale, "scale");
-        s = glm::scale(glm::dmat4(1.0), glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
+        scale = glm::dvec3(node.scale[0], node.scale[1], node.scale[2]);
     }
+    if (scale) s = glm::scale(glm::dmat4(1.0), *scale);
     return t * r * s;
 }
 
@@ -311,18 +319,6 @@ void addLight(gltf::Context& ctx, const tinygltf::Value& ext, const glm::dmat4& 
     ctx.scene.punctualLights.push_back(out);
 }
 
-// The machine's physical memory in bytes (0 if unknown).
-std::uint64_t physicalMemory() {
-    const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
-    return pages > 0 && pageSize > 0 ? std::uint64_t(pages) * std::uint64_t(pageSize) : 0;
-}
-
-std::string gibibytes(std::uint64_t bytes) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.1f GiB", double(bytes) / double(1ull << 30));
-    return text;
-}
-
 // The checks of the file's JSON (precheckJson) and the estimate of what loading it costs;
 // an empty estimate if the JSON is not parseable (tinygltf reports that).
 SceneEstimate precheck(const std::vector<unsigned char>& jsonBytes) {
@@ -362,16 +358,6 @@ void checkSceneExtent(const Scene& scene) {
                   "(single-precision triangle normals and areas), so scale it into that range",
                   extent, gltf::kMinSceneExtent, gltf::kMaxSceneExtent);
     throw Error(text);
-}
-
-// A node's local transform in the pose: the animated parts replace the node's own.
-glm::dmat4 posedMatrix(const tinygltf::Node& node, const NodePose& pose) {
-    tinygltf::Node posed = node;  // animated nodes have no matrix (readAnimations checks)
-    if (pose.translation) posed.translation = {pose.translation->x, pose.translation->y, pose.translation->z};
-    if (pose.rotation)
-        posed.rotation = {pose.rotation->x, pose.rotation->y, pose.rotation->z, pose.rotation->w};
-    if (pose.scale) posed.scale = {pose.scale->x, pose.scale->y, pose.scale->z};
-    return localMatrix(posed);
 }
 
 }  // namespace
@@ -460,8 +446,7 @@ Scene GltfAsset::Impl::instance(int animation, double time) const {
         const tinygltf::Node& node = model.nodes[static_cast<std::size_t>(index)];
         try {
             const auto posed = pose.find(index);
-            const glm::dmat4 local =
-                posed == pose.end() ? gltf::localMatrix(node) : gltf::posedMatrix(node, posed->second);
+            const glm::dmat4 local = gltf::localMatrix(node, posed == pose.end() ? nullptr : &posed->second);
             const glm::dmat4 world = parentWorld * local;
             if (node.mesh >= 0) {
                 if (static_cast<std::size_t>(node.mesh) >= model.meshes.size())

@@ -1,0 +1,21 @@
+// memory.cpp — see memory.h.
+#include "util/memory.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+
+namespace gdpt {
+
+std::uint64_t physicalMemory() {
+    const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && pageSize > 0 ? std::uint64_t(pages) * std::uint64_t(pageSize) : 0;
+}
+
+std::string gibibytes(std::uint64_t bytes) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f GiB", double(bytes) / double(1ull << 30));
+    return text;
+}
+
+}  // namespace gdpt

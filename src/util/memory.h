@@ -1,0 +1,16 @@
+// memory.h — the machine's memory, and byte counts as people read them, for the checks that
+// refuse work too large for the machine before it starts (the glTF loader, tgpt's windows).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace gdpt {
+
+// The machine's physical memory in bytes (0 if unknown).
+[[nodiscard]] std::uint64_t physicalMemory();
+
+// "1.5 GiB": bytes in gibibytes with one decimal.
+[[nodiscard]] std::string gibibytes(std::uint64_t bytes);
+
+}  // namespace gdpt
