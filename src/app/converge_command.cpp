@@ -24,6 +24,7 @@
 #include "image/metrics.h"
 #include "integrator/integrator.h"
 #include "integrator/pt_sampler.h"
+#include "poisson/debias.h"
 #include "scene/gltf_loader.h"
 #include "scene/light_sources.h"
 #include "util/error.h"
@@ -54,6 +55,7 @@ struct ConvergeArgs {
     std::uint32_t emitterSupersampling = kDefaultEmitterSupersampling;
     std::uint32_t edgeSamples = kDefaultEdgeSamples;
     std::string demodulate = "auto";
+    int debiasScale = kDefaultDebiasScale;
 };
 
 // FNV-1a of the scene file's bytes and the render settings: the cache key of a made reference.
@@ -146,6 +148,7 @@ private:
         MethodOptions m;
         m.gpt.sampling.edgeSamples = a_.edgeSamples;
         m.gpt.sampling.demodulate = parseDemodulation(a_.demodulate);
+        m.gpt.debiasScale = a_.debiasScale;
         return m;
     }
 
@@ -463,6 +466,9 @@ Subcommand addConvergeCommand(CLI::App& app) {
                   "G-PT methods: first-hit texture demodulation (as gdpt render: auto, on, off)")
         ->capture_default_str()
         ->check(CLI::IsMember({"auto", "on", "off"}));
+    c->add_option("--debias-scale", a->debiasScale, std::string("G-PT methods (as gdpt render): ") + kDebiasScaleHelp)
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1 << 20));
     c->add_option("--width", a->width, "Image width")->capture_default_str()->check(CLI::Range(1, 16384));
     c->add_option("--height", a->height, "Image height")->capture_default_str()->check(CLI::Range(1, 16384));
     c->add_option("--target", a->target,

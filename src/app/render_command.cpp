@@ -66,6 +66,7 @@ std::string renderArgsJson(const RenderArgs& a) {
                     {"all_recon", a.allRecon},
                     {"alpha", a.alpha},
                     {"tolerance", a.tolerance},
+                    {"debias_scale", a.debiasScale},
                     {"workgroup", a.workgroup}};
     return j.dump();
 }
@@ -92,6 +93,8 @@ RenderArgs renderArgsFromJson(const std::string& text, const std::string& where)
         a.allRecon = j.at("all_recon").get<bool>();
         a.alpha = j.at("alpha").get<double>();
         a.tolerance = j.at("tolerance").get<double>();
+        // Renders written before the debiasing had none.
+        a.debiasScale = j.value("debias_scale", 0);
         a.workgroup = j.at("workgroup").get<std::string>();
     } catch (const json::exception& e) {
         throw Error(where + ": the render's settings (gdpt.info.render_args) cannot be read: " + e.what());
@@ -401,6 +404,10 @@ Subcommand addRenderCommand(CLI::App& app) {
     r->add_option("--tolerance", a.tolerance, "Relative residual at which the solver stops")
         ->capture_default_str()
         ->check(CLI::Range(1e-9, 1.0))
+        ->group(gpt);
+    r->add_option("--debias-scale", a.debiasScale, kDebiasScaleHelp)
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1 << 20))
         ->group(gpt);
     r->add_option("--shift-threshold", a.shiftThreshold,
                   "Roughness at or below which a vertex takes the half-vector shift instead of reconnection")

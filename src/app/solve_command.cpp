@@ -6,11 +6,13 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "app/subcommand.h"
 #include "image/exr_io.h"
 #include "image/finite_check.h"
 #include "integrator/gpt_sampler.h"
+#include "poisson/debias.h"
 #include "poisson/poisson_gpu.h"
 #include "util/error.h"
 #include "util/interrupt.h"
@@ -34,6 +36,7 @@ struct SolveArgs {
     double irlsRegInit = SolveOptions{}.irlsRegInit;
     double irlsRegIter = SolveOptions{}.irlsRegIter;
     double irlsInnerTolerance = SolveOptions{}.irlsInnerTolerance;
+    int debiasScale = kDefaultDebiasScale;
     std::string primal, dx, dy;
     std::string device;
     bool quiet = false;
@@ -192,7 +195,9 @@ int runSolve(const SolveArgs& a) {
                                           : std::string()) +
                             std::to_string(iterations) + " iterations");
     };
-    const Image recon = reconstruct(ctx, primal, dx, dy, varP, varX, varY, o, &report);
+    Image recon = reconstruct(ctx, primal, dx, dy, varP, varX, varY, o, &report);
+    std::optional<DebiasReport> debiased;
+    if (debiases(o.method, a.debiasScale)) debiased = debiasImage(recon, primal, a.debiasScale);
     if (shown) {
         progress.update(1.0);
         progress.finish(std::to_string(report.iterations) + " iterations");
@@ -216,6 +221,7 @@ int runSolve(const SolveArgs& a) {
                 "gdpt: note: inputs above %g were scaled by 2^-%d for the solve (its float32 sums of "
                 "squares would overflow) and the result by 2^%d\n",
                 kSolveMaxMagnitude, report.scaleExponent, report.scaleExponent);
+        if (debiased) std::fprintf(stderr, "gdpt: %s\n", describeDebias(*debiased, a.debiasScale).c_str());
     }
     return 0;
 }
@@ -236,6 +242,9 @@ Subcommand addSolveCommand(CLI::App& app) {
            "Reconstruction: l1, l2, wl2 (inverse-variance weighted L2) or wl1 (L1 with inverse-variance "
            "weights from a 7x7 box of the variance)")
         ->check(CLI::IsMember({"l1", "l2", "wl2", "wl1"}))
+        ->capture_default_str();
+    sub->add_option("--debias-scale", a->debiasScale, kDebiasScaleHelp)
+        ->check(CLI::Range(0, 1 << 20))
         ->capture_default_str();
     sub->add_option("--solver", a->solver, "Linear solver: mg-pcg, cg, jacobi or mg")
         ->check(CLI::IsMember({"mg-pcg", "cg", "jacobi", "mg"}))

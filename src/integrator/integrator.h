@@ -16,6 +16,7 @@
 #include "image/exr_io.h"
 #include "integrator/gpt_sampler.h"
 #include "integrator/render_options.h"
+#include "poisson/debias.h"
 #include "poisson/poisson_gpu.h"
 #include "scene/scene.h"
 
@@ -96,6 +97,9 @@ struct GptOptions {
     std::vector<Reconstruction> reconstructions = {Reconstruction::L1};
     double alpha = 0.2;       // weight of the primal term
     double tolerance = 1e-4;  // relative residual at which each solve stops
+    // Pixels between the coarse nodes at which the biased reconstructions take their coarse
+    // scales from the primal (poisson/debias.h); 0 = the published reconstruction.
+    int debiasScale = kDefaultDebiasScale;
     // Timed renders: the reconstruction time remembered per configuration (recon_reserve.h);
     // null: measured once per integrator and raised to its longest real reconstruction.
     const ReconTimeCache* reconCache = nullptr;

@@ -80,7 +80,9 @@ struct ReconstructionStats {
     double residual = 0.0;   // final relative residual, max over channels
     double tolerance = 0.0;  // the relative residual asked for
     bool converged = false;  // every channel reached the tolerance
-    double ms = 0.0;
+    double ms = 0.0;         // the solve and the debiasing
+    int debiasScale = 0;     // coarse scale of the debiasing (poisson/debias.h); 0: not debiased
+    double debiasMeanChange = 0.0;  // the debiasing's change of the image mean, relative
 };
 
 // A render split across processes (sample_share.h): how its parts were merged.

@@ -95,6 +95,8 @@ bool needsVariance(Reconstruction r) {
     return r == Reconstruction::WeightedL2 || r == Reconstruction::WeightedL1;
 }
 
+bool debiases(Reconstruction r, int debiasScale) { return debiasScale > 0 && r != Reconstruction::L2; }
+
 std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& nonFinite,
                                        std::size_t& negative) {
     const int w = var.width(), h = var.height();
