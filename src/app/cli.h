@@ -40,7 +40,7 @@ struct RenderArgs {
     std::string recon = "l1";
     double alpha = 0.2;
     double tolerance = 1e-4;
-    int debiasScale = kDefaultDebiasScale;  // poisson/debias.h
+    int debiasCells = kDefaultDebiasCells;  // poisson/debias.h
     bool allRecon = false;
     std::string checkpoint;        // write the sampler state here on interrupt / periodically / at the end
     double checkpointEvery = 0.0;  // seconds between periodic checkpoints (0 = only at the end)

@@ -55,7 +55,7 @@ struct ConvergeArgs {
     std::uint32_t emitterSupersampling = kDefaultEmitterSupersampling;
     std::uint32_t edgeSamples = kDefaultEdgeSamples;
     std::string demodulate = "auto";
-    int debiasScale = kDefaultDebiasScale;
+    int debiasCells = kDefaultDebiasCells;
 };
 
 // FNV-1a of the scene file's bytes and the render settings: the cache key of a made reference.
@@ -148,7 +148,7 @@ private:
         MethodOptions m;
         m.gpt.sampling.edgeSamples = a_.edgeSamples;
         m.gpt.sampling.demodulate = parseDemodulation(a_.demodulate);
-        m.gpt.debiasScale = a_.debiasScale;
+        m.gpt.debiasCells = a_.debiasCells;
         return m;
     }
 
@@ -466,7 +466,8 @@ Subcommand addConvergeCommand(CLI::App& app) {
                   "G-PT methods: first-hit texture demodulation (as gdpt render: auto, on, off)")
         ->capture_default_str()
         ->check(CLI::IsMember({"auto", "on", "off"}));
-    c->add_option("--debias-scale", a->debiasScale, std::string("G-PT methods (as gdpt render): ") + kDebiasScaleHelp)
+    c->add_option("--debias-cells", a->debiasCells,
+                  std::string("G-PT methods (as gdpt render): ") + kDebiasCellsHelp)
         ->capture_default_str()
         ->check(CLI::Range(0, 1 << 20));
     c->add_option("--width", a->width, "Image width")->capture_default_str()->check(CLI::Range(1, 16384));

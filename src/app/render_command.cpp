@@ -66,7 +66,7 @@ std::string renderArgsJson(const RenderArgs& a) {
                     {"all_recon", a.allRecon},
                     {"alpha", a.alpha},
                     {"tolerance", a.tolerance},
-                    {"debias_scale", a.debiasScale},
+                    {"debias_cells", a.debiasCells},
                     {"workgroup", a.workgroup}};
     return j.dump();
 }
@@ -94,7 +94,7 @@ RenderArgs renderArgsFromJson(const std::string& text, const std::string& where)
         a.alpha = j.at("alpha").get<double>();
         a.tolerance = j.at("tolerance").get<double>();
         // Renders written before the debiasing had none.
-        a.debiasScale = j.value("debias_scale", 0);
+        a.debiasCells = j.value("debias_cells", 0);
         a.workgroup = j.at("workgroup").get<std::string>();
     } catch (const json::exception& e) {
         throw Error(where + ": the render's settings (gdpt.info.render_args) cannot be read: " + e.what());
@@ -405,7 +405,7 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(1e-9, 1.0))
         ->group(gpt);
-    r->add_option("--debias-scale", a.debiasScale, kDebiasScaleHelp)
+    r->add_option("--debias-cells", a.debiasCells, kDebiasCellsHelp)
         ->capture_default_str()
         ->check(CLI::Range(0, 1 << 20))
         ->group(gpt);

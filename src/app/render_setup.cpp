@@ -77,7 +77,7 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
             if (args.recon != other) g.reconstructions.push_back(parseReconstruction(other));
     g.alpha = args.alpha;
     g.tolerance = args.tolerance;
-    g.debiasScale = args.debiasScale;
+    g.debiasCells = args.debiasCells;
     MltOptions& mlt = m.mlt;
     mlt.chains = args.chains;
     mlt.largeStep = args.largeStep;

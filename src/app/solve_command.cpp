@@ -36,7 +36,7 @@ struct SolveArgs {
     double irlsRegInit = SolveOptions{}.irlsRegInit;
     double irlsRegIter = SolveOptions{}.irlsRegIter;
     double irlsInnerTolerance = SolveOptions{}.irlsInnerTolerance;
-    int debiasScale = kDefaultDebiasScale;
+    int debiasCells = kDefaultDebiasCells;
     std::string primal, dx, dy;
     std::string device;
     bool quiet = false;
@@ -197,7 +197,7 @@ int runSolve(const SolveArgs& a) {
     };
     Image recon = reconstruct(ctx, primal, dx, dy, varP, varX, varY, o, &report);
     std::optional<DebiasReport> debiased;
-    if (debiases(o.method, a.debiasScale)) debiased = debiasImage(recon, primal, a.debiasScale);
+    if (debiases(o.method, a.debiasCells)) debiased = debiasImage(recon, primal, a.debiasCells);
     if (shown) {
         progress.update(1.0);
         progress.finish(std::to_string(report.iterations) + " iterations");
@@ -221,7 +221,7 @@ int runSolve(const SolveArgs& a) {
                 "gdpt: note: inputs above %g were scaled by 2^-%d for the solve (its float32 sums of "
                 "squares would overflow) and the result by 2^%d\n",
                 kSolveMaxMagnitude, report.scaleExponent, report.scaleExponent);
-        if (debiased) std::fprintf(stderr, "gdpt: %s\n", describeDebias(*debiased, a.debiasScale).c_str());
+        if (debiased) std::fprintf(stderr, "gdpt: %s\n", describeDebias(*debiased).c_str());
     }
     return 0;
 }
@@ -243,7 +243,7 @@ Subcommand addSolveCommand(CLI::App& app) {
            "weights from a 7x7 box of the variance)")
         ->check(CLI::IsMember({"l1", "l2", "wl2", "wl1"}))
         ->capture_default_str();
-    sub->add_option("--debias-scale", a->debiasScale, kDebiasScaleHelp)
+    sub->add_option("--debias-cells", a->debiasCells, kDebiasCellsHelp)
         ->check(CLI::Range(0, 1 << 20))
         ->capture_default_str();
     sub->add_option("--solver", a->solver, "Linear solver: mg-pcg, cg, jacobi or mg")

@@ -16,7 +16,7 @@ namespace gdpt {
 GptIntegrator::GptIntegrator(std::string name, GptOptions options)
     : name_(std::move(name)),
       options_(std::move(options)),
-      stage_(options_.reconstructions, options_.alpha, options_.tolerance, options_.debiasScale) {}
+      stage_(options_.reconstructions, options_.alpha, options_.tolerance, options_.debiasCells) {}
 
 GptIntegrator::~GptIntegrator() = default;
 

@@ -97,9 +97,9 @@ struct GptOptions {
     std::vector<Reconstruction> reconstructions = {Reconstruction::L1};
     double alpha = 0.2;       // weight of the primal term
     double tolerance = 1e-4;  // relative residual at which each solve stops
-    // Pixels between the coarse nodes at which the biased reconstructions take their coarse
-    // scales from the primal (poisson/debias.h); 0 = the published reconstruction.
-    int debiasScale = kDefaultDebiasScale;
+    // Cells across the image's shorter side of the coarse grid whose scales the biased
+    // reconstructions take from the primal (poisson/debias.h); 0 = the published reconstruction.
+    int debiasCells = kDefaultDebiasCells;
     // Timed renders: the reconstruction time remembered per configuration (recon_reserve.h);
     // null: measured once per integrator and raised to its longest real reconstruction.
     const ReconTimeCache* reconCache = nullptr;

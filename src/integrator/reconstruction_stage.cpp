@@ -12,8 +12,8 @@
 namespace gdpt {
 
 ReconstructionStage::ReconstructionStage(std::vector<Reconstruction> reconstructions, double alpha,
-                                         double tolerance, int debiasScale)
-    : debiasScale_(debiasScale) {
+                                         double tolerance, int debiasCells)
+    : debiasCells_(debiasCells) {
     for (Reconstruction r : reconstructions) {
         SolveOptions so;
         so.method = r;
@@ -69,17 +69,18 @@ std::vector<NamedLayer> ReconstructionStage::run(const PoissonInput& input, cons
         so.progress = [&](int, int, int) { stopIfCancelled(); };
         Image recon;
         const SolveReport report = solver_->solve(input, so, recon);
-        ReconstructionStats rs{toString(so.method), report.iterations, report.irlsIterations, report.residual,
-                               so.tolerance,        report.converged,  report.ms};
+        ReconstructionStats rs{
+            toString(so.method), report.iterations, report.irlsIterations, report.residual, so.tolerance,
+            report.converged,    report.ms};
         std::string debiased;
-        if (debiases(so.method, debiasScale_)) {
+        if (debiases(so.method, debiasCells_)) {
             // The coarse scales from the primal (poisson/debias.h): a few ms on the host.
             Timer debiasTimer;
-            const DebiasReport d = debiasImage(recon, *input.primal, debiasScale_);
-            rs.debiasScale = debiasScale_;
+            const DebiasReport d = debiasImage(recon, *input.primal, debiasCells_);
+            rs.debiasScale = d.scale;
             rs.debiasMeanChange = d.meanBefore > 0.0 ? d.meanCorrection / d.meanBefore : 0.0;
             rs.ms += debiasTimer.ms();
-            debiased = ", " + describeDebias(d, debiasScale_);
+            debiased = ", " + describeDebias(d);
         }
         // Not converged (the iteration cap, or a tolerance below what float32 residuals
         // reach) is said as `gdpt solve` says it, and recorded for the JSON summary.
@@ -109,7 +110,7 @@ nlohmann::json reconstructionsJson(const RenderStats& s) {
                           {"residual", r.residual},
                           {"tolerance", r.tolerance},
                           {"converged", r.converged},
-                          {"debias_scale", r.debiasScale},
+                          {"debias_scale_px", r.debiasScale},
                           {"debias_mean_change", r.debiasMeanChange},
                           {"ms", r.ms}});
     return recons;

@@ -23,10 +23,10 @@ class ReconTimeCache;
 class ReconstructionStage {
 public:
     // The reconstructions in order (the first gives the final image), with the primal weight
-    // alpha, the relative residual at which each solve stops, and the coarse scale at which the
-    // biased ones are debiased against the primal (poisson/debias.h; 0 = not).
+    // alpha, the relative residual at which each solve stops, and the cells of the coarse grid
+    // at which the biased ones are debiased against the primal (poisson/debias.h; 0 = not).
     ReconstructionStage(std::vector<Reconstruction> reconstructions, double alpha, double tolerance,
-                        int debiasScale = 0);
+                        int debiasCells = 0);
     ~ReconstructionStage();
 
     [[nodiscard]] const std::vector<SolveOptions>& solves() const { return solves_; }
@@ -49,7 +49,7 @@ public:
 
 private:
     std::vector<SolveOptions> solves_;
-    int debiasScale_ = 0;
+    int debiasCells_ = 0;
     std::unique_ptr<PoissonSolverGpu> solver_;
     const vk::Context* solverCtx_ = nullptr;
     int solverWidth_ = 0, solverHeight_ = 0;

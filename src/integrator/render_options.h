@@ -74,14 +74,14 @@ struct RenderOptions {
 
 // One screened Poisson reconstruction of a render (G-PT): the solver's report in brief.
 struct ReconstructionStats {
-    std::string method;      // "l1", "l2", "wl2", "wl1"
-    int iterations = 0;      // inner iterations, summed over IRLS rounds
-    int irlsIterations = 0;  // 1 for L2/WL2
-    double residual = 0.0;   // final relative residual, max over channels
-    double tolerance = 0.0;  // the relative residual asked for
-    bool converged = false;  // every channel reached the tolerance
-    double ms = 0.0;         // the solve and the debiasing
-    int debiasScale = 0;     // coarse scale of the debiasing (poisson/debias.h); 0: not debiased
+    std::string method;             // "l1", "l2", "wl2", "wl1"
+    int iterations = 0;             // inner iterations, summed over IRLS rounds
+    int irlsIterations = 0;         // 1 for L2/WL2
+    double residual = 0.0;          // final relative residual, max over channels
+    double tolerance = 0.0;         // the relative residual asked for
+    bool converged = false;         // every channel reached the tolerance
+    double ms = 0.0;                // the solve and the debiasing
+    int debiasScale = 0;            // node spacing (px) of the debiasing (poisson/debias.h); 0: not debiased
     double debiasMeanChange = 0.0;  // the debiasing's change of the image mean, relative
 };
 

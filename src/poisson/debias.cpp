@@ -66,8 +66,10 @@ struct Hats {
 }  // namespace
 
 std::vector<double> coarseProjection(int width, int height, const std::vector<double>& d, int scale) {
-    if (scale < 1) throw Error("debias: the coarse scale must be at least 1 pixel (got " + std::to_string(scale) + ")");
-    if (width < 1 || height < 1 || d.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height))
+    if (scale < 1)
+        throw Error("debias: the coarse scale must be at least 1 pixel (got " + std::to_string(scale) + ")");
+    if (width < 1 || height < 1 ||
+        d.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height))
         throw Error("debias: a " + std::to_string(width) + "x" + std::to_string(height) + " field needs " +
                     std::to_string(static_cast<std::size_t>(std::max(width, 0)) * std::max(height, 0)) +
                     " values (got " + std::to_string(d.size()) + ")");
@@ -115,8 +117,8 @@ DebiasReport debiasChannel(int width, int height, std::vector<float>& recon, con
                            int scale) {
     const std::size_t n = recon.size();
     if (primal.size() != n)
-        throw Error("debias: the primal has " + std::to_string(primal.size()) + " values, the reconstruction " +
-                    std::to_string(n));
+        throw Error("debias: the primal has " + std::to_string(primal.size()) +
+                    " values, the reconstruction " + std::to_string(n));
     std::vector<double> d(n, 0.0);
     double sumBefore = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -137,14 +139,24 @@ DebiasReport debiasChannel(int width, int height, std::vector<float>& recon, con
     return report;
 }
 
-DebiasReport debiasImage(Image& recon, const Image& primal, int scale) {
+int debiasScale(int width, int height, int cells) {
+    if (cells < 1)
+        throw Error("debias: the coarse grid needs at least 1 cell (got " + std::to_string(cells) + ")");
+    const int side = std::max(1, std::min(width, height));
+    return std::max(1, (side + cells - 1) / cells);
+}
+
+DebiasReport debiasImage(Image& recon, const Image& primal, int cells) {
     if (!recon.sameSize(primal))
         throw Error("debias: the reconstruction is " + std::to_string(recon.width()) + "x" +
                     std::to_string(recon.height()) + ", the primal " + std::to_string(primal.width()) + "x" +
                     std::to_string(primal.height()));
+    const int scale = debiasScale(recon.width(), recon.height(), cells);
     DebiasReport total;
+    total.scale = scale;
     for (int c = 0; c < Image::kChannels; ++c) {
-        const DebiasReport r = debiasChannel(recon.width(), recon.height(), recon.plane(c), primal.plane(c), scale);
+        const DebiasReport r =
+            debiasChannel(recon.width(), recon.height(), recon.plane(c), primal.plane(c), scale);
         total.meanBefore += r.meanBefore / Image::kChannels;
         total.meanCorrection += r.meanCorrection / Image::kChannels;
         total.maxCorrection = std::max(total.maxCorrection, r.maxCorrection);
@@ -152,7 +164,8 @@ DebiasReport debiasImage(Image& recon, const Image& primal, int scale) {
     return total;
 }
 
-std::string describeDebias(const DebiasReport& report, int scale) {
+std::string describeDebias(const DebiasReport& report) {
+    const int scale = report.scale;
     char buf[160];
     if (report.meanBefore > 0.0)
         std::snprintf(buf, sizeof buf, "debiased at %d px: mean %+.2f %% (largest change %.3g)", scale,

@@ -31,20 +31,28 @@
 
 namespace gdpt {
 
-// The default coarse scale of a render's debiasing (`--debias-scale`), in pixels: chosen by
-// measurement on the scene set (bench/RESULTS.md, "Bias of the reconstructions").
-inline constexpr int kDefaultDebiasScale = 16;
-// The --debias-scale option's help, for every command that has it.
-inline constexpr const char* kDebiasScaleHelp =
-    "Pixels between the nodes of the coarse grid whose bilinear functions the biased reconstructions "
-    "(l1, wl1, wl2) take from the unbiased primal, so that their mean and coarse content are unbiased "
-    "(0 = off: the published reconstruction)";
+// A render's coarse grid has `cells` cells across the image's shorter side (`--debias-cells`),
+// so that it covers the same part of the scene at any resolution: nodes every
+// ceil(min(width, height) / cells) pixels. The default, 8 (32 px at 256²), was chosen by
+// measurement on the scene set: the lowest relMSE of 4, 8, 16 and 32 px at 256², and at 64²
+// (8 px) 16×16 blocks unbiased within their noise over 24 seeds, which 16 px at 64² are not
+// (bench/RESULTS.md, "Bias of the reconstructions").
+inline constexpr int kDefaultDebiasCells = 8;
+// The --debias-cells option's help, for every command that has it.
+inline constexpr const char* kDebiasCellsHelp =
+    "Cells across the image's shorter side of the coarse grid whose bilinear functions the biased "
+    "reconstructions (l1, wl1, wl2) take from the unbiased primal, so that their mean and coarse content "
+    "are unbiased (0 = off: the published reconstruction)";
+
+// The node spacing in pixels of a width x height image's grid of `cells` (> 0) cells.
+[[nodiscard]] int debiasScale(int width, int height, int cells);
 
 // What a debiasing changed (over the channels of an image: means of the channels' figures).
 struct DebiasReport {
     double meanBefore = 0.0;      // mean of the reconstruction before
     double meanCorrection = 0.0;  // mean of the correction added (the coarse bias removed)
     double maxCorrection = 0.0;   // largest |correction| of any pixel (and channel)
+    int scale = 0;                // node spacing in pixels
 };
 
 // Replaces the coarse scales of one channel: recon += Π(primal − recon), `scale` pixels
@@ -55,13 +63,15 @@ struct DebiasReport {
 DebiasReport debiasChannel(int width, int height, std::vector<float>& recon, const std::vector<float>& primal,
                            int scale);
 
-// debiasChannel on each channel of `recon` against `primal` (same size, else gdpt::Error).
-DebiasReport debiasImage(Image& recon, const Image& primal, int scale);
+// debiasChannel on each channel of `recon` against `primal` (same size, else gdpt::Error) at the
+// scale of `cells` cells (debiasScale).
+DebiasReport debiasImage(Image& recon, const Image& primal, int cells);
 
-// One line on what a debiasing did, e.g. "debiased at 16 px: mean +3.1 % (largest change 0.42)".
-[[nodiscard]] std::string describeDebias(const DebiasReport& report, int scale);
+// One line on what a debiasing did, e.g. "debiased at 32 px: mean +3.1 % (largest change 0.42)".
+[[nodiscard]] std::string describeDebias(const DebiasReport& report);
 
 // The coarse projection Π d of a width x height field (exposed for the tests).
-[[nodiscard]] std::vector<double> coarseProjection(int width, int height, const std::vector<double>& d, int scale);
+[[nodiscard]] std::vector<double> coarseProjection(int width, int height, const std::vector<double>& d,
+                                                   int scale);
 
 }  // namespace gdpt

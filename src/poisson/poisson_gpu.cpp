@@ -95,7 +95,9 @@ bool needsVariance(Reconstruction r) {
     return r == Reconstruction::WeightedL2 || r == Reconstruction::WeightedL1;
 }
 
-bool debiases(Reconstruction r, int debiasScale) { return debiasScale > 0 && r != Reconstruction::L2; }
+bool debiases(Reconstruction r, int debiasCells) {
+    return debiasCells > 0 && r != Reconstruction::L2;
+}
 
 std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& nonFinite,
                                        std::size_t& negative) {

@@ -142,10 +142,10 @@ struct PoissonInput {
 // Whether `r` is solved by IRLS rounds (L1, WL1) / needs the variance layers (WL2, WL1).
 bool isIrls(Reconstruction r);
 bool needsVariance(Reconstruction r);
-// Whether a render (or `gdpt solve`) with this --debias-scale takes r's coarse scales from the
-// primal (poisson/debias.h): the biased reconstructions (L1, WL1, WL2) with a scale > 0. L2 is
+// Whether a render (or `gdpt solve`) with this --debias-cells takes r's coarse scales from the
+// primal (poisson/debias.h): the biased reconstructions (L1, WL1, WL2) with cells > 0. L2 is
 // unbiased as it is (a linear function of unbiased estimates).
-bool debiases(Reconstruction r, int debiasScale);
+bool debiases(Reconstruction r, int debiasCells);
 
 // Mean over RGB of `var`, averaged over the (2·radius+1)² box around each pixel (clipped at
 // the borders; separable, linear in the pixels). A pixel with a non-finite or a negative

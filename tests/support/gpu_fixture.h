@@ -54,4 +54,30 @@ private:
     std::uint32_t errorsBefore_ = 0;
 };
 
+// For tests of many short renders of the same kernels: a second context that keeps its
+// pipelines (as a sequence's does), validation on, its errors checked after every test.
+class KeptPipelinesTest : public GpuTest {
+protected:
+    static vk::Context& keeping() {
+        static std::unique_ptr<vk::Context> ctx = [] {
+            vk::ContextOptions o;
+            o.validation = true;
+            o.keepPipelines = true;
+            return std::make_unique<vk::Context>(o);
+        }();
+        return *ctx;
+    }
+    void SetUp() override {
+        GpuTest::SetUp();
+        keptErrorsBefore_ = keeping().validationErrors();
+    }
+    void TearDown() override {
+        EXPECT_EQ(keeping().validationErrors(), keptErrorsBefore_) << "Vulkan validation reported errors";
+        GpuTest::TearDown();
+    }
+
+private:
+    std::uint32_t keptErrorsBefore_ = 0;
+};
+
 }  // namespace gdpt::test

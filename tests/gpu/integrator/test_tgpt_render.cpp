@@ -27,31 +27,8 @@
 namespace gdpt {
 namespace {
 
-// Many short renders of the same kernels: a context that keeps its pipelines (as a sequence's
-// does), validation on, its errors checked after every test.
-class TgptRender : public test::GpuTest {
-protected:
-    static vk::Context& keeping() {
-        static std::unique_ptr<vk::Context> ctx = [] {
-            vk::ContextOptions o;
-            o.validation = true;
-            o.keepPipelines = true;
-            return std::make_unique<vk::Context>(o);
-        }();
-        return *ctx;
-    }
-    void SetUp() override {
-        test::GpuTest::SetUp();
-        errorsBefore_ = keeping().validationErrors();
-    }
-    void TearDown() override {
-        EXPECT_EQ(keeping().validationErrors(), errorsBefore_) << "Vulkan validation reported errors";
-        test::GpuTest::TearDown();
-    }
-
-private:
-    std::uint32_t errorsBefore_ = 0;
-};
+// Many short renders of the same kernels: a context that keeps its pipelines.
+class TgptRender : public test::KeptPipelinesTest {};
 
 const Image& layer(const RenderOutput& out, const std::string& name) {
     for (const NamedLayer& l : out.layers)

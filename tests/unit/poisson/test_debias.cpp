@@ -17,9 +17,13 @@ namespace gdpt {
 namespace {
 
 // Hat k of an axis with nodes every `scale` pixels, written from the definition.
-double hat(int x, int k, int scale) { return std::max(0.0, 1.0 - std::abs(double(x - k * scale)) / scale); }
+double hat(int x, int k, int scale) {
+    return std::max(0.0, 1.0 - std::abs(double(x - k * scale)) / scale);
+}
 
-int nodeCount(int n, int scale) { return n == 1 ? 1 : 1 + std::max(1, (n - 1 + scale - 1) / scale); }
+int nodeCount(int n, int scale) {
+    return n == 1 ? 1 : 1 + std::max(1, (n - 1 + scale - 1) / scale);
+}
 
 // Π d by dense normal equations over explicit basis functions (Gaussian elimination).
 std::vector<double> denseProjection(int w, int h, const std::vector<double>& d, int scale) {
@@ -41,11 +45,13 @@ std::vector<double> denseProjection(int w, int h, const std::vector<double>& d, 
         int p = c;
         for (int r = c + 1; r < m; ++r)
             if (std::abs(a[std::size_t(r) * (m + 1) + c]) > std::abs(a[std::size_t(p) * (m + 1) + c])) p = r;
-        for (int j = 0; j <= m; ++j) std::swap(a[std::size_t(c) * (m + 1) + j], a[std::size_t(p) * (m + 1) + j]);
+        for (int j = 0; j <= m; ++j)
+            std::swap(a[std::size_t(c) * (m + 1) + j], a[std::size_t(p) * (m + 1) + j]);
         for (int r = 0; r < m; ++r) {
             if (r == c) continue;
             const double f = a[std::size_t(r) * (m + 1) + c] / a[std::size_t(c) * (m + 1) + c];
-            for (int j = c; j <= m; ++j) a[std::size_t(r) * (m + 1) + j] -= f * a[std::size_t(c) * (m + 1) + j];
+            for (int j = c; j <= m; ++j)
+                a[std::size_t(r) * (m + 1) + j] -= f * a[std::size_t(c) * (m + 1) + j];
         }
     }
     std::vector<double> out(std::size_t(w) * h, 0.0);
@@ -75,7 +81,8 @@ TEST(Debias, ProjectionMatchesDenseLeastSquares) {
         const std::vector<double> fast = coarseProjection(c.w, c.h, d, c.scale);
         const std::vector<double> dense = denseProjection(c.w, c.h, d, c.scale);
         for (std::size_t i = 0; i < d.size(); ++i)
-            ASSERT_NEAR(fast[i], dense[i], 1e-9) << c.w << "x" << c.h << " scale " << c.scale << " pixel " << i;
+            ASSERT_NEAR(fast[i], dense[i], 1e-9)
+                << c.w << "x" << c.h << " scale " << c.scale << " pixel " << i;
     }
 }
 
@@ -92,7 +99,8 @@ TEST(Debias, ProjectionReproducesTheCoarseSpaceAndIsIdempotent) {
         for (int x = 0; x < w; ++x)
             for (int l = 0; l < ky; ++l)
                 for (int k = 0; k < kx; ++k)
-                    f[std::size_t(y) * w + x] += nodes[std::size_t(l) * kx + k] * hat(x, k, scale) * hat(y, l, scale);
+                    f[std::size_t(y) * w + x] +=
+                        nodes[std::size_t(l) * kx + k] * hat(x, k, scale) * hat(y, l, scale);
     const std::vector<double> pf = coarseProjection(w, h, f, scale);
     for (std::size_t i = 0; i < f.size(); ++i) ASSERT_NEAR(pf[i], f[i], 1e-10);
 
@@ -106,7 +114,7 @@ TEST(Debias, ProjectionReproducesTheCoarseSpaceAndIsIdempotent) {
         sumPd += pd[i];
         change += std::abs(pd[i] - d[i]);
     }
-    EXPECT_NEAR(sumPd, sumD, 1e-9);   // the hats sum to 1: the projection keeps the image sum
+    EXPECT_NEAR(sumPd, sumD, 1e-9);             // the hats sum to 1: the projection keeps the image sum
     EXPECT_GT(change / double(d.size()), 0.5);  // and it is not the identity on noise
     // Galerkin orthogonality: every hat's weighted sum of the residual is zero.
     for (int l = 0; l < ky; ++l)
@@ -114,7 +122,8 @@ TEST(Debias, ProjectionReproducesTheCoarseSpaceAndIsIdempotent) {
             double s = 0.0;
             for (int y = 0; y < h; ++y)
                 for (int x = 0; x < w; ++x)
-                    s += hat(x, k, scale) * hat(y, l, scale) * (d[std::size_t(y) * w + x] - pd[std::size_t(y) * w + x]);
+                    s += hat(x, k, scale) * hat(y, l, scale) *
+                         (d[std::size_t(y) * w + x] - pd[std::size_t(y) * w + x]);
             ASSERT_NEAR(s, 0.0, 1e-9) << "node " << k << "," << l;
         }
 }
