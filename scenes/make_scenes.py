@@ -18,6 +18,8 @@ Outputs (see scenes/README.md):
                       animation: an object moving under a fixed camera)
   camera_move.gltf    the Cornell box seen by a camera that moves in and pans (2 s animation,
                       CUBICSPLINE)
+  open_scene.gltf     48 small boxes on a large floor under a constant sky (an emissive dome)
+                      and one small, bright area light
 
 Python standard library only, so that anyone can regenerate the files. Conventions follow
 ../shared/scenes/README.md: Y up, metres, radiance = emissiveFactor x emissive_strength,
@@ -456,6 +458,75 @@ def furnace():
     return w
 
 
+def oriented_box(centre, size, yaw_deg):
+    """A closed box of `size` (x, y, z) standing on y = 0 at `centre` (x, z), turned by yaw_deg
+    about +Y; faces wound counter-clockwise seen from outside."""
+    c, s_ = math.cos(math.radians(yaw_deg)), math.sin(math.radians(yaw_deg))
+    hx, hz = size[0] / 2.0, size[2] / 2.0
+
+    def corner(ix, iy, iz):
+        x, z = (2 * ix - 1) * hx, (2 * iz - 1) * hz
+        return (centre[0] + c * x + s_ * z, iy * size[1], centre[1] - s_ * x + c * z)
+
+    faces = []
+    for axis in range(3):
+        for side in (0, 1):
+            quad = []
+            for u, v in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                idx = [0, 0, 0]
+                idx[axis] = side
+                idx[(axis + 1) % 3], idx[(axis + 2) % 3] = u, v
+                quad.append(corner(*idx))
+            # Wind it so that its normal points away from the box's centre.
+            mid = [sum(q[i] for q in quad) / 4.0 for i in range(3)]
+            n = cross(sub(quad[1], quad[0]), sub(quad[2], quad[0]))
+            centre3 = (centre[0], size[1] / 2.0, centre[1])
+            if sum(n[i] * (mid[i] - centre3[i]) for i in range(3)) < 0.0:
+                quad.reverse()
+            faces.append(quad)
+    return quads(faces)
+
+
+def open_scene():
+    """Dozens of small boxes on a large floor under a constant sky (an emissive dome) and one
+    small, bright area light: an outdoor-like scene, open to the sky."""
+    w = GltfWriter()
+    floor = w.material("floor", (0.5, 0.5, 0.5))
+    albedos = [(0.7, 0.7, 0.7), (0.7, 0.25, 0.2), (0.25, 0.6, 0.25), (0.25, 0.35, 0.7), (0.75, 0.65, 0.3)]
+    box_mats = [w.material("box%d" % i, a) for i, a in enumerate(albedos)]
+    sky = w.material("sky", (0.0, 0.0, 0.0), emission=(0.25, 0.32, 0.45))
+    lamp = w.material("lamp", (0.0, 0.0, 0.0), emission=(400.0, 330.0, 240.0))
+    # The floor: 40 m x 40 m, facing up.
+    pos, nrm, idx = quads([[(-20.0, 0.0, -20.0), (-20.0, 0.0, 20.0), (20.0, 0.0, 20.0), (20.0, 0.0, -20.0)]])
+    w.mesh("floor", pos, nrm, idx, floor)
+    # 48 boxes (0.15-0.6 m) scattered by a hash over a 7 m x 7 m patch in front of the camera.
+    boxes = {m: ([], [], []) for m in range(len(box_mats))}
+    for i in range(48):
+        h = [hash32(i * 7 + k) / 2.0 ** 32 for k in range(6)]
+        centre = (-3.5 + 7.0 * h[0], -4.0 + 7.0 * h[1])
+        size = (0.15 + 0.45 * h[2], 0.15 + 0.6 * h[3], 0.15 + 0.45 * h[4])
+        bp, bn, _ = oriented_box(centre, size, 90.0 * h[5])
+        m = i % len(box_mats)
+        base = len(boxes[m][0])
+        boxes[m][0].extend(bp)
+        boxes[m][1].extend(bn)
+        boxes[m][2].extend(range(base, base + len(bp)))
+    for m, (bp, bn, bi) in boxes.items():
+        w.mesh("boxes%d" % m, bp, bn, bi, box_mats[m])
+    # A 0.3 m x 0.3 m lamp 3 m above the patch, facing down.
+    pos, nrm, idx = quads([[(-0.15, 3.0, -1.15), (0.15, 3.0, -1.15), (0.15, 3.0, -0.85), (-0.15, 3.0, -0.85)]])
+    w.mesh("lamp", pos, nrm, idx, lamp)
+    # The sky: an inward-facing dome of radius 60 m (icosphere, 320 triangles).
+    verts, tris = icosphere(2)
+    w.mesh("sky", [[60.0 * c for c in v] for v in verts], [[-c for c in v] for v in verts],
+           [i for a, b, c in tris for i in (a, c, b)], sky)
+    # Camera 2.2 m up, 6 m back, looking 22 degrees down at the patch.
+    pitch = math.radians(-22.0)
+    w.camera("camera", (0.0, 2.2, 5.0), math.radians(45.0),
+             rotation=(math.sin(pitch / 2.0), 0.0, 0.0, math.cos(pitch / 2.0)))
+    return w
+
+
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
     cornell(False).write(os.path.join(out, "cornell_box.gltf"))
@@ -466,6 +537,7 @@ def main():
     cornell(False, textured=True).write(os.path.join(out, "textured.gltf"))
     moving_box().write(os.path.join(out, "moving_box.gltf"))
     camera_move().write(os.path.join(out, "camera_move.gltf"))
+    open_scene().write(os.path.join(out, "open_scene.gltf"))
 
 
 if __name__ == "__main__":

@@ -4,7 +4,7 @@
 # reference.exr, a converged render by an independent path tracer) and on each
 # scene of scenes/ (against a PT reference made and cached with --make-reference), each into
 # OUT/<scene>/ (results.json, results.csv, error_vs_time.png), then prints every scene's
-# equal-time table with each method's gain over PT. Not a test: a long benchmark (hours with
+# equal-time table with each method's gain over PT and bias. Not a test: a long benchmark (hours with
 # the defaults on 2 cores).
 #
 #   scripts/converge-set.sh [-o OUT] [--times 4,8,16,32] [--repeats 3] [--reference-spp 4096]
@@ -12,7 +12,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=converge-set times=4,8,16,32 repeats=3 refspp=4096 methods=pt,gpt-l1,gpt-l2,gpt-wl2 size=256
-scenes=cbox,cornell_box,glossy_cornell,small_light,indirect_gap,textured
+scenes=cbox,cornell_box,glossy_cornell,small_light,indirect_gap,textured,furnace,open_scene
 while (($#)); do
   case "$1" in
     -o) out=$2; shift 2 ;;
@@ -47,13 +47,17 @@ d = json.load(open(sys.argv[1]))
 rows = d["summary"]
 methods = list(dict.fromkeys(r["method"] for r in rows))
 budgets = sorted({r["budget_s"] for r in rows})
-# relMSE medians per method, then each other method's gain over PT (PT's error / its error).
+# relMSE medians per method, each other method's gain over PT (PT's error / its error), and
+# each method's bias (median over repeats of the image mean minus the reference's).
 others = [m for m in methods if m != "pt"] if "pt" in methods else []
-print("budget_s " + " ".join(f"{m:>12}" for m in methods) + "".join(f" {m + ' gain':>12}" for m in others))
+print("budget_s " + " ".join(f"{m:>12}" for m in methods) + "".join(f" {m + ' gain':>12}" for m in others)
+      + "".join(f" {m + ' bias':>12}" for m in methods))
 for b in budgets:
-    cells = {r["method"]: r["relmse_median"] for r in rows if r["budget_s"] == b}
-    gains = [cells.get("pt", float("nan")) / cells[m] if cells.get(m) else float("nan") for m in others]
-    print(f"{b:8g} " + " ".join(f"{cells.get(m, float('nan')):12.5g}" for m in methods)
-          + "".join(f" {g:11.2f}x" for g in gains))
+    cells = {r["method"]: r for r in rows if r["budget_s"] == b}
+    rel = {m: cells[m]["relmse_median"] for m in cells}
+    gains = [rel.get("pt", float("nan")) / rel[m] if rel.get(m) else float("nan") for m in others]
+    print(f"{b:8g} " + " ".join(f"{rel.get(m, float('nan')):12.5g}" for m in methods)
+          + "".join(f" {g:11.2f}x" for g in gains)
+          + "".join(f" {cells[m]['bias_median']:12.3g}" if m in cells else " " * 13 for m in methods))
 PY
 done

@@ -79,7 +79,8 @@ std::vector<NamedLayer> ReconstructionStage::run(const PoissonInput& input, cons
             const DebiasReport d = debiasImage(recon, *input.primal, debiasCells_);
             rs.debiasScale = d.scale;
             rs.debiasMeanChange = d.meanBefore > 0.0 ? d.meanCorrection / d.meanBefore : 0.0;
-            rs.ms += debiasTimer.ms();
+            rs.debiasMs = debiasTimer.ms();
+            rs.ms += rs.debiasMs;
             debiased = ", " + describeDebias(d);
         }
         // Not converged (the iteration cap, or a tolerance below what float32 residuals
@@ -112,6 +113,7 @@ nlohmann::json reconstructionsJson(const RenderStats& s) {
                           {"converged", r.converged},
                           {"debias_scale_px", r.debiasScale},
                           {"debias_mean_change", r.debiasMeanChange},
+                          {"debias_ms", r.debiasMs},
                           {"ms", r.ms}});
     return recons;
 }

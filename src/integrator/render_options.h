@@ -83,6 +83,7 @@ struct ReconstructionStats {
     double ms = 0.0;                // the solve and the debiasing
     int debiasScale = 0;            // node spacing (px) of the debiasing (poisson/debias.h); 0: not debiased
     double debiasMeanChange = 0.0;  // the debiasing's change of the image mean, relative
+    double debiasMs = 0.0;          // of ms: the debiasing (host)
 };
 
 // A render split across processes (sample_share.h): how its parts were merged.

@@ -3,7 +3,9 @@
 // 1e-9 lies below what float32 residuals reach (about 1e-7 relative, poisson_gpu.h), so the
 // solver stops at its iteration cap or stagnates, and the summary line must say
 // "NOT converged" and --json record converged = false; the default tolerance (1e-4) is met
-// on the same render (the test's power check: the flag is not always false).
+// on the same render (the test's power check: the flag is not always false). And the
+// debiasing (--debias-cells) is reported: its node spacing and mean change in the JSON and a
+// line, on L1 by default, not with --debias-cells 0 and not on L2; bad values are usage errors.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -50,6 +52,39 @@ TEST_F(ReconReportCli, RenderReportsAReconstructionThatDidNotConverge) {
     ASSERT_TRUE(normal.is_array() && normal.size() == 1u) << normal.dump();
     EXPECT_TRUE(normal[0]["converged"].get<bool>()) << normal.dump();
     EXPECT_EQ(normal[0]["method"].get<std::string>(), "l1");
+}
+
+TEST_F(ReconReportCli, RenderReportsTheDebiasing) {
+    RunResult r;
+    const nlohmann::json byDefault = render("--all-recon", r);
+    ASSERT_EQ(r.code, 0) << r.output;
+    ASSERT_EQ(byDefault.size(), 4u) << byDefault.dump();
+    for (const auto& recon : byDefault) {
+        const bool l2 = recon["method"] == "l2";
+        // 16 px / 8 cells: nodes every 2 px.
+        EXPECT_EQ(recon["debias_scale_px"].get<int>(), l2 ? 0 : 2) << recon.dump();
+        if (!l2) {
+            EXPECT_NE(recon["debias_mean_change"].get<double>(), 0.0) << recon.dump();
+        }
+        EXPECT_GE(recon["debias_ms"].get<double>(), 0.0);
+    }
+    EXPECT_NE(r.output.find("l1 reconstruction: "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("debiased at 2 px: mean "), std::string::npos) << r.output;
+
+    const nlohmann::json off = render("--debias-cells 0", r);
+    ASSERT_EQ(r.code, 0) << r.output;
+    ASSERT_EQ(off.size(), 1u);
+    EXPECT_EQ(off[0]["debias_scale_px"].get<int>(), 0);
+    EXPECT_EQ(r.output.find("debiased at"), std::string::npos) << r.output;
+
+    const nlohmann::json coarse = render("--debias-cells 1", r);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_EQ(coarse[0]["debias_scale_px"].get<int>(), 16);
+
+    for (const char* bad : {"--debias-cells -1", "--debias-cells x"}) {
+        render(bad, r);
+        EXPECT_EQ(r.code, 2) << bad << ": " << r.output;
+    }
 }
 
 }  // namespace

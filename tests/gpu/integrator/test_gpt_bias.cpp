@@ -14,9 +14,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
-#include <cmath>
 #include <string>
 #include <vector>
 
@@ -37,7 +37,9 @@ const Image& layer(const RenderOutput& out, const std::string& name) {
     throw std::runtime_error("no layer " + name);
 }
 
-Scene sceneFile(const char* name) { return loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/" + name); }
+Scene sceneFile(const char* name) {
+    return loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/" + name);
+}
 
 // Sums of R + G + B over the blocks of an image (block b = by * (w / B) + bx), divided by the
 // block's pixels: block means.
@@ -81,7 +83,8 @@ struct TResult {
     double relativeBias = 0.0;  // of the worst block: (mean − expected) / expected
 };
 
-TResult tTest(const SeedStats& s, const std::vector<double>& expected, const std::vector<double>& expectedVar) {
+TResult tTest(const SeedStats& s, const std::vector<double>& expected,
+              const std::vector<double>& expectedVar) {
     TResult r;
     for (std::size_t i = 0; i < expected.size(); ++i) {
         const double t = std::abs(s.mean(i) - expected[i]) / std::sqrt(s.varOfMean(i) + expectedVar[i]);
@@ -140,17 +143,20 @@ void GptBias::checkScene(const char* file, int size, std::uint32_t spp, int seed
         EXPECT_GT(p.maxT, limit) << file << ": the test has no power: the published L1's worst block "
                                  << p.where << " is off by " << 100.0 * p.relativeBias << " %, t " << p.maxT;
     }
-    std::printf("%s: limit %.2f; debiased worst t %.2f (%+.2f %%); published worst t %.2f (%+.2f %%), image mean "
-                "%+.2f %%\n",
-                file, limit, d.maxT, 100.0 * d.relativeBias, p.maxT, 100.0 * p.relativeBias,
-                100.0 * (raw.mean(expected.size() - 1) / expected.back() - 1.0));
+    std::printf(
+        "%s: limit %.2f; debiased worst t %.2f (%+.2f %%); published worst t %.2f (%+.2f %%), image mean "
+        "%+.2f %%\n",
+        file, limit, d.maxT, 100.0 * d.relativeBias, p.maxT, 100.0 * p.relativeBias,
+        100.0 * (raw.mean(expected.size() - 1) / expected.back() - 1.0));
 }
 
 TEST_F(GptBias, DoorAjarBlocksAreUnbiasedWhereThePublishedL1IsDark) {
     checkScene("indirect_gap.gltf", 64, 8, 24, 2048, true);
 }
 
-TEST_F(GptBias, CornellBoxBlocksAreUnbiased) { checkScene("cornell_box.gltf", 64, 4, 24, 1024, true); }
+TEST_F(GptBias, CornellBoxBlocksAreUnbiased) {
+    checkScene("cornell_box.gltf", 64, 4, 24, 1024, true);
+}
 
 TEST_F(GptBias, FurnaceMeanIsOneForEveryReconstruction) {
     const Scene scene = sceneFile("furnace.gltf");

@@ -1,7 +1,8 @@
 // test_scene_set.cpp — the benchmark scene set in scenes/ (written by scenes/make_scenes.py):
 // every file loads cleanly, and each scene has the property it is in the set for: the small
 // light has the default light's power, the textured scene carries its 256x256 texture, and
-// the indirect-gap scene never shows its light to a camera ray.
+// the indirect-gap scene never shows its light to a camera ray, the open scene is dozens of
+// small boxes under a sky whose power dwarfs its small lamp's.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -100,6 +101,7 @@ constexpr Expected kSet[] = {
     {"furnace.gltf", 1280, 1280, 1280, 1280}, {"small_light.gltf", 36, 36, 2, 2},
     {"indirect_gap.gltf", 40, 200, 2, 2},     {"textured.gltf", 36, 36, 2, 2},
     {"moving_box.gltf", 36, 36, 2, 2},        {"camera_move.gltf", 36, 36, 2, 2},
+    {"open_scene.gltf", 500, 1000, 322, 322},
 };
 
 TEST(SceneSet, EveryFileIsListedAndLoadsCleanly) {
@@ -211,6 +213,60 @@ TEST(SceneSet, IndirectGapCameraNeverSeesTheLight) {
     // And the light exists and is bright enough to matter.
     EXPECT_EQ(emissiveTriangles(s), 2u);
     EXPECT_GT(emittedPower(s).x, 10.0);
+}
+
+// The open scene: a floor, 48 boxes of 12 triangles, a lamp of 2 triangles and a sky dome of
+// 320; the lamp is tiny (0.09 m², under 1e-4 of the floor) but over 1000x the sky's radiance,
+// and the sky holds almost all the emitted power (light selection by power rarely picks the
+// lamp: the hard case for next-event estimation); the camera sees boxes, floor and sky.
+TEST(SceneSet, OpenSceneHasManySmallBoxesUnderASkyAndASmallLamp) {
+    const Scene s = loadClean("open_scene.gltf");
+    EXPECT_EQ(s.triangles.size(), 2u + 48u * 12u + 2u + 320u);
+    double lampArea = 0.0, lampRadiance = 0.0, skyRadiance = 0.0;
+    glm::dvec3 lampPower(0.0), skyPower(0.0);
+    for (std::size_t t = 0; t < s.triangles.size(); ++t) {
+        if (!isEmissive(s, t)) continue;
+        const glm::uvec3 tri = s.triangles[t];
+        const glm::dvec3 a(s.positions[tri.x]), b(s.positions[tri.y]), c(s.positions[tri.z]);
+        const double area = 0.5 * glm::length(glm::cross(b - a, c - a));
+        const glm::dvec3 e(s.materials[s.triangleMaterial[t]].emissive);
+        if (glm::length(a) < 10.0) {
+            lampArea += area;
+            lampRadiance = e.x;
+            lampPower += area * e;
+        } else {
+            skyRadiance = e.x;
+            skyPower += area * e;
+        }
+    }
+    EXPECT_NEAR(lampArea, 0.09, 1e-4);
+    EXPECT_GT(lampRadiance, 1000.0 * skyRadiance);
+    EXPECT_GT(skyPower.x, 100.0 * lampPower.x);
+    const Camera& cam = s.cameras[0];
+    const glm::dvec3 o(cam.position), fwd(glm::normalize(glm::dvec3(cam.forward)));
+    const glm::dvec3 up(glm::normalize(glm::dvec3(cam.up))), right = glm::normalize(glm::cross(fwd, up));
+    const double tanHalf = std::tan(0.5 * static_cast<double>(cam.yfov));
+    std::size_t sky = 0, floor = 0, boxes = 0, lamp = 0;
+    for (int py = 0; py < 48; ++py)
+        for (int px = 0; px < 48; ++px) {
+            const double ndcX = (px + 0.5) / 24.0 - 1.0, ndcY = 1.0 - (py + 0.5) / 24.0;
+            const glm::dvec3 d = glm::normalize(fwd + ndcX * tanHalf * right + ndcY * tanHalf * up);
+            const long long t = closestHit(s, o, d);
+            ASSERT_GE(t, 0) << "the sky dome encloses the scene";
+            const auto i = static_cast<std::size_t>(t);
+            if (i < 2)
+                ++floor;
+            else if (i < 2 + 48 * 12)
+                ++boxes;
+            else if (i < 2 + 48 * 12 + 2)
+                ++lamp;
+            else
+                ++sky;
+        }
+    EXPECT_EQ(lamp, 0u);
+    EXPECT_GT(sky, 48u);
+    EXPECT_GT(boxes, 48u * 48u / 20u);
+    EXPECT_GT(floor, 48u * 48u / 4u);
 }
 
 // The animated scenes start from the Cornell box: moving_box's short box at time 0 has the
