@@ -201,6 +201,15 @@ TEST_F(GptRender, GlossyCornellWithMirrorGradientsAndPrimalMatchPathTracer) {
     checkAgainstPt(g, pt, 6, "glossy cornell");
 }
 
+// The open scene: boxes on a floor under an emissive sky dome (320 large, distant emitter
+// triangles) and a small lamp that light selection by power rarely picks.
+TEST_F(GptRender, OpenSceneGradientsAndPrimalMatchPathTracer) {
+    const Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/open_scene.gltf");
+    const RenderResultGpt g = renderGpt(ctx(), scene, renderOptions(24, 24, 256, 111));
+    const RenderResult pt = renderPt(ctx(), scene, renderOptions(24, 24, 1024, 212));
+    checkAgainstPt(g, pt, 6, "open scene", false);
+}
+
 // Same scene with a threshold above the metal's roughness: the GGX vertices become glossy
 // and are shifted by half-vector copies of a smooth lobe (Jacobian |wo'·h| / |wo·h|).
 TEST_F(GptRender, GlossyLobeHalfVectorShiftMatchesPathTracer) {
