@@ -78,7 +78,7 @@ BaseNee gptBaseNee(LightSample ls, vec3 ul, BsdfParams bsdf, vec3 woLocal, vec3 
     n.f = bsdfEval(bsdf, woLocal, n.wiLocal);
     float pdfBsdf = ls.isDelta != 0u ? 0.0 : bsdfPdf(bsdf, woLocal, n.wiLocal);
     rays++;
-    n.visible = !traceAny(origin, ls.wi, 0.0, ls.dist * (1.0 - 1e-4));
+    n.visible = !occludedTowards(origin, ls.pLight);
     n.fBase = n.visible ? beta * n.f * ls.Li / ls.pdf : vec3(0.0);
     n.pdfBsdf = n.visible ? pdfBsdf : 0.0;
     return n;
@@ -153,7 +153,7 @@ OffsetNee gptNeeOwnVertex(OffsetPath o, BaseNee nee, LightConnection c, vec3 fEv
     if (maxComponent(fo) > 0.0 || (pdfBsdfO > 0.0 && maxComponent(nee.fBase) > 0.0)) {
         rays++;
         vec3 origin = offsetRayOriginScaled(o.hit.p, o.hit.ng, scene.sceneRadius);
-        if (!traceAny(origin, c.wi, 0.0, c.dist * (1.0 - 1e-4)))
+        if (!occludedTowards(origin, nee.ls.pLight))
             r.f = o.beta * fo * (c.jacobian / nee.ls.pdf);
         else
             pdfBsdfO = 0.0;
@@ -260,7 +260,7 @@ void gptReconnectOffset(inout OffsetPath o, OffsetVertex v, BaseSegment s, inout
         // Visibility from the offset vertex, for the environment too.
         rays++;
         vec3 origin = offsetRayOriginScaled(oh.p, oh.ng, scene.sceneRadius);
-        if (traceAny(origin, c.wi, 0.0, s.missed ? kInf : c.dist * (1.0 - 1e-4))) {
+        if (s.missed ? traceAny(origin, c.wi, 0.0, kInf) : occludedTowards(origin, s.next.p)) {
             // Occluded: no BSDF density and no contribution, but light sampling could still
             // produce this path, so its light density stays in the target's emission weight.
             // r = 0 and beta' = 0 then act as a failed shift for everything after.

@@ -96,7 +96,7 @@ void ptProcessHit(inout PathState s, Hit hit) {
             vec3 f = bsdfEval(bsdf, woLocal, wiLocal);
             if (maxComponent(f) > 0.0) {
                 s.rays++;
-                if (!traceAny(origin, ls.wi, 0.0, ls.dist * (1.0 - 1e-4))) {
+                if (!occludedTowards(origin, ls.pLight)) {
                     float w = 1.0;
                     if (ls.isDelta == 0u) w = powerHeuristic(1.0, ls.pdf, 1.0, bsdfPdf(bsdf, woLocal, wiLocal));
                     s.radiance += s.beta * f * ls.Li * (w / ls.pdf);
