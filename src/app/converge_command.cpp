@@ -469,7 +469,7 @@ Subcommand addConvergeCommand(CLI::App& app) {
     c->add_option("--debias-cells", a->debiasCells,
                   std::string("G-PT methods (as gdpt render): ") + kDebiasCellsHelp)
         ->capture_default_str()
-        ->check(CLI::Range(0, 1 << 20));
+        ->check(CLI::Range(0, kMaxDebiasCells));
     c->add_option("--width", a->width, "Image width")->capture_default_str()->check(CLI::Range(1, 16384));
     c->add_option("--height", a->height, "Image height")->capture_default_str()->check(CLI::Range(1, 16384));
     c->add_option("--target", a->target,

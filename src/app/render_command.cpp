@@ -407,7 +407,7 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->group(gpt);
     r->add_option("--debias-cells", a.debiasCells, kDebiasCellsHelp)
         ->capture_default_str()
-        ->check(CLI::Range(0, 1 << 20))
+        ->check(CLI::Range(0, kMaxDebiasCells))
         ->group(gpt);
     r->add_option("--shift-threshold", a.shiftThreshold,
                   "Roughness at or below which a vertex takes the half-vector shift instead of reconnection")

@@ -244,7 +244,7 @@ Subcommand addSolveCommand(CLI::App& app) {
         ->check(CLI::IsMember({"l1", "l2", "wl2", "wl1"}))
         ->capture_default_str();
     sub->add_option("--debias-cells", a->debiasCells, kDebiasCellsHelp)
-        ->check(CLI::Range(0, 1 << 20))
+        ->check(CLI::Range(0, kMaxDebiasCells))
         ->capture_default_str();
     sub->add_option("--solver", a->solver, "Linear solver: mg-pcg, cg, jacobi or mg")
         ->check(CLI::IsMember({"mg-pcg", "cg", "jacobi", "mg"}))

@@ -19,6 +19,7 @@
 #include "poisson/debias.h"
 #include "poisson/poisson_gpu.h"
 #include "scene/scene.h"
+#include "util/error.h"
 
 namespace gdpt {
 
@@ -34,6 +35,12 @@ struct RenderOutput {
     std::vector<NamedLayer> layers;
     RenderStats stats;
     [[nodiscard]] const Image& image() const { return layers.front().image; }
+    // The layer called `name` ("" = the final image); throws gdpt::Error if there is none.
+    [[nodiscard]] const Image& layer(const std::string& name) const {
+        for (const NamedLayer& l : layers)
+            if (l.name == name) return l.image;
+        throw Error("the render has no layer '" + name + "'");
+    }
 };
 
 // Consecutive frames of an animation, as a temporal method renders them at once

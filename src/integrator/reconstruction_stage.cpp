@@ -78,7 +78,7 @@ std::vector<NamedLayer> ReconstructionStage::run(const PoissonInput& input, cons
             Timer debiasTimer;
             const DebiasReport d = debiasImage(recon, *input.primal, debiasCells_);
             rs.debiasScale = d.scale;
-            rs.debiasMeanChange = d.meanBefore > 0.0 ? d.meanCorrection / d.meanBefore : 0.0;
+            rs.debiasMeanChange = d.relativeMeanChange();
             rs.debiasMs = debiasTimer.ms();
             rs.ms += rs.debiasMs;
             debiased = ", " + describeDebias(d);

@@ -169,7 +169,7 @@ std::string describeDebias(const DebiasReport& report) {
     char buf[160];
     if (report.meanBefore > 0.0)
         std::snprintf(buf, sizeof buf, "debiased at %d px: mean %+.2f %% (largest change %.3g)", scale,
-                      100.0 * report.meanCorrection / report.meanBefore, report.maxCorrection);
+                      100.0 * report.relativeMeanChange(), report.maxCorrection);
     else
         std::snprintf(buf, sizeof buf, "debiased at %d px: mean %+.3g (largest change %.3g)", scale,
                       report.meanCorrection, report.maxCorrection);

@@ -38,6 +38,8 @@ namespace gdpt {
 // (8 px) 16×16 blocks unbiased within their noise over 24 seeds, which 16 px at 64² are not
 // (bench/RESULTS.md, "Bias of the reconstructions").
 inline constexpr int kDefaultDebiasCells = 8;
+// The largest --debias-cells a command accepts (a grid finer than a pixel changes nothing).
+inline constexpr int kMaxDebiasCells = 1 << 20;
 // The --debias-cells option's help, for every command that has it.
 inline constexpr const char* kDebiasCellsHelp =
     "Cells across the image's shorter side of the coarse grid whose bilinear functions the biased "
@@ -53,6 +55,10 @@ struct DebiasReport {
     double meanCorrection = 0.0;  // mean of the correction added (the coarse bias removed)
     double maxCorrection = 0.0;   // largest |correction| of any pixel (and channel)
     int scale = 0;                // node spacing in pixels
+    // The correction relative to the mean before (0 when that mean is not positive).
+    [[nodiscard]] double relativeMeanChange() const {
+        return meanBefore > 0.0 ? meanCorrection / meanBefore : 0.0;
+    }
 };
 
 // Replaces the coarse scales of one channel: recon += Π(primal − recon), `scale` pixels

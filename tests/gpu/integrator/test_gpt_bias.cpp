@@ -16,7 +16,6 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -30,12 +29,6 @@
 
 namespace gdpt {
 namespace {
-
-const Image& layer(const RenderOutput& out, const std::string& name) {
-    for (const NamedLayer& l : out.layers)
-        if (l.name == name) return l.image;
-    throw std::runtime_error("no layer " + name);
-}
 
 Scene sceneFile(const char* name) {
     return loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/" + name);
@@ -130,10 +123,10 @@ void GptBias::checkScene(const char* file, int size, std::uint32_t spp, int seed
         const RenderOutput out =
             integrator.render(ctx, scene, renderOptions(size, size, spp, 1000u + unsigned(s)));
         ASSERT_EQ(out.stats.nanSamples, 0u);
-        Image recon = layer(out, "recon_l1");
-        raw.add(withImageMean(blockMeans(layer(out, ""), block)));
-        debiasImage(recon, layer(out, "primal"), kDefaultDebiasCells);
-        debiased.add(withImageMean(blockMeans(addImages(recon, layer(out, "direct")), block)));
+        Image recon = out.layer("recon_l1");
+        raw.add(withImageMean(blockMeans(out.layer(""), block)));
+        debiasImage(recon, out.layer("primal"), kDefaultDebiasCells);
+        debiased.add(withImageMean(blockMeans(addImages(recon, out.layer("direct")), block)));
     }
     const double limit = test::twoSidedT(test::sidakAlpha(1e-3, int(expected.size())), seeds - 1);
     const TResult d = tTest(debiased, expected, expectedVar), p = tTest(raw, expected, expectedVar);
@@ -175,7 +168,7 @@ TEST_F(GptBias, FurnaceMeanIsOneForEveryReconstruction) {
         for (std::size_t r = 0; r < o.reconstructions.size(); ++r) {
             const std::string name = std::string("recon_") + toString(o.reconstructions[r]);
             const auto mean = [&](const RenderOutput& x) {
-                const std::array<double, 3> m = addImages(layer(x, name), layer(x, "direct")).meanRgb();
+                const std::array<double, 3> m = addImages(x.layer(name), x.layer("direct")).meanRgb();
                 return std::vector<double>{(m[0] + m[1] + m[2]) / 3.0};
             };
             debiased[r].add(mean(out));
@@ -204,10 +197,10 @@ TEST_F(GptBias, TheFinalImageIsTheDebiasedReconstructionPlusDirect) {
     o.debiasCells = 0;
     GptIntegrator published("gpt", o);
     const RenderOutput raw = published.render(keeping(), scene, renderOptions(48, 40, 2, 9));
-    Image recon = layer(raw, "recon_l1");
-    const DebiasReport r = debiasImage(recon, layer(raw, "primal"), kDefaultDebiasCells);
-    test::expectSameBits(layer(out, "recon_l1"), recon, "recon_l1");
-    test::expectSameBits(layer(out, ""), addImages(recon, layer(out, "direct")), "final");
+    Image recon = raw.layer("recon_l1");
+    const DebiasReport r = debiasImage(recon, raw.layer("primal"), kDefaultDebiasCells);
+    test::expectSameBits(out.layer("recon_l1"), recon, "recon_l1");
+    test::expectSameBits(out.layer(""), addImages(recon, out.layer("direct")), "final");
     EXPECT_NE(r.meanCorrection, 0.0);
     ASSERT_EQ(out.stats.reconstructions.size(), 1u);
     EXPECT_EQ(out.stats.reconstructions[0].debiasScale, 5);  // 40 px / 8 cells

@@ -29,12 +29,6 @@ class MltRender : public test::GpuTest {};
 
 constexpr int kSeeds = 10;
 
-const Image& layer(const RenderOutput& out, const std::string& name) {
-    for (const NamedLayer& l : out.layers)
-        if (l.name == name) return l.image;
-    throw std::runtime_error("no layer " + name);
-}
-
 // Mean of channel c over the pixels [x0, x1) x [y0, y1).
 double regionMean(const Image& im, int c, int x0, int y0, int x1, int y1) {
     double s = 0.0;
@@ -68,10 +62,10 @@ TEST_F(MltRender, FurnaceMeanIsOneForBothTargets) {
         std::vector<double> means;
         for (int s = 0; s < kSeeds; ++s) {
             const RenderOutput out = integrator->render(ctx(), scene, renderOptions(16, 16, 16, 100 + s));
-            const Image& im = layer(out, estimateLayer(method));
+            const Image& im = out.layer(estimateLayer(method));
             means.push_back(regionMean(im, 1, 0, 0, 16, 16));
             // The very-direct light of the furnace is its emission, 0.5, exactly.
-            EXPECT_FLOAT_EQ(layer(out, "direct").at(5, 7, 0), 0.5f);
+            EXPECT_FLOAT_EQ(out.layer("direct").at(5, 7, 0), 0.5f);
             EXPECT_GT(out.stats.mlt.acceptedSmall, 0u);
             EXPECT_GT(out.stats.mlt.acceptedLarge, 0u);
         }
@@ -86,7 +80,7 @@ TEST_F(MltRender, CornellBoxQuadrantsMatchThePathTracer) {
     constexpr int kSize = 32, kHalf = kSize / 2;
     const RenderOutput pt = makeIntegrator("pt")->render(ctx(), scene, renderOptions(kSize, kSize, 1024, 7));
     const Image& ptImage = pt.image();
-    const Image& ptVar = layer(pt, "variance");
+    const Image& ptVar = pt.layer("variance");
     const double threshold = test::twoSidedT(test::sidakAlpha(1e-3, 2 * 4 * 3), kSeeds - 1);
     for (const std::string method : {"pssmlt", "gmlt"}) {
         std::unique_ptr<Integrator> integrator = makeIntegrator(method);
@@ -94,7 +88,7 @@ TEST_F(MltRender, CornellBoxQuadrantsMatchThePathTracer) {
         for (int s = 0; s < kSeeds; ++s) {
             const RenderOutput out =
                 integrator->render(ctx(), scene, renderOptions(kSize, kSize, 32, 200 + s));
-            const Image& im = layer(out, estimateLayer(method));
+            const Image& im = out.layer(estimateLayer(method));
             for (int q = 0; q < 4; ++q)
                 for (int c = 0; c < 3; ++c)
                     quadrant[std::size_t(q * 3 + c)].push_back(regionMean(

@@ -30,12 +30,6 @@ namespace {
 // Many short renders of the same kernels: a context that keeps its pipelines.
 class TgptRender : public test::KeptPipelinesTest {};
 
-const Image& layer(const RenderOutput& out, const std::string& name) {
-    for (const NamedLayer& l : out.layers)
-        if (l.name == name) return l.image;
-    throw std::runtime_error("no layer " + name);
-}
-
 FrameWindow windowOf(std::function<Scene(int)> scene, int first, int count, unsigned seed,
                      bool starts = true) {
     FrameWindow w;
@@ -68,9 +62,9 @@ TEST_F(TgptRender, AStillSceneHasZeroTemporalDifferencesAndJoinsWindows) {
     EXPECT_EQ(first[1].stats.spp, 4u);
     for (const auto* frame : {&first[1], &second[0], &second[1]})
         for (int c = 0; c < 3; ++c)
-            for (float v : layer(*frame, "dt").plane(c)) ASSERT_EQ(v, 0.0f);
+            for (float v : frame->layer("dt").plane(c)) ASSERT_EQ(v, 0.0f);
     // The halves of frames 0 and 1 differ (other seeds), so their primals do, but not dt.
-    EXPECT_NE(layer(first[0], "primal").plane(0), layer(first[1], "primal").plane(0));
+    EXPECT_NE(first[0].layer("primal").plane(0), first[1].layer("primal").plane(0));
     for (const RenderOutput& f : first) {
         ASSERT_EQ(f.stats.reconstructions.size(), 1u);
         EXPECT_TRUE(f.stats.reconstructions[0].converged);
@@ -93,7 +87,7 @@ TEST_F(TgptRender, TemporalDifferencesAreUnbiased) {
     for (int seed = 0; seed < kSeeds; ++seed) {
         const auto frames = tgpt.renderWindow(keeping(), windowOf(sceneAt, 0, 2, unsigned(seed) * 7919u),
                                               renderOptions(w, h, 8, 0));
-        const Image& dt = layer(frames[1], "dt");
+        const Image& dt = frames[1].layer("dt");
         for (int c = 0; c < 3; ++c)
             for (int b = 0; b < bx * by; ++b) {
                 double sum = 0.0;
