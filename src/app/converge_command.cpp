@@ -101,7 +101,7 @@ public:
         // The time the method needs after sampling (G-PT: the reconstruction) is measured
         // before the clock starts: it is calibration, not part of the run. Sampling gets the
         // rest.
-        const double reserve = integrator.reserveAfterSampling(ctx_, a_.width, a_.height);
+        const double reserve = integrator.reserveAfterSampling(ctx_, a_.width, a_.height).seconds;
         o.timeBudget = std::max(0.05 * budget, budget - reserve);
         Timer total;
         const RenderOutput out = integrator.render(ctx_, scene_, o);

@@ -22,6 +22,7 @@
 #include "image/exr_io.h"
 #include "image/finite_check.h"
 #include "image/png_preview.h"
+#include "integrator/budget_report.h"
 #include "integrator/checkpoint.h"
 #include "integrator/integrator.h"
 #include "integrator/recon_reserve.h"
@@ -150,7 +151,7 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
     std::unique_ptr<Integrator> integrator;
     std::optional<Checkpoint> resumed;
     ExrAttributes identity;
-    double reserved = 0.0, finishReserved = 0.0;
+    ReservedTime reserved, finishReserved;
     const bool timed = args.time > 0.0;
     const std::string finishKeyMethod =
         args.method + (args.method == "gpt" ? "|" + std::to_string(args.allRecon ? 4 : 1) + " solves" : "") +
@@ -184,10 +185,15 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
         // it (G-PT: the reconstructions) and by what the rest took the last time for this
         // device, method, size and settings (readback, output layers, EXR + PNG; nothing the
         // first time).
-        reserved = timed ? integrator->reserveAfterSampling(ctx, args.width, args.height) : 0.0;
+        if (timed) reserved = integrator->reserveAfterSampling(ctx, args.width, args.height);
         finishKey = "finish|" + reservationKey(ctx, args.width, args.height) + "|" + finishKeyMethod;
-        finishReserved = timed ? cache.get(finishKey).value_or(0.0) : 0.0;
-        if (timed) options.timeBudget = std::max(0.05 * args.time, args.time - reserved - finishReserved);
+        if (timed) finishReserved = cache.get(finishKey).value_or(ReservedTime{});
+        if (timed) {
+            options.timeBudget =
+                std::max(0.05 * args.time, args.time - reserved.seconds - finishReserved.seconds);
+            // Each rank of a distributed render samples for rank 0's budget, as agreed below.
+            if (!world) options.reservedAfterSampling = {reserved, finishReserved};
+        }
         options.elapsedBefore = total.seconds();
 
         // Checkpoints: the identity of this render is recorded in every checkpoint written, and
@@ -294,16 +300,21 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
     throwIfInterrupted("writing");
     const double writeMs = writeTimer.ms();
     const double seconds = total.seconds();
+    const BudgetReport budget = budgetReport(args.time, s, seconds, reserved.seconds + finishReserved.seconds,
+                                             seconds - afterSampling);
     if (args.profile) printProfile(s.kernels);
     if (jsonOutput.wanted()) {
-        json summary = summaryJson(args, ctx, *integrator, s, seconds, reserved, finishReserved, writeMs);
+        json summary = summaryJson(args, ctx, *integrator, s, seconds, reserved.seconds,
+                                   finishReserved.seconds, writeMs);
         if (shard) summary["shard"] = options.share.text();
+        if (timed) summary["budget"] = budgetJson(budget, s);
         jsonOutput.write(summary.dump(2) + "\n");
         throwIfInterrupted("writing");
     }
     outputs.commit();
     if (timed && !shard)
-        cache.put(finishKey, std::max(0.0, total.seconds() - afterSampling - s.reconstructionMs * 1e-3));
+        cache.put(finishKey, {std::max(0.0, total.seconds() - afterSampling - s.reconstructionMs * 1e-3),
+                              s.samplingLoad});
     if (!quiet) {
         const std::string partial =
             s.partialPassRows ? " + 1 in the top " + std::to_string(s.partialPassRows) + " rows" : "";
@@ -321,6 +332,9 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
         std::fprintf(stderr, "gdpt: wrote %s%s (%u spp%s%s%s, %.2f s total%s)\n", shard ? "shard " : "",
                      args.output.c_str(), s.spp, partial.c_str(), parts.c_str(),
                      integrator->summary(s).c_str(), seconds, sampling);
+        if (timed)
+            if (const std::optional<std::string> note = budgetNote(budget, s))
+                std::fprintf(stderr, "gdpt: note: %s\n", note->c_str());
     }
     return validationExitStatus(ctx);
 }

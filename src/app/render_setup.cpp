@@ -139,6 +139,8 @@ json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrato
                 {"bvh_build", s.bvhBuildMs * 1e-3},
                 {"upload", s.uploadMs * 1e-3},
                 {"pipeline_wait", s.pipelineWaitMs * 1e-3},
+                {"kernel_compile", s.compileMs * 1e-3},
+                {"setup", s.setupSeconds},
                 {"sampling", s.samplingMs * 1e-3},
                 {"readback", s.readbackMs * 1e-3},
                 {"reconstruction", s.reconstructionMs * 1e-3},

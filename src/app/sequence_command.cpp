@@ -119,7 +119,8 @@ int runSequence(const RenderArgs& args) {
                 ? (", animation " + std::to_string(animation) + " (" + seconds(duration) + ")").c_str()
                 : "");
     std::unique_ptr<Integrator> integrator = integratorFor(args, &cache);
-    const double reserved = timed ? integrator->reserveAfterSampling(ctx, args.width, args.height) : 0.0;
+    const double reserved =
+        timed ? integrator->reserveAfterSampling(ctx, args.width, args.height).seconds : 0.0;
 
     json frames = json::array();
     double afterSamplingSeconds = 0.0;  // the last frame's time after its sampling (reconstruction aside)

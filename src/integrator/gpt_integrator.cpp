@@ -30,7 +30,7 @@ ExrAttributes GptIntegrator::identity(const Scene& scene, const RenderOptions& o
             {"demodulate", demodulates(scene, options_.sampling.demodulate) ? "on" : "off"}};
 }
 
-double GptIntegrator::reserveAfterSampling(const vk::Context& ctx, int width, int height) {
+ReservedTime GptIntegrator::reserveAfterSampling(const vk::Context& ctx, int width, int height) {
     return stage_.reserve(ctx, width, height, options_.reconCache);
 }
 

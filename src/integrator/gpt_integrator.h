@@ -29,11 +29,11 @@ public:
     [[nodiscard]] std::string name() const override { return name_; }
     [[nodiscard]] std::uint32_t maxBatchSpp(int width, int height) const override;
     [[nodiscard]] ExrAttributes identity(const Scene& scene, const RenderOptions& options) const override;
-    // With options.reconCache: the remembered time of this device, size and solves, else one
-    // calibration solve per reconstruction (cold, as a single render pays it). Without: one
-    // warm calibration per integrator, raised to the longest reconstruction it has run (the
-    // steady state of a benchmark that renders many times).
-    double reserveAfterSampling(const vk::Context& ctx, int width, int height) override;
+    // The reconstructions' time (ReconstructionStage::reserve): with options.reconCache the
+    // remembered time of this device, size and solves, else a calibration solve per
+    // reconstruction; without, one calibration per integrator raised to the longest
+    // reconstruction it has run (the steady state of a benchmark that renders many times).
+    ReservedTime reserveAfterSampling(const vk::Context& ctx, int width, int height) override;
     RenderOutput render(const vk::Context& ctx, const Scene& scene, const RenderOptions& options) override;
     void describe(nlohmann::json& summary, const RenderStats& stats) const override;
     [[nodiscard]] std::string summary(const RenderStats& stats) const override;

@@ -65,11 +65,11 @@ public:
     // The checkpoint identity entries of the method's own settings (the common ones, scene,
     // size, seed, ..., are added by renderIdentity).
     [[nodiscard]] virtual ExrAttributes identity(const Scene& scene, const RenderOptions& options) const = 0;
-    // Seconds a timed render of this size must leave after sampling for the method's own
+    // The time a timed render of this size must leave after sampling for the method's own
     // later stages (G-PT: the reconstructions); measured or remembered, see the method.
-    virtual double reserveAfterSampling(const vk::Context& ctx, int width, int height) {
+    virtual ReservedTime reserveAfterSampling(const vk::Context& ctx, int width, int height) {
         (void)ctx, (void)width, (void)height;
-        return 0.0;
+        return {};
     }
     // Renders: samples with `options` (spp or time budget, checkpoints, cancellation), then
     // runs the method's later stages, unless sampling was cancelled (stats.cancelled; then

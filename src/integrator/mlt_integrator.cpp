@@ -55,7 +55,7 @@ ExrAttributes MltIntegrator::identity(const Scene&, const RenderOptions& options
             {"shift_threshold", exactFloat(options.scene.shiftThreshold)}};
 }
 
-double MltIntegrator::reserveAfterSampling(const vk::Context& ctx, int width, int height) {
+ReservedTime MltIntegrator::reserveAfterSampling(const vk::Context& ctx, int width, int height) {
     return stage_.reserve(ctx, width, height, nullptr);
 }
 

@@ -33,7 +33,7 @@ public:
     [[nodiscard]] std::string name() const override { return name_; }
     [[nodiscard]] std::uint32_t maxBatchSpp(int width, int height) const override;
     [[nodiscard]] ExrAttributes identity(const Scene& scene, const RenderOptions& options) const override;
-    double reserveAfterSampling(const vk::Context& ctx, int width, int height) override;
+    ReservedTime reserveAfterSampling(const vk::Context& ctx, int width, int height) override;
     RenderOutput render(const vk::Context& ctx, const Scene& scene, const RenderOptions& options) override;
     void describe(nlohmann::json& summary, const RenderStats& stats) const override;
     [[nodiscard]] std::string summary(const RenderStats& stats) const override;

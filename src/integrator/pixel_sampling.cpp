@@ -60,6 +60,9 @@ void PixelSampling::run(const std::function<Image()>& preview) {
     stats_.pipelineWaitMs = 1e3 * pass_->waitForPipelines();
     if (options_.resume) pass_->uploadStats(options_.resume->buffers);
     stats_.uploadMs += phase.ms();
+    Timer compile;
+    submitAndWait(kind_ + " kernels' first dispatch", [&](VkCommandBuffer cmd) { pass_->recordWarmUp(cmd); });
+    stats_.compileMs = compile.ms();
 
     const auto snapshot = [&](SamplerState& state) {
         state.buffers = pass_->downloadStats();
@@ -73,6 +76,7 @@ void PixelSampling::run(const std::function<Image()>& preview) {
     const SampleShare share = options_.share;
     RenderOptions loop = options_;
     loop.spp = share.localSpp(options_.spp);
+    loop.measureLoad = ctx_.info().type == "cpu";
     runBatchLoop(
         loop, label.c_str(), total_, stats_,
         [&](std::uint32_t first, std::uint32_t n, std::uint32_t rows, const std::function<void()>& onWait) {

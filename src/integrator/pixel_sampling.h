@@ -2,7 +2,7 @@
 //   1. set-up: the pass's pipelines compile on worker threads while this thread builds the
 //      BVH and uploads the scene; the pass's one-off work (G-PT: the edge probe); the
 //      caller's whileCompiling; the wait for the pipelines; the statistics of a resumed
-//      checkpoint;
+//      checkpoint; an empty first dispatch of the main kernels (lavapipe compiles them there);
 //   2. the batch loop (sampling_loop.h): record a batch, submit, wait, fold its counters,
 //      snapshots for checkpoints;
 //   3. the statistics of the run (emitter supersampling, per-kernel times).

@@ -1,6 +1,8 @@
 // recon_reserve.cpp — reconstruction-time estimates for timed G-PT renders (recon_reserve.h).
 #include "integrator/recon_reserve.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -48,18 +50,29 @@ nlohmann::json readCache(const std::string& path) {
 
 }  // namespace
 
-std::optional<double> ReconTimeCache::get(const std::string& key) const {
+std::optional<ReservedTime> ReconTimeCache::get(const std::string& key) const {
     const nlohmann::json j = readCache(path_);
     const auto it = j.find(key);
-    if (it == j.end() || !it->is_number() || !(it->get<double>() >= 0.0)) return std::nullopt;
-    return it->get<double>();
+    if (it == j.end()) return std::nullopt;
+    ReservedTime t;
+    if (it->is_number()) {
+        t.seconds = it->get<double>();
+    } else if (it->is_object() && it->contains("seconds") && (*it)["seconds"].is_number()) {
+        t.seconds = (*it)["seconds"].get<double>();
+        if (it->contains("load") && (*it)["load"].is_number())
+            t.load = std::max(0.0, (*it)["load"].get<double>());
+    } else {
+        return std::nullopt;
+    }
+    if (!(t.seconds >= 0.0) || !std::isfinite(t.seconds) || !std::isfinite(t.load)) return std::nullopt;
+    return t;
 }
 
-void ReconTimeCache::put(const std::string& key, double seconds) const {
+void ReconTimeCache::put(const std::string& key, ReservedTime time) const {
     if (path_.empty()) return;
     try {
         nlohmann::json j = readCache(path_);
-        j[key] = seconds;
+        j[key] = {{"seconds", time.seconds}, {"load", time.load}};
         std::filesystem::create_directories(std::filesystem::path(path_).parent_path());
         writeTextFileAtomically(path_, j.dump(1) + "\n");
     } catch (const std::exception&) {
@@ -79,11 +92,11 @@ ReconReservation reserveReconstruction(const vk::Context& ctx, PoissonSolverGpu&
     for (const SolveOptions& so : solves)
         r.key += std::string("|") + toString(so.method) + " alpha " + std::to_string(so.alpha) + " tol " +
                  std::to_string(so.tolerance);
-    if (const std::optional<double> known = cache.get(r.key)) {
-        r.seconds = *known;
+    if (const std::optional<ReservedTime> known = cache.get(r.key)) {
+        r.time = *known;
     } else {
         for (const SolveOptions& so : solves)
-            r.seconds += calibrateReconSeconds(solver, so, /*warmUp=*/false);
+            r.time.seconds += calibrateReconSeconds(solver, so, /*warmUp=*/false);
     }
     return r;
 }

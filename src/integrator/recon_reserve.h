@@ -4,8 +4,9 @@
 //
 // The estimate is a measurement: a solve of a synthetic noisy problem of the render's size
 // (calibrate), or the time of the last real reconstruction with the same device, driver,
-// size and settings, remembered in a small cache file (ReconTimeCache). The first timed
-// render of a configuration pays for one calibration solve; later ones pay nothing.
+// size and settings, remembered in a small cache file (ReconTimeCache) with the load its
+// run's sampling felt (util/cpu_share.h), so that a render under another load scales it. The
+// first timed render of a configuration pays for one calibration solve; later ones pay nothing.
 #pragma once
 
 #include <cstdint>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "image/image.h"
+#include "integrator/render_options.h"
 #include "poisson/poisson_gpu.h"
 
 namespace gdpt::vk {
@@ -28,8 +30,9 @@ namespace gdpt {
 // costs one solve, not two (for a render about to solve once for real).
 double calibrateReconSeconds(PoissonSolverGpu& solver, const SolveOptions& options, bool warmUp);
 
-// Remembered reconstruction times, one JSON object in `path` (key -> seconds). Read and
-// write failures are ignored: the cache only saves a calibration solve.
+// Remembered times, one JSON object in `path` (key -> {"seconds", "load"}; a bare number, as
+// earlier versions wrote, is seconds of unknown load). Read and write failures are ignored:
+// the cache only saves a calibration solve.
 class ReconTimeCache {
 public:
     // $GDPT_CACHE_DIR/recon_times.json, else $XDG_CACHE_HOME/gdpt/..., else
@@ -37,8 +40,8 @@ public:
     static std::string defaultPath();
 
     explicit ReconTimeCache(std::string path) : path_(std::move(path)) {}
-    [[nodiscard]] std::optional<double> get(const std::string& key) const;
-    void put(const std::string& key, double seconds) const;
+    [[nodiscard]] std::optional<ReservedTime> get(const std::string& key) const;
+    void put(const std::string& key, ReservedTime time) const;
 
 private:
     std::string path_;
@@ -50,11 +53,12 @@ private:
 std::string reservationKey(const vk::Context& ctx, std::uint32_t width, std::uint32_t height);
 
 // The reservation of a timed G-PT render: the cache key of its configuration (device,
-// driver, size, each solve's method, alpha and tolerance) and the seconds to reserve (the
-// cached time, else the sum of one calibration solve per entry of `solves`).
+// driver, size, each solve's method, alpha and tolerance) and the time to reserve (the
+// cached time and its load, else the sum of one calibration solve per entry of `solves`,
+// measured now: load 0).
 struct ReconReservation {
     std::string key;
-    double seconds = 0.0;
+    ReservedTime time;
 };
 ReconReservation reserveReconstruction(const vk::Context& ctx, PoissonSolverGpu& solver,
                                        const std::vector<SolveOptions>& solves, const ReconTimeCache& cache);

@@ -37,21 +37,21 @@ PoissonSolverGpu& ReconstructionStage::solver(const vk::Context& ctx, int width,
     return *solver_;
 }
 
-double ReconstructionStage::reserve(const vk::Context& ctx, int width, int height,
-                                    const ReconTimeCache* cache) {
-    if (solves_.empty()) return 0.0;
+ReservedTime ReconstructionStage::reserve(const vk::Context& ctx, int width, int height,
+                                          const ReconTimeCache* cache) {
+    if (solves_.empty()) return {};
     PoissonSolverGpu& solverGpu = solver(ctx, width, height);  // first: a new solver resets the calibration
     if (cache) {
         const ReconReservation r = reserveReconstruction(ctx, solverGpu, solves_, *cache);
         reserveKey_ = r.key;
-        return r.seconds;
+        return r.time;
     }
     if (calibratedSeconds_ < 0.0) {
         calibratedSeconds_ = 0.0;
         for (const SolveOptions& so : solves_)
             calibratedSeconds_ += calibrateReconSeconds(solverGpu, so, true);
     }
-    return std::max(calibratedSeconds_, longestSeconds_);
+    return {std::max(calibratedSeconds_, longestSeconds_), 0.0};
 }
 
 std::vector<NamedLayer> ReconstructionStage::run(const PoissonInput& input, const RenderOptions& options,
@@ -97,7 +97,8 @@ std::vector<NamedLayer> ReconstructionStage::run(const PoissonInput& input, cons
         stats.reconstructionMs += rs.ms;
         recons.push_back({std::string("recon_") + toString(so.method), std::move(recon)});
     }
-    if (cache && !reserveKey_.empty()) cache->put(reserveKey_, stats.reconstructionMs * 1e-3);
+    if (cache && !reserveKey_.empty())
+        cache->put(reserveKey_, {stats.reconstructionMs * 1e-3, stats.samplingLoad});
     longestSeconds_ = std::max(longestSeconds_, reconTimer.seconds());
     return recons;
 }

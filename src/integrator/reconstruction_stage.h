@@ -34,12 +34,13 @@ public:
     // The solver for this device and size (made on first use, kept for later renders so that
     // its pipelines are compiled once).
     PoissonSolverGpu& solver(const vk::Context& ctx, int width, int height);
-    // Seconds a timed render reserves for the solves. With a cache: the remembered time of
-    // this device, size and solves, else one calibration solve per reconstruction (cold, as
-    // a single render pays it). Without: one warm calibration per stage, raised to the
-    // longest reconstruction it has run (the steady state of a benchmark that renders many
-    // times).
-    double reserve(const vk::Context& ctx, int width, int height, const ReconTimeCache* cache);
+    // The time a timed render reserves for the solves. With a cache: the remembered time (and
+    // load) of this device, size and solves, else one calibration solve per reconstruction
+    // (its first dispatches compile the solver's kernels, which takes seconds only when
+    // lavapipe's shader cache is cold, when the set-up is long anyway). Without: one warm
+    // calibration per stage, raised to the longest reconstruction it has run (the steady
+    // state of a benchmark that renders many times).
+    ReservedTime reserve(const vk::Context& ctx, int width, int height, const ReconTimeCache* cache);
     // Runs every solve of `input` (after solver() for the input's size): the layers
     // recon_<name> in order; adds each solve's report to stats (and says it unless
     // options.quiet); an interrupt (options.cancel) stops it after the solver's current batch

@@ -31,11 +31,27 @@ std::uint32_t maxBatchSppFor(int width, int height, std::uint64_t pixelSamplesPe
 
 struct RenderStats;
 
+// Seconds a timed render reserves for its stages after sampling (the reconstruction; readback
+// and output), and the load factor (util/cpu_share.h) that the sampling of the run which
+// measured them felt; 0: measured in this run, or on a device whose load is not measured.
+struct ReservedTime {
+    double seconds = 0.0;
+    double load = 0.0;
+};
+
 struct RenderOptions {
     SceneGpuOptions scene;
     std::uint32_t spp = 16;      // samples per pixel (ignored when timeBudget > 0)
     double timeBudget = 0.0;     // seconds for the whole render (0 = use spp)
     double elapsedBefore = 0.0;  // seconds already spent (e.g. loading) counted in the budget
+    // Timed renders: the reservations already taken off timeBudget, as measured. The batch
+    // loop carries each to the load it measures on its last batch (atLoad) and takes off the
+    // difference too, so that a busier (or idler) machine than the one that measured them
+    // moves the end of sampling accordingly.
+    std::vector<ReservedTime> reservedAfterSampling;
+    // Measure the load during sampling (stats.samplingLoad); set by the sampler on CPU devices,
+    // where other processes compete with the device's threads.
+    bool measureLoad = false;
     std::uint32_t seed = 0;
     bool profile = false;
     bool quiet = false;
@@ -125,7 +141,11 @@ struct RenderStats {
     std::uint32_t bvhRegisterStack = 0;  // entries of the kernels' register traversal stack (0: in memory)
     double uploadMs = 0.0;               // scene upload + pipeline creation (the part not overlapped)
     double pipelineWaitMs = 0.0;         // of which: waiting for the pipelines after the scene upload
-    double samplingMs = 0.0;             // wall time of the batch loop
+    double compileMs = 0.0;              // the main kernels' first, empty, dispatch (lavapipe compiles there)
+    double setupSeconds = 0.0;           // the render's time when sampling began (its fixed costs before it)
+    double samplingLoad = 0.0;  // load factor over the batch loop (util/cpu_share.h); 0: not measured
+    double reserveScale = 1.0;  // timed: the reservations at the last batch's load ÷ as measured
+    double samplingMs = 0.0;    // wall time of the batch loop
     double readbackMs = 0.0;
     double reconstructionMs = 0.0;                     // G-PT: screened Poisson solve(s)
     std::vector<ReconstructionStats> reconstructions;  // G-PT: one per reconstruction, in order

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <string>
 
+#include "util/cpu_share.h"
 #include "util/progress.h"
 
 namespace gdpt {
@@ -14,10 +15,36 @@ std::uint32_t partialPassRows(double secondsLeft, double secondsPerSpp, std::uin
     return rows >= static_cast<double>(height) ? height : static_cast<std::uint32_t>(rows);
 }
 
+TimedBatch nextTimedBatch(double secondsLeft, double secondsPerSpp, std::uint32_t scheduled, bool partialPass,
+                          std::uint32_t height) {
+    const auto fits = static_cast<std::uint32_t>(std::max(0.0, secondsLeft / std::max(secondsPerSpp, 1e-9)));
+    if (fits > 0) return {std::min(scheduled, std::max(1u, fits / 2)), height};
+    const std::uint32_t rows = partialPass ? partialPassRows(secondsLeft, secondsPerSpp, height) : 0;
+    if (rows == 0 || rows >= height) return {0, 0};
+    return {1, rows};
+}
+
+double reservedAtLoad(const std::vector<ReservedTime>& reserved, double load) {
+    double seconds = 0.0;
+    for (const ReservedTime& r : reserved) seconds += atLoad(r.seconds, r.load, load);
+    return seconds;
+}
+
 void runBatchLoop(const RenderOptions& options, const char* label, const Timer& total, RenderStats& stats,
                   const TraceBatchFn& traceBatch, const SnapshotFn& snapshot) {
     const bool timed = options.timeBudget > 0.0;
     const double budget = options.timeBudget - options.elapsedBefore;
+    stats.setupSeconds = options.elapsedBefore + total.seconds();
+    // The reservations after sampling, carried to the load of the last batch: what they add
+    // to (or take from) what timeBudget already leaves for them.
+    const double reserved = reservedAtLoad(options.reservedAfterSampling, 0.0);
+    double load = 0.0;  // load factor of the last batch; 0 until one is measured
+    const auto reserveChange = [&] {
+        const double now = reservedAtLoad(options.reservedAfterSampling, load);
+        stats.reserveScale = reserved > 0.0 ? now / reserved : 1.0;
+        return now - reserved;
+    };
+    CpuShareMeter samplingShare;
     Progress progress(label, timed ? budget : static_cast<double>(options.spp), options.quiet);
     Timer phase;
     std::uint32_t done = 0;
@@ -54,19 +81,15 @@ void runBatchLoop(const RenderOptions& options, const char* label, const Timer& 
             if (done >= options.spp) break;
             n = std::min(batch, options.spp - done);
         } else if (done > 0) {
-            // Shrink the next batch to what fits the remaining budget; stop when not even one
-            // sample per pixel fits (at least one batch always runs).
-            const double left = budget - total.seconds();
-            const auto fits = static_cast<std::uint32_t>(std::max(0.0, left / std::max(secondsPerSpp, 1e-9)));
-            if (fits == 0) {
-                rows = partialPass ? partialPassRows(left, secondsPerSpp, height) : 0;
-                if (rows == 0 || rows >= height) break;
-                n = 1;
-            } else {
-                n = std::min(n, fits);
-            }
+            // At least one batch always runs, however little the fixed costs before it left.
+            const TimedBatch next = nextTimedBatch(budget - total.seconds() - reserveChange(), secondsPerSpp,
+                                                   n, partialPass, height);
+            if (next.spp == 0) break;
+            n = next.spp;
+            rows = next.rows;
         }
         Timer batchTimer;
+        CpuShareMeter batchShare;
         const gpu::Counters c = traceBatch(done, n, rows, [&] {
             if (timed) progress.update(total.seconds());
         });
@@ -82,6 +105,7 @@ void runBatchLoop(const RenderOptions& options, const char* label, const Timer& 
         }
         done += n;
         secondsPerSpp = batchTimer.seconds() / n;
+        if (options.measureLoad) load = loadFactor(batchShare.share());
         const double mraysPerS =
             static_cast<double>(stats.raysTraced) / std::max(1e-9, phase.seconds()) * 1e-6;
         char rate[64];
@@ -96,6 +120,7 @@ void runBatchLoop(const RenderOptions& options, const char* label, const Timer& 
     }
     if (options.checkpoint) emitCheckpoint();
     stats.samplingMs = phase.ms();
+    if (options.measureLoad) stats.samplingLoad = loadFactor(samplingShare.share());
     stats.spp = done;
     progress.finish(std::to_string(done) + " spp");
     if (stats.nanSamples > 0 && !options.quiet)

@@ -232,6 +232,13 @@ void GptPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_
                   edges_.count());
 }
 
+void GptPass::recordWarmUp(VkCommandBuffer cmd) const {
+    gpu::GptFrameParams p = frameParams();
+    p.rowCount = 0;  // every invocation returns at once
+    kernel_.dispatch(cmd, 1, 1, 1, &p, nullptr);
+    resolveKernel_.dispatch(cmd, 1, 1, 1, &p, nullptr);
+}
+
 void GptPass::resolve(VkCommandBuffer cmd, vk::GpuTimer* timer) {
     gpu::GptFrameParams p = frameParams();
     p.rowOffset = 0;

@@ -91,6 +91,7 @@ public:
     void attach(const SceneGpu& scene) override;
     // Waits for pipelines created in the background; the seconds waited.
     double waitForPipelines() const override;
+    void recordWarmUp(VkCommandBuffer cmd) const override;
 
     // Finds the edge pixels (edge_pass.h) on `stream`, submitting and waiting; before the
     // first record(), else the batches have no extra edge samples. Once per pass.

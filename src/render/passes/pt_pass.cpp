@@ -96,6 +96,12 @@ void PtPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t
                 });
 }
 
+void PtPass::recordWarmUp(VkCommandBuffer cmd) const {
+    gpu::FrameParams p{};
+    p.rowCount = 0;  // every invocation returns at once
+    kernel_.dispatch(cmd, 1, 1, 1, &p, nullptr);
+}
+
 gpu::Counters PtPass::takeCounters() {
     gpu::Counters c{};
     counters_.download(&c, sizeof c);

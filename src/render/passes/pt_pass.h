@@ -73,6 +73,7 @@ public:
     void attach(const SceneGpu& scene) override;
     // Waits for pipelines created in the background; the seconds waited.
     double waitForPipelines() const override;
+    void recordWarmUp(VkCommandBuffer cmd) const override;
 
     // Clears the statistics and counters.
     void reset();

@@ -31,6 +31,11 @@ public:
     virtual void prepare(vk::CommandStream& stream) { (void)stream; }
     // Waits for pipelines created in the background; the seconds waited.
     virtual double waitForPipelines() const = 0;
+    // Records one dispatch of each of the pass's main kernels that does no work (no rows):
+    // lavapipe compiles a kernel to machine code at its first dispatch (seconds for the large
+    // ones when its shader cache is cold), so this moves that compile before the first batch,
+    // where a timed render counts it as a fixed cost and not as the price of a sample.
+    virtual void recordWarmUp(VkCommandBuffer cmd) const = 0;
     // Records a batch of `spp` camera samples per pixel from sample `sampleBase`; `rows`:
     // only the first that many image rows (a timed render's partial last pass).
     virtual void record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::uint32_t seed,
