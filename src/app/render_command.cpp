@@ -108,7 +108,9 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
     checkArgs(args);
     Timer total;
     RenderOptions options = renderOptionsFor(args);
-    const ReconTimeCache cache(ReconTimeCache::defaultPath());
+    // Remembered times per scene first (a reconstruction's time follows the image), else of the
+    // last render of the same configuration.
+    const ReconTimeCache cache(ReconTimeCache::defaultPath(), "scene " + absolutePath(args.scene));
 
     // A render split across processes: the ranks of mpirun (distributed/mpi_world.h), or a
     // shard run as a job of its own (distributed/shards.h).

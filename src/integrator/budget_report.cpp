@@ -11,9 +11,12 @@ BudgetReport budgetReport(double budget, const RenderStats& stats, double total,
     r.total = total;
     r.setup = stats.setupSeconds;
     r.compile = stats.compileMs * 1e-3;
+    r.firstBatch = stats.firstBatchSeconds;
     r.reserved = reserved * stats.reserveScale;
     r.afterSampling = afterSampling;
-    r.fixedExceeded = budget > 0.0 && r.fixed() >= budget;
+    // Only a render that stopped at the minimum: a later rise of the reservation (the load grew)
+    // is an overrun, not the fixed costs.
+    r.fixedExceeded = budget > 0.0 && r.fixed() >= budget && stats.spp <= 1 && stats.partialPassRows == 0;
     return r;
 }
 
@@ -23,6 +26,7 @@ nlohmann::json budgetJson(const BudgetReport& r, const RenderStats& stats) {
             {"overrun", r.overrun()},
             {"setup_s", r.setup},
             {"kernel_compile_s", r.compile},
+            {"first_batch_s", r.firstBatch},
             {"reserved_after_sampling_s", r.reserved},
             {"after_sampling_s", r.afterSampling},
             {"reserve_scale", stats.reserveScale},
@@ -36,9 +40,9 @@ std::optional<std::string> budgetNote(const BudgetReport& r, const RenderStats& 
     if (r.fixedExceeded) {
         std::snprintf(line, sizeof line,
                       "--time %g: the fixed costs alone take %.2f s (set-up %.2f s, of which the kernels' "
-                      "compile %.2f s; %.2f s after sampling), more than the budget: sampled the minimum, "
-                      "%u spp, and ended at %.2f s",
-                      r.budget, r.fixed(), r.setup, r.compile, r.reserved, stats.spp, r.total);
+                      "compile %.2f s; one sample per pixel %.2f s; %.2f s after sampling), more than the "
+                      "budget: sampled the minimum, %u spp, and ended at %.2f s",
+                      r.budget, r.fixed(), r.setup, r.compile, r.firstBatch, r.reserved, stats.spp, r.total);
         return std::string(line);
     }
     if (r.overrun() <= kBudgetTolerance) return std::nullopt;

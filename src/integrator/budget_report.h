@@ -1,15 +1,14 @@
 // budget_report.h — how a timed render (render --time) spent its budget: what it cost before
-// the first sample (loading, upload, the kernels' compile), what it reserved for the stages
-// after sampling (at the load it measured), and whether those fixed costs alone exceeded the
-// budget. When they do the render samples the minimum (one sample per pixel) and ends as
-// early as it can; it says so in one line and in --json, as it says any overrun of more than
-// the tolerance.
+// the first sample (loading, upload, the kernels' compile), its first batch of one sample per
+// pixel (the least an image takes), what it reserved for the stages after sampling (at the
+// load it measured), and whether those fixed costs alone exceeded the budget. When they do the
+// render samples that minimum and ends as early as it can; it says so in one line and in
+// --json, as it says any overrun of more than the tolerance.
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
-
-#include <nlohmann/json.hpp>
 
 #include "integrator/render_options.h"
 
@@ -23,11 +22,13 @@ struct BudgetReport {
     double total = 0.0;          // the render's wall time, seconds
     double setup = 0.0;          // time before the first sample (stats.setupSeconds)
     double compile = 0.0;        // of setup: the main kernels' first dispatch
+    double firstBatch = 0.0;     // the first batch: one sample per pixel
     double reserved = 0.0;       // reserved after sampling, at the load of the last batch
     double afterSampling = 0.0;  // what the stages after sampling took
-    bool fixedExceeded = false;  // setup + reserved >= budget
+    bool fixedExceeded = false;  // fixed() >= budget, and the render sampled that minimum
 
-    [[nodiscard]] double fixed() const { return setup + reserved; }
+    // What every render of the scene pays: the set-up, one sample per pixel, the stages after.
+    [[nodiscard]] double fixed() const { return setup + firstBatch + reserved; }
     [[nodiscard]] double overrun() const { return budget > 0.0 ? total / budget - 1.0 : 0.0; }
 };
 

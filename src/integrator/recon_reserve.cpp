@@ -48,10 +48,7 @@ nlohmann::json readCache(const std::string& path) {
     return j.is_object() ? j : nlohmann::json::object();
 }
 
-}  // namespace
-
-std::optional<ReservedTime> ReconTimeCache::get(const std::string& key) const {
-    const nlohmann::json j = readCache(path_);
+std::optional<ReservedTime> entry(const nlohmann::json& j, const std::string& key) {
     const auto it = j.find(key);
     if (it == j.end()) return std::nullopt;
     ReservedTime t;
@@ -68,11 +65,22 @@ std::optional<ReservedTime> ReconTimeCache::get(const std::string& key) const {
     return t;
 }
 
+}  // namespace
+
+std::optional<ReservedTime> ReconTimeCache::get(const std::string& key) const {
+    const nlohmann::json j = readCache(path_);
+    if (!scope_.empty())
+        if (std::optional<ReservedTime> scoped = entry(j, key + "|" + scope_)) return scoped;
+    return entry(j, key);
+}
+
 void ReconTimeCache::put(const std::string& key, ReservedTime time) const {
     if (path_.empty()) return;
     try {
         nlohmann::json j = readCache(path_);
-        j[key] = {{"seconds", time.seconds}, {"load", time.load}};
+        const nlohmann::json value = {{"seconds", time.seconds}, {"load", time.load}};
+        j[key] = value;
+        if (!scope_.empty()) j[key + "|" + scope_] = value;
         std::filesystem::create_directories(std::filesystem::path(path_).parent_path());
         writeTextFileAtomically(path_, j.dump(1) + "\n");
     } catch (const std::exception&) {

@@ -39,12 +39,17 @@ public:
     // $HOME/.cache/gdpt/...; empty (no cache) if none is set.
     static std::string defaultPath();
 
-    explicit ReconTimeCache(std::string path) : path_(std::move(path)) {}
+    // `scope` (e.g. the scene's path; empty: none): times differ by scene (the L1
+    // reconstruction's iterations follow the image), so get() prefers the entry of the key in
+    // this scope and falls back to the key's latest entry of any scope; put() writes both.
+    explicit ReconTimeCache(std::string path, std::string scope = "")
+        : path_(std::move(path)), scope_(std::move(scope)) {}
     [[nodiscard]] std::optional<ReservedTime> get(const std::string& key) const;
     void put(const std::string& key, ReservedTime time) const;
 
 private:
     std::string path_;
+    std::string scope_;
 };
 
 // The part of a reservation's cache key that names the configuration's device, driver and

@@ -105,6 +105,7 @@ void runBatchLoop(const RenderOptions& options, const char* label, const Timer& 
         }
         done += n;
         secondsPerSpp = batchTimer.seconds() / n;
+        if (stats.firstBatchSeconds == 0.0) stats.firstBatchSeconds = batchTimer.seconds();
         if (options.measureLoad) load = loadFactor(batchShare.share());
         const double mraysPerS =
             static_cast<double>(stats.raysTraced) / std::max(1e-9, phase.seconds()) * 1e-6;

@@ -25,7 +25,9 @@ double CpuShareMeter::share() const {
     return std::clamp(share, 1.0 / 64.0, 1.0);
 }
 
-double loadFactor(double share) { return share > 0.0 ? 1.0 / share : 0.0; }
+double loadFactor(double share) {
+    return share > 0.0 ? 1.0 / share : 0.0;
+}
 
 double atLoad(double seconds, double then, double now) {
     if (!(then > 0.0) || !(now > 0.0)) return seconds;

@@ -166,28 +166,48 @@ TEST_F(Cli, TimedGptRenderReservesTheRememberedReconstructionTime) {
     EXPECT_GT(readJson(path("g.json"))["time_s"]["reconstruction_reserved"].get<double>(), 0.0);
     ASSERT_TRUE(fs::exists(cached));
     nlohmann::json entries = readJson(cached);
-    // The reconstruction's entry and the finish's (readback, layers, writing: finish_reserved).
-    ASSERT_EQ(entries.size(), 2u) << entries.dump();
+    // The reconstruction's entry and the finish's (readback, layers, writing: finish_reserved),
+    // each for the configuration and for it with this scene ("|scene <path>").
+    ASSERT_EQ(entries.size(), 4u) << entries.dump();
     std::string key;
     std::string finishKey;
-    for (const auto& [k, v] : entries.items()) (k.rfind("finish|", 0) == 0 ? finishKey : key) = k;
+    for (const auto& [k, v] : entries.items())
+        if (k.find("|scene ") == std::string::npos) (k.rfind("finish|", 0) == 0 ? finishKey : key) = k;
     ASSERT_FALSE(key.empty()) << entries.dump();
     ASSERT_FALSE(finishKey.empty()) << entries.dump();
     EXPECT_NE(finishKey.find("gpt"), std::string::npos) << finishKey;
     EXPECT_NE(key.find("16x16"), std::string::npos) << key;
     EXPECT_NE(key.find("l1"), std::string::npos) << key;
-    entries[key] = 0.125;  // values no measurement produces, to see them come back
-    entries[finishKey] = 0.0625;
+    const std::string sceneKey = key + "|scene " + kScene, sceneFinishKey = finishKey + "|scene " + kScene;
+    ASSERT_TRUE(entries.contains(sceneKey)) << entries.dump();
+    ASSERT_TRUE(entries.contains(sceneFinishKey)) << entries.dump();
+    // Values no measurement produces, to see them come back: the scene's entries first; the
+    // configuration's, in the form earlier versions wrote (bare seconds), when the scene has none.
+    entries[sceneKey] = 0.125;
+    entries[sceneFinishKey] = 0.0625;
+    entries[key] = 0.5;
+    entries[finishKey] = 0.25;
     std::ofstream(cached) << entries.dump();
     r = runWithEnv(env, cmd);
     ASSERT_EQ(r.code, 0) << r.output;
     EXPECT_DOUBLE_EQ(readJson(path("g.json"))["time_s"]["reconstruction_reserved"].get<double>(), 0.125);
     EXPECT_DOUBLE_EQ(readJson(path("g.json"))["time_s"]["finish_reserved"].get<double>(), 0.0625);
+    entries = readJson(cached);
+    entries.erase(sceneKey);
+    entries.erase(sceneFinishKey);
+    entries[key] = 0.5;
+    entries[finishKey] = 0.25;
+    std::ofstream(cached) << entries.dump();
+    r = runWithEnv(env, cmd);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_DOUBLE_EQ(readJson(path("g.json"))["time_s"]["reconstruction_reserved"].get<double>(), 0.5);
+    EXPECT_DOUBLE_EQ(readJson(path("g.json"))["time_s"]["finish_reserved"].get<double>(), 0.25);
     // The real times replace them, each with the load its render's sampling felt (0 here: a
     // sampling this short is not measured; test_time_budget_cli.cpp measures one).
     entries = readJson(cached);
-    EXPECT_NE(entries[key]["seconds"].get<double>(), 0.125) << "the real reconstruction time replaces it";
-    EXPECT_NE(entries[finishKey]["seconds"].get<double>(), 0.0625) << "the real finishing time replaces it";
+    EXPECT_NE(entries[key]["seconds"].get<double>(), 0.5) << "the real reconstruction time replaces it";
+    EXPECT_NE(entries[finishKey]["seconds"].get<double>(), 0.25) << "the real finishing time replaces it";
+    EXPECT_EQ(entries[sceneKey], entries[key]);
     EXPECT_GE(entries[key]["load"].get<double>(), 0.0);
     EXPECT_GE(entries[finishKey]["load"].get<double>(), 0.0);
 }

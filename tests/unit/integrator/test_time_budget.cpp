@@ -37,7 +37,8 @@ TEST(TimedBatch, TakesAtMostHalfOfTheTimeLeft) {
 TEST(TimedBatch, ReservationsCarryToTheLoadMeasured) {
     const std::vector<ReservedTime> r = {{1.0, 2.0}, {0.5, 0.0}};
     EXPECT_DOUBLE_EQ(reservedAtLoad(r, 0.0), 1.5) << "no load measured: as remembered";
-    EXPECT_DOUBLE_EQ(reservedAtLoad(r, 4.0), 2.5) << "twice as busy: the first doubles; the second was measured now";
+    EXPECT_DOUBLE_EQ(reservedAtLoad(r, 4.0), 2.5)
+        << "twice as busy: the first doubles; the second was measured now";
     EXPECT_DOUBLE_EQ(reservedAtLoad(r, 1.0), 1.0);
     EXPECT_DOUBLE_EQ(reservedAtLoad({}, 3.0), 0.0);
 }
@@ -45,6 +46,7 @@ TEST(TimedBatch, ReservationsCarryToTheLoadMeasured) {
 RenderStats statsOf(double setup, double compileMs, double reserveScale, std::uint32_t spp) {
     RenderStats s;
     s.setupSeconds = setup;
+    s.firstBatchSeconds = 0.25;
     s.compileMs = compileMs;
     s.reserveScale = reserveScale;
     s.spp = spp;
@@ -53,10 +55,12 @@ RenderStats statsOf(double setup, double compileMs, double reserveScale, std::ui
     return s;
 }
 
-TEST(BudgetReport, FixedCostsAreTheSetUpAndTheReservationAtTheLastLoad) {
+// The fixed costs: the set-up, the first batch (one sample per pixel) and the reservation at
+// the last batch's load (0.6 s remembered, scaled by 2).
+TEST(BudgetReport, FixedCostsAreTheSetUpTheFirstSampleAndTheReservationAtTheLastLoad) {
     const BudgetReport r = budgetReport(4.0, statsOf(3.0, 2000.0, 2.0, 1), 4.9, 0.6, 0.5);
     EXPECT_DOUBLE_EQ(r.reserved, 1.2);
-    EXPECT_DOUBLE_EQ(r.fixed(), 4.2);
+    EXPECT_DOUBLE_EQ(r.fixed(), 4.45);
     EXPECT_TRUE(r.fixedExceeded);
     EXPECT_NEAR(r.overrun(), 0.225, 1e-12);
     const nlohmann::json j = budgetJson(r, statsOf(3.0, 2000.0, 2.0, 1));
@@ -66,13 +70,15 @@ TEST(BudgetReport, FixedCostsAreTheSetUpAndTheReservationAtTheLastLoad) {
     EXPECT_DOUBLE_EQ(j["reserve_scale"].get<double>(), 2.0);
     const auto note = budgetNote(r, statsOf(3.0, 2000.0, 2.0, 1));
     ASSERT_TRUE(note.has_value());
-    EXPECT_NE(note->find("fixed costs alone take 4.20 s"), std::string::npos) << *note;
+    EXPECT_NE(note->find("fixed costs alone take 4.45 s"), std::string::npos) << *note;
+    EXPECT_NE(note->find("one sample per pixel 0.25 s"), std::string::npos) << *note;
     EXPECT_NE(note->find("compile 2.00 s"), std::string::npos) << *note;
     EXPECT_NE(note->find("the minimum, 1 spp"), std::string::npos) << *note;
 }
 
 TEST(BudgetReport, NoteOnlyBeyondTheTolerance) {
     const RenderStats s = statsOf(1.0, 0.0, 1.0, 12);
+    EXPECT_FALSE(budgetReport(1.0, s, 4.0, 0.5, 0.5).fixedExceeded) << "12 spp: not the minimum";
     EXPECT_FALSE(budgetReport(4.0, s, 4.0, 0.5, 0.5).fixedExceeded);
     EXPECT_FALSE(budgetNote(budgetReport(4.0, s, 4.39, 0.5, 0.5), s).has_value()) << "within 10 %";
     const auto over = budgetNote(budgetReport(4.0, s, 4.6, 0.5, 1.1), s);
@@ -103,6 +109,20 @@ TEST_F(ReconTimeCacheFile, ReadsBothFormsAndWritesTheLoad) {
     EXPECT_DOUBLE_EQ(j["old"]["seconds"].get<double>(), 0.75);
     EXPECT_DOUBLE_EQ(j["old"]["load"].get<double>(), 3.0);
     EXPECT_DOUBLE_EQ(j["new"]["seconds"].get<double>(), 0.5) << "the other entries are kept";
+}
+
+// A scoped cache (a scene's) prefers its own entry, falls back to the key's latest entry of any
+// scope, and writes both, so another scene's render finds the latest time of the configuration.
+TEST_F(ReconTimeCacheFile, AScopePrefersItsOwnEntry) {
+    const std::string file = path("recon_times.json");
+    const ReconTimeCache door(file, "scene door"), box(file, "scene box");
+    door.put("k", {0.9, 1.0});
+    ASSERT_TRUE(box.get("k").has_value());
+    EXPECT_DOUBLE_EQ(box.get("k")->seconds, 0.9) << "no entry of its own: the latest";
+    box.put("k", {0.4, 1.0});
+    EXPECT_DOUBLE_EQ(door.get("k")->seconds, 0.9) << "its own entry, not the latest";
+    EXPECT_DOUBLE_EQ(box.get("k")->seconds, 0.4);
+    EXPECT_DOUBLE_EQ(ReconTimeCache(file).get("k")->seconds, 0.4) << "unscoped: the latest";
 }
 
 }  // namespace

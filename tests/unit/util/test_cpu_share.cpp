@@ -1,11 +1,11 @@
 // The processor share and load factor of util/cpu_share.h: the arithmetic by hand, and the
 // meter against threads whose use of the processors is known (one asleep, one spinning).
-#include "util/cpu_share.h"
-
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <thread>
+
+#include "util/cpu_share.h"
 
 namespace gdpt {
 namespace {
