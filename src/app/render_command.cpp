@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -194,7 +195,13 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
             options.timeBudget =
                 std::max(0.05 * args.time, args.time - reserved.seconds - finishReserved.seconds);
             // Each rank of a distributed render samples for rank 0's budget, as agreed below.
-            if (!world) options.reservedAfterSampling = {reserved, finishReserved};
+            if (!world) {
+                options.reservedAfterSampling = {reserved, finishReserved};
+                options.reconstructionDeadline =
+                    std::chrono::steady_clock::now() +
+                    std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                        std::chrono::duration<double>(args.time - total.seconds() - finishReserved.seconds));
+            }
         }
         options.elapsedBefore = total.seconds();
 
@@ -495,7 +502,11 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->group(animation);
 
     const char* budget = "Time budget and checkpoints";
-    r->add_option("--time", a.time, "Seconds for the whole render, reconstruction included; overrides --spp")
+    r->add_option(
+         "--time", a.time,
+         "Seconds for the whole render, reconstruction included; overrides --spp. If the fixed costs "
+         "alone (set-up, the kernels' first compile, one sample per pixel, reconstruction) exceed "
+         "it, renders that minimum and says so")
         ->check(CLI::Range(1e-3, 1e7))
         ->group(budget);
     CLI::Option* checkpoint =

@@ -67,11 +67,13 @@ std::vector<NamedLayer> ReconstructionStage::run(const PoissonInput& input, cons
     for (SolveOptions so : solves_) {
         stopIfCancelled();
         so.progress = [&](int, int, int) { stopIfCancelled(); };
+        so.deadline = options.reconstructionDeadline;
         Image recon;
         const SolveReport report = solver_->solve(input, so, recon);
         ReconstructionStats rs{
             toString(so.method), report.iterations, report.irlsIterations, report.residual, so.tolerance,
             report.converged,    report.ms};
+        rs.stoppedAtDeadline = report.stoppedAtDeadline;
         std::string debiased;
         if (debiases(so.method, debiasCells_)) {
             // The coarse scales from the primal (poisson/debias.h): a few ms on the host.
@@ -88,10 +90,15 @@ std::vector<NamedLayer> ReconstructionStage::run(const PoissonInput& input, cons
         if (!options.quiet) {
             const std::string scaled =
                 report.scaleExponent ? ", inputs scaled by 2^-" + std::to_string(report.scaleExponent) : "";
+            const std::string stopped =
+                report.stoppedAtDeadline
+                    ? " of " + std::to_string(so.irlsIterations) + ", stopped for the budget"
+                    : "";
             std::fprintf(stderr,
-                         "gdpt: %s reconstruction: %d iterations (%d IRLS), residual %.2g%s%s, %.1f ms%s\n",
-                         toString(so.method), report.iterations, report.irlsIterations, report.residual,
-                         report.converged ? "" : " NOT converged", scaled.c_str(), rs.ms, debiased.c_str());
+                         "gdpt: %s reconstruction: %d iterations (%d IRLS%s), residual %.2g%s%s, %.1f ms%s\n",
+                         toString(so.method), report.iterations, report.irlsIterations, stopped.c_str(),
+                         report.residual, report.converged ? "" : " NOT converged", scaled.c_str(), rs.ms,
+                         debiased.c_str());
         }
         stats.reconstructions.push_back(rs);
         stats.reconstructionMs += rs.ms;
@@ -115,6 +122,7 @@ nlohmann::json reconstructionsJson(const RenderStats& s) {
                           {"debias_scale_px", r.debiasScale},
                           {"debias_mean_change", r.debiasMeanChange},
                           {"debias_ms", r.debiasMs},
+                          {"stopped_at_deadline", r.stoppedAtDeadline},
                           {"ms", r.ms}});
     return recons;
 }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -49,6 +50,10 @@ struct RenderOptions {
     // difference too, so that a busier (or idler) machine than the one that measured them
     // moves the end of sampling accordingly.
     std::vector<ReservedTime> reservedAfterSampling;
+    // Timed renders: when the reconstruction must end (the budget's end less the time reserved
+    // for the output); an L1 reconstruction starts no reweighting round that would end later
+    // (SolveOptions::deadline). None: no limit.
+    std::optional<std::chrono::steady_clock::time_point> reconstructionDeadline;
     // Measure the load during sampling (stats.samplingLoad); set by the sampler on CPU devices,
     // where other processes compete with the device's threads.
     bool measureLoad = false;
@@ -90,16 +95,17 @@ struct RenderOptions {
 
 // One screened Poisson reconstruction of a render (G-PT): the solver's report in brief.
 struct ReconstructionStats {
-    std::string method;             // "l1", "l2", "wl2", "wl1"
-    int iterations = 0;             // inner iterations, summed over IRLS rounds
-    int irlsIterations = 0;         // 1 for L2/WL2
-    double residual = 0.0;          // final relative residual, max over channels
-    double tolerance = 0.0;         // the relative residual asked for
-    bool converged = false;         // every channel reached the tolerance
-    double ms = 0.0;                // the solve and the debiasing
-    int debiasScale = 0;            // node spacing (px) of the debiasing (poisson/debias.h); 0: not debiased
-    double debiasMeanChange = 0.0;  // the debiasing's change of the image mean, relative
-    double debiasMs = 0.0;          // of ms: the debiasing (host)
+    std::string method;              // "l1", "l2", "wl2", "wl1"
+    int iterations = 0;              // inner iterations, summed over IRLS rounds
+    int irlsIterations = 0;          // 1 for L2/WL2
+    double residual = 0.0;           // final relative residual, max over channels
+    double tolerance = 0.0;          // the relative residual asked for
+    bool converged = false;          // every channel reached the tolerance
+    double ms = 0.0;                 // the solve and the debiasing
+    int debiasScale = 0;             // node spacing (px) of the debiasing (poisson/debias.h); 0: not debiased
+    double debiasMeanChange = 0.0;   // the debiasing's change of the image mean, relative
+    double debiasMs = 0.0;           // of ms: the debiasing (host)
+    bool stoppedAtDeadline = false;  // IRLS rounds left out to end within a timed render's budget
 };
 
 // A render split across processes (sample_share.h): how its parts were merged.

@@ -6,6 +6,7 @@
 #include "poisson/poisson_gpu.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <string>
 
@@ -490,7 +491,15 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
         report.irlsIterations = 1;
     } else {
         double reg = std::ldexp(o.irlsRegInit, -report.scaleExponent);  // radiance units, scaled
+        const auto started = std::chrono::steady_clock::now();
         for (int k = 0; k < rounds_; ++k) {
+            if (k > 0 && o.deadline) {
+                const auto now = std::chrono::steady_clock::now();
+                if (now + (now - started) / k > *o.deadline) {
+                    report.stoppedAtDeadline = true;
+                    break;
+                }
+            }
             const bool last = k + 1 == rounds_;
             const double tol = last ? o.tolerance : std::max(o.tolerance, o.irlsInnerTolerance);
             if (k > 0) {

@@ -34,6 +34,7 @@
 #pragma once
 
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -93,6 +94,10 @@ struct SolveOptions {
     // Called after every submitted batch: IRLS rounds finished (L2: 0, then 1), rounds in
     // all, inner iterations recorded so far. For progress reports on long solves.
     std::function<void(int roundsDone, int rounds, int iterations)> progress;
+    // IRLS (L1, WL1): no further reweighting round is started that would end after this time,
+    // at the mean time of the rounds so far (a timed render's budget). The result is then the
+    // last finished round's: a milder L1 (weights of a larger regulariser). None: no limit.
+    std::optional<std::chrono::steady_clock::time_point> deadline;
 };
 
 // Values replaced (each counted once per value; a variance per pixel and layer).
@@ -109,12 +114,13 @@ struct NonFiniteCounts {
 inline constexpr double kSolveMaxMagnitude = 4294967296.0;
 
 struct SolveReport {
-    int iterations = 0;      // inner iterations, summed over IRLS rounds
-    int irlsIterations = 0;  // 1 for L2/WL2
-    int batches = 0;         // command buffers submitted (host round trips)
-    double residual = 0.0;   // true final relative residual, max over channels
-    bool converged = false;  // every channel of the last solve reached the tolerance
-    double ms = 0.0;         // wall time of the solve (upload to download)
+    int iterations = 0;              // inner iterations, summed over IRLS rounds
+    int irlsIterations = 0;          // 1 for L2/WL2
+    int batches = 0;                 // command buffers submitted (host round trips)
+    double residual = 0.0;           // true final relative residual, max over channels
+    bool converged = false;          // every channel of the last solve reached the tolerance
+    bool stoppedAtDeadline = false;  // IRLS rounds left out for SolveOptions::deadline
+    double ms = 0.0;                 // wall time of the solve (upload to download)
     NonFiniteCounts nonFinite;
     // The inputs were scaled by 2^-scaleExponent for the device and the result back by
     // 2^scaleExponent (0: unscaled; kSolveMaxMagnitude).

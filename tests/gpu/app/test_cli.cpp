@@ -9,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 
 #include "cli_runner.h"
 #include "image/exr_io.h"
@@ -183,25 +184,25 @@ TEST_F(Cli, TimedGptRenderReservesTheRememberedReconstructionTime) {
     ASSERT_TRUE(entries.contains(sceneFinishKey)) << entries.dump();
     // Values no measurement produces, to see them come back: the scene's entries first; the
     // configuration's, in the form earlier versions wrote (bare seconds), when the scene has none.
-    entries[sceneKey] = 0.125;
-    entries[sceneFinishKey] = 0.0625;
-    entries[key] = 0.5;
-    entries[finishKey] = 0.25;
-    std::ofstream(cached) << entries.dump();
-    r = runWithEnv(env, cmd);
-    ASSERT_EQ(r.code, 0) << r.output;
-    EXPECT_DOUBLE_EQ(readJson(path("g.json"))["time_s"]["reconstruction_reserved"].get<double>(), 0.125);
-    EXPECT_DOUBLE_EQ(readJson(path("g.json"))["time_s"]["finish_reserved"].get<double>(), 0.0625);
-    entries = readJson(cached);
-    entries.erase(sceneKey);
-    entries.erase(sceneFinishKey);
-    entries[key] = 0.5;
-    entries[finishKey] = 0.25;
-    std::ofstream(cached) << entries.dump();
-    r = runWithEnv(env, cmd);
-    ASSERT_EQ(r.code, 0) << r.output;
-    EXPECT_DOUBLE_EQ(readJson(path("g.json"))["time_s"]["reconstruction_reserved"].get<double>(), 0.5);
-    EXPECT_DOUBLE_EQ(readJson(path("g.json"))["time_s"]["finish_reserved"].get<double>(), 0.25);
+    const auto reservedWith = [&](bool sceneEntries) {
+        nlohmann::json e = readJson(cached);
+        e.erase(sceneKey);
+        e.erase(sceneFinishKey);
+        if (sceneEntries) {
+            e[sceneKey] = 0.125;
+            e[sceneFinishKey] = 0.0625;
+        }
+        e[key] = 0.5;
+        e[finishKey] = 0.25;
+        std::ofstream(cached) << e.dump();
+        const RunResult rr = runWithEnv(env, cmd);
+        EXPECT_EQ(rr.code, 0) << rr.output;
+        const nlohmann::json times = readJson(path("g.json"))["time_s"];
+        return std::make_pair(times["reconstruction_reserved"].get<double>(),
+                              times["finish_reserved"].get<double>());
+    };
+    EXPECT_EQ(reservedWith(true), std::make_pair(0.125, 0.0625));
+    EXPECT_EQ(reservedWith(false), std::make_pair(0.5, 0.25));
     // The real times replace them, each with the load its render's sampling felt (0 here: a
     // sampling this short is not measured; test_time_budget_cli.cpp measures one).
     entries = readJson(cached);

@@ -68,7 +68,8 @@ private:
 TEST_F(TimeBudgetCli, FixedCostsAboveTheBudgetGiveTheMinimumAndSaySo) {
     for (const char* method : {"gpt", "pt"}) {
         SCOPED_TRACE(method);
-        const test::RunResult r = render(std::string("--method ") + method + " --width 32 --height 32 --time 0.05");
+        const test::RunResult r =
+            render(std::string("--method ") + method + " --width 32 --height 32 --time 0.05");
         ASSERT_EQ(r.code, 0) << r.output;
         const nlohmann::json j = readJson("out.json");
         EXPECT_EQ(j["spp"], 1);

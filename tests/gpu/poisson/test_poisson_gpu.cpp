@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -483,6 +484,40 @@ TEST_F(PoissonGpu, L1RecoversCorruptedGradientsBetterThanL2) {
     EXPECT_EQ(r.irlsIterations, o.irlsIterations);
     const double e2 = rmse(l2), e1 = rmse(l1);
     EXPECT_LT(e1, 0.25 * e2) << "L1 rmse " << e1 << " L2 rmse " << e2;
+}
+
+// A deadline (a timed render's budget) stops IRLS between rounds: already passed, only the
+// first round runs and the report says so; an hour away, all six run. The early result is
+// the first round's (an L2-like solve, weights of the largest regulariser): finite, and not
+// the six rounds' result.
+TEST_F(PoissonGpu, L1StopsReweightingAtItsDeadline) {
+    const int w = 32, h = 32;
+    const Image truth = structuredImage(w, h);
+    Image dx, dy;
+    gradients(truth, dx, dy);
+    Image primal = truth;
+    std::mt19937 rng(5);
+    std::normal_distribution<float> noise(0.0f, 0.05f);
+    for (int c = 0; c < 3; ++c)
+        for (float& v : primal.plane(c)) v += noise(rng);
+    SolveOptions o;
+    o.method = Reconstruction::L1;
+    Image full, early;
+    o.deadline = std::chrono::steady_clock::now() + std::chrono::hours(1);
+    const SolveReport all = solve(primal, dx, dy, o, full);
+    EXPECT_EQ(all.irlsIterations, o.irlsIterations);
+    EXPECT_FALSE(all.stoppedAtDeadline);
+    o.deadline = std::chrono::steady_clock::now() - std::chrono::seconds(1);
+    const SolveReport cut = solve(primal, dx, dy, o, early);
+    EXPECT_EQ(cut.irlsIterations, 1);
+    EXPECT_TRUE(cut.stoppedAtDeadline);
+    double differs = 0.0;
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < early.pixelCount(); ++i) {
+            ASSERT_TRUE(std::isfinite(early.plane(c)[i]));
+            differs = std::max(differs, double(std::abs(early.plane(c)[i] - full.plane(c)[i])));
+        }
+    EXPECT_GT(differs, 0.0) << "the rounds left out change the result";
 }
 
 // Extreme scales, α, and degenerate sizes agree with the CPU exact solve.
