@@ -115,10 +115,11 @@ TEST_F(TimeBudgetCli, BusyMachineStillEndsWithinTheTolerance) {
     EXPECT_GT(b["reserve_scale"].get<double>(), 1.0) << b.dump();
     // The budget holds, unless the machine is so busy that the minimum render does not fit;
     // then the render must have stopped at that minimum and said so.
-    if (b["fixed_exceeded"].get<bool>())
+    if (b["fixed_exceeded"].get<bool>()) {
         EXPECT_NE(r.output.find("the fixed costs alone take"), std::string::npos) << r.output;
-    else
+    } else {
         EXPECT_LE(b["overrun"].get<double>(), kBudgetTolerance) << b.dump();
+    }
 }
 
 }  // namespace

@@ -30,7 +30,9 @@ TEST(CpuShare, AtLoadScalesByTheRatioOfTheFactors) {
 TEST(CpuShare, UsableProcessorsAreThoseOfTheMachineAtMost) {
     EXPECT_GE(usableProcessors(), 1u);
     const unsigned hardware = std::thread::hardware_concurrency();
-    if (hardware > 0) EXPECT_LE(usableProcessors(), hardware);
+    if (hardware > 0) {
+        EXPECT_LE(usableProcessors(), hardware);
+    }
 }
 
 // A process that sleeps uses (almost) none of the machine: the meter must count CPU time, not
