@@ -40,7 +40,7 @@ std::optional<std::string> budgetNote(const BudgetReport& r, const RenderStats& 
     if (r.fixedExceeded) {
         std::snprintf(line, sizeof line,
                       "--time %g: the fixed costs alone take %.2f s (set-up %.2f s, of which the kernels' "
-                      "compile %.2f s; one sample per pixel %.2f s; %.2f s after sampling), more than the "
+                      "compile %.2f s; the first batch %.2f s; %.2f s after sampling), more than the "
                       "budget: sampled the minimum, %u spp, and ended at %.2f s",
                       r.budget, r.fixed(), r.setup, r.compile, r.firstBatch, r.reserved, stats.spp, r.total);
         return std::string(line);

@@ -148,6 +148,7 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
                [&](VkCommandBuffer cmd) { pass.recordStart(cmd, starts, options.seed, timer); });
         Progress progress("render " + name_, timed ? budget : double(wantedSteps), options.quiet);
         double secondsPerStep = 0.0;
+        stats.setupSeconds = options.elapsedBefore + total.seconds();  // the bootstrap included
         while (!cancelled()) {
             std::uint32_t n = kStepsPerBatch;
             if (!timed) {
@@ -175,6 +176,7 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
             steps += n;
             ++stats.batches;
             secondsPerStep = batch.seconds() / n;
+            if (stats.firstBatchSeconds == 0.0) stats.firstBatchSeconds = batch.seconds();
             char rate[64];
             std::snprintf(rate, sizeof rate, "%.1f mutations/pixel",
                           double(steps) * double(po.chains) / double(pixels));

@@ -149,8 +149,7 @@ struct RenderStats {
     double pipelineWaitMs = 0.0;         // of which: waiting for the pipelines after the scene upload
     double compileMs = 0.0;              // the main kernels' first, empty, dispatch (lavapipe compiles there)
     double setupSeconds = 0.0;           // the render's time when sampling began (its fixed costs before it)
-    double firstBatchSeconds =
-        0.0;                    // this run's first batch (one sample per pixel, the least a render takes)
+    double firstBatchSeconds = 0.0;      // this run's first batch (PT, G-PT: 1 spp; MLT: one step)
     double samplingLoad = 0.0;  // load factor over the batch loop (util/cpu_share.h); 0: not measured
     double reserveScale = 1.0;  // timed: the reservations at the last batch's load ÷ as measured
     double samplingMs = 0.0;    // wall time of the batch loop

@@ -63,18 +63,22 @@ private:
 };
 
 // A budget below what any machine spends before the first sample (loading the scene and
-// creating the device take longer than 50 ms): each method renders one batch of one sample per
-// pixel (no partial pass), writes its image and says why it overran, once, and --json says so.
+// creating the device take longer than 50 ms): each method renders one batch (PT and G-PT: of
+// one sample per pixel, no partial pass; gmlt: one mutation step), writes its image and says why
+// it overran, once, and --json says so.
 TEST_F(TimeBudgetCli, FixedCostsAboveTheBudgetGiveTheMinimumAndSaySo) {
-    for (const char* method : {"gpt", "pt"}) {
+    for (const std::string method : {"gpt", "pt", "gmlt"}) {
         SCOPED_TRACE(method);
-        const test::RunResult r =
-            render(std::string("--method ") + method + " --width 32 --height 32 --time 0.05");
+        const test::RunResult r = render("--method " + method + " --width 32 --height 32 --time 0.05");
         ASSERT_EQ(r.code, 0) << r.output;
         const nlohmann::json j = readJson("out.json");
-        EXPECT_EQ(j["spp"], 1);
+        if (method != "gmlt") {
+            EXPECT_EQ(j["spp"], 1);
+        }
         EXPECT_EQ(j["batches"], 1);
         EXPECT_EQ(j["partial_pass_rows"], 0);
+        EXPECT_GT(j["budget"]["setup_s"].get<double>(), 0.0) << "measured by every method";
+        EXPECT_GT(j["budget"]["first_batch_s"].get<double>(), 0.0);
         const nlohmann::json& b = j["budget"];
         EXPECT_EQ(b["fixed_exceeded"], true) << b.dump();
         EXPECT_DOUBLE_EQ(b["seconds"].get<double>(), 0.05);
