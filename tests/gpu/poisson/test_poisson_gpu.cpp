@@ -452,17 +452,30 @@ TEST_F(PoissonGpu, CgErrorAndMultigridResidualAreMonotone) {
             EXPECT_LT(r.history[k][c], r.history[k - 1][c]) << "V-cycle " << k;
 }
 
+// The structured image, its exact gradients, and a primal with Gaussian noise (σ 0.05).
+struct NoisyProblem {
+    Image truth, primal, dx, dy;
+};
+NoisyProblem noisyProblem(int w, int h, unsigned seed) {
+    NoisyProblem p;
+    p.truth = structuredImage(w, h);
+    gradients(p.truth, p.dx, p.dy);
+    p.primal = p.truth;
+    std::mt19937 rng(seed);
+    std::normal_distribution<float> noise(0.0f, 0.05f);
+    for (int c = 0; c < 3; ++c)
+        for (float& v : p.primal.plane(c)) v += noise(rng);
+    return p;
+}
+
 // L1 (IRLS) shrugs off a few grossly wrong gradients that L2 smears over the image.
 TEST_F(PoissonGpu, L1RecoversCorruptedGradientsBetterThanL2) {
     const int w = 48, h = 48;
-    const Image truth = structuredImage(w, h);
-    Image dx, dy;
-    gradients(truth, dx, dy);
-    Image primal = truth;
-    std::mt19937 rng(17);
-    std::normal_distribution<float> noise(0.0f, 0.05f);
-    for (int c = 0; c < 3; ++c)
-        for (float& v : primal.plane(c)) v += noise(rng);
+    NoisyProblem p = noisyProblem(w, h, 17);
+    const Image& truth = p.truth;
+    const Image& primal = p.primal;
+    Image& dx = p.dx;
+    const Image& dy = p.dy;
     for (int k = 0; k < 12; ++k) {
         const int x = 3 + (k * 7) % (w - 6), y = 2 + (k * 11) % (h - 4);
         for (int c = 0; c < 3; ++c) dx.at(x, y, c) += 5.0f;
@@ -491,15 +504,8 @@ TEST_F(PoissonGpu, L1RecoversCorruptedGradientsBetterThanL2) {
 // the first round's (an L2-like solve, weights of the largest regulariser): finite, and not
 // the six rounds' result.
 TEST_F(PoissonGpu, L1StopsReweightingAtItsDeadline) {
-    const int w = 32, h = 32;
-    const Image truth = structuredImage(w, h);
-    Image dx, dy;
-    gradients(truth, dx, dy);
-    Image primal = truth;
-    std::mt19937 rng(5);
-    std::normal_distribution<float> noise(0.0f, 0.05f);
-    for (int c = 0; c < 3; ++c)
-        for (float& v : primal.plane(c)) v += noise(rng);
+    const NoisyProblem p = noisyProblem(32, 32, 5);
+    const Image &primal = p.primal, &dx = p.dx, &dy = p.dy;
     SolveOptions o;
     o.method = Reconstruction::L1;
     Image full, early;
