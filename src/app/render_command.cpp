@@ -188,10 +188,10 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
         // it (G-PT: the reconstructions) and by what the rest took the last time for this
         // device, method, size and settings (readback, output layers, EXR + PNG; nothing the
         // first time).
-        if (timed) reserved = integrator->reserveAfterSampling(ctx, args.width, args.height);
         finishKey = "finish|" + reservationKey(ctx, args.width, args.height) + "|" + finishKeyMethod;
-        if (timed) finishReserved = cache.get(finishKey).value_or(ReservedTime{});
         if (timed) {
+            reserved = integrator->reserveAfterSampling(ctx, args.width, args.height);
+            finishReserved = cache.get(finishKey).value_or(ReservedTime{});
             options.timeBudget =
                 std::max(0.05 * args.time, args.time - reserved.seconds - finishReserved.seconds);
             // Each rank of a distributed render samples for rank 0's budget, as agreed below.

@@ -22,12 +22,12 @@ struct BudgetReport {
     double total = 0.0;          // the render's wall time, seconds
     double setup = 0.0;          // time before the first sample (stats.setupSeconds)
     double compile = 0.0;        // of setup: the main kernels' first dispatch
-    double firstBatch = 0.0;     // the first batch: one sample per pixel
+    double firstBatch = 0.0;     // the first batch (PT, G-PT: one sample per pixel; MLT: one step)
     double reserved = 0.0;       // reserved after sampling, at the load of the last batch
     double afterSampling = 0.0;  // what the stages after sampling took
     bool fixedExceeded = false;  // fixed() >= budget, and the render sampled that minimum
 
-    // What every render of the scene pays: the set-up, one sample per pixel, the stages after.
+    // What every render of the scene pays: the set-up, the first batch, the stages after.
     [[nodiscard]] double fixed() const { return setup + firstBatch + reserved; }
     [[nodiscard]] double overrun() const { return budget > 0.0 ? total / budget - 1.0 : 0.0; }
 };
