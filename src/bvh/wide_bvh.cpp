@@ -1,6 +1,7 @@
 #include "bvh/wide_bvh.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -28,8 +29,10 @@ float scaleOf(int biased) {
     return gpu::wideAxisScale(static_cast<uint32_t>(biased), 0u);
 }
 
+// q·scale is exact (an 8-bit integer times a power of two), so origin + q·scale is one
+// rounding, the same in the kernels' vector form (gpu::wideDecodeAxis) and here.
 float decode(float origin, uint32_t q, float scale) {
-    return gpu::wideDecodeAxis(origin, q, scale).x;
+    return origin + float(q) * scale;
 }
 
 // The smallest power-of-two scale whose 255 steps from origin reach `top` (biased exponent).
@@ -70,7 +73,21 @@ float halfArea(const Slot& s) {
 // The wide node of up to four child boxes: origin = their union's lower corner, per axis the
 // scale of axisExponent and each bound rounded outwards (BvhWideNode). Children and counts
 // are left for the caller (empty slots keep kInvalidIndex).
-gpu::BvhWideNode quantiseWideNode(const std::vector<Slot>& slots) {
+// The children of one wide node under construction (at most four: a node starts from its
+// binary node's two children and replaces one inner child by two while it has fewer than four).
+struct Slots {
+    std::array<Slot, 4> slot{};
+    std::size_t count = 0;
+    std::size_t size() const { return count; }
+    const Slot& operator[](std::size_t i) const { return slot[i]; }
+    void push(const Slot& s) { slot[count++] = s; }
+    void erase(std::size_t i) {
+        for (std::size_t k = i + 1; k < count; ++k) slot[k - 1] = slot[k];
+        --count;
+    }
+};
+
+gpu::BvhWideNode quantiseWideNode(const Slots& slots) {
     const std::size_t count = slots.size();
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     for (std::size_t i = 0; i < count; ++i) {
@@ -95,26 +112,31 @@ gpu::BvhWideNode quantiseWideNode(const std::vector<Slot>& slots) {
 
 class Collapser {
 public:
-    explicit Collapser(const std::vector<gpu::BvhNode>& binary) : binary_(binary) {}
+    // Every wide node replaces at least one binary node: reserving as many never moves them.
+    explicit Collapser(const std::vector<gpu::BvhNode>& binary) : binary_(binary) {
+        out_.nodes.reserve(binary.size());
+    }
 
     // Emits the wide node for binary node `b`; returns its index. `depth` is the depth of
     // its children, `stack` the entries a traversal may hold on reaching it.
     uint32_t emit(uint32_t b, uint32_t depth, uint32_t stack) {
-        std::vector<Slot> slots;
+        Slots slots;
         addChildren(binary_[b], slots);
         while (slots.size() < 4) {
-            auto best = slots.end();
-            for (auto it = slots.begin(); it != slots.end(); ++it)
-                if (it->count == 0 && (best == slots.end() || halfArea(*it) > halfArea(*best))) best = it;
-            if (best == slots.end()) break;
-            const uint32_t inner = best->index;
+            std::size_t best = slots.size();
+            for (std::size_t i = 0; i < slots.size(); ++i)
+                if (slots[i].count == 0 &&
+                    (best == slots.size() || halfArea(slots[i]) > halfArea(slots[best])))
+                    best = i;
+            if (best == slots.size()) break;
+            const uint32_t inner = slots[best].index;
             slots.erase(best);
             addChildren(binary_[inner], slots);
         }
         const auto me = static_cast<uint32_t>(out_.nodes.size());
         out_.nodes.emplace_back();
-        const auto inner = static_cast<uint32_t>(
-            std::count_if(slots.begin(), slots.end(), [](const Slot& s) { return s.count == 0; }));
+        uint32_t inner = 0;
+        for (std::size_t i = 0; i < slots.size(); ++i) inner += slots[i].count == 0 ? 1u : 0u;
         // Visiting this node pushes every inner child but the one it descends into.
         const uint32_t below = stack + (inner > 0 ? inner - 1 : 0);
         out_.maxStack = std::max(out_.maxStack, below);
@@ -137,9 +159,9 @@ public:
     WideBvh take() { return std::move(out_); }
 
 private:
-    static void addChildren(const gpu::BvhNode& n, std::vector<Slot>& slots) {
-        if (n.left != gpu::kInvalidIndex) slots.push_back({n.lmin, n.lmax, n.left, n.leftCount});
-        if (n.right != gpu::kInvalidIndex) slots.push_back({n.rmin, n.rmax, n.right, n.rightCount});
+    static void addChildren(const gpu::BvhNode& n, Slots& slots) {
+        if (n.left != gpu::kInvalidIndex) slots.push({n.lmin, n.lmax, n.left, n.leftCount});
+        if (n.right != gpu::kInvalidIndex) slots.push({n.rmin, n.rmax, n.right, n.rightCount});
     }
 
     const std::vector<gpu::BvhNode>& binary_;

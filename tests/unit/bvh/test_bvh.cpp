@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -408,18 +409,51 @@ TEST(BvhBuilder, RejectsOutOfRangeVertexIndex) {
     EXPECT_THROW(buildBvh(p, {{0, 1, 3}}), std::invalid_argument);
 }
 
+// The references are made in parallel chunks of 65536 triangles: the error still names the
+// first bad triangle, whichever chunk finishes first.
+TEST(BvhBuilder, NamesTheFirstBadTriangleOfAnyChunk) {
+    Mesh m = test::randomSoup(140000, 0.01f, 19);
+    m.triangles[139000].y = static_cast<uint32_t>(m.positions.size());
+    m.triangles[70000].z = static_cast<uint32_t>(m.positions.size()) + 5;
+    for (const uint32_t threads : {1u, 2u, 3u}) {
+        BvhBuildOptions o;
+        o.buildThreads = threads;
+        try {
+            (void)buildBvh(m.positions, m.triangles, o);
+            ADD_FAILURE() << "no error with " << threads << " threads";
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find("triangle 70000 "), std::string::npos) << e.what();
+        }
+    }
+    Mesh f = test::randomSoup(140000, 0.01f, 20);
+    f.positions[f.triangles[100000].x].y = std::numeric_limits<float>::infinity();
+    try {
+        (void)buildBvh(f.positions, f.triangles);
+        ADD_FAILURE() << "no error for an infinite vertex";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("triangle 100000 has a non-finite"), std::string::npos)
+            << e.what();
+    }
+}
+
 TEST(BvhBuilder, SameResultForAnyThreadCount) {
     const Mesh m = test::randomSoup(60000, 0.02f, 14);
     BvhBuildOptions serial;
     serial.buildThreads = 1;
-    BvhBuildOptions parallel;
-    parallel.buildThreads = 4;
     const Bvh a = buildBvh(m.positions, m.triangles, serial);
-    const Bvh b = buildBvh(m.positions, m.triangles, parallel);
-    checkStructure(m, b, serial.maxLeafSize);
-    ASSERT_EQ(a.nodes.size(), b.nodes.size());
-    EXPECT_EQ(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(gpu::BvhNode)), 0);
-    EXPECT_EQ(a.triangleOrder, b.triangleOrder);
+    checkStructure(m, a, serial.maxLeafSize);
+    // 60000 triangles: a top phase of three levels, the root binned in three chunks with
+    // three or more threads, then subtrees on every thread.
+    for (const uint32_t threads : {2u, 3u, 4u, 7u}) {
+        BvhBuildOptions parallel;
+        parallel.buildThreads = threads;
+        const Bvh b = buildBvh(m.positions, m.triangles, parallel);
+        ASSERT_EQ(a.nodes.size(), b.nodes.size()) << threads << " threads";
+        EXPECT_EQ(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(gpu::BvhNode)), 0)
+            << threads << " threads";
+        EXPECT_EQ(a.triangleOrder, b.triangleOrder) << threads << " threads";
+        EXPECT_EQ(a.stats.sahCost, b.stats.sahCost);
+    }
 }
 
 // After pbrt-v3 shapes_test.cpp (Triangle.Watertight): rays from inside a closed mesh towards
