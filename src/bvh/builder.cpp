@@ -118,7 +118,7 @@ struct Range {
 };
 
 struct BuildInput {
-    std::vector<PrimRef>& refs;  // ranges are disjoint between threads
+    PrimRef* refs;  // ranges are disjoint between threads
     uint32_t leafMax;
     uint32_t binCount;
     uint32_t maxDepth;
@@ -281,7 +281,7 @@ Split findSahSplit(const BuildInput& in, const Range& r, const Bins& bins, const
 }
 
 // Bounds of references [begin, end).
-Range makeRange(const std::vector<PrimRef>& refs, uint32_t begin, uint32_t end) {
+Range makeRange(const PrimRef* refs, uint32_t begin, uint32_t end) {
     Range r;
     r.begin = begin;
     r.end = end;
@@ -299,7 +299,7 @@ uint32_t partitionRefs(const BuildInput& in, const Range& r, const Split& s, con
     const int a = s.axis;
     const float lo = m.lo[a];
     const float scale = m.scale[a];
-    PrimRef* refs = in.refs.data();
+    PrimRef* refs = in.refs;
     auto goesLeft = [&](const PrimRef& p) { return binOf(centroidOf(p, a), lo, scale, in.binCount) < s.bin; };
     auto addTo = [](Range& side, const PrimRef& p) {
         side.box.grow(primLo(p), primHi(p));
@@ -359,7 +359,7 @@ Decision decide(const BuildInput& in, const Range& r, uint32_t depth, std::vecto
             const uint32_t b0 = r.begin + static_cast<uint32_t>(uint64_t{n} * c / chunks);
             const uint32_t b1 = r.begin + static_cast<uint32_t>(uint64_t{n} * (c + 1) / chunks);
             clearBins(scratch[c], in.binCount);
-            binRefs(in.refs.data(), b0, b1, m, in.binCount, scratch[c]);
+            binRefs(in.refs, b0, b1, m, in.binCount, scratch[c]);
         });
         for (uint32_t c = 1; c < chunks; ++c) mergeBins(scratch[0], scratch[c], in.binCount);
         const Split s = findSahSplit(in, r, scratch[0], m);
@@ -383,7 +383,7 @@ Decision decide(const BuildInput& in, const Range& r, uint32_t depth, std::vecto
         const int a = (ex >= ey && ex >= ez) ? 0 : (ey >= ez ? 1 : 2);
         const uint32_t mid = r.begin + n / 2;
         std::nth_element(
-            in.refs.begin() + r.begin, in.refs.begin() + mid, in.refs.begin() + r.end,
+            in.refs + r.begin, in.refs + mid, in.refs + r.end,
             [a](const PrimRef& x, const PrimRef& y) { return centroidOf(x, a) < centroidOf(y, a); });
         d.left = makeRange(in.refs, r.begin, mid);
         d.right = makeRange(in.refs, mid, r.end);
@@ -578,9 +578,8 @@ gpu::BvhNode emptyNode() {
 // The padded references of every triangle and the root range; throws for a bad vertex index
 // or a non-finite vertex, naming the first such triangle.
 Range makeRefs(const std::vector<glm::vec3>& positions, const std::vector<glm::uvec3>& triangles,
-               std::vector<PrimRef>& refs, uint32_t threads) {
+               PrimRef* refs, uint32_t threads) {
     const auto count = static_cast<uint32_t>(triangles.size());
-    refs.resize(count);
     const size_t chunks = (size_t{count} + kPrepChunk - 1) / kPrepChunk;
     std::vector<Box4> chunkBox(chunks);
     std::vector<std::string> chunkError(chunks);
@@ -676,13 +675,15 @@ Bvh buildBvh(const std::vector<glm::vec3>& positions, const std::vector<glm::uve
     if (threads == 0) {
         threads = std::max(1u, std::thread::hardware_concurrency());
     }
-    std::vector<PrimRef> refs;
-    const Range root = makeRefs(positions, triangles, refs, threads);
+    // Left uninitialised: makeRefs writes every reference, on every thread (so the pages are
+    // first touched in parallel, and only once).
+    const std::unique_ptr<PrimRef[]> refs(new PrimRef[triangles.size()]);
+    const Range root = makeRefs(positions, triangles, refs.get(), threads);
 
     const uint32_t leafMax = std::clamp(options.maxLeafSize, 1u, gpu::kMaxLeafTriangles);
     // The shallowest possible tree has its leaves at depth levels(count) (>= 1).
     const uint32_t minDepth = std::max(1u, ceilLog2((uint64_t{count} + leafMax - 1) / leafMax));
-    const BuildInput in{refs,
+    const BuildInput in{refs.get(),
                         leafMax,
                         std::clamp(options.binCount, 2u, kMaxBins),
                         std::clamp(options.maxDepth, minDepth, gpu::kBvhMaxDepth),

@@ -18,19 +18,35 @@ namespace gdpt::bvh_simd {
 struct Float4 {
     __m128 v;
 };
-inline Float4 load4(const float* p) { return {_mm_loadu_ps(p)}; }
+inline Float4 load4(const float* p) {
+    return {_mm_loadu_ps(p)};
+}
 // p[0..2] with a zero fourth lane (p[3] is read, then masked).
 inline Float4 loadXyz(const float* p) {
     const __m128 mask = _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1));
     return {_mm_and_ps(_mm_loadu_ps(p), mask)};
 }
-inline void store4(float* p, Float4 a) { _mm_storeu_ps(p, a.v); }
-inline Float4 splat4(float x) { return {_mm_set1_ps(x)}; }
-inline Float4 min4(Float4 a, Float4 b) { return {_mm_min_ps(a.v, b.v)}; }
-inline Float4 max4(Float4 a, Float4 b) { return {_mm_max_ps(a.v, b.v)}; }
-inline Float4 add4(Float4 a, Float4 b) { return {_mm_add_ps(a.v, b.v)}; }
-inline Float4 sub4(Float4 a, Float4 b) { return {_mm_sub_ps(a.v, b.v)}; }
-inline Float4 mul4(Float4 a, Float4 b) { return {_mm_mul_ps(a.v, b.v)}; }
+inline void store4(float* p, Float4 a) {
+    _mm_storeu_ps(p, a.v);
+}
+inline Float4 splat4(float x) {
+    return {_mm_set1_ps(x)};
+}
+inline Float4 min4(Float4 a, Float4 b) {
+    return {_mm_min_ps(a.v, b.v)};
+}
+inline Float4 max4(Float4 a, Float4 b) {
+    return {_mm_max_ps(a.v, b.v)};
+}
+inline Float4 add4(Float4 a, Float4 b) {
+    return {_mm_add_ps(a.v, b.v)};
+}
+inline Float4 sub4(Float4 a, Float4 b) {
+    return {_mm_sub_ps(a.v, b.v)};
+}
+inline Float4 mul4(Float4 a, Float4 b) {
+    return {_mm_mul_ps(a.v, b.v)};
+}
 // Truncation towards zero of each lane (the lanes are non-negative and below 2^31 here).
 inline void truncate4(Float4 a, std::int32_t* out) {
     _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm_cvttps_epi32(a.v));
@@ -39,12 +55,18 @@ inline void truncate4(Float4 a, std::int32_t* out) {
 struct Float4 {
     float v[4];
 };
-inline Float4 load4(const float* p) { return {{p[0], p[1], p[2], p[3]}}; }
-inline Float4 loadXyz(const float* p) { return {{p[0], p[1], p[2], 0.0f}}; }
+inline Float4 load4(const float* p) {
+    return {{p[0], p[1], p[2], p[3]}};
+}
+inline Float4 loadXyz(const float* p) {
+    return {{p[0], p[1], p[2], 0.0f}};
+}
 inline void store4(float* p, Float4 a) {
     for (int k = 0; k < 4; ++k) p[k] = a.v[k];
 }
-inline Float4 splat4(float x) { return {{x, x, x, x}}; }
+inline Float4 splat4(float x) {
+    return {{x, x, x, x}};
+}
 // The same operand order as SSE's minps/maxps: (a < b ? a : b), (a > b ? a : b).
 inline Float4 min4(Float4 a, Float4 b) {
     return {{a.v[0] < b.v[0] ? a.v[0] : b.v[0], a.v[1] < b.v[1] ? a.v[1] : b.v[1],
@@ -54,9 +76,15 @@ inline Float4 max4(Float4 a, Float4 b) {
     return {{a.v[0] > b.v[0] ? a.v[0] : b.v[0], a.v[1] > b.v[1] ? a.v[1] : b.v[1],
              a.v[2] > b.v[2] ? a.v[2] : b.v[2], a.v[3] > b.v[3] ? a.v[3] : b.v[3]}};
 }
-inline Float4 add4(Float4 a, Float4 b) { return {{a.v[0] + b.v[0], a.v[1] + b.v[1], a.v[2] + b.v[2], a.v[3] + b.v[3]}}; }
-inline Float4 sub4(Float4 a, Float4 b) { return {{a.v[0] - b.v[0], a.v[1] - b.v[1], a.v[2] - b.v[2], a.v[3] - b.v[3]}}; }
-inline Float4 mul4(Float4 a, Float4 b) { return {{a.v[0] * b.v[0], a.v[1] * b.v[1], a.v[2] * b.v[2], a.v[3] * b.v[3]}}; }
+inline Float4 add4(Float4 a, Float4 b) {
+    return {{a.v[0] + b.v[0], a.v[1] + b.v[1], a.v[2] + b.v[2], a.v[3] + b.v[3]}};
+}
+inline Float4 sub4(Float4 a, Float4 b) {
+    return {{a.v[0] - b.v[0], a.v[1] - b.v[1], a.v[2] - b.v[2], a.v[3] - b.v[3]}};
+}
+inline Float4 mul4(Float4 a, Float4 b) {
+    return {{a.v[0] * b.v[0], a.v[1] * b.v[1], a.v[2] * b.v[2], a.v[3] * b.v[3]}};
+}
 inline void truncate4(Float4 a, std::int32_t* out) {
     for (int k = 0; k < 4; ++k) out[k] = static_cast<std::int32_t>(a.v[k]);
 }

@@ -2,10 +2,15 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <exception>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "lib/bvh_traverse.glsl"
 
@@ -54,13 +59,15 @@ int axisExponent(float origin, float top) {
 // Largest q whose decoded bound is <= v (a lower bound) or smallest whose bound is >= v.
 // floor/ceil in double are already right whenever v - origin is exact in double (rounding
 // to float is monotonic); the loops check the float decode itself for the other cases.
-uint32_t quantiseDown(float origin, float scale, float v) {
-    auto q = static_cast<uint32_t>(std::clamp(std::floor((double(v) - origin) / scale), 0.0, 255.0));
+// (v - origin) / scale is computed as a product with `inverse` = 1 / scale: the same value,
+// scale being a power of two.
+uint32_t quantiseDown(float origin, float scale, double inverse, float v) {
+    auto q = static_cast<uint32_t>(std::clamp(std::floor((double(v) - origin) * inverse), 0.0, 255.0));
     while (q > 0 && decode(origin, q, scale) > v) --q;
     return q;
 }
-uint32_t quantiseUp(float origin, float scale, float v) {
-    auto q = static_cast<uint32_t>(std::clamp(std::ceil((double(v) - origin) / scale), 0.0, 255.0));
+uint32_t quantiseUp(float origin, float scale, double inverse, float v) {
+    auto q = static_cast<uint32_t>(std::clamp(std::ceil((double(v) - origin) * inverse), 0.0, 255.0));
     while (q < 255 && decode(origin, q, scale) < v) ++q;
     return q;
 }
@@ -101,42 +108,86 @@ gpu::BvhWideNode quantiseWideNode(const Slots& slots) {
         const int biased = count > 0 ? axisExponent(w.origin[a], hi[a]) : 127;
         w.exponents |= static_cast<uint32_t>(biased) << (8 * a);
         const float scale = scaleOf(biased);
+        const double inverse = 1.0 / double(scale);
         for (std::size_t i = 0; i < count; ++i) {
             const auto shift = static_cast<uint32_t>(8 * i);
-            w.qMin[a] |= quantiseDown(w.origin[a], scale, slots[i].min[a]) << shift;
-            w.qMax[a] |= quantiseUp(w.origin[a], scale, slots[i].max[a]) << shift;
+            w.qMin[a] |= quantiseDown(w.origin[a], scale, inverse, slots[i].min[a]) << shift;
+            w.qMax[a] |= quantiseUp(w.origin[a], scale, inverse, slots[i].max[a]) << shift;
         }
     }
     return w;
 }
 
+// The four children of binary node b's wide node: its two children, then repeatedly the inner
+// child of largest surface area replaced by its own two children.
+Slots gatherSlots(const std::vector<gpu::BvhNode>& binary, uint32_t b) {
+    auto addChildren = [](const gpu::BvhNode& n, Slots& slots) {
+        if (n.left != gpu::kInvalidIndex) slots.push({n.lmin, n.lmax, n.left, n.leftCount});
+        if (n.right != gpu::kInvalidIndex) slots.push({n.rmin, n.rmax, n.right, n.rightCount});
+    };
+    Slots slots;
+    addChildren(binary[b], slots);
+    while (slots.size() < 4) {
+        std::size_t best = slots.size();
+        for (std::size_t i = 0; i < slots.size(); ++i)
+            if (slots[i].count == 0 && (best == slots.size() || halfArea(slots[i]) > halfArea(slots[best])))
+                best = i;
+        if (best == slots.size()) break;
+        const uint32_t inner = slots[best].index;
+        slots.erase(best);
+        addChildren(binary[inner], slots);
+    }
+    return slots;
+}
+
+uint32_t innerSlots(const Slots& slots) {
+    uint32_t inner = 0;
+    for (std::size_t i = 0; i < slots.size(); ++i) inner += slots[i].count == 0 ? 1u : 0u;
+    return inner;
+}
+
+// Inner binary nodes in the subtree of b (b included).
+std::size_t binarySubtreeSize(const std::vector<gpu::BvhNode>& binary, uint32_t b) {
+    std::size_t size = 0;
+    std::vector<uint32_t> stack{b};
+    while (!stack.empty()) {
+        const gpu::BvhNode& n = binary[stack.back()];
+        stack.pop_back();
+        ++size;
+        if (n.leftCount == 0 && n.left != gpu::kInvalidIndex) stack.push_back(n.left);
+        if (n.rightCount == 0 && n.right != gpu::kInvalidIndex) stack.push_back(n.right);
+    }
+    return size;
+}
+
+// A wide subtree collapsed on its own (node indices local, root at 0), to be appended.
+struct WideSubtree {
+    uint32_t binary = 0;  // its root's binary node
+    uint32_t depth = 0;   // depth of the root's children
+    uint32_t stack = 0;   // stack entries a traversal may hold on reaching the root
+    WideBvh tree;
+};
+
 class Collapser {
 public:
-    // Every wide node replaces at least one binary node: reserving as many never moves them.
-    explicit Collapser(const std::vector<gpu::BvhNode>& binary) : binary_(binary) {
-        out_.nodes.reserve(binary.size());
+    // `ready`: subtrees collapsed beforehand, by binary root, appended instead of collapsed.
+    Collapser(const std::vector<gpu::BvhNode>& binary, std::size_t reserve,
+              const std::map<uint32_t, const WideSubtree*>* ready = nullptr)
+        : binary_(binary), ready_(ready) {
+        out_.nodes.reserve(reserve);
     }
 
     // Emits the wide node for binary node `b`; returns its index. `depth` is the depth of
     // its children, `stack` the entries a traversal may hold on reaching it.
     uint32_t emit(uint32_t b, uint32_t depth, uint32_t stack) {
-        Slots slots;
-        addChildren(binary_[b], slots);
-        while (slots.size() < 4) {
-            std::size_t best = slots.size();
-            for (std::size_t i = 0; i < slots.size(); ++i)
-                if (slots[i].count == 0 &&
-                    (best == slots.size() || halfArea(slots[i]) > halfArea(slots[best])))
-                    best = i;
-            if (best == slots.size()) break;
-            const uint32_t inner = slots[best].index;
-            slots.erase(best);
-            addChildren(binary_[inner], slots);
+        if (ready_) {
+            const auto it = ready_->find(b);
+            if (it != ready_->end()) return append(it->second->tree);
         }
+        const Slots slots = gatherSlots(binary_, b);
         const auto me = static_cast<uint32_t>(out_.nodes.size());
         out_.nodes.emplace_back();
-        uint32_t inner = 0;
-        for (std::size_t i = 0; i < slots.size(); ++i) inner += slots[i].count == 0 ? 1u : 0u;
+        const uint32_t inner = innerSlots(slots);
         // Visiting this node pushes every inner child but the one it descends into.
         const uint32_t below = stack + (inner > 0 ? inner - 1 : 0);
         out_.maxStack = std::max(out_.maxStack, below);
@@ -159,20 +210,81 @@ public:
     WideBvh take() { return std::move(out_); }
 
 private:
-    static void addChildren(const gpu::BvhNode& n, Slots& slots) {
-        if (n.left != gpu::kInvalidIndex) slots.push({n.lmin, n.lmax, n.left, n.leftCount});
-        if (n.right != gpu::kInvalidIndex) slots.push({n.rmin, n.rmax, n.right, n.rightCount});
+    uint32_t append(const WideBvh& sub) {
+        const auto offset = static_cast<uint32_t>(out_.nodes.size());
+        for (gpu::BvhWideNode n : sub.nodes) {
+            for (glm::length_t k = 0; k < 4; ++k) {
+                const uint32_t count = (n.qMin.w >> (8u * static_cast<uint32_t>(k))) & 255u;
+                if (count == 0 && n.child[k] != gpu::kInvalidIndex) n.child[k] += offset;
+            }
+            out_.nodes.push_back(n);
+        }
+        out_.maxStack = std::max(out_.maxStack, sub.maxStack);
+        out_.maxDepth = std::max(out_.maxDepth, sub.maxDepth);
+        return offset;
     }
 
     const std::vector<gpu::BvhNode>& binary_;
+    const std::map<uint32_t, const WideSubtree*>* ready_;
     WideBvh out_;
 };
 
+// Wide subtrees below the top kParallelLevels wide levels are collapsed on their own, in
+// parallel, when the tree is large; the result is the same as one depth-first collapse.
+constexpr uint32_t kParallelLevels = 2;
+constexpr std::size_t kParallelMinNodes = 16384;
+
+void collectSubtrees(const std::vector<gpu::BvhNode>& binary, uint32_t b, uint32_t depth, uint32_t stack,
+                     uint32_t level, std::vector<WideSubtree>& out) {
+    const Slots slots = gatherSlots(binary, b);
+    const uint32_t inner = innerSlots(slots);
+    const uint32_t below = stack + (inner > 0 ? inner - 1 : 0);
+    for (std::size_t i = 0; i < slots.size(); ++i) {
+        if (slots[i].count > 0) continue;
+        if (level + 1 == kParallelLevels) {
+            out.push_back(WideSubtree{slots[i].index, depth + 1, below, {}});
+        } else {
+            collectSubtrees(binary, slots[i].index, depth + 1, below, level + 1, out);
+        }
+    }
+}
+
 }  // namespace
 
-WideBvh collapseToWide(const std::vector<gpu::BvhNode>& binary) {
+WideBvh collapseToWide(const std::vector<gpu::BvhNode>& binary, uint32_t threads) {
     if (binary.empty()) throw std::invalid_argument("collapseToWide: the binary tree has no root");
-    Collapser c(binary);
+    if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+    std::vector<WideSubtree> subtrees;
+    if (threads > 1 && binary.size() >= kParallelMinNodes) collectSubtrees(binary, 0, 1, 0, 0, subtrees);
+    std::atomic<std::size_t> next{0};
+    auto work = [&] {
+        for (std::size_t i = next++; i < subtrees.size(); i = next++) {
+            WideSubtree& t = subtrees[i];
+            Collapser c(binary, binarySubtreeSize(binary, t.binary));
+            c.emit(t.binary, t.depth, t.stack);
+            t.tree = c.take();
+        }
+    };
+    // quantiseWideNode throws for a node too large to quantise: the first error is kept.
+    std::exception_ptr error;
+    std::mutex errorMutex;
+    auto guarded = [&] {
+        try {
+            work();
+        } catch (...) {
+            std::lock_guard<std::mutex> lock(errorMutex);
+            if (!error) error = std::current_exception();
+            next = subtrees.size();
+        }
+    };
+    std::vector<std::thread> pool;
+    for (uint32_t w = 1; w < std::min<std::size_t>(threads, subtrees.size()); ++w) pool.emplace_back(guarded);
+    guarded();
+    for (std::thread& t : pool) t.join();
+    if (error) std::rethrow_exception(error);
+    std::map<uint32_t, const WideSubtree*> ready;
+    for (const WideSubtree& t : subtrees) ready[t.binary] = &t;
+    Collapser c(binary, binary.size(), &ready);
     c.emit(0, 1, 0);
     WideBvh w = c.take();
     if (w.maxStack > gpu::kBvhWideStackSize)

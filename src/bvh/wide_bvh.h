@@ -26,7 +26,9 @@ struct WideBvh {
 // minus one; the binary depth cap keeps real trees far below it).
 // The slab bounds also throw std::invalid_argument if a node is too large for a finite
 // 8-bit quantisation (extents beyond about 2^127).
-WideBvh collapseToWide(const std::vector<gpu::BvhNode>& binary);
+// threads: 0 = hardware concurrency; large trees collapse the subtrees under the top two wide
+// levels in parallel. The result is the same for every value.
+WideBvh collapseToWide(const std::vector<gpu::BvhNode>& binary, uint32_t threads = 0);
 
 // Child k's box as the kernels decode it (gpu::wideDecodeAxis); meaningless for an empty slot.
 struct WideChildBox {

@@ -454,6 +454,19 @@ TEST(BvhBuilder, SameResultForAnyThreadCount) {
         EXPECT_EQ(a.triangleOrder, b.triangleOrder) << threads << " threads";
         EXPECT_EQ(a.stats.sahCost, b.stats.sahCost);
     }
+    // The collapse too: subtrees under the top two wide levels collapsed in parallel.
+    ASSERT_GE(a.nodes.size(), 16384u) << "too small for the parallel collapse";
+    const WideBvh serialWide = collapseToWide(a.nodes, 1);
+    for (const uint32_t threads : {2u, 3u}) {
+        const WideBvh w = collapseToWide(a.nodes, threads);
+        ASSERT_EQ(w.nodes.size(), serialWide.nodes.size());
+        EXPECT_EQ(
+            std::memcmp(w.nodes.data(), serialWide.nodes.data(), w.nodes.size() * sizeof(gpu::BvhWideNode)),
+            0)
+            << threads << " threads";
+        EXPECT_EQ(w.maxStack, serialWide.maxStack);
+        EXPECT_EQ(w.maxDepth, serialWide.maxDepth);
+    }
 }
 
 // After pbrt-v3 shapes_test.cpp (Triangle.Watertight): rays from inside a closed mesh towards
