@@ -38,6 +38,7 @@
 #include <thread>
 
 #include "bvh/float4.h"
+#include "util/huge_pages.h"
 #include "util/interrupt.h"
 
 namespace gdpt {
@@ -493,6 +494,7 @@ public:
             // A binary tree over n leaves has n - 1 inner nodes: reserving that touches no page
             // the subtree does not use, and the nodes are never moved as the vector grows.
             p.subtree.nodes.reserve(p.range.size());
+            adviseHugePages(p.subtree.nodes.data(), p.subtree.nodes.capacity() * sizeof(gpu::BvhNode));
             SubtreeBuilder sub(in_);
             p.subtreeRoot = sub.build(p.range, p.depth, p.subtree);
         });
@@ -500,6 +502,7 @@ public:
         size_t total = 0;
         for (const Piece& p : pieces_) total += p.split ? 1 : p.subtree.nodes.size();
         out.nodes.reserve(total + 1);  // + 1: the root node of a one-leaf mesh
+        adviseHugePages(out.nodes.data(), out.nodes.capacity() * sizeof(gpu::BvhNode));
         rootRef_ = place(0, out);
         return out;
     }
@@ -678,6 +681,7 @@ Bvh buildBvh(const std::vector<glm::vec3>& positions, const std::vector<glm::uve
     // Left uninitialised: makeRefs writes every reference, on every thread (so the pages are
     // first touched in parallel, and only once).
     const std::unique_ptr<PrimRef[]> refs(new PrimRef[triangles.size()]);
+    adviseHugePages(refs.get(), triangles.size() * sizeof(PrimRef));
     const Range root = makeRefs(positions, triangles, refs.get(), threads);
 
     const uint32_t leafMax = std::clamp(options.maxLeafSize, 1u, gpu::kMaxLeafTriangles);

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "lib/bvh_traverse.glsl"
+#include "util/huge_pages.h"
 
 namespace gdpt {
 namespace {
@@ -175,6 +176,7 @@ public:
               const std::map<uint32_t, const WideSubtree*>* ready = nullptr)
         : binary_(binary), ready_(ready) {
         out_.nodes.reserve(reserve);
+        adviseHugePages(out_.nodes.data(), out_.nodes.capacity() * sizeof(gpu::BvhWideNode));
     }
 
     // Emits the wide node for binary node `b`; returns its index. `depth` is the depth of
