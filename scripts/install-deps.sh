@@ -28,6 +28,7 @@ packages=(
   gnuplot-nox python3 clang libclang-rt-dev clang-format-14
   assimp-testmodels
   libopenmpi-dev openmpi-bin
+  libembree-dev
   ffmpeg
 )
 SUDO=""
