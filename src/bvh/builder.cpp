@@ -40,6 +40,7 @@
 #include "bvh/float4.h"
 #include "util/huge_pages.h"
 #include "util/interrupt.h"
+#include "util/parallel.h"
 
 namespace gdpt {
 namespace {
@@ -133,36 +134,6 @@ uint32_t ceilLog2(uint64_t x) {
         ++levels;
     }
     return levels;
-}
-
-// Runs fn(i) for i in [0, count) on up to `threads` threads (the caller's included), taking
-// indices in order; the first exception is rethrown after every thread has stopped.
-template <class Fn>
-void parallelFor(uint32_t threads, size_t count, const Fn& fn) {
-    const auto workers = static_cast<uint32_t>(std::min<size_t>(threads, count));
-    if (workers <= 1) {
-        for (size_t i = 0; i < count; ++i) fn(i);
-        return;
-    }
-    std::atomic<size_t> next{0};
-    std::atomic<bool> failed{false};
-    std::exception_ptr error;
-    std::mutex errorMutex;
-    auto work = [&] {
-        try {
-            for (size_t i = next++; i < count && !failed.load(std::memory_order_relaxed); i = next++) fn(i);
-        } catch (...) {
-            std::lock_guard<std::mutex> lock(errorMutex);
-            if (!error) error = std::current_exception();
-            failed = true;
-        }
-    };
-    std::vector<std::thread> pool;
-    pool.reserve(workers - 1);
-    for (uint32_t w = 1; w < workers; ++w) pool.emplace_back(work);
-    work();
-    for (std::thread& t : pool) t.join();
-    if (error) std::rethrow_exception(error);
 }
 
 // Bin of a centroid coordinate; the same expression is used for binning and partitioning.
@@ -674,10 +645,7 @@ Bvh buildBvh(const std::vector<glm::vec3>& positions, const std::vector<glm::uve
                                     ")");
     }
     const auto count = static_cast<uint32_t>(triangles.size());
-    uint32_t threads = options.buildThreads;
-    if (threads == 0) {
-        threads = std::max(1u, std::thread::hardware_concurrency());
-    }
+    const uint32_t threads = defaultThreads(options.buildThreads);
     // Left uninitialised: makeRefs writes every reference, on every thread (so the pages are
     // first touched in parallel, and only once).
     const std::unique_ptr<PrimRef[]> refs(new PrimRef[triangles.size()]);
@@ -723,19 +691,25 @@ Bvh buildBvh(const std::vector<glm::vec3>& positions, const std::vector<glm::uve
     return bvh;
 }
 
-std::vector<gpu::TriangleGeom> makeTriangleGeoms(const std::vector<glm::vec3>& positions,
-                                                 const std::vector<glm::uvec3>& triangles,
-                                                 const std::vector<uint32_t>& triangleOrder) {
-    std::vector<gpu::TriangleGeom> geoms(triangleOrder.size());
-    for (size_t i = 0; i < triangleOrder.size(); ++i) {
+void writeTriangleGeoms(const std::vector<glm::vec3>& positions, const std::vector<glm::uvec3>& triangles,
+                        const std::vector<uint32_t>& triangleOrder, size_t begin, size_t end,
+                        gpu::TriangleGeom* out) {
+    for (size_t i = begin; i < end; ++i) {
         const glm::uvec3 tri = triangles.at(triangleOrder[i]);
         const glm::vec3 p0 = positions.at(tri.x);
-        gpu::TriangleGeom& g = geoms[i];
+        gpu::TriangleGeom& g = out[i - begin];
         g.v0 = p0;
         g.e1 = positions.at(tri.y) - p0;
         g.e2 = positions.at(tri.z) - p0;
         g.pad0 = g.pad1 = g.pad2 = 0.0f;
     }
+}
+
+std::vector<gpu::TriangleGeom> makeTriangleGeoms(const std::vector<glm::vec3>& positions,
+                                                 const std::vector<glm::uvec3>& triangles,
+                                                 const std::vector<uint32_t>& triangleOrder) {
+    std::vector<gpu::TriangleGeom> geoms(triangleOrder.size());
+    writeTriangleGeoms(positions, triangles, triangleOrder, 0, triangleOrder.size(), geoms.data());
     return geoms;
 }
 

@@ -3,6 +3,7 @@
 // TriangleGeom array that the traversal (shaders/lib/bvh_traverse.glsl, traverse_cpu.h) reads.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <vector>
@@ -53,6 +54,12 @@ Bvh buildBvh(const std::vector<glm::vec3>& positions, const std::vector<glm::uve
 std::vector<gpu::TriangleGeom> makeTriangleGeoms(const std::vector<glm::vec3>& positions,
                                                  const std::vector<glm::uvec3>& triangles,
                                                  const std::vector<uint32_t>& triangleOrder);
+
+// The same for leaf positions [begin, end) only, written to out[0, end - begin) (callers fill
+// one table in parallel ranges, or straight into mapped device memory).
+void writeTriangleGeoms(const std::vector<glm::vec3>& positions, const std::vector<glm::uvec3>& triangles,
+                        const std::vector<uint32_t>& triangleOrder, size_t begin, size_t end,
+                        gpu::TriangleGeom* out);
 
 // Conservative bounds of the triangle that the intersector actually tests, i.e.
 // (v0, v0 + e1, v0 + e2) with e1, e2 rounded as in makeTriangleGeoms, padded by 2^-18 of its

@@ -2,18 +2,15 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <map>
-#include <mutex>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 #include "lib/bvh_traverse.glsl"
 #include "util/huge_pages.h"
+#include "util/parallel.h"
 
 namespace gdpt {
 namespace {
@@ -255,35 +252,16 @@ void collectSubtrees(const std::vector<gpu::BvhNode>& binary, uint32_t b, uint32
 
 WideBvh collapseToWide(const std::vector<gpu::BvhNode>& binary, uint32_t threads) {
     if (binary.empty()) throw std::invalid_argument("collapseToWide: the binary tree has no root");
-    if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+    threads = defaultThreads(threads);
     std::vector<WideSubtree> subtrees;
     if (threads > 1 && binary.size() >= kParallelMinNodes) collectSubtrees(binary, 0, 1, 0, 0, subtrees);
-    std::atomic<std::size_t> next{0};
-    auto work = [&] {
-        for (std::size_t i = next++; i < subtrees.size(); i = next++) {
-            WideSubtree& t = subtrees[i];
-            Collapser c(binary, binarySubtreeSize(binary, t.binary));
-            c.emit(t.binary, t.depth, t.stack);
-            t.tree = c.take();
-        }
-    };
-    // quantiseWideNode throws for a node too large to quantise: the first error is kept.
-    std::exception_ptr error;
-    std::mutex errorMutex;
-    auto guarded = [&] {
-        try {
-            work();
-        } catch (...) {
-            std::lock_guard<std::mutex> lock(errorMutex);
-            if (!error) error = std::current_exception();
-            next = subtrees.size();
-        }
-    };
-    std::vector<std::thread> pool;
-    for (uint32_t w = 1; w < std::min<std::size_t>(threads, subtrees.size()); ++w) pool.emplace_back(guarded);
-    guarded();
-    for (std::thread& t : pool) t.join();
-    if (error) std::rethrow_exception(error);
+    // quantiseWideNode throws for a node too large to quantise; parallelFor rethrows it.
+    parallelFor(threads, subtrees.size(), [&](std::size_t i) {
+        WideSubtree& t = subtrees[i];
+        Collapser c(binary, binarySubtreeSize(binary, t.binary));
+        c.emit(t.binary, t.depth, t.stack);
+        t.tree = c.take();
+    });
     std::map<uint32_t, const WideSubtree*> ready;
     for (const WideSubtree& t : subtrees) ready[t.binary] = &t;
     Collapser c(binary, binary.size(), &ready);

@@ -30,6 +30,10 @@ public:
     // maxStorageBufferRange.
     [[nodiscard]] std::uint64_t deviceAddress() const;
 
+    // The buffer's memory mapped into the process when it is host-visible (CPU devices,
+    // ReBAR GPUs), for writing tables in place; nullptr otherwise (use upload).
+    [[nodiscard]] void* mapped() const { return mapped_; }
+
     // Copies `bytes` bytes from host memory into the buffer at `offset`.
     void upload(const void* data, std::uint64_t bytes, std::uint64_t offset = 0);
     // Copies `bytes` bytes out of the buffer at `offset`. The caller has waited for the

@@ -32,6 +32,11 @@ float triangleArea(const Scene& scene, std::size_t tri) {
     return 0.5f * glm::length(glm::cross(p1 - p0, p2 - p0));
 }
 
+bool materialIsEmissive(const Scene& scene, std::size_t tri) {
+    const std::uint32_t mi = scene.triangleMaterial[tri];
+    return mi < scene.materials.size() && (scene.materials[mi].flags & gpu::kMatFlagEmissive) != 0;
+}
+
 double emitterPower(const Scene& scene, std::size_t tri, float area) {
     constexpr float kPi = 3.14159265358979f;  // float products, as the light table was always built
     const std::uint32_t mi = scene.triangleMaterial[tri];

@@ -42,6 +42,8 @@ float triangleArea(const Scene& scene, std::size_t tri);
 // the largest Le component where the luminance is 0), or 0 when it is not a light: not
 // emissive, no area, or no power. The light table's CDF is proportional to it.
 double emitterPower(const Scene& scene, std::size_t tri, float area);
+// Whether triangle `tri`'s material emits (a cheap test that emitterPower > 0 requires).
+bool materialIsEmissive(const Scene& scene, std::size_t tri);
 
 // shiftThreshold: roughness at or below which a vertex is "glossy" for gradient-domain
 // shifts (Kettunen et al. 2015 reference default 0.001).

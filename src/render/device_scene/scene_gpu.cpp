@@ -9,6 +9,7 @@
 #include "bvh/wide_bvh.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
+#include "util/parallel.h"
 #include "util/progress.h"
 #include "vk/context.h"
 #include "vk/kernel.h"
@@ -22,28 +23,97 @@ float luminance(glm::vec3 c) {
     return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
 }
 
-// The buffer of scene binding `binding`, checked against the limit of how the kernels read
-// it: a texel buffer of its SceneSpec::sceneTexelBindings format, else a storage buffer.
-template <typename T>
-vk::Buffer makeBuffer(const vk::Context& ctx, const std::vector<T>& data, const std::string& name,
+// A scene binding's size checked against the limit of how the kernels read it: a texel buffer
+// of its SceneSpec::sceneTexelBindings format, else a storage buffer.
+void checkSceneBuffer(const vk::Context& ctx, std::uint64_t bytes, const std::string& name,
                       std::uint32_t binding) {
-    const std::uint64_t bytes = data.size() * sizeof(T);
     const VkFormat format = vk::texelFormat(SceneSpec::sceneTexelBindings(), binding);
     if (format != VK_FORMAT_UNDEFINED)
         ctx.checkTexelBufferSize(bytes / vk::texelBytes(format), name);
     else
         ctx.checkStorageBufferSize(bytes, name);
+}
+
+// The buffer of scene binding `binding` holding `data`.
+template <typename T>
+vk::Buffer makeBuffer(const vk::Context& ctx, const std::vector<T>& data, const std::string& name,
+                      std::uint32_t binding) {
+    const std::uint64_t bytes = data.size() * sizeof(T);
+    checkSceneBuffer(ctx, bytes, name, binding);
     vk::Buffer b(ctx, bytes, name);
     b.uploadVector(data);
     return b;
 }
 
-// Triangle shading records in BVH leaf order.
-std::vector<gpu::TriangleShading> makeShading(const Scene& scene, const std::vector<std::uint32_t>& order) {
-    std::vector<gpu::TriangleShading> out(order.size());
+// Records per leaf position handed to the threads in ranges of this many.
+constexpr std::size_t kTableGrain = std::size_t{1} << 16;
+
+// The buffer of scene binding `binding` holding `count` records that fill(out, begin, end)
+// writes for leaf positions [begin, end), on every thread: in place when the buffer is mapped
+// (a CPU device: no second copy of a table of hundreds of MiB), else through a vector.
+template <typename T, typename Fill>
+vk::Buffer makeFilledBuffer(const vk::Context& ctx, std::size_t count, const std::string& name,
+                            std::uint32_t binding, const Fill& fill) {
+    checkSceneBuffer(ctx, std::uint64_t{count} * sizeof(T), name, binding);
+    vk::Buffer b(ctx, std::uint64_t{count} * sizeof(T), name);
+    if (auto* out = static_cast<T*>(b.mapped())) {
+        parallelRanges(0, count, kTableGrain, [&](std::size_t s, std::size_t e) { fill(out + s, s, e); });
+    } else {
+        std::vector<T> v(count);
+        parallelRanges(0, count, kTableGrain,
+                       [&](std::size_t s, std::size_t e) { fill(v.data() + s, s, e); });
+        b.uploadVector(v);
+    }
+    return b;
+}
+
+// Emissive triangles in leaf order (LightTriangle::triangle = the leaf position), with a CDF
+// proportional to power = area * luminance(Le) * pi (x2 for double-sided emitters; emitterPower).
+// Emissive textures are not in the weight (factor only).
+struct LightTable {
+    std::vector<gpu::LightTriangle> lights;
+    double total = 0.0;
+};
+
+LightTable makeLightTable(const Scene& scene, const std::vector<std::uint32_t>& order) {
+    const std::size_t ranges = (order.size() + kTableGrain - 1) / kTableGrain;
+    std::vector<std::vector<std::pair<std::uint32_t, double>>> found(ranges);
+    parallelFor(0, ranges, [&](std::size_t r) {
+        const std::size_t end = std::min(order.size(), (r + 1) * kTableGrain);
+        for (std::size_t i = r * kTableGrain; i < end; ++i) {
+            if (!materialIsEmissive(scene, order[i])) continue;
+            const double p = emitterPower(scene, order[i], triangleArea(scene, order[i]));
+            if (p > 0.0) found[r].emplace_back(static_cast<std::uint32_t>(i), p);
+        }
+    });
+    LightTable t;
+    for (const auto& range : found) {
+        for (const auto& [i, p] : range) {
+            t.lights.push_back({i, 0.0f, 0.0f, 0.0f});
+            t.total += p;
+        }
+    }
+    double running = 0.0;
+    std::size_t k = 0;
+    for (const auto& range : found) {
+        for (const auto& [i, p] : range) {
+            running += p;
+            t.lights[k].pmf = static_cast<float>(p / t.total);
+            t.lights[k].cdf = k + 1 == t.lights.size() ? 1.0f : static_cast<float>(running / t.total);
+            ++k;
+        }
+    }
+    return t;
+}
+
+// Triangle shading records for leaf positions [begin, end); `lights` gives each emitter's
+// index in the light table.
+void writeShading(const Scene& scene, const std::vector<std::uint32_t>& order,
+                  const std::vector<gpu::LightTriangle>& lights, std::size_t begin, std::size_t end,
+                  gpu::TriangleShading* out) {
     const bool normals = !scene.normals.empty();
     const bool uvs = !scene.uvs.empty();
-    for (std::size_t i = 0; i < order.size(); ++i) {
+    for (std::size_t i = begin; i < end; ++i) {
         const glm::uvec3 t = scene.triangles[order[i]];
         gpu::TriangleShading s{};
         s.material = scene.triangleMaterial[order[i]];
@@ -60,9 +130,15 @@ std::vector<gpu::TriangleShading> makeShading(const Scene& scene, const std::vec
             s.uv2 = scene.uvs[t.z];
         }
         s.lightIndex = gpu::kInvalidIndex;
-        out[i] = s;
+        if (materialIsEmissive(scene, order[i])) {
+            const auto it =
+                std::lower_bound(lights.begin(), lights.end(), i,
+                                 [](const gpu::LightTriangle& l, std::size_t x) { return l.triangle < x; });
+            if (it != lights.end() && it->triangle == i)
+                s.lightIndex = static_cast<std::uint32_t>(it - lights.begin());
+        }
+        out[i - begin] = s;
     }
-    return out;
 }
 
 }  // namespace
@@ -148,29 +224,9 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     bvhInfo_.buildMs = built->buildMs;
     bvhInfo_.nodes = static_cast<std::uint32_t>(bvh.nodes.size());
     bvhInfo_.maxDepth = bvh.stats.maxDepth;
-    std::vector<gpu::TriangleGeom> geoms =
-        makeTriangleGeoms(scene.positions, scene.triangles, bvh.triangleOrder);
-    std::vector<gpu::TriangleShading> shading = makeShading(scene, bvh.triangleOrder);
-
-    // Emissive triangles, with a CDF proportional to power = area * luminance(Le) * pi
-    // (x2 for double-sided emitters). Emissive textures are not in the weight (factor only).
-    std::vector<gpu::LightTriangle> lights;
-    double total = 0.0;
-    std::vector<double> power;
-    for (std::uint32_t i = 0; i < shading.size(); ++i) {
-        const double p = emitterPower(scene, bvh.triangleOrder[i], shading[i].area);
-        if (!(p > 0.0)) continue;
-        shading[i].lightIndex = static_cast<std::uint32_t>(lights.size());
-        lights.push_back({i, 0.0f, 0.0f, 0.0f});
-        power.push_back(p);
-        total += p;
-    }
-    double running = 0.0;
-    for (std::size_t i = 0; i < lights.size(); ++i) {
-        running += power[i];
-        lights[i].pmf = static_cast<float>(power[i] / total);
-        lights[i].cdf = i + 1 == lights.size() ? 1.0f : static_cast<float>(running / total);
-    }
+    const LightTable lightTable = makeLightTable(scene, bvh.triangleOrder);
+    const std::vector<gpu::LightTriangle>& lights = lightTable.lights;
+    const double total = lightTable.total;
     // The spec counted the same lights (emitterPower) to specialise the kernels.
     GDPT_CHECK(lights.size() == spec_.features().emissiveTriangles);
 
@@ -209,13 +265,22 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     constants_.punctualPower = static_cast<float>(punctualPower);
     constants_.maxDepth = options.maxDepth;
     constants_.rrDepth = options.rrDepth;
-    constants_.numTriangles = static_cast<std::uint32_t>(geoms.size());
+    constants_.numTriangles = static_cast<std::uint32_t>(bvh.triangleOrder.size());
     const Bounds b = scene.bounds();
     constants_.sceneRadius = 0.5f * glm::length(b.max - b.min);
 
     if (progress) progress->update(2.0, "upload");
-    triGeom_ = makeBuffer(ctx, geoms, "triangle geometry", gpu::kBindTriGeom);
-    triShading_ = makeBuffer(ctx, shading, "triangle shading", gpu::kBindTriShading);
+    const std::vector<std::uint32_t>& order = bvh.triangleOrder;
+    triGeom_ = makeFilledBuffer<gpu::TriangleGeom>(
+        ctx, order.size(), "triangle geometry", gpu::kBindTriGeom,
+        [&](gpu::TriangleGeom* out, std::size_t begin, std::size_t end) {
+            writeTriangleGeoms(scene.positions, scene.triangles, order, begin, end, out);
+        });
+    triShading_ = makeFilledBuffer<gpu::TriangleShading>(
+        ctx, order.size(), "triangle shading", gpu::kBindTriShading,
+        [&](gpu::TriangleShading* out, std::size_t begin, std::size_t end) {
+            writeShading(scene, order, lights, begin, end, out);
+        });
     bvh_ = makeBuffer(ctx, built->wide.nodes, "BVH nodes (4-wide)", gpu::kBindBvh);
     materials_ = makeBuffer(ctx, scene.materials, "materials", gpu::kBindMaterials);
     texInfo_ = makeBuffer(ctx, texInfo, "texture table", gpu::kBindTexInfo);
