@@ -160,11 +160,14 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
         args.method + (args.method == "gpt" ? "|" + std::to_string(args.allRecon ? 4 : 1) + " solves" : "") +
         (world ? "|" + std::to_string(world->size()) + " ranks" : "");
     std::string finishKey;
+    double loadSeconds = 0.0;
     try {
         enterPhase("loading");
         if (world) world->testFault("loading");
+        Timer loadTimer;
         const GltfAsset asset(args.scene, deviceLoadOptions(args.device, quiet));
         loaded.emplace(asset.instance());
+        loadSeconds = loadTimer.seconds();
         const Scene& scene = *loaded;
         if (!asset.animations().empty() && !quiet)
             std::fprintf(
@@ -315,6 +318,8 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
     if (jsonOutput.wanted()) {
         json summary = summaryJson(args, ctx, *integrator, s, seconds, reserved.seconds,
                                    finishReserved.seconds, writeMs);
+        summary["time_s"]["load"] = loadSeconds;
+        summary["scene_size"] = sceneSizeJson(scene, s, summary["memory"]["host_peak_bytes"].get<double>());
         if (shard) summary["shard"] = options.share.text();
         if (timed) summary["budget"] = budgetJson(budget, s);
         jsonOutput.write(summary.dump(2) + "\n");

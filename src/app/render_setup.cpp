@@ -44,6 +44,19 @@ json memoryJson(const vk::Context& ctx, int width, int height) {
 
 }  // namespace
 
+json sceneSizeJson(const Scene& scene, const RenderStats& s, double hostPeakBytes) {
+    std::uint64_t texels = 0;
+    for (const Texture& t : scene.textures) texels += t.texels.size();
+    const double triangles = double(std::max<std::size_t>(scene.triangles.size(), 1));
+    return {{"triangles", scene.triangles.size()},
+            {"vertices", scene.positions.size()},
+            {"textures", scene.textures.size()},
+            {"texels", texels},
+            {"device_bytes", s.sceneDeviceBytes},
+            {"device_bytes_per_triangle", double(s.sceneDeviceBytes) / triangles},
+            {"host_peak_bytes_per_triangle", hostPeakBytes / triangles}};
+}
+
 std::string previewPath(const std::string& exrPath) {
     const auto dot = exrPath.rfind('.');
     const auto slash = exrPath.rfind('/');

@@ -34,6 +34,10 @@ RenderOptions renderOptionsFor(const RenderArgs& args);
 
 // A render's JSON summary (--json): settings, times, counters, kernels, memory, the method's
 // own keys.
+// --json's "scene_size": the scene's triangles, vertices, textures and texels, its device
+// tables' bytes, and those bytes and the process's peak resident set per triangle.
+nlohmann::json sceneSizeJson(const Scene& scene, const RenderStats& s, double hostPeakBytes);
+
 nlohmann::json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrator& integrator,
                            const RenderStats& s, double seconds, double reserved, double finishReserved,
                            double writeMs);

@@ -32,7 +32,8 @@ struct BenchPathCount {
 
 // camera.glsl's cameraRay for the scene constants `c`.
 inline glm::vec3 benchCameraRay(const gpu::SceneConstants& c, glm::vec2 pixelPos) {
-    const glm::vec2 ndc(2.0f * pixelPos.x / float(c.width) - 1.0f, 1.0f - 2.0f * pixelPos.y / float(c.height));
+    const glm::vec2 ndc(2.0f * pixelPos.x / float(c.width) - 1.0f,
+                        1.0f - 2.0f * pixelPos.y / float(c.height));
     const glm::vec3 d =
         c.camForward + ndc.x * c.tanHalfFovY * c.aspect * c.camRight + ndc.y * c.tanHalfFovY * c.camUp;
     return glm::normalize(d);
@@ -41,8 +42,9 @@ inline glm::vec3 benchCameraRay(const gpu::SceneConstants& c, glm::vec2 pixelPos
 // bench_rays.comp's main() for pixel (x, y): `spp` samples from sample index `sampleBase`, one
 // closest-hit segment each (primary) or up to four (incoherent).
 template <class Trace>
-BenchPathCount benchPixelPaths(const gpu::SceneConstants& c, std::uint32_t x, std::uint32_t y, std::uint32_t spp,
-                               std::uint32_t sampleBase, std::uint32_t seed, bool incoherent, const Trace& trace) {
+BenchPathCount benchPixelPaths(const gpu::SceneConstants& c, std::uint32_t x, std::uint32_t y,
+                               std::uint32_t spp, std::uint32_t sampleBase, std::uint32_t seed,
+                               bool incoherent, const Trace& trace) {
     BenchPathCount count;
     const std::uint32_t pixel = y * c.width + x;
     for (std::uint32_t s = 0; s < spp; ++s) {

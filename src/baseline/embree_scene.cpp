@@ -26,7 +26,8 @@ void onEmbreeError(void* user, RTCError code, const char* message) {
     auto* sink = static_cast<ErrorSink*>(user);
     std::lock_guard<std::mutex> lock(sink->mutex);
     if (sink->message.empty())
-        sink->message = "Embree error " + std::to_string(static_cast<int>(code)) + ": " + (message ? message : "");
+        sink->message =
+            "Embree error " + std::to_string(static_cast<int>(code)) + ": " + (message ? message : "");
 }
 
 }  // namespace
@@ -46,7 +47,8 @@ struct EmbreeScene::Impl {
     }
     void check(const char* what) {
         std::lock_guard<std::mutex> lock(errors.mutex);
-        if (!errors.message.empty()) throw Error(std::string("Embree baseline: ") + what + ": " + errors.message);
+        if (!errors.message.empty())
+            throw Error(std::string("Embree baseline: ") + what + ": " + errors.message);
     }
 };
 
@@ -81,7 +83,9 @@ EmbreeScene::EmbreeScene(const std::vector<glm::vec3>& positions, const std::vec
 
 EmbreeScene::~EmbreeScene() = default;
 
-double EmbreeScene::buildMs() const { return impl_->buildMs; }
+double EmbreeScene::buildMs() const {
+    return impl_->buildMs;
+}
 
 EmbreeHit EmbreeScene::intersect(glm::vec3 origin, glm::vec3 direction, float tMin, float tMax) const {
     RTCIntersectContext context;
@@ -107,8 +111,9 @@ EmbreeHit EmbreeScene::intersect(glm::vec3 origin, glm::vec3 direction, float tM
     return h;
 }
 
-EmbreeScene::RayRun EmbreeScene::traceBenchPaths(const gpu::SceneConstants& c, std::uint32_t spp, bool incoherent,
-                                                 std::uint32_t seed, std::uint32_t threads) const {
+EmbreeScene::RayRun EmbreeScene::traceBenchPaths(const gpu::SceneConstants& c, std::uint32_t spp,
+                                                 bool incoherent, std::uint32_t seed,
+                                                 std::uint32_t threads) const {
     const auto& positions = impl_->positions;
     const auto& triangles = impl_->triangles;
     auto trace = [&](glm::vec3 o, glm::vec3 d) {

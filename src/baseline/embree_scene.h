@@ -45,8 +45,8 @@ public:
         double seconds = 0.0;     // wall time
         double cpuSeconds = 0.0;  // process CPU time meanwhile
     };
-    [[nodiscard]] RayRun traceBenchPaths(const gpu::SceneConstants& constants, std::uint32_t spp, bool incoherent,
-                                         std::uint32_t seed, std::uint32_t threads) const;
+    [[nodiscard]] RayRun traceBenchPaths(const gpu::SceneConstants& constants, std::uint32_t spp,
+                                         bool incoherent, std::uint32_t seed, std::uint32_t threads) const;
 
 private:
     struct Impl;

@@ -83,6 +83,7 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     SceneGpu sceneGpu(ctx, scene, options.scene, std::move(spec));
     pass.attach(sceneGpu);
     stats.bvhBuildMs = sceneGpu.bvhInfo().buildMs;
+    stats.sceneDeviceBytes = sceneGpu.deviceBytes();
     stats.bvhRegisterStack = sceneGpu.spec().bvhRegisterStack();
     stats.features = sceneGpu.features();
     if (options.whileCompiling) options.whileCompiling();

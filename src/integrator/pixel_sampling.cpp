@@ -35,6 +35,7 @@ PixelSampling::PixelSampling(const vk::Context& ctx, const Scene& scene, const R
     scene_ = std::make_unique<SceneGpu>(ctx, scene, options.scene, std::move(spec));
     pass_->attach(*scene_);
     stats_.bvhBuildMs = scene_->bvhInfo().buildMs;
+    stats_.sceneDeviceBytes = scene_->deviceBytes();
     stats_.bvhRegisterStack = scene_->spec().bvhRegisterStack();
     stats_.features = scene_->features();
     stats_.uploadMs = phase.ms() - stats_.bvhBuildMs;

@@ -144,6 +144,7 @@ struct RenderStats {
     std::uint32_t partialPassRows = 0;  // timed renders: rows (from the top) with one sample more
     std::uint32_t batches = 0;
     double bvhBuildMs = 0.0;
+    std::uint64_t sceneDeviceBytes = 0;  // the scene's tables on the device (BVH, triangles, textures...)
     std::uint32_t bvhRegisterStack = 0;  // entries of the kernels' register traversal stack (0: in memory)
     double uploadMs = 0.0;               // scene upload + pipeline creation (the part not overlapped)
     double pipelineWaitMs = 0.0;         // of which: waiting for the pipelines after the scene upload

@@ -34,7 +34,8 @@ void parallelFor(std::uint32_t threads, std::size_t count, const Fn& fn) {
     std::mutex errorMutex;
     auto work = [&] {
         try {
-            for (std::size_t i = next++; i < count && !failed.load(std::memory_order_relaxed); i = next++) fn(i);
+            for (std::size_t i = next++; i < count && !failed.load(std::memory_order_relaxed); i = next++)
+                fn(i);
         } catch (...) {
             std::lock_guard<std::mutex> lock(errorMutex);
             if (!error) error = std::current_exception();

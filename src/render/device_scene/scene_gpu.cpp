@@ -9,6 +9,7 @@
 #include "bvh/wide_bvh.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
+#include "util/memory.h"
 #include "util/parallel.h"
 #include "util/progress.h"
 #include "vk/context.h"
@@ -166,6 +167,21 @@ void checkTrianglesFit(const vk::DeviceInfo& device, std::uint64_t triangles, co
                 beyondDevice(triangles, device));
 }
 
+void checkRenderMemory(const SceneEstimate& estimate) {
+    const std::uint64_t memory = physicalMemory();
+    if (memory == 0 || estimate.triangles == 0) return;
+    const std::uint64_t needed = estimate.bytes + kRenderBytesPerTriangle * estimate.triangles;
+    if (needed <= memory) return;
+    const double perTriangle =
+        double(estimate.bytes) / double(estimate.triangles) + double(kRenderBytesPerTriangle);
+    const auto fits = static_cast<std::uint64_t>(double(memory) / perTriangle);
+    throw Error("rendering the scene (" + std::to_string(estimate.triangles) + " triangles) needs about " +
+                memoryText(needed) +
+                " of memory (the loaded scene, its BVH and its tables), more than this machine's " +
+                memoryText(memory) + ": a scene like it fits with up to about " + std::to_string(fits) +
+                " triangles");
+}
+
 LoadOptions deviceLoadOptions(const std::string& device, bool quiet) {
     LoadOptions options;
     options.quiet = quiet;
@@ -173,7 +189,10 @@ LoadOptions deviceLoadOptions(const std::string& device, bool quiet) {
         // Every device holds this many (Vulkan's required minimum of maxTexelBufferElements is
         // 65536); larger scenes are compared with the device's own limit, read from a
         // short-lived context that chooses the device as the render's will.
-        if (estimate.triangles <= 65536 / gpu::kTriangleShadingTexels) return;
+        if (estimate.triangles <= 65536 / gpu::kTriangleShadingTexels) {
+            checkRenderMemory(estimate);
+            return;
+        }
         vk::ContextOptions probe;
         probe.device = device;
         std::optional<vk::Context> ctx;
@@ -185,6 +204,7 @@ LoadOptions deviceLoadOptions(const std::string& device, bool quiet) {
         }
         if (estimate.triangles > maxDeviceTriangles(ctx->info()))
             throw Error("the scene has up to " + beyondDevice(estimate.triangles, ctx->info()));
+        checkRenderMemory(estimate);
     };
     return options;
 }
@@ -293,6 +313,14 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
         progress->update(3.0);
         progress->finish("uploaded");
     }
+}
+
+std::uint64_t SceneGpu::deviceBytes() const {
+    std::uint64_t bytes = 0;
+    for (const vk::Buffer* b : {&triGeom_, &triShading_, &bvh_, &materials_, &texInfo_, &texels_, &lightTris_,
+                                &punctual_, &sceneConst_})
+        bytes += b->size();
+    return bytes;
 }
 
 void SceneGpu::bindTo(vk::Kernel& kernel) const {
