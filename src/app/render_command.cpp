@@ -107,6 +107,7 @@ RenderArgs renderArgsFromJson(const std::string& text, const std::string& where)
 int runRender(const RenderArgs& args, const MergedShards* merged) {
     installInterruptHandlers();
     checkArgs(args);
+    checkImageMemory(args);
     Timer total;
     RenderOptions options = renderOptionsFor(args);
     // Remembered times per scene first (a reconstruction's time follows the image), else of the

@@ -7,9 +7,11 @@
 
 #include "app/bench_util.h"
 #include "integrator/recon_reserve.h"
+#include "render/passes/pixel_buffers.h"
 #include "scene/light_sources.h"
 #include "util/error.h"
 #include "util/interrupt.h"
+#include "util/memory.h"
 #include "vk/context.h"
 
 namespace gdpt {
@@ -43,6 +45,12 @@ json memoryJson(const vk::Context& ctx, int width, int height) {
 }
 
 }  // namespace
+
+void checkImageMemory(const RenderArgs& args) {
+    const std::string refusal = imageMemoryRefusal(args.method, static_cast<std::uint32_t>(args.width),
+                                                   static_cast<std::uint32_t>(args.height), physicalMemory());
+    if (!refusal.empty()) throw Error(refusal);
+}
 
 json sceneSizeJson(const Scene& scene, const RenderStats& s, double hostPeakBytes) {
     std::uint64_t texels = 0;

@@ -34,6 +34,11 @@ RenderOptions renderOptionsFor(const RenderArgs& args);
 
 // A render's JSON summary (--json): settings, times, counters, kernels, memory, the method's
 // own keys.
+// Throws gdpt::Error, before any work, if a PT or G-PT render of args.width x args.height
+// would need more memory than the machine has (imageMemoryRefusal against physicalMemory),
+// naming the largest image of the same shape that fits.
+void checkImageMemory(const RenderArgs& args);
+
 // --json's "scene_size": the scene's triangles, vertices, textures and texels, its device
 // tables' bytes, and those bytes and the process's peak resident set per triangle.
 nlohmann::json sceneSizeJson(const Scene& scene, const RenderStats& s, double hostPeakBytes);

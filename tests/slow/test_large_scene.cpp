@@ -19,14 +19,15 @@ class LargeScene : public test::TempDirTest {};
 
 TEST_F(LargeScene, FiveMillionTexturedTrianglesRender) {
     const std::string scene = path("terrain_5m.glb");
-    const test::RunResult made = test::runShell("python3 " + std::string(GDPT_SOURCE_DIR) +
-                                                "/scripts/make-large-scene.py --triangles 5000000 -o " + scene);
+    const test::RunResult made =
+        test::runShell("python3 " + std::string(GDPT_SOURCE_DIR) +
+                       "/scripts/make-large-scene.py --triangles 5000000 -o " + scene);
     ASSERT_EQ(made.code, 0) << made.output;
     for (const char* method : {"pt", "gpt"}) {
         const std::string out = path(std::string(method) + ".json");
-        const test::RunResult r = test::runGdpt("render " + scene + " --method " + method +
-                                                " --spp 1 --width 64 --height 64 --quiet -o " + path("r.exr") +
-                                                " --json " + out);
+        const test::RunResult r =
+            test::runGdpt("render " + scene + " --method " + method +
+                          " --spp 1 --width 64 --height 64 --quiet -o " + path("r.exr") + " --json " + out);
         ASSERT_EQ(r.code, 0) << method << ": " << r.output;  // finite pixels are checked before writing
         std::ifstream in(out);
         const json j = json::parse(in);
@@ -38,7 +39,8 @@ TEST_F(LargeScene, FiveMillionTexturedTrianglesRender) {
         EXPECT_LE(s.at("host_peak_bytes_per_triangle").get<double>(), 380.0) << method;
         for (const char* phase : {"load", "bvh_build", "upload"})
             EXPECT_GT(j.at("time_s").at(phase).get<double>(), 0.0) << method << " " << phase;
-        std::fprintf(stderr, "%s: load %.2f s, BVH %.2f s, upload %.2f s, %.0f bytes per triangle at the peak\n",
+        std::fprintf(stderr,
+                     "%s: load %.2f s, BVH %.2f s, upload %.2f s, %.0f bytes per triangle at the peak\n",
                      method, j["time_s"]["load"].get<double>(), j["time_s"]["bvh_build"].get<double>(),
                      j["time_s"]["upload"].get<double>(), s["host_peak_bytes_per_triangle"].get<double>());
     }

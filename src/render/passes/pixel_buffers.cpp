@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "util/error.h"
+#include "util/memory.h"
 #include "vk/context.h"
 
 namespace gdpt {
@@ -44,6 +45,30 @@ void checkPixelBuffers(const vk::Context& ctx, std::uint32_t width, std::uint32_
                         std::to_string(fit.width) + "x" + std::to_string(fit.height) + ")");
         }
     }
+}
+
+std::uint64_t imageBytesPerMegapixel(const std::string& method) {
+    if (method == "pt") return std::uint64_t{170} << 20;
+    if (method == "gpt") return std::uint64_t{850} << 20;
+    return 0;
+}
+
+std::string imageMemoryRefusal(const std::string& method, std::uint32_t width, std::uint32_t height,
+                               std::uint64_t memory) {
+    const std::uint64_t perMegapixel = imageBytesPerMegapixel(method);
+    if (perMegapixel == 0 || memory == 0) return "";
+    // Whole pixels that fit: memory / bytes per pixel, with bytes per pixel = perMegapixel / 1e6.
+    const auto maxPixels = static_cast<std::uint64_t>(double(memory) / double(perMegapixel) * 1e6);
+    const std::uint64_t pixels = std::uint64_t{width} * height;
+    if (pixels <= maxPixels) return "";
+    const Extent fit = largestFittingImage(width, height, maxPixels);
+    const double needed = double(pixels) * 1e-6 * double(perMegapixel);
+    return "a " + std::to_string(width) + "x" + std::to_string(height) + " " +
+           (method == "gpt" ? "G-PT" : "PT") + " render needs about " +
+           memoryText(static_cast<std::uint64_t>(needed)) + " of memory (" + memoryText(perMegapixel) +
+           " per megapixel), more than this machine's " + memoryText(memory) +
+           ": the largest image of this shape that fits is " + std::to_string(fit.width) + "x" +
+           std::to_string(fit.height);
 }
 
 }  // namespace gdpt

@@ -12,6 +12,8 @@
 // suite (bit-exact checkpoints, G-PT against PT), since the same code serves every size.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include "cli_runner.h"
@@ -50,6 +52,32 @@ TEST_F(LargeImagesCli, BuffersBeyondTheStorageBufferRangeHoldEveryPixel) {
                 }
         EXPECT_EQ(wrong, 0u) << c.method << ": first at pixel " << first % image.width() << ", "
                              << first / image.width();
+    }
+}
+
+// A render whose image would not fit the machine's memory is refused before any work with the
+// largest image of the same shape that fits (GDPT_TEST_MEMORY_BYTES stands in for a 2 GB
+// machine). That the advised image passes the check, and one a pixel wider does not, is
+// tested on the check itself (PixelBuffers.ImageMemory*).
+TEST_F(LargeImagesCli, AnImageBeyondTheMachinesMemoryIsRefusedWithTheLargestThatFits) {
+    const std::string scene = std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.gltf";
+    const std::string exr = path("r.exr");
+    const std::string small = "GDPT_TEST_MEMORY_BYTES=2000000000";
+    for (const char* method : {"gpt", "pt"}) {
+        // G-PT takes about 850 MiB per megapixel, PT 170: 2 GB holds 2.2 and 11 megapixels.
+        const std::string size =
+            std::string(method) == "gpt" ? "--width 2000 --height 1500" : "--width 6000 --height 3000";
+        const test::RunResult r = test::runGdpt(
+            "render " + scene + " --method " + method + " " + size + " --spp 1 -o " + exr, small);
+        EXPECT_EQ(r.code, 1) << r.output;
+        EXPECT_NE(r.output.find("more than this machine's"), std::string::npos) << r.output;
+        const auto at = r.output.find("the largest image of this shape that fits is ");
+        ASSERT_NE(at, std::string::npos) << r.output;
+        unsigned w = 0, h = 0;
+        ASSERT_EQ(std::sscanf(r.output.c_str() + at + 45, "%ux%u", &w, &h), 2) << r.output;
+        EXPECT_LT(w, std::string(method) == "gpt" ? 2000u : 6000u);
+        EXPECT_NEAR(double(w) / double(h), 2.0 / (std::string(method) == "gpt" ? 1.5 : 1.0), 0.01);
+        EXPECT_FALSE(std::filesystem::exists(exr)) << "output left behind";
     }
 }
 

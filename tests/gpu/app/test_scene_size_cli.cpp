@@ -39,8 +39,9 @@ TEST_F(SceneSizeCli, JsonReportsTheSceneAndItsBytesPerTriangle) {
     const std::string scene = path("terrain.glb");
     const std::uint64_t triangles = makeScene(scene, 20000);
     const std::string out = path("r.json");
-    const test::RunResult r = test::runGdpt("render " + scene + " --method pt --spp 1 --width 16 --height 16 -o " +
-                                            path("r.exr") + " --quiet --json " + out);
+    const test::RunResult r =
+        test::runGdpt("render " + scene + " --method pt --spp 1 --width 16 --height 16 -o " + path("r.exr") +
+                      " --quiet --json " + out);
     ASSERT_EQ(r.code, 0) << r.output;
     std::ifstream in(out);
     const json j = json::parse(in);
@@ -64,9 +65,9 @@ TEST_F(SceneSizeCli, ARenderBeyondTheMachinesMemoryIsRefusedWithTheSizeThatFits)
     // 20 MB holds the loaded scene (about 90 bytes per triangle, which the loader checks) but
     // not its render (about 200 more per triangle).
     const std::string exr = path("r.exr");
-    const test::RunResult refused = test::runGdpt(
-        "render " + scene + " --method pt --spp 1 --width 16 --height 16 --quiet -o " + exr,
-        "GDPT_TEST_MEMORY_BYTES=20000000");
+    const test::RunResult refused =
+        test::runGdpt("render " + scene + " --method pt --spp 1 --width 16 --height 16 --quiet -o " + exr,
+                      "GDPT_TEST_MEMORY_BYTES=20000000");
     EXPECT_EQ(refused.code, 1) << refused.output;
     std::smatch m;
     const std::regex fits("fits with up to about ([0-9]+) triangles");
@@ -79,9 +80,9 @@ TEST_F(SceneSizeCli, ARenderBeyondTheMachinesMemoryIsRefusedWithTheSizeThatFits)
         << refused.output;
     EXPECT_FALSE(std::filesystem::exists(exr)) << "output left behind";
     // The same scene renders when the machine has room for it.
-    const test::RunResult rendered = test::runGdpt(
-        "render " + scene + " --method pt --spp 1 --width 16 --height 16 --quiet -o " + exr,
-        "GDPT_TEST_MEMORY_BYTES=200000000");
+    const test::RunResult rendered =
+        test::runGdpt("render " + scene + " --method pt --spp 1 --width 16 --height 16 --quiet -o " + exr,
+                      "GDPT_TEST_MEMORY_BYTES=200000000");
     EXPECT_EQ(rendered.code, 0) << rendered.output;
 }
 

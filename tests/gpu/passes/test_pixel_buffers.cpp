@@ -69,8 +69,10 @@ TEST(PixelBuffers, AnImageBeyondTheAllocationLimitIsRefusedWithTheLargestThatFit
     const std::string out = ::testing::TempDir() + "gdpt_refused.exr";
     const std::uint64_t maxAllocation = test::gpuContext().info().maxMemoryAllocationSize;
     if (maxAllocation >= 7680ull * 4320ull * 96ull) GTEST_SKIP() << "this device holds an 8K G-PT render";
+    // As if the machine had 10 TB, so that its memory (checked first) does not bind.
     const test::RunResult refused = test::runGdpt(
-        "render " + scene + " --method gpt --width 7680 --height 4320 --spp 1 --quiet -o " + out);
+        "render " + scene + " --method gpt --width 7680 --height 4320 --spp 1 --quiet -o " + out,
+        "GDPT_TEST_MEMORY_BYTES=10000000000000");
     ASSERT_EQ(refused.code, 1) << refused.output;
     EXPECT_NE(refused.output.find("maxMemoryAllocationSize"), std::string::npos) << refused.output;
     const std::string advice = "image of this shape that fits is ";
@@ -82,6 +84,31 @@ TEST(PixelBuffers, AnImageBeyondTheAllocationLimitIsRefusedWithTheLargestThatFit
     // Every buffer of the advised image fits, and a 1 % larger one would not.
     EXPECT_LE(std::uint64_t{w} * h * 96u, maxAllocation);
     EXPECT_GT(std::uint64_t{w} * h * 96u * 102u / 100u, maxAllocation);
+}
+
+// The memory check of a whole render: an image that fits is not refused, the advised image
+// fits, and one a pixel larger on each side does not (so the advice is nearly the largest of
+// its width steps); methods not measured are not checked.
+TEST(PixelBuffers, ImageMemoryRefusalAdvisesTheLargestImageThatFits) {
+    const std::uint64_t memory = 2'000'000'000;
+    for (const std::string method : {"pt", "gpt"}) {
+        const std::uint64_t perPixel = imageBytesPerMegapixel(method);
+        ASSERT_GT(perPixel, 0u) << method;
+        EXPECT_EQ(imageMemoryRefusal(method, 256, 256, memory), "") << method;
+        const std::uint32_t width = method == "gpt" ? 2000 : 6000;
+        const std::uint32_t height = method == "gpt" ? 1500 : 3000;
+        const std::string refusal = imageMemoryRefusal(method, width, height, memory);
+        const auto at = refusal.find("fits is ");
+        ASSERT_NE(at, std::string::npos) << refusal;
+        unsigned w = 0, h = 0;
+        ASSERT_EQ(std::sscanf(refusal.c_str() + at + 8, "%ux%u", &w, &h), 2) << refusal;
+        EXPECT_EQ(imageMemoryRefusal(method, w, h, memory), "") << method << " " << w << "x" << h;
+        EXPECT_NE(imageMemoryRefusal(method, w + 1, h + 1, memory), "") << method;
+        // The advice holds nearly all the memory allows: within a row or column of it.
+        const double allowed = double(memory) / double(perPixel) * 1e6;
+        EXPECT_GT(double(w) * double(h), allowed - double(std::max(w, h)) - 1.0) << method;
+    }
+    EXPECT_EQ(imageMemoryRefusal("gmlt", 100000, 100000, memory), "");
 }
 
 }  // namespace
