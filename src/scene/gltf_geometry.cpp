@@ -11,6 +11,7 @@
 #include <numeric>
 
 #include "scene/gltf_internal.h"
+#include "util/huge_pages.h"
 
 namespace gdpt::gltf {
 namespace {
@@ -296,6 +297,7 @@ const char* modeName(int mode) {
 std::vector<glm::uvec3> assembleTriangles(const std::vector<std::uint32_t>& idx, int mode) {
     std::vector<glm::uvec3> tris;
     const std::size_t n = idx.size();
+    reserveHuge(tris, mode == TINYGLTF_MODE_TRIANGLES ? n / 3 : (n >= 2 ? n - 2 : 0));
     if (mode == TINYGLTF_MODE_TRIANGLES) {
         if (n % 3 != 0)
             throw Error("TRIANGLES primitive has " + std::to_string(n) +
@@ -340,7 +342,8 @@ void noteIgnoredAttributes(Context& ctx, const tinygltf::Primitive& prim) {
 std::vector<glm::vec3> readVec3(const tinygltf::Model& model, int accessor, const char* role) {
     const CheckedAccessor a =
         checkAccessor(model, accessor, role, TINYGLTF_TYPE_VEC3, {TINYGLTF_COMPONENT_TYPE_FLOAT});
-    std::vector<glm::vec3> out(a.count);  // zeros where the accessor has no bufferView
+    std::vector<glm::vec3> out =
+        hugeVector<glm::vec3>(a.count);  // zeros where the accessor has no bufferView
     readElements(a, [&](std::size_t i, int c, double v) { out[i][c] = static_cast<float>(v); });
     for (std::size_t i = 0; i < out.size(); ++i)
         if (!std::isfinite(out[i].x) || !std::isfinite(out[i].y) || !std::isfinite(out[i].z))
@@ -354,7 +357,7 @@ std::vector<glm::vec2> readTexcoords(const tinygltf::Model& model, int accessor,
         checkAccessor(model, accessor, role, TINYGLTF_TYPE_VEC2,
                       {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
                        TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
-    std::vector<glm::vec2> out(a.count);
+    std::vector<glm::vec2> out = hugeVector<glm::vec2>(a.count);
     readElements(a, [&](std::size_t i, int c, double v) { out[i][c] = static_cast<float>(v); });
     for (std::size_t i = 0; i < out.size(); ++i)
         if (!std::isfinite(out[i].x) || !std::isfinite(out[i].y))
@@ -385,7 +388,7 @@ std::vector<std::uint32_t> readIndices(const tinygltf::Model& model, int accesso
                       {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
                        TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT});
     if (a.normalized) throw Error(a.label + " must not be normalized");
-    std::vector<std::uint32_t> out(a.count);
+    std::vector<std::uint32_t> out = hugeVector<std::uint32_t>(a.count);
     readElements(a, [&](std::size_t i, int, double v) { out[i] = static_cast<std::uint32_t>(v); });
     return out;
 }
@@ -458,7 +461,7 @@ void addMeshInstance(Context& ctx, const MeshInstance& inst, bool sceneHasNormal
 
             // World-space vertices of this primitive, within the coordinates gdpt renders
             // (kMaxSceneExtent).
-            std::vector<glm::vec3> wPos(pos.size());
+            std::vector<glm::vec3> wPos = hugeVector<glm::vec3>(pos.size());
             for (std::size_t i = 0; i < pos.size(); ++i) {
                 const glm::dvec3 p = glm::dvec3(inst.world * glm::dvec4(glm::dvec3(pos[i]), 1.0));
                 if (!allFinite(p))

@@ -21,6 +21,7 @@
 #include <string_view>
 
 #include "scene/gltf_internal.h"
+#include "util/huge_pages.h"
 #include "util/interrupt.h"
 #include "util/memory.h"
 #include "util/progress.h"
@@ -478,11 +479,11 @@ Scene GltfAsset::Impl::instance(int animation, double time) const {
             anyUvs = anyUvs || prim.attributes.count("TEXCOORD_0") > 0;
         }
     // The estimate bounds what the instances add (fewer when triangles are degenerate).
-    scene.positions.reserve(static_cast<std::size_t>(estimate.vertices));
-    if (anyNormals) scene.normals.reserve(static_cast<std::size_t>(estimate.vertices));
-    if (anyUvs) scene.uvs.reserve(static_cast<std::size_t>(estimate.vertices));
-    scene.triangles.reserve(static_cast<std::size_t>(estimate.triangles));
-    scene.triangleMaterial.reserve(static_cast<std::size_t>(estimate.triangles));
+    reserveHuge(scene.positions, static_cast<std::size_t>(estimate.vertices));
+    if (anyNormals) reserveHuge(scene.normals, static_cast<std::size_t>(estimate.vertices));
+    if (anyUvs) reserveHuge(scene.uvs, static_cast<std::size_t>(estimate.vertices));
+    reserveHuge(scene.triangles, static_cast<std::size_t>(estimate.triangles));
+    reserveHuge(scene.triangleMaterial, static_cast<std::size_t>(estimate.triangles));
     for (const auto& inst : instances) {
         throwIfInterrupted("loading");
         gltf::addMeshInstance(ctx, inst, anyNormals, anyUvs);

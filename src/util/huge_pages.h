@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -25,6 +26,22 @@ inline void adviseHugePages(void* data, std::size_t bytes) {
     (void)data;
     (void)bytes;
 #endif
+}
+
+// v.reserve(n), the new buffer advised for huge pages before anything touches it.
+template <class T>
+void reserveHuge(std::vector<T>& v, std::size_t n) {
+    v.reserve(n);
+    adviseHugePages(v.data(), v.capacity() * sizeof(T));
+}
+
+// std::vector<T>(n, value) whose buffer is advised for huge pages before it is filled.
+template <class T>
+std::vector<T> hugeVector(std::size_t n, const T& value = T()) {
+    std::vector<T> v;
+    reserveHuge(v, n);
+    v.assign(n, value);
+    return v;
 }
 
 }  // namespace gdpt
