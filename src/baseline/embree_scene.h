@@ -26,6 +26,7 @@ class EmbreeScene {
 public:
     // Copies the triangles into an Embree scene and builds its BVH (RTC_BUILD_QUALITY_MEDIUM,
     // Embree's default: binned SAH) on `threads` threads; throws Error with Embree's message.
+    // traceBenchPaths reads `positions` and `triangles` again: they must outlive the scene.
     EmbreeScene(const std::vector<glm::vec3>& positions, const std::vector<glm::uvec3>& triangles,
                 std::uint32_t threads);
     ~EmbreeScene();
