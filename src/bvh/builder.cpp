@@ -3,7 +3,7 @@
 // gpu::BvhNode layout: a node stores the boxes of both children, and a child is either an
 // inner node (count 0) or a leaf range of TriangleGeom (count > 0).
 //
-// Data layout (after Wald 2007 §4 and Embree's PrimRef): every triangle becomes a 32-byte
+// Data layout (as Embree's builders keep their PrimRefs): every triangle becomes a 32-byte
 // reference holding its padded box and its index; splits partition these references in place,
 // so each level streams through contiguous memory instead of gathering boxes through an index
 // array, and binning and the box arithmetic run on four-float registers (float4.h).
@@ -24,18 +24,13 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <exception>
 #include <limits>
 #include <memory>
-#include <mutex>
-#include <numeric>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 #include "bvh/float4.h"
 #include "util/huge_pages.h"
