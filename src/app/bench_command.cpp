@@ -132,6 +132,9 @@ int runBench(const BenchArgs& a) {
                 const auto seed = static_cast<std::uint32_t>(r);
                 for (const bool inc : {false, true}) {
                     const auto p = pass.run(a.spp, inc, seed);
+                    // One camera ray per sample: the kernel's counts (summed per subgroup) miss none.
+                    const std::uint64_t cameraRays = std::uint64_t(a.width) * std::uint64_t(a.height) * a.spp;
+                    GDPT_CHECK(inc ? p.rays >= cameraRays : p.rays == cameraRays);
                     (inc ? incoherent : primary).push_back(static_cast<double>(p.rays) / p.seconds);
                     (inc ? incoherentCpu : primaryCpu).push_back(static_cast<double>(p.rays) / p.cpuSeconds);
 #if defined(GDPT_HAVE_EMBREE)
@@ -139,6 +142,7 @@ int runBench(const BenchArgs& a) {
                     if (embree) {
                         const auto e =
                             embree->traceBenchPaths(sceneGpu.constants(), a.spp, inc, seed, threads);
+                        GDPT_CHECK(inc ? e.count.rays >= cameraRays : e.count.rays == cameraRays);
                         (inc ? embreeIncoherent : embreePrimary)
                             .push_back(static_cast<double>(e.count.rays) / e.seconds);
                         (inc ? embreeIncoherentCpu : embreePrimaryCpu)
