@@ -459,16 +459,14 @@ public:
             Piece& p = pieces_[tasks[i]];
             // A binary tree over n leaves has n - 1 inner nodes: reserving that touches no page
             // the subtree does not use, and the nodes are never moved as the vector grows.
-            p.subtree.nodes.reserve(p.range.size());
-            adviseHugePages(p.subtree.nodes.data(), p.subtree.nodes.capacity() * sizeof(gpu::BvhNode));
+            reserveHuge(p.subtree.nodes, p.range.size());
             SubtreeBuilder sub(in_);
             p.subtreeRoot = sub.build(p.range, p.depth, p.subtree);
         });
         NodeList out;
         size_t total = 0;
         for (const Piece& p : pieces_) total += p.split ? 1 : p.subtree.nodes.size();
-        out.nodes.reserve(total + 1);  // + 1: the root node of a one-leaf mesh
-        adviseHugePages(out.nodes.data(), out.nodes.capacity() * sizeof(gpu::BvhNode));
+        reserveHuge(out.nodes, total + 1);  // + 1: the root node of a one-leaf mesh
         rootRef_ = place(0, out);
         return out;
     }
@@ -552,11 +550,10 @@ Range makeRefs(const std::vector<glm::vec3>& positions, const std::vector<glm::u
     const size_t chunks = (size_t{count} + kPrepChunk - 1) / kPrepChunk;
     std::vector<Box4> chunkBox(chunks);
     std::vector<std::string> chunkError(chunks);
-    parallelFor(threads, chunks, [&](size_t c) {
-        const auto begin = static_cast<uint32_t>(c * kPrepChunk);
-        const uint32_t end = std::min(count, begin + kPrepChunk);
+    parallelRanges(threads, count, kPrepChunk, [&](size_t begin, size_t end) {
+        const size_t c = begin / kPrepChunk;
         Box4 box;
-        for (uint32_t t = begin; t < end; ++t) {
+        for (auto t = static_cast<uint32_t>(begin); t < end; ++t) {
             const glm::uvec3 tri = triangles[t];
             if (tri.x >= positions.size() || tri.y >= positions.size() || tri.z >= positions.size()) {
                 chunkError[c] = "buildBvh: triangle " + std::to_string(t) +
@@ -599,17 +596,16 @@ Range makeRefs(const std::vector<glm::vec3>& positions, const std::vector<glm::u
     for (int a = 0; a < 3; ++a) mag = std::max(mag, std::max(std::abs(slo[a]), std::abs(shi[a])));
     const float pad = mag * kBoundsPad;
     std::vector<Range> chunkRange(chunks);
-    parallelFor(threads, chunks, [&](size_t c) {
-        const auto begin = static_cast<uint32_t>(c * kPrepChunk);
-        const uint32_t end = std::min(count, begin + kPrepChunk);
-        for (uint32_t t = begin; t < end; ++t) {
+    parallelRanges(threads, count, kPrepChunk, [&](size_t begin, size_t end) {
+        for (size_t t = begin; t < end; ++t) {
             PrimRef& p = refs[t];
             for (int a = 0; a < 3; ++a) {
                 p.lo[a] -= pad;
                 p.hi[a] += pad;
             }
         }
-        chunkRange[c] = makeRange(refs, begin, end);
+        chunkRange[begin / kPrepChunk] =
+            makeRange(refs, static_cast<uint32_t>(begin), static_cast<uint32_t>(end));
     });
     Range root;
     root.begin = 0;

@@ -172,8 +172,7 @@ public:
     Collapser(const std::vector<gpu::BvhNode>& binary, std::size_t reserve,
               const std::map<uint32_t, const WideSubtree*>* ready = nullptr)
         : binary_(binary), ready_(ready) {
-        out_.nodes.reserve(reserve);
-        adviseHugePages(out_.nodes.data(), out_.nodes.capacity() * sizeof(gpu::BvhWideNode));
+        reserveHuge(out_.nodes, reserve);
     }
 
     // Emits the wide node for binary node `b`; returns its index. `depth` is the depth of

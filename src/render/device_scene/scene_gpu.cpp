@@ -77,32 +77,31 @@ struct LightTable {
 };
 
 LightTable makeLightTable(const Scene& scene, const std::vector<std::uint32_t>& order) {
-    const std::size_t ranges = (order.size() + kTableGrain - 1) / kTableGrain;
-    std::vector<std::vector<std::pair<std::uint32_t, double>>> found(ranges);
-    parallelFor(0, ranges, [&](std::size_t r) {
-        const std::size_t end = std::min(order.size(), (r + 1) * kTableGrain);
-        for (std::size_t i = r * kTableGrain; i < end; ++i) {
+    // Each range's emitters (leaf position, power), found in parallel and joined in order.
+    std::vector<std::vector<std::pair<std::uint32_t, double>>> found((order.size() + kTableGrain - 1) /
+                                                                     kTableGrain);
+    parallelRanges(0, order.size(), kTableGrain, [&](std::size_t begin, std::size_t end) {
+        auto& range = found[begin / kTableGrain];
+        for (std::size_t i = begin; i < end; ++i) {
             if (!materialIsEmissive(scene, order[i])) continue;
             const double p = emitterPower(scene, order[i], triangleArea(scene, order[i]));
-            if (p > 0.0) found[r].emplace_back(static_cast<std::uint32_t>(i), p);
+            if (p > 0.0) range.emplace_back(static_cast<std::uint32_t>(i), p);
         }
     });
     LightTable t;
+    std::vector<double> power;
     for (const auto& range : found) {
         for (const auto& [i, p] : range) {
             t.lights.push_back({i, 0.0f, 0.0f, 0.0f});
+            power.push_back(p);
             t.total += p;
         }
     }
     double running = 0.0;
-    std::size_t k = 0;
-    for (const auto& range : found) {
-        for (const auto& [i, p] : range) {
-            running += p;
-            t.lights[k].pmf = static_cast<float>(p / t.total);
-            t.lights[k].cdf = k + 1 == t.lights.size() ? 1.0f : static_cast<float>(running / t.total);
-            ++k;
-        }
+    for (std::size_t k = 0; k < t.lights.size(); ++k) {
+        running += power[k];
+        t.lights[k].pmf = static_cast<float>(power[k] / t.total);
+        t.lights[k].cdf = k + 1 == t.lights.size() ? 1.0f : static_cast<float>(running / t.total);
     }
     return t;
 }
@@ -189,21 +188,19 @@ LoadOptions deviceLoadOptions(const std::string& device, bool quiet) {
         // Every device holds this many (Vulkan's required minimum of maxTexelBufferElements is
         // 65536); larger scenes are compared with the device's own limit, read from a
         // short-lived context that chooses the device as the render's will.
-        if (estimate.triangles <= 65536 / gpu::kTriangleShadingTexels) {
-            checkRenderMemory(estimate);
-            return;
+        if (estimate.triangles > 65536 / gpu::kTriangleShadingTexels) {
+            vk::ContextOptions probe;
+            probe.device = device;
+            std::optional<vk::Context> ctx;
+            try {
+                ctx.emplace(probe);
+            } catch (const Error& e) {
+                // The loader puts the scene's name in front; say that the device is the problem.
+                throw e.withContext("no device to check the scene's size against");
+            }
+            if (estimate.triangles > maxDeviceTriangles(ctx->info()))
+                throw Error("the scene has up to " + beyondDevice(estimate.triangles, ctx->info()));
         }
-        vk::ContextOptions probe;
-        probe.device = device;
-        std::optional<vk::Context> ctx;
-        try {
-            ctx.emplace(probe);
-        } catch (const Error& e) {
-            // The loader puts the scene's name in front; say that the device is the problem.
-            throw e.withContext("no device to check the scene's size against");
-        }
-        if (estimate.triangles > maxDeviceTriangles(ctx->info()))
-            throw Error("the scene has up to " + beyondDevice(estimate.triangles, ctx->info()));
         checkRenderMemory(estimate);
     };
     return options;
