@@ -4,13 +4,12 @@
 
 #include <algorithm>
 #include <cstring>
-#include <exception>
 #include <limits>
 #include <mutex>
 #include <string>
-#include <thread>
 
 #include "util/error.h"
+#include "util/parallel.h"
 #include "util/timer.h"
 
 namespace gdpt {
@@ -128,33 +127,21 @@ EmbreeScene::RayRun EmbreeScene::traceBenchPaths(const gpu::SceneConstants& c, s
         h.point = positions[tri.x] + e.u * h.e1 + e.v * h.e2;
         return h;
     };
-    const std::uint32_t workers = std::max(1u, std::min(threads, c.height));
-    std::vector<BenchPathCount> counts(workers);
-    std::vector<std::exception_ptr> errors(workers);
-    auto work = [&](std::uint32_t w) {
-        try {
-            for (std::uint32_t y = w; y < c.height; y += workers) {
-                for (std::uint32_t x = 0; x < c.width; ++x) {
-                    const BenchPathCount p = benchPixelPaths(c, x, y, spp, 0, seed, incoherent, trace);
-                    counts[w].rays += p.rays;
-                    counts[w].hits += p.hits;
-                }
-            }
-        } catch (...) {
-            errors[w] = std::current_exception();
-        }
-    };
+    // One count per row, summed in row order once every thread has stopped.
+    std::vector<BenchPathCount> counts(c.height);
     RayRun run;
     const double cpu0 = processCpuSeconds();
     Timer timer;
-    std::vector<std::thread> pool;
-    for (std::uint32_t w = 1; w < workers; ++w) pool.emplace_back(work, w);
-    work(0);
-    for (std::thread& t : pool) t.join();
+    parallelFor(threads, c.height, [&](std::size_t y) {
+        for (std::uint32_t x = 0; x < c.width; ++x) {
+            const BenchPathCount p =
+                benchPixelPaths(c, x, static_cast<std::uint32_t>(y), spp, 0, seed, incoherent, trace);
+            counts[y].rays += p.rays;
+            counts[y].hits += p.hits;
+        }
+    });
     run.seconds = timer.ms() * 1e-3;
     run.cpuSeconds = processCpuSeconds() - cpu0;
-    for (const std::exception_ptr& e : errors)
-        if (e) std::rethrow_exception(e);
     for (const BenchPathCount& p : counts) {
         run.count.rays += p.rays;
         run.count.hits += p.hits;

@@ -40,7 +40,7 @@ public:
     [[nodiscard]] EmbreeHit intersect(glm::vec3 origin, glm::vec3 direction, float tMin, float tMax) const;
 
     // bench_rays.comp's paths for every pixel of `constants` (spp samples from sample 0, `seed`),
-    // traced on `threads` threads, rows interleaved.
+    // traced on `threads` threads, rows handed out in order (util/parallel.h).
     struct RayRun {
         BenchPathCount count;
         double seconds = 0.0;     // wall time
