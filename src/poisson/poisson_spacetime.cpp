@@ -18,8 +18,10 @@ namespace {
 // + cp_i x_i over the x, y and frame neighbours (poisson_problem.h's form, one more axis).
 struct Operator {
     int width = 0, height = 0, frames = 0;
-    Field cx, cy, ct, cp;  // edge i–(i+1), i–(i+W), i–(i+W·H); screening
-    Field cb;              // frame 0's rows to the fixed previous frame (W·H; empty: none)
+    Field cx, cy, ct, cp;  // edge i–(i+1), i–(i+W), i–next(i); screening
+    Field cb;              // rows from the fixed previous frame's pixel j to bnext(j) (W·H; empty: none)
+    std::vector<std::size_t> next;   // next(i): the temporal neighbour of i in the window (where ct > 0)
+    std::vector<std::size_t> bnext;  // bnext(j): the pixel of frame 0 of the previous frame's pixel j
     [[nodiscard]] std::size_t pixels() const { return std::size_t(width) * std::size_t(height); }
     [[nodiscard]] std::size_t size() const { return pixels() * std::size_t(frames); }
 };
@@ -55,6 +57,47 @@ void check(const SpaceTimeProblem& p) {
     }
     if (p.previous[0].empty() != p.previous[1].empty() || p.previous[0].empty() != p.previous[2].empty())
         throw Error("space-time Poisson: previous is given for some channels only");
+    const auto partners = [&](const std::vector<std::uint32_t>& v, std::size_t want, const char* what) {
+        if (v.empty()) return;
+        if (v.size() != want)
+            throw Error(std::string("space-time Poisson: ") + what + " has " + std::to_string(v.size()) +
+                        " entries, expected " + std::to_string(want));
+        for (std::uint32_t j : v)
+            if (j != kNoTemporalPartner && j >= p.pixels())
+                throw Error(std::string("space-time Poisson: ") + what + " names pixel " + std::to_string(j) +
+                            " of a frame of " + std::to_string(p.pixels()));
+    };
+    partners(p.temporalPartner, nt, "temporalPartner");
+    partners(p.previousPartner, p.previous[0].empty() ? 0 : p.pixels(), "previousPartner");
+}
+
+// The temporal neighbour of every row's pixel in the window (frame f's i → frame f+1's π(i))
+// and of the previous frame's pixels in frame 0; kNoRow where π names none.
+constexpr std::size_t kNoRow = ~std::size_t{0};
+
+std::vector<std::size_t> nextPixels(const SpaceTimeProblem& p) {
+    const std::size_t np = p.pixels(), nt = np * std::size_t(p.frames - 1);
+    std::vector<std::size_t> next(nt);
+    for (std::size_t i = 0; i < nt; ++i) {
+        const std::size_t frameStart = (i / np + 1) * np;
+        if (p.temporalPartner.empty())
+            next[i] = i + np;
+        else
+            next[i] = p.temporalPartner[i] == kNoTemporalPartner ? kNoRow : frameStart + p.temporalPartner[i];
+    }
+    return next;
+}
+
+std::vector<std::size_t> previousNext(const SpaceTimeProblem& p) {
+    if (p.previous[0].empty()) return {};
+    std::vector<std::size_t> next(p.pixels());
+    for (std::size_t j = 0; j < next.size(); ++j) {
+        if (p.previousPartner.empty())
+            next[j] = j;
+        else
+            next[j] = p.previousPartner[j] == kNoTemporalPartner ? kNoRow : p.previousPartner[j];
+    }
+    return next;
 }
 
 Weights unitWeights(const SpaceTimeProblem& p) {
@@ -65,6 +108,10 @@ Weights unitWeights(const SpaceTimeProblem& p) {
         if ((i % np) % w + 1 == w) wt.dx[i] = 0.0;
         if ((i % np) + w >= np) wt.dy[i] = 0.0;
     }
+    for (std::size_t i = 0; i < p.temporalPartner.size(); ++i)
+        if (p.temporalPartner[i] == kNoTemporalPartner) wt.dt[i] = 0.0;
+    for (std::size_t j = 0; j < p.previousPartner.size() && !wt.boundary.empty(); ++j)
+        if (p.previousPartner[j] == kNoTemporalPartner) wt.boundary[j] = 0.0;
     return wt;
 }
 
@@ -77,7 +124,11 @@ Operator makeOperator(const SpaceTimeProblem& p, const Weights& wt) {
     op.cx = wt.dx;
     op.cy = wt.dy;
     op.ct.assign(n, 0.0);
-    for (std::size_t i = 0; i + np < n; ++i) op.ct[i] = p.beta * p.beta * wt.dt[i];
+    op.next = nextPixels(p);
+    op.next.resize(n, kNoRow);
+    op.bnext = previousNext(p);
+    for (std::size_t i = 0; i + np < n; ++i)
+        if (op.next[i] != kNoRow) op.ct[i] = p.beta * p.beta * wt.dt[i];
     op.cp.resize(n);
     for (std::size_t i = 0; i < n; ++i) op.cp[i] = p.alpha * p.alpha * wt.primal[i];
     op.cb = wt.boundary;
@@ -87,10 +138,11 @@ Operator makeOperator(const SpaceTimeProblem& p, const Weights& wt) {
 
 // b = Pᵀ W target: α² wp t minus the weighted divergence of the (dx, dy, dt) field.
 Field rhs(const SpaceTimeProblem& p, const Operator& op, int c) {
-    const std::size_t n = op.size(), np = op.pixels(), w = std::size_t(op.width);
+    const std::size_t n = op.size(), w = std::size_t(op.width);
     Field b(n);
     for (std::size_t i = 0; i < n; ++i) b[i] = op.cp[i] * p.primal[c][i];
-    for (std::size_t i = 0; i < op.cb.size(); ++i) b[i] += op.cb[i] * (p.previous[c][i] + p.dtPrevious[c][i]);
+    for (std::size_t j = 0; j < op.cb.size(); ++j)
+        if (op.cb[j] != 0.0) b[op.bnext[j]] += op.cb[j] * (p.previous[c][j] + p.dtPrevious[c][j]);
     for (std::size_t i = 0; i < n; ++i) {
         if (op.cx[i] != 0.0) {
             b[i] -= op.cx[i] * p.dx[c][i];
@@ -102,16 +154,17 @@ Field rhs(const SpaceTimeProblem& p, const Operator& op, int c) {
         }
         if (op.ct[i] != 0.0) {
             b[i] -= op.ct[i] * p.dt[c][i];
-            b[i + np] += op.ct[i] * p.dt[c][i];
+            b[op.next[i]] += op.ct[i] * p.dt[c][i];
         }
     }
     return b;
 }
 
 void apply(const Operator& op, const Field& x, Field& y) {
-    const std::size_t n = op.size(), np = op.pixels(), w = std::size_t(op.width);
+    const std::size_t n = op.size(), w = std::size_t(op.width);
     for (std::size_t i = 0; i < n; ++i) y[i] = op.cp[i] * x[i];
-    for (std::size_t i = 0; i < op.cb.size(); ++i) y[i] += op.cb[i] * x[i];
+    for (std::size_t j = 0; j < op.cb.size(); ++j)
+        if (op.cb[j] != 0.0) y[op.bnext[j]] += op.cb[j] * x[op.bnext[j]];
     for (std::size_t i = 0; i < n; ++i) {
         const double xi = x[i];
         if (op.cx[i] != 0.0) {
@@ -125,21 +178,23 @@ void apply(const Operator& op, const Field& x, Field& y) {
             y[i + w] -= f;
         }
         if (op.ct[i] != 0.0) {
-            const double f = op.ct[i] * (xi - x[i + np]);
+            const std::size_t j = op.next[i];
+            const double f = op.ct[i] * (xi - x[j]);
             y[i] += f;
-            y[i + np] -= f;
+            y[j] -= f;
         }
     }
 }
 
 Field diagonalOf(const Operator& op) {
-    const std::size_t n = op.size(), np = op.pixels(), w = std::size_t(op.width);
+    const std::size_t n = op.size(), w = std::size_t(op.width);
     Field d = op.cp;
-    for (std::size_t i = 0; i < op.cb.size(); ++i) d[i] += op.cb[i];
+    for (std::size_t j = 0; j < op.cb.size(); ++j)
+        if (op.cb[j] != 0.0) d[op.bnext[j]] += op.cb[j];
     for (std::size_t i = 0; i < n; ++i) {
         if (op.cx[i] != 0.0) d[i] += op.cx[i], d[i + 1] += op.cx[i];
         if (op.cy[i] != 0.0) d[i] += op.cy[i], d[i + w] += op.cy[i];
-        if (op.ct[i] != 0.0) d[i] += op.ct[i], d[i + np] += op.ct[i];
+        if (op.ct[i] != 0.0) d[i] += op.ct[i], d[op.next[i]] += op.ct[i];
     }
     return d;
 }
@@ -193,6 +248,7 @@ SolveStats pcg(const Operator& op, const Field& b, Field& x, double tolerance, i
 // IRLS weights of the estimate x: 1 / (‖e‖_RGB + reg) for every kept row, mean 1.
 Weights irlsWeights(const SpaceTimeProblem& p, const std::array<Field, 3>& x, double reg) {
     Weights wt = unitWeights(p);
+    const std::vector<std::size_t> next = nextPixels(p), bnext = previousNext(p);
     const std::size_t n = p.size(), np = p.pixels(), w = std::size_t(p.width);
     double sum = 0.0;
     std::size_t rows = 0;
@@ -214,13 +270,16 @@ Weights irlsWeights(const SpaceTimeProblem& p, const std::array<Field, 3>& x, do
             for (int c = 0; c < 3; ++c) e[c] = x[c][i + w] - x[c][i] - p.dy[c][i];
             wt.dy[i] = weightOf(e);
         }
-        if (i + np < n) {
-            for (int c = 0; c < 3; ++c) e[c] = p.beta * (x[c][i + np] - x[c][i] - p.dt[c][i]);
+        if (i + np < n && wt.dt[i] != 0.0) {
+            const std::size_t j = next[i];
+            for (int c = 0; c < 3; ++c) e[c] = p.beta * (x[c][j] - x[c][i] - p.dt[c][i]);
             wt.dt[i] = weightOf(e);
         }
     }
     for (std::size_t i = 0; i < wt.boundary.size(); ++i) {
-        for (int c = 0; c < 3; ++c) e[c] = p.beta * (x[c][i] - p.previous[c][i] - p.dtPrevious[c][i]);
+        if (wt.boundary[i] == 0.0) continue;
+        const std::size_t j = bnext[i];
+        for (int c = 0; c < 3; ++c) e[c] = p.beta * (x[c][j] - p.previous[c][i] - p.dtPrevious[c][i]);
         wt.boundary[i] = weightOf(e);
     }
     const double scale = double(rows) / sum;
@@ -283,7 +342,7 @@ Field solveSpaceTimeExactL2(const SpaceTimeProblem& problem, int channel) {
     const Operator op = makeOperator(problem, unitWeights(problem));
     const Field b = rhs(problem, op, channel);
     const Field d = diagonalOf(op);
-    const std::size_t n = op.size(), np = op.pixels(), w = std::size_t(op.width);
+    const std::size_t n = op.size(), w = std::size_t(op.width);
     std::vector<Eigen::Triplet<double>> triplets;
     triplets.reserve(n * 7);
     for (std::size_t i = 0; i < n; ++i) {
@@ -296,7 +355,7 @@ Field solveSpaceTimeExactL2(const SpaceTimeProblem& problem, int channel) {
         };
         edge(i + 1, op.cx[i]);
         edge(i + w, op.cy[i]);
-        edge(i + np, op.ct[i]);
+        if (op.ct[i] != 0.0) edge(op.next[i], op.ct[i]);
     }
     Eigen::SparseMatrix<double> a(static_cast<int>(n), static_cast<int>(n));
     a.setFromTriplets(triplets.begin(), triplets.end());

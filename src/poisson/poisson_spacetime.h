@@ -6,11 +6,14 @@
 //     E(I) = Σ_f [ α² Σ_i wp (I_f,i − t_f,i)²                     primal rows
 //                + Σ_i wdx (I_f,i+1 − I_f,i − dx_f,i)²             (x < W−1)
 //                + Σ_i wdy (I_f,i+W − I_f,i − dy_f,i)² ]           (y < H−1)
-//          + β² Σ_{f<F−1} Σ_i wdt (I_f+1,i − I_f,i − dt_f,i)²      temporal rows
-//          [+ β² Σ_i wdb (I_0,i − previous_i − dtPrevious_i)²       the frame before, fixed]
-// which is poisson_problem.h's energy of each frame plus the temporal rows: a weighted
-// 7-point graph Laplacian in (x, y, f) plus the screening diagonal. One frame (F = 1) is
-// exactly the 2D problem (tested against poisson_cpu.h).
+//          + β² Σ_{f<F−1} Σ_i wdt (I_f+1,π(i) − I_f,i − dt_f,i)²   temporal rows
+//          [+ β² Σ_i wdb (I_0,π(i) − previous_i − dtPrevious_i)²    the frame before, fixed]
+// which is poisson_problem.h's energy of each frame plus the temporal rows: a weighted graph
+// Laplacian over the pixels' x, y and temporal neighbours plus the screening diagonal. π(i) is
+// the pixel of the next frame that pixel i's temporal difference ends at: i itself (the
+// same pixel: a 7-point Laplacian in (x, y, f)), or where the scene's motion carries i's
+// surface point (integrator/motion_map.h); a pixel without one has no temporal row. One frame
+// (F = 1) is exactly the 2D problem (tested against poisson_cpu.h).
 //
 // L2: the weights are 1. L1 (the default of G-PT): iteratively reweighted least squares as the
 // 2D device solver does it (poisson_irls.h, poisson_gpu.h's schedule): round 0 is the L2
@@ -26,10 +29,14 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "poisson/poisson_cpu.h"
 
 namespace gdpt {
+
+// A pixel whose temporal difference ends nowhere (SpaceTimeProblem::temporalPartner).
+inline constexpr std::uint32_t kNoTemporalPartner = 0xFFFFFFFFu;
 
 struct SpaceTimeProblem {
     int width = 0;
@@ -47,6 +54,11 @@ struct SpaceTimeProblem {
     // target of I_0 − previous: temporal rows β (I_0 − previous − dtPrevious) that tie the
     // window to the one before it (a sequence reconstructed window by window has no seam).
     std::array<Field, 3> previous, dtPrevious;
+    // π: where each temporal row ends, or empty for the same pixel everywhere. temporalPartner
+    // has (F − 1)·W·H entries: for frame f's pixel i (at f·W·H + i), the pixel index (0 ..
+    // W·H − 1) in frame f+1 that dt_f,i is the difference to, or kNoTemporalPartner (no row).
+    // previousPartner (W·H, with `previous`): the same from the frame before into frame 0.
+    std::vector<std::uint32_t> temporalPartner, previousPartner;
 
     [[nodiscard]] std::size_t pixels() const { return std::size_t(width) * std::size_t(height); }
     [[nodiscard]] std::size_t size() const { return pixels() * std::size_t(frames); }

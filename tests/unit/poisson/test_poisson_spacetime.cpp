@@ -2,9 +2,11 @@
 // exact sparse factorisation; one frame is the 2D problem of poisson_cpu.h; β = 0 decouples the
 // frames; consistent data (gradients and temporal differences of one sequence) is recovered
 // exactly by L2 and L1; an L1 solve shrugs off an outlier that L2 smears; temporal rows cut
-// frame-to-frame noise; bad input is refused.
+// frame-to-frame noise; temporal rows along motion (each pixel's partner in the next frame)
+// solve the least-squares problem they state, built here row by row; bad input is refused.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <cmath>
 #include <random>
 
@@ -215,6 +217,145 @@ TEST(SpaceTimePoisson, TheFrameBeforeTiesTheWindowToIt) {
     EXPECT_GT(maxDiff(solveSpaceTimeExactL2(free, 0), x[0]), 1e-3);
 }
 
+// The L2 minimiser of a problem's energy (poisson_spacetime.h) for channel c, from its rows
+// written out one by one as a dense least-squares system and solved by QR: an answer that
+// shares no code with the solver's operator.
+Field denseLeastSquares(const SpaceTimeProblem& p, int c) {
+    const std::size_t np = p.pixels(), n = p.size(), w = std::size_t(p.width);
+    std::vector<std::vector<std::pair<std::size_t, double>>> rows;
+    std::vector<double> targets;
+    const auto row = [&](std::vector<std::pair<std::size_t, double>> r, double t) {
+        rows.push_back(std::move(r));
+        targets.push_back(t);
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::size_t f = i / np, k = i % np;
+        row({{i, p.alpha}}, p.alpha * p.primal[c][i]);
+        if (k % w + 1 < w) row({{i + 1, 1.0}, {i, -1.0}}, p.dx[c][i]);
+        if (k + w < np) row({{i + w, 1.0}, {i, -1.0}}, p.dy[c][i]);
+        if (f + 1 < std::size_t(p.frames)) {
+            const std::uint32_t to = p.temporalPartner.empty() ? std::uint32_t(k) : p.temporalPartner[i];
+            if (to != kNoTemporalPartner) row({{(f + 1) * np + to, p.beta}, {i, -p.beta}}, p.beta * p.dt[c][i]);
+        }
+    }
+    for (std::size_t j = 0; j < p.previous[c].size(); ++j) {
+        const std::uint32_t to = p.previousPartner.empty() ? std::uint32_t(j) : p.previousPartner[j];
+        if (to != kNoTemporalPartner)
+            row({{to, p.beta}}, p.beta * (p.previous[c][j] + p.dtPrevious[c][j]));
+    }
+    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(Eigen::Index(rows.size()), Eigen::Index(n));
+    Eigen::VectorXd b(Eigen::Index(rows.size()));
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+        for (const auto& [col, v] : rows[r]) a(Eigen::Index(r), Eigen::Index(col)) += v;
+        b[Eigen::Index(r)] = targets[r];
+    }
+    const Eigen::VectorXd x = a.colPivHouseholderQr().solve(b);
+    return Field(x.data(), x.data() + n);
+}
+
+// Frames 1..3 of consistentProblem's window as the unknowns and frame 0 as the fixed previous
+// frame; random partners (a quarter of them none) in both kinds of temporal rows.
+SpaceTimeProblem withRandomPartners(unsigned seed) {
+    const SpaceTimeProblem all = noisy(consistentProblem(6, 5, 4), 0.3, seed);
+    const std::size_t np = 30;
+    SpaceTimeProblem p;
+    p.width = 6;
+    p.height = 5;
+    p.frames = 3;
+    for (int c = 0; c < 3; ++c) {
+        const auto from = [&](const Field& f, std::size_t a, std::size_t b) {
+            return Field(f.begin() + a, f.begin() + b);
+        };
+        p.primal[c] = from(all.primal[c], np, 4 * np);
+        p.dx[c] = from(all.dx[c], np, 4 * np);
+        p.dy[c] = from(all.dy[c], np, 4 * np);
+        p.dt[c] = from(all.dt[c], np, 3 * np);
+        p.previous[c] = from(all.primal[c], 0, np);
+        p.dtPrevious[c] = from(all.dt[c], 0, np);
+    }
+    std::mt19937 rng(seed);
+    const auto partner = [&] {
+        return rng() % 4 == 0 ? kNoTemporalPartner : std::uint32_t(rng() % np);
+    };
+    for (std::size_t i = 0; i < 2 * np; ++i) p.temporalPartner.push_back(partner());
+    for (std::size_t j = 0; j < np; ++j) p.previousPartner.push_back(partner());
+    return p;
+}
+
+TEST(SpaceTimePoisson, MotionPartnersSolveTheLeastSquaresOfTheirRows) {
+    for (const unsigned seed : {1u, 2u}) {
+        const SpaceTimeProblem p = withRandomPartners(seed);
+        SpaceTimeOptions o;
+        o.l1 = false;
+        o.tolerance = 1e-12;
+        const auto x = solveSpaceTime(p, o);
+        for (int c = 0; c < 3; ++c) {
+            const Field dense = denseLeastSquares(p, c);
+            EXPECT_LT(maxDiff(x[c], dense), 1e-8) << "seed " << seed << " channel " << c;
+            EXPECT_LT(maxDiff(solveSpaceTimeExactL2(p, c), dense), 1e-8) << "seed " << seed << " channel " << c;
+        }
+        // The partners matter: the same rows at the same pixel give another answer.
+        SpaceTimeProblem same = p;
+        same.temporalPartner.clear();
+        same.previousPartner.clear();
+        EXPECT_GT(maxDiff(solveSpaceTime(same, o)[0], x[0]), 1e-3);
+        EXPECT_LT(maxDiff(solveSpaceTime(same, o)[0], denseLeastSquares(same, 0)), 1e-8);
+    }
+}
+
+TEST(SpaceTimePoisson, IdentityPartnersAreTheSamePixel) {
+    const SpaceTimeProblem p = withRandomPartners(3);
+    SpaceTimeProblem a = p, b = p;
+    a.temporalPartner.clear();
+    a.previousPartner.clear();
+    for (std::size_t i = 0; i < b.temporalPartner.size(); ++i) b.temporalPartner[i] = std::uint32_t(i % 30);
+    for (std::size_t j = 0; j < b.previousPartner.size(); ++j) b.previousPartner[j] = std::uint32_t(j);
+    for (const bool l1 : {false, true}) {
+        SpaceTimeOptions o;
+        o.l1 = l1;
+        const auto xa = solveSpaceTime(a, o), xb = solveSpaceTime(b, o);
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(xa[c], xb[c]) << c;
+    }
+}
+
+TEST(SpaceTimePoisson, DifferencesAlongTheMotionRecoverAMovingPattern) {
+    // A pattern moving one pixel right per frame; its differences along the motion are 0.05
+    // (the brightness ramp), its same-pixel differences are large. Rows along the motion (the
+    // pixel that enters at the left edge has none) recover the frames exactly, L2 and L1.
+    const int w = 9, h = 6, frames = 4;
+    const auto pattern = [](int x, int y, int f, int c) {
+        const int xs = x - f;
+        return (1.0 + 0.25 * c) * (0.5 + 0.4 * std::sin(0.9 * xs + 0.3 * y) + 0.05 * f);
+    };
+    SpaceTimeProblem p = consistentProblem(w, h, frames);
+    const std::size_t np = std::size_t(w) * h;
+    p.temporalPartner.assign(np * (frames - 1), kNoTemporalPartner);
+    for (int c = 0; c < 3; ++c)
+        for (int f = 0; f < frames; ++f)
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x) {
+                    const std::size_t i = f * np + std::size_t(y) * w + x;
+                    p.primal[c][i] = pattern(x, y, f, c);
+                    p.dx[c][i] = x + 1 < w ? pattern(x + 1, y, f, c) - pattern(x, y, f, c) : 0.0;
+                    p.dy[c][i] = y + 1 < h ? pattern(x, y + 1, f, c) - pattern(x, y, f, c) : 0.0;
+                    if (f + 1 == frames) continue;
+                    if (x + 1 < w) {
+                        p.temporalPartner[i] = std::uint32_t(y * w + x + 1);
+                        p.dt[c][i] = pattern(x + 1, y, f + 1, c) - pattern(x, y, f, c);
+                    } else {
+                        p.dt[c][i] = 1e3;  // no row: never read
+                    }
+                }
+    for (int c = 0; c < 3; ++c) p.initial[c].assign(p.size(), 0.0);
+    for (const bool l1 : {false, true}) {
+        SpaceTimeOptions o;
+        o.l1 = l1;
+        o.tolerance = 1e-10;
+        const auto x = solveSpaceTime(p, o);
+        for (int c = 0; c < 3; ++c) EXPECT_LT(maxDiff(x[c], p.primal[c]), 1e-6) << (l1 ? "l1 " : "l2 ") << c;
+    }
+}
+
 TEST(SpaceTimePoisson, BadInputIsRefused) {
     SpaceTimeProblem p = consistentProblem(4, 4, 3);
     p.dt[1].pop_back();
@@ -225,6 +366,14 @@ TEST(SpaceTimePoisson, BadInputIsRefused) {
     p = consistentProblem(4, 4, 3);
     p.alpha = 0.0;
     EXPECT_THROW((void)solveSpaceTime(p), Error);
+    p = consistentProblem(4, 4, 3);
+    p.temporalPartner.assign(16, 0u);  // two frames of rows need 32
+    EXPECT_THROW((void)solveSpaceTime(p), Error);
+    p.temporalPartner.assign(32, 0u);
+    p.temporalPartner[7] = 16u;  // beyond the frame
+    EXPECT_THROW((void)solveSpaceTime(p), Error);
+    p.temporalPartner[7] = kNoTemporalPartner;
+    EXPECT_NO_THROW((void)solveSpaceTime(p));
 }
 
 }  // namespace
