@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Animations at equal time: PT, per-frame G-PT and temporal G-PT (docs/animation.md) render the
-# same frames of each animated scene with the same --time for the whole sequence, and each
+# Animations at equal time: PT, per-frame G-PT and temporal G-PT (docs/animation.md; `tgpt` with
+# its default motion shift, `tgpt-replay` with --temporal-shift replay) render the same frames of each animated scene with the same --time for the whole sequence, and each
 # sequence is compared with a PT reference sequence of REFSPP samples per pixel by
 # `gdpt diff-sequence`: the mean per-frame relMSE and the mean temporal relMSE (the error of
 # the frame-to-frame change: flicker). The reference is rendered twice (seeds 1001, 2002) and
@@ -11,11 +11,11 @@
 #
 #   scripts/bench-temporal.sh [-o OUT] [--scenes moving_box,camera_move] [--frames 0:15]
 #                             [--size 96] [--seconds-per-frame 1] [--reference-spp 1024]
-#                             [--methods pt,gpt,tgpt] [--repeats 1]
+#                             [--methods pt,gpt,tgpt,tgpt-replay] [--repeats 1]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=bench-temporal scenes=moving_box,camera_move frames=0:15 size=96 perframe=1 refspp=1024
-methods=pt,gpt,tgpt repeats=1
+methods=pt,gpt,tgpt,tgpt-replay repeats=1
 while (($#)); do
   case "$1" in
     -o) out=$2; shift 2 ;;
@@ -50,7 +50,9 @@ for scene in ${scenes//,/ }; do
   for ((r = 1; r <= repeats; r++)); do
     for m in ${methods//,/ }; do  # interleaved: one sequence of each method per round
       run=$dir/${m}_$r
-      build/gdpt render "$file" --method "$m" --time "$budget" --seed "$((r * 7))" -o "$run/f_%04d.exr" \
+      method=(--method "$m")
+      [ "$m" = tgpt-replay ] && method=(--method tgpt --temporal-shift replay)
+      build/gdpt render "$file" "${method[@]}" --time "$budget" --seed "$((r * 7))" -o "$run/f_%04d.exr" \
         --json "$run.json" "${common[@]}"
       build/gdpt diff-sequence "$run/f_%04d.exr" "$dir/reference_1001/f_%04d.exr" --frames "$frames" \
         --json "$run.diff.json" > /dev/null
@@ -81,7 +83,7 @@ with open(out + "/results.csv", "w") as csv:
     for r in results:
         csv.write(f"{r['scene']},{r['method']},{r['repeat']},{r['budget_s']:g},{r['time_s']:.2f},"
                   f"{r['spp_per_frame']:.1f},{r['relmse']:.6g},{r['temporal_relmse']:.6g}\n")
-print(f"{'scene':12} {'method':6} {'time s':>7} {'spp/frame':>9} {'relMSE':>10} {'temporal':>10} "
+print(f"{'scene':12} {'method':11} {'time s':>7} {'spp/frame':>9} {'relMSE':>10} {'temporal':>10} "
       f"{'relMSE÷gpt':>10} {'temp.÷gpt':>10}")
 for scene in dict.fromkeys(r["scene"] for r in results):
     med = {}
@@ -90,7 +92,7 @@ for scene in dict.fromkeys(r["scene"] for r in results):
         med[m] = {k: statistics.median(r[k] for r in rs) for k in ("time_s", "spp_per_frame", "relmse", "temporal_relmse")}
     for m, v in med.items():
         g = med.get("gpt")
-        print(f"{scene:12} {m:6} {v['time_s']:7.1f} {v['spp_per_frame']:9.1f} {v['relmse']:10.4g} "
+        print(f"{scene:12} {m:11} {v['time_s']:7.1f} {v['spp_per_frame']:9.1f} {v['relmse']:10.4g} "
               f"{v['temporal_relmse']:10.4g} {v['relmse'] / g['relmse'] if g else float('nan'):10.3f} "
               f"{v['temporal_relmse'] / g['temporal_relmse'] if g else float('nan'):10.3f}")
     fr, ft = floors[scene]

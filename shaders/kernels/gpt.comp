@@ -76,6 +76,8 @@ GDPT_PIXEL_BUFFER(kBindGptEdgeList, UintArray, edgeList);
 #define edgeList edgeList_.v
 GDPT_PIXEL_BUFFER(kBindGptDemodMask, UintArray, demodMask);
 #define demodMask demodMask_.v
+GDPT_PIXEL_BUFFER(kBindGptStreamKey, UintArray, streamKey);
+#define streamKey streamKey_.v
 GDPT_PIXEL_BUFFER(kBindGptModulation, PixelStatsArray, statModulation);
 #define statModulation statModulation_.v
 layout(constant_id = kSpecGptDemodulate) const bool kDemodulate = false;
@@ -148,10 +150,14 @@ void main() {
     uint shiftPairs = 0u, shiftFailures = 0u;
     OffsetPath offs[kGptNumOffsets];
     bool countDirect = !emissionSupersampled(pixel);
+    // The random stream of this pixel's samples: its own (as pt.comp's), or the one the host
+    // assigned (temporal G-PT: the stream of the pixel of the previous frame whose primary hit
+    // moved here, so that the same path is replayed on the same surface).
+    uint stream = frame.streamKeys != 0u ? streamKey[pixel] : pixel;
     for (uint s = 0u; s < frame.samplesPerPixel; ++s) {
         // Same stream as pt.comp's sample s: the base path is PT's path.
-        Rng rng = rngInit(pixel, frame.sampleBase + s, frame.seed);
-        LdSample lds = ldSampleInit(pixel, frame.sampleBase + s, frame.seed);
+        Rng rng = rngInit(stream, frame.sampleBase + s, frame.seed);
+        LdSample lds = ldSampleInit(stream, frame.sampleBase + s, frame.seed);
         vec2 jitter = ldGet2(lds, kLdDimPixel);
         vec3 direct, baseModulation;
         traceSample(lds, rng, vec2(x, y) + jitter, x, y, countDirect, rays, direct, baseModulation, offs);

@@ -20,7 +20,7 @@ GDPT_CONST uint kGptLeft = 2u;
 GDPT_CONST uint kGptUp = 3u;
 GDPT_CONST uint kGptNumOffsets = 4u;
 
-// Per-batch push constants of gpt.comp and gpt_resolve.comp (<= 128 bytes). 36 bytes.
+// Per-batch push constants of gpt.comp and gpt_resolve.comp (<= 128 bytes). 40 bytes.
 struct GptFrameParams {
     uint sampleBase;       // index of the first sample of this batch (per pixel)
     uint samplesPerPixel;  // samples per pixel in this batch
@@ -34,6 +34,9 @@ struct GptFrameParams {
     uint listCount;        // 0: the dispatch covers image rows; > 0: edge-list mode, the
                            // dispatch's (x, row) is entry row·width + x of kBindGptEdgeList
                            // (rowOffset/rowCount tile those virtual rows), listCount entries
+    uint streamKeys;       // 1: pixel p's camera samples draw their random numbers from stream
+                           // kBindGptStreamKey[p] instead of stream p (temporal G-PT's motion-
+                           // carried shift, motion_map.h); 0: stream p
 };
 
 // Resolved per-pixel output of gpt_resolve.comp (linear RGB radiance, W/(m^2 sr)). 96 bytes;
@@ -87,11 +90,13 @@ kBindGptCentral = 40u,        // base's MIS-weighted radiance summed over the pa
     kBindGptDemodMask = 53u,   // uint per pixel: 1 = demodulate the paths that start in it
     kBindGptModulation = 54u,  // PixelStats per pixel: m at the base paths' first hits (1 where
                                // not demodulated, also on a miss)
-    kBindGptEdgeProbe = 55u    // EdgeProbe per pixel written by edge.comp
+    kBindGptEdgeProbe = 55u,   // EdgeProbe per pixel written by edge.comp
+    kBindGptStreamKey = 56u    // uint per pixel: the random stream of its camera samples (read
+                               // when GptFrameParams::streamKeys is 1)
     GDPT_ENUM_END();
 
 #ifdef __cplusplus
-static_assert(sizeof(GptFrameParams) == 36, "GptFrameParams layout");
+static_assert(sizeof(GptFrameParams) == 40, "GptFrameParams layout");
 static_assert(sizeof(GptResolved) == 96, "GptResolved layout (scalar)");
 static_assert(sizeof(EdgeProbe) == 32, "EdgeProbe layout (scalar)");
 static_assert(std::uint32_t{kBindGptCentral} > std::uint32_t{kBindTestOutput2},

@@ -114,6 +114,7 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
     t.l1 = args.recon == "l1";
     t.alpha = args.alpha;
     t.beta = args.beta;
+    t.shift = parseTemporalShift(args.temporalShift);
     t.tolerance = args.tolerance;
     // Timed renders remember each configuration's reconstruction time.
     if (args.time > 0.0) g.reconCache = cache;

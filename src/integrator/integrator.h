@@ -127,8 +127,18 @@ struct MltOptions {
 };
 
 // The settings of temporal G-PT (tgpt; tgpt_integrator.h).
+// How temporal G-PT pairs a frame's paths with the next frame's (tgpt_integrator.h): Motion
+// replays each path in the pixel the scene's motion carries its primary hit to (motion_map.h),
+// Replay in the same pixel.
+enum class TemporalShift { Motion, Replay };
+
+// "motion" | "replay"; throws gdpt::UsageError otherwise.
+TemporalShift parseTemporalShift(const std::string& text);
+const char* temporalShiftName(TemporalShift shift);
+
 struct TgptOptions {
     GptSamplingOptions sampling;  // of each frame's two half renders (demodulation off)
+    TemporalShift shift = TemporalShift::Motion;
     int window = 10;              // frames reconstructed at once (Manzi et al. 2016 use about 10)
     bool l1 = true;               // the space-time reconstruction: L1 (IRLS) or L2
     double alpha = 0.2;           // weight of the primal rows

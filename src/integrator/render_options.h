@@ -137,6 +137,10 @@ struct TgptStats {
     std::uint32_t secondHalfSpp = 0;    // ... with the next frame's seed (paired with it)
     bool temporalToPrevious = false;    // the frame has a dt to the frame before it
     bool joinedPreviousWindow = false;  // the window's solve was tied to the window before
+    // Motion shift (TemporalShift::Motion): pixels of the frame before with a partner in this
+    // frame (motion_map.h), and the host time of its primary hits and the map.
+    std::uint64_t motionPartnered = 0;
+    double motionMs = 0.0;
 };
 
 struct RenderStats {

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "integrator/gpt_sampler.h"
+#include "integrator/motion_map.h"
 #include "integrator/reconstruction_stage.h"
 #include "integrator/render_identity.h"
 #include "poisson/poisson_spacetime.h"
@@ -23,6 +24,9 @@ struct FrameSamples {
     Image primal, dx, dy, direct, varPrimal, varDx, varDy, varDirect;
     Image firstHalfPrimal;   // seeded σ(f): pairs with the previous frame's second half
     Image secondHalfPrimal;  // seeded σ(f+1): pairs with the next frame's first half
+    // Where each pixel of the frame before moved to in this one (its first half's streams
+    // follow it); empty for the replay shift or without a frame before.
+    std::vector<std::uint32_t> fromPrevious;
     RenderStats stats;
 };
 
@@ -38,10 +42,40 @@ Image weighted(const Image& a, double na, const Image& b, double nb, int power) 
     return out;
 }
 
-Image difference(const Image& a, const Image& b) {
-    Image out = a;
+// The temporal differences from `earlier` to `later`, at the earlier frame's pixels p:
+// later(π(p)) − earlier(p), 0 where p has no partner; π = the same pixel if `partner` is empty.
+Image differenceAlong(const Image& later, const Image& earlier, const std::vector<std::uint32_t>& partner) {
+    Image out(earlier.width(), earlier.height());
     for (int c = 0; c < 3; ++c)
-        for (std::size_t i = 0; i < out.pixelCount(); ++i) out.plane(c)[i] = a.plane(c)[i] - b.plane(c)[i];
+        for (std::size_t p = 0; p < out.pixelCount(); ++p) {
+            const std::uint32_t q = partner.empty() ? std::uint32_t(p) : partner[p];
+            if (q != kNoTemporalPartner) out.plane(c)[p] = later.plane(c)[q] - earlier.plane(c)[p];
+        }
+    return out;
+}
+
+// The same differences moved to the later frame's pixels (the dt layer of the later frame).
+Image atLaterPixels(const Image& dt, const std::vector<std::uint32_t>& partner) {
+    if (partner.empty()) return dt;
+    Image out(dt.width(), dt.height());
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t p = 0; p < out.pixelCount(); ++p)
+            if (partner[p] != kNoTemporalPartner) out.plane(c)[partner[p]] = dt.plane(c)[p];
+    return out;
+}
+
+// Per pixel q of a frame: the offset (x, y) to the pixel of the frame before that it came
+// from, and 1 in the third channel where it has one (the same pixel for the replay shift).
+Image motionLayer(const std::vector<std::uint32_t>& partner, bool hasPrevious, int width, int height) {
+    Image out(width, height);
+    if (!hasPrevious) return out;
+    for (std::size_t p = 0; p < out.pixelCount(); ++p) {
+        const std::uint32_t q = partner.empty() ? std::uint32_t(p) : partner[p];
+        if (q == kNoTemporalPartner) continue;
+        out.plane(0)[q] = float(int(p % std::size_t(width)) - int(q % std::uint32_t(width)));
+        out.plane(1)[q] = float(int(p / std::size_t(width)) - int(q / std::uint32_t(width)));
+        out.plane(2)[q] = 1.0f;
+    }
     return out;
 }
 
@@ -106,6 +140,16 @@ void checkWindowMemory(int width, int height, int frames) {
 
 }  // namespace
 
+TemporalShift parseTemporalShift(const std::string& text) {
+    if (text == "motion") return TemporalShift::Motion;
+    if (text == "replay") return TemporalShift::Replay;
+    throw UsageError("--temporal-shift must be motion or replay, not '" + text + "'");
+}
+
+const char* temporalShiftName(TemporalShift shift) {
+    return shift == TemporalShift::Motion ? "motion" : "replay";
+}
+
 TgptIntegrator::TgptIntegrator(TgptOptions options) : options_(std::move(options)) {
     options_.sampling.demodulate = Demodulation::Off;
     if (options_.window < 1) throw UsageError("--window must be at least 1 frame");
@@ -119,7 +163,8 @@ ExrAttributes TgptIntegrator::identity(const Scene& scene, const RenderOptions& 
     (void)scene;
     return {{"shift_threshold", exactFloat(options.scene.shiftThreshold)},
             {"edge_samples", std::to_string(options_.sampling.edgeSamples)},
-            {"window", std::to_string(options_.window)}};
+            {"window", std::to_string(options_.window)},
+            {"temporal_shift", temporalShiftName(options_.shift)}};
 }
 
 RenderOutput TgptIntegrator::render(const vk::Context& ctx, const Scene& scene,
@@ -139,11 +184,39 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
     std::vector<FrameSamples> frames;
     if (window.startsSequence) carry_.reset();
     const bool joined = carry_ && carry_->frame == window.first - 1;
+    const bool motion = options_.shift == TemporalShift::Motion;
+    // The frame before the one being sampled, for the motion between them.
+    std::shared_ptr<const Scene> previousScene = joined ? carry_->scene : nullptr;
+    std::vector<PrimaryHit> previousHits = joined ? carry_->hits : std::vector<PrimaryHit>{};
 
     // 1. Sampling: two half renders per frame, seeded σ(f) and σ(f+1).
     for (int k = 0; k < window.count; ++k) {
         const int frame = window.first + k;
-        const Scene scene = window.scene(frame);
+        const auto scene = std::make_shared<const Scene>(window.scene(frame));
+        // The motion shift: where the frame before's pixels moved, and the streams that
+        // replay their paths there in this frame's first half.
+        GptSamplingOptions firstSampling = options_.sampling;
+        std::vector<std::uint32_t> fromPrevious;
+        std::uint64_t partnered = 0;
+        Timer motionTimer;
+        if (motion) {
+            std::vector<PrimaryHit> hits = primaryHits(*scene, options.scene.camera, width, height);
+            if (previousScene) {
+                MotionMap map = motionBetween(*previousScene, previousHits, *scene, hits, options.scene.camera,
+                                              width, height);
+                if (!map.sameTopology && !options.quiet)
+                    std::fprintf(stderr,
+                                 "gdpt: warning: frames %d and %d have different triangle lists; their "
+                                 "temporal differences replay paths at the same pixel\n",
+                                 frame - 1, frame);
+                firstSampling.streamKeys = std::make_shared<const std::vector<std::uint32_t>>(carriedStreams(map));
+                partnered = map.partnered;
+                fromPrevious = std::move(map.partner);
+            }
+            previousScene = scene;
+            previousHits = std::move(hits);
+        }
+        const double motionMs = motionTimer.ms();
         RenderOptions half = options;
         half.spp = std::max<std::uint32_t>(1, options.spp / 2);
         half.whileCompiling = nullptr;
@@ -157,14 +230,14 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
                                double(window.count - k));
         if (timed) half.timeBudget = 0.5 * share;
         half.seed = window.seed(frame);
-        RenderResultGpt first = renderGpt(ctx, scene, half, options_.sampling);
+        RenderResultGpt first = renderGpt(ctx, *scene, half, firstSampling);
         if (first.stats.cancelled) {
             outputs.push_back({{}, first.stats});
             return outputs;
         }
         if (timed) half.timeBudget = std::max(1e-3, share - (timer.seconds() - frameStart));
         half.seed = window.seed(frame + 1);
-        RenderResultGpt second = renderGpt(ctx, scene, half, options_.sampling);
+        RenderResultGpt second = renderGpt(ctx, *scene, half, options_.sampling);
         if (second.stats.cancelled) {
             outputs.push_back({{}, addStats(first.stats, second.stats)});
             return outputs;
@@ -184,6 +257,9 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         f.stats = addStats(first.stats, second.stats);
         f.stats.tgpt.firstHalfSpp = first.stats.spp;
         f.stats.tgpt.secondHalfSpp = second.stats.spp;
+        f.stats.tgpt.motionPartnered = partnered;
+        f.stats.tgpt.motionMs = motionMs;
+        f.fromPrevious = std::move(fromPrevious);
         frames.push_back(std::move(f));
     }
 
@@ -195,20 +271,30 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
     problem.frames = window.count;
     problem.alpha = options_.alpha;
     problem.beta = options_.beta;
+    // dt at the earlier frame's pixels, as the solve takes it; the layers hold it at the
+    // later frame's pixels.
     std::vector<Image> dtToPrevious(frames.size());
     for (std::size_t k = 0; k < frames.size(); ++k) {
         append(problem.primal, frames[k].primal);
         append(problem.dx, frames[k].dx);
         append(problem.dy, frames[k].dy);
         if (k > 0) {
-            dtToPrevious[k] = difference(frames[k].firstHalfPrimal, frames[k - 1].secondHalfPrimal);
-            append(problem.dt, dtToPrevious[k]);
+            const Image dt = differenceAlong(frames[k].firstHalfPrimal, frames[k - 1].secondHalfPrimal,
+                                             frames[k].fromPrevious);
+            append(problem.dt, dt);
+            if (motion)
+                problem.temporalPartner.insert(problem.temporalPartner.end(), frames[k].fromPrevious.begin(),
+                                               frames[k].fromPrevious.end());
+            dtToPrevious[k] = atLaterPixels(dt, frames[k].fromPrevious);
         }
     }
     if (joined) {
-        dtToPrevious[0] = difference(frames[0].firstHalfPrimal, carry_->secondHalfPrimal);
+        const Image dt =
+            differenceAlong(frames[0].firstHalfPrimal, carry_->secondHalfPrimal, frames[0].fromPrevious);
         problem.previous = carry_->recon;
-        append(problem.dtPrevious, dtToPrevious[0]);
+        append(problem.dtPrevious, dt);
+        if (motion) problem.previousPartner = frames[0].fromPrevious;
+        dtToPrevious[0] = atLaterPixels(dt, frames[0].fromPrevious);
     }
     SpaceTimeOptions solve;
     solve.l1 = options_.l1;
@@ -245,6 +331,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         out.stats.tgpt.windowFrames = window.count;
         out.stats.tgpt.temporalToPrevious = k > 0 || joined;
         out.stats.tgpt.joinedPreviousWindow = joined;
+        const bool hasPrevious = k > 0 || joined;
         if (dtToPrevious[k].empty()) dtToPrevious[k] = Image(width, height);
         out.layers.push_back({"", gptFinal(recon, nullptr, &f.direct)});
         Image primalPlusDirect = gptFinal(f.primal, nullptr, &f.direct);
@@ -253,6 +340,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         out.layers.push_back({"dx", std::move(f.dx)});
         out.layers.push_back({"dy", std::move(f.dy)});
         out.layers.push_back({"dt", std::move(dtToPrevious[k])});
+        out.layers.push_back({"motion", motionLayer(f.fromPrevious, hasPrevious, width, height)});
         out.layers.push_back({"direct", std::move(f.direct)});
         out.layers.push_back({"var_primal", std::move(f.varPrimal)});
         out.layers.push_back({"var_dx", std::move(f.varDx)});
@@ -261,7 +349,8 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         out.layers.push_back({"primal_plus_direct", std::move(primalPlusDirect)});
         outputs.push_back(std::move(out));
     }
-    carry_ = Carry{window.first + window.count - 1, {}, std::move(frames.back().secondHalfPrimal)};
+    carry_ = Carry{window.first + window.count - 1, {}, std::move(frames.back().secondHalfPrimal),
+                   std::move(previousScene), std::move(previousHits)};
     const std::size_t last = std::size_t(window.count - 1) * std::size_t(width) * std::size_t(height);
     for (int c = 0; c < 3; ++c) carry_->recon[c].assign(x[c].begin() + std::ptrdiff_t(last), x[c].end());
     return outputs;
@@ -276,6 +365,9 @@ void TgptIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
                  {"second_half_spp", s.tgpt.secondHalfSpp},
                  {"temporal_to_previous", s.tgpt.temporalToPrevious},
                  {"joined_previous_window", s.tgpt.joinedPreviousWindow},
+                 {"temporal_shift", temporalShiftName(options_.shift)},
+                 {"motion_partnered", s.tgpt.motionPartnered},
+                 {"motion_ms", s.tgpt.motionMs},
                  {"alpha", options_.alpha},
                  {"beta", options_.beta}};
 }

@@ -24,11 +24,13 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "integrator/integrator.h"
+#include "integrator/motion_map.h"
 
 namespace gdpt {
 
@@ -55,6 +57,9 @@ private:
         int frame = -1;
         std::array<std::vector<double>, 3> recon;
         Image secondHalfPrimal;
+        // The motion shift: the last frame's scene and primary hits (motion_map.h).
+        std::shared_ptr<const Scene> scene;
+        std::vector<PrimaryHit> hits;
     };
     std::optional<Carry> carry_;
     // The last window's solve, reserved (per frame) from the next window's budget.

@@ -217,6 +217,16 @@ void setCamera(gpu::SceneConstants& c, const Camera& camera, int width, int heig
     c.height = static_cast<std::uint32_t>(height);
 }
 
+Camera renderCamera(const Scene& scene, int index) {
+    if (index >= 0) {
+        if (index >= static_cast<int>(scene.cameras.size()))
+            throw Error("--camera " + std::to_string(index) + " is out of range: the scene has " +
+                        std::to_string(scene.cameras.size()) + " camera(s)");
+        return scene.cameras[static_cast<std::size_t>(index)];
+    }
+    return scene.cameras.empty() ? defaultCamera(scene) : scene.cameras.front();
+}
+
 SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOptions& options)
     : SceneGpu(ctx, scene, options, SceneSpec(scene, options)) {}
 
@@ -265,16 +275,7 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
         texInfo.push_back(info);
     }
 
-    Camera camera;
-    if (options.camera >= 0) {
-        if (options.camera >= static_cast<int>(scene.cameras.size()))
-            throw Error("--camera " + std::to_string(options.camera) + " is out of range: the scene has " +
-                        std::to_string(scene.cameras.size()) + " camera(s)");
-        camera = scene.cameras[static_cast<std::size_t>(options.camera)];
-    } else {
-        camera = scene.cameras.empty() ? defaultCamera(scene) : scene.cameras.front();
-    }
-    setCamera(constants_, camera, options.width, options.height);
+    setCamera(constants_, renderCamera(scene, options.camera), options.width, options.height);
     constants_.envRadiance = options.envRadiance;
     constants_.numLightTriangles = static_cast<std::uint32_t>(lights.size());
     constants_.numPunctualLights = static_cast<std::uint32_t>(scene.punctualLights.size());

@@ -95,4 +95,9 @@ private:
 // Builds the camera constants for an image of width × height (shared with tests).
 void setCamera(gpu::SceneConstants& c, const Camera& camera, int width, int height);
 
+// The camera a render of `scene` uses: Scene::cameras[index] (SceneGpuOptions::camera), or for
+// -1 the first, or a framing default if the scene has none. Throws gdpt::Error if the index is
+// out of range.
+[[nodiscard]] Camera renderCamera(const Scene& scene, int index);
+
 }  // namespace gdpt

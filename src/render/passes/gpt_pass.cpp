@@ -31,7 +31,8 @@ bool splitBounceFor(const vk::DeviceInfo& device, GptPassOptions::SplitBounce s)
 
 vk::KernelDesc gptDesc(const SceneSpec& scene, WorkgroupSize wg, bool halfVector, bool splitBounce,
                        bool demodulate, const EmitterSupersamplingPass& visible) {
-    std::vector<std::uint32_t> extra = {gpu::kBindCounters, gpu::kBindGptDemodMask, gpu::kBindGptModulation};
+    std::vector<std::uint32_t> extra = {gpu::kBindCounters, gpu::kBindGptDemodMask, gpu::kBindGptModulation,
+                                        gpu::kBindGptStreamKey};
     for (std::uint32_t i = 0; i < kNumStats; ++i) extra.push_back(gpu::kBindGptCentral + i);
     vk::KernelDesc d = scene.kernelDesc(splitBounce ? vk::kernelDesc("gpt", GDPT_KERNEL_SPIRV(gpt_split))
                                                     : vk::kernelDesc("gpt", GDPT_KERNEL_SPIRV(gpt)),
@@ -68,6 +69,7 @@ std::vector<PixelBuffer> pixelBuffers(const GptPassOptions& options) {
         b.push_back({"the demodulation mask", sizeof(std::uint32_t)});
         b.push_back({"the modulation statistics", sizeof(gpu::PixelStats)});
     }
+    if (options.streamKeys) b.push_back({"the stream keys", sizeof(std::uint32_t)});
     return b;
 }
 
@@ -154,7 +156,15 @@ GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize w
       demodMask_(ctx, options.demodulate ? std::uint64_t{width_} * height_ * sizeof(std::uint32_t) : 0,
                  "gpt demodulation mask"),
       modulation_(ctx, options.demodulate ? std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats) : 0,
-                  "gpt modulation") {
+                  "gpt modulation"),
+      streamKey_(ctx, options.streamKeys ? std::uint64_t{width_} * height_ * sizeof(std::uint32_t) : 0,
+                 "gpt stream keys") {
+    if (options_.streamKeys) {
+        if (options_.streamKeys->size() != std::size_t{width_} * height_)
+            throw Error("gpt stream keys: " + std::to_string(options_.streamKeys->size()) + " entries for " +
+                        std::to_string(width_) + "x" + std::to_string(height_) + " pixels");
+        streamKey_.uploadVector(*options_.streamKeys);
+    }
     kernel_.bind(gpu::kBindCounters, counters_);
     for (std::uint32_t i = 0; i < kNumStats; ++i) {
         kernel_.bindAddress(gpu::kBindGptCentral + i, stats_[i]);
@@ -163,6 +173,7 @@ GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize w
     resolveKernel_.bindAddress(gpu::kBindGptResolved, resolved_);
     kernel_.bindAddress(gpu::kBindGptDemodMask, demodMask_);  // all 0 (no pixel) until findEdges()
     kernel_.bindAddress(gpu::kBindGptModulation, modulation_);
+    kernel_.bindAddress(gpu::kBindGptStreamKey, streamKey_);
     demodMask_.zero();
     emitterSupersampling_.bindTo(kernel_);
     emitterSupersampling_.bindTo(resolveKernel_);
@@ -205,6 +216,7 @@ gpu::GptFrameParams GptPass::frameParams() const {
     p.shiftThreshold = shiftThreshold_;
     p.width = width_;
     p.height = height_;
+    p.streamKeys = options_.streamKeys ? 1u : 0u;
     return p;
 }
 

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "gpt_shared.h"
@@ -46,6 +47,10 @@ struct GptPassOptions {
     // saw another surface); GptImages::modulation then holds m̄ and primal/dx/dy are of
     // J = I / m̄.
     bool demodulate = false;
+    // The random stream of each pixel's camera samples (width × height entries, any uint; see
+    // gpt.comp), or null: pixel p draws stream p, as the path tracer does. Temporal G-PT sets
+    // it to carry paths along the scene's motion (integrator/motion_map.h).
+    std::shared_ptr<const std::vector<std::uint32_t>> streamKeys;
 };
 
 // Whether first-hit demodulation can act on a scene: some material has a base-colour texture
@@ -148,6 +153,7 @@ private:
     vk::Buffer resolved_;
     vk::Buffer demodMask_;   // uint per pixel (16-byte placeholder without demodulation)
     vk::Buffer modulation_;  // PixelStats per pixel (placeholder without demodulation)
+    vk::Buffer streamKey_;   // uint per pixel (16-byte placeholder without stream keys)
     std::uint32_t demodulatedPixels_ = 0;
 };
 
