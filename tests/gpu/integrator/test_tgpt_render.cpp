@@ -3,8 +3,10 @@
 //     replay the same paths), and its reconstruction is tied across window boundaries;
 //   - E[dt] = I_f+1 − I_f: block means of dt over independent seeds against the difference of
 //     two path-traced frames of the moving-box animation (many samples, independent), by a
-//     Student t test per block (Šidák-corrected family level 1e-3); the test shows its power
-//     by rejecting the difference of the frames the other way round;
+//     Student t test per block (Šidák-corrected family level 1e-3), at the same pixel for the
+//     replay shift and along the motion for the motion shift; the test shows its power by
+//     rejecting the difference of the frames the other way round (replay) and the same-pixel
+//     difference (motion);
 //   - the same seed gives the same bits.
 #include <gtest/gtest.h>
 
@@ -28,7 +30,10 @@ namespace gdpt {
 namespace {
 
 // Many short renders of the same kernels: a context that keeps its pipelines.
-class TgptRender : public test::KeptPipelinesTest {};
+class TgptRender : public test::KeptPipelinesTest {
+protected:
+    void expectUnbiasedTemporalDifferences(TemporalShift shift);
+};
 
 FrameWindow windowOf(std::function<Scene(int)> scene, int first, int count, unsigned seed,
                      bool starts = true) {
@@ -60,6 +65,9 @@ TEST_F(TgptRender, AStillSceneHasZeroTemporalDifferencesAndJoinsWindows) {
     EXPECT_TRUE(second[0].stats.tgpt.temporalToPrevious);
     EXPECT_EQ(first[1].stats.tgpt.firstHalfSpp, 2u);
     EXPECT_EQ(first[1].stats.spp, 4u);
+    // The motion shift's map of a still scene: every pixel its own partner.
+    EXPECT_EQ(first[1].stats.tgpt.motionPartnered, 20u * 16u);
+    EXPECT_EQ(second[0].stats.tgpt.motionPartnered, 20u * 16u);
     for (const auto* frame : {&first[1], &second[0], &second[1]})
         for (int c = 0; c < 3; ++c)
             for (float v : frame->layer("dt").plane(c)) ASSERT_EQ(v, 0.0f);
@@ -73,8 +81,11 @@ TEST_F(TgptRender, AStillSceneHasZeroTemporalDifferencesAndJoinsWindows) {
 }
 
 // Block means of dt (frame 1 − frame 0 of moving_box at 2 fps) over independent seeds against
-// the difference of the two frames path-traced with many samples.
-TEST_F(TgptRender, TemporalDifferencesAreUnbiased) {
+// the difference of the two frames path-traced with many samples: at the same pixel for the
+// replay shift; for the motion shift, dt at frame 1's pixel q is I_1(q) − I_0(s(q)) with s(q) the
+// pixel its paths came from (the motion layer), and 0 where q has none.
+void TgptRender::expectUnbiasedTemporalDifferences(TemporalShift shift) {
+    const vk::Context& ctx = keeping();
     const GltfAsset asset(std::string(GDPT_SOURCE_DIR) + "/scenes/moving_box.gltf");
     const auto sceneAt = [&](int f) { return asset.instance(0, f * 0.5); };
     const int w = 32, h = 24, block = 8, bx = w / block, by = h / block;
@@ -82,13 +93,17 @@ TEST_F(TgptRender, TemporalDifferencesAreUnbiased) {
     TgptOptions o;
     o.window = 2;
     o.l1 = false;
+    o.shift = shift;
     TgptIntegrator tgpt(o);
     std::vector<std::vector<double>> blocks(bx * by * 3);  // per block and channel: one value per seed
+    Image motion;
     for (int seed = 0; seed < kSeeds; ++seed) {
-        const auto frames = tgpt.renderWindow(keeping(), windowOf(sceneAt, 0, 2, unsigned(seed) * 7919u),
+        const auto frames = tgpt.renderWindow(ctx, windowOf(sceneAt, 0, 2, unsigned(seed) * 7919u),
                                               renderOptions(w, h, 8, 0));
         const Image& dt = frames[1].layer("dt");
-        for (int c = 0; c < 3; ++c)
+        if (seed == 0) motion = frames[1].layer("motion");
+        for (int c = 0; c < 3; ++c) {
+            ASSERT_EQ(frames[1].layer("motion").plane(c), motion.plane(c)) << "the motion depends on the seed";
             for (int b = 0; b < bx * by; ++b) {
                 double sum = 0.0;
                 for (int y = 0; y < block; ++y)
@@ -96,12 +111,29 @@ TEST_F(TgptRender, TemporalDifferencesAreUnbiased) {
                         sum += dt.at((b % bx) * block + x, (b / bx) * block + y, c);
                 blocks[(b * 3) + c].push_back(sum / (block * block));
             }
+        }
+    }
+    int carried = 0, moved = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            carried += motion.at(x, y, 2) != 0.0f ? 1 : 0;
+            moved += motion.at(x, y, 0) != 0.0f || motion.at(x, y, 1) != 0.0f ? 1 : 0;
+        }
+    if (shift == TemporalShift::Replay) {
+        EXPECT_EQ(carried, w * h);
+        EXPECT_EQ(moved, 0);
+    } else {
+        // The box moves by several pixels between the frames and the background stays.
+        EXPECT_GT(moved, 20);
+        EXPECT_GT(carried, w * h / 2);
+        EXPECT_LT(carried, w * h);
     }
     // The reference: the two frames path-traced, independent of each other and of tgpt.
-    const RenderResult pt0 = renderPt(keeping(), sceneAt(0), renderOptions(w, h, 2048, 101));
-    const RenderResult pt1 = renderPt(keeping(), sceneAt(1), renderOptions(w, h, 2048, 202));
+    const RenderResult pt0 = renderPt(ctx, sceneAt(0), renderOptions(w, h, 2048, 101));
+    const RenderResult pt1 = renderPt(ctx, sceneAt(1), renderOptions(w, h, 2048, 202));
     const double threshold = test::twoSidedT(test::sidakAlpha(1e-3, bx * by * 3), kSeeds - 1);
-    const auto rejected = [&](double sign) {
+    // `alongMotion`: the differences the shift estimates; else those at the same pixel.
+    const auto rejected = [&](double sign, bool alongMotion) {
         int count = 0;
         double worst = 0.0;
         for (int c = 0; c < 3; ++c)
@@ -110,8 +142,11 @@ TEST_F(TgptRender, TemporalDifferencesAreUnbiased) {
                 for (int y = 0; y < block; ++y)
                     for (int x = 0; x < block; ++x) {
                         const int px = (b % bx) * block + x, py = (b / bx) * block + y;
-                        ref += pt1.image.at(px, py, c) - pt0.image.at(px, py, c);
-                        refVar += pt1.varianceOfMean.at(px, py, c) + pt0.varianceOfMean.at(px, py, c);
+                        if (alongMotion && motion.at(px, py, 2) == 0.0f) continue;
+                        const int sx = px + (alongMotion ? int(motion.at(px, py, 0)) : 0);
+                        const int sy = py + (alongMotion ? int(motion.at(px, py, 1)) : 0);
+                        ref += pt1.image.at(px, py, c) - pt0.image.at(sx, sy, c);
+                        refVar += pt1.varianceOfMean.at(px, py, c) + pt0.varianceOfMean.at(sx, sy, c);
                     }
                 ref = sign * ref / (block * block);
                 refVar /= double(block * block) * double(block * block);
@@ -127,11 +162,26 @@ TEST_F(TgptRender, TemporalDifferencesAreUnbiased) {
             }
         return std::make_pair(count, worst);
     };
-    const auto [fails, worst] = rejected(1.0);
+    const auto [fails, worst] = rejected(1.0, true);
     EXPECT_EQ(fails, 0) << "worst |t| " << worst << " against the threshold " << threshold;
-    // Power: the box moved, so the difference the other way round must be rejected.
-    const auto [reversedFails, reversedWorst] = rejected(-1.0);
-    EXPECT_GE(reversedFails, 3) << "the test cannot tell dt from -dt (worst |t| " << reversedWorst << ")";
+    // Power: the box moved, so the difference the other way round must be rejected, and for
+    // the motion shift also the difference at the same pixel (what the replay shift estimates).
+    const auto [reversedFails, reversedWorst] = rejected(-1.0, true);
+    if (shift == TemporalShift::Replay) {
+        EXPECT_GE(reversedFails, 3) << "the test cannot tell dt from -dt (worst |t| " << reversedWorst << ")";
+    } else {
+        const auto [samePixelFails, samePixelWorst] = rejected(1.0, false);
+        EXPECT_GE(samePixelFails, 3) << "the test cannot tell the motion's dt from the same pixel's (worst |t| "
+                                     << samePixelWorst << ")";
+    }
+}
+
+TEST_F(TgptRender, TemporalDifferencesAreUnbiased) {
+    expectUnbiasedTemporalDifferences(TemporalShift::Replay);
+}
+
+TEST_F(TgptRender, TemporalDifferencesAlongTheMotionAreUnbiased) {
+    expectUnbiasedTemporalDifferences(TemporalShift::Motion);
 }
 
 TEST_F(TgptRender, SameSeedSameBits) {
