@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Animations at equal time: PT, per-frame G-PT and temporal G-PT (docs/animation.md; `tgpt` with
-# its default motion shift, `tgpt-replay` with --temporal-shift replay) render the same frames of each animated scene with the same --time for the whole sequence, and each
-# sequence is compared with a PT reference sequence of REFSPP samples per pixel by
-# `gdpt diff-sequence`: the mean per-frame relMSE and the mean temporal relMSE (the error of
-# the frame-to-frame change: flicker). The reference is rendered twice (seeds 1001, 2002) and
+# its default motion shift, `tgpt-replay` with --temporal-shift replay) render the same frames
+# of each animated scene with the same --time for the whole sequence, and each sequence is
+# compared with a PT reference sequence of REFSPP samples per pixel by `gdpt diff-sequence`:
+# the mean per-frame relMSE and the mean temporal relMSE (the error of the frame-to-frame
+# change: flicker). The reference is rendered twice (seeds 1001, 2002) and
 # the two are compared with each other: their relMSE is twice the reference's noise floor.
 # Writes OUT/<scene>/<method>/f_*.exr (+ .json summaries, .diff.json metrics), OUT/results.csv,
 # OUT/results.json and OUT/temporal.png (gnuplot); the table goes to stdout. Not a test: about
@@ -26,7 +27,7 @@ while (($#)); do
     --reference-spp) refspp=$2; shift 2 ;;
     --methods) methods=$2; shift 2 ;;
     --repeats) repeats=$2; shift 2 ;;
-    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
     *) echo "bench-temporal.sh: unknown option '$1' (try --help)" >&2; exit 2 ;;
   esac
 done

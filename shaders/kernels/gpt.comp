@@ -76,8 +76,9 @@ GDPT_PIXEL_BUFFER(kBindGptEdgeList, UintArray, edgeList);
 #define edgeList edgeList_.v
 GDPT_PIXEL_BUFFER(kBindGptDemodMask, UintArray, demodMask);
 #define demodMask demodMask_.v
-GDPT_PIXEL_BUFFER(kBindGptStreamKey, UintArray, streamKey);
-#define streamKey streamKey_.v
+layout(buffer_reference, scalar, buffer_reference_align = 4) buffer PixelStreamArray { PixelStream v[]; };
+GDPT_PIXEL_BUFFER(kBindGptStreamKey, PixelStreamArray, pixelStream);
+#define pixelStream pixelStream_.v
 GDPT_PIXEL_BUFFER(kBindGptModulation, PixelStatsArray, statModulation);
 #define statModulation statModulation_.v
 layout(constant_id = kSpecGptDemodulate) const bool kDemodulate = false;
@@ -152,13 +153,20 @@ void main() {
     bool countDirect = !emissionSupersampled(pixel);
     // The random stream of this pixel's samples: its own (as pt.comp's), or the one the host
     // assigned (temporal G-PT: the stream of the pixel of the previous frame whose primary hit
-    // moved here, so that the same path is replayed on the same surface).
-    uint stream = frame.streamKeys != 0u ? streamKey[pixel] : pixel;
+    // moved here, with the sub-pixel part of that motion as a toroidal shift of the position
+    // in the pixel, so that the same path is replayed from the same surface point).
+    uint stream = pixel;
+    vec2 jitterShift = vec2(0.0);
+    if (frame.streamKeys != 0u) {
+        PixelStream ps = pixelStream[pixel];
+        stream = ps.key;
+        jitterShift = vec2(ps.jitterShift & 0xFFFFu, ps.jitterShift >> 16u) * (1.0 / 65536.0);
+    }
     for (uint s = 0u; s < frame.samplesPerPixel; ++s) {
         // Same stream as pt.comp's sample s: the base path is PT's path.
         Rng rng = rngInit(stream, frame.sampleBase + s, frame.seed);
         LdSample lds = ldSampleInit(stream, frame.sampleBase + s, frame.seed);
-        vec2 jitter = ldGet2(lds, kLdDimPixel);
+        vec2 jitter = fract(ldGet2(lds, kLdDimPixel) + jitterShift);
         vec3 direct, baseModulation;
         traceSample(lds, rng, vec2(x, y) + jitter, x, y, countDirect, rays, direct, baseModulation, offs);
         if (kDemodulate) {

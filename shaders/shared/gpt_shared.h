@@ -34,9 +34,18 @@ struct GptFrameParams {
     uint listCount;        // 0: the dispatch covers image rows; > 0: edge-list mode, the
                            // dispatch's (x, row) is entry row·width + x of kBindGptEdgeList
                            // (rowOffset/rowCount tile those virtual rows), listCount entries
-    uint streamKeys;       // 1: pixel p's camera samples draw their random numbers from stream
-                           // kBindGptStreamKey[p] instead of stream p (temporal G-PT's motion-
-                           // carried shift, motion_map.h); 0: stream p
+    uint streamKeys;       // 1: pixel p's camera samples draw their random numbers from the
+                           // stream kBindGptStreamKey[p] names instead of stream p, and shift
+                           // their position in the pixel by its jitter shift (temporal G-PT's
+                           // motion-carried shift, motion_map.h); 0: stream p, unshifted
+};
+
+// Where pixel p's camera samples come from when GptFrameParams::streamKeys is 1. 8 bytes.
+struct PixelStream {
+    uint key;          // the random stream (any uint; pixel p's own is p)
+    uint jitterShift;  // s in [0,1)^2 in 1/65536 pixels, x in the low 16 bits, y in the high:
+                       // each sample's position in the pixel is fract(u + s) for its uniform
+                       // u (a toroidal shift: still uniform over the pixel)
 };
 
 // Resolved per-pixel output of gpt_resolve.comp (linear RGB radiance, W/(m^2 sr)). 96 bytes;
@@ -91,7 +100,7 @@ kBindGptCentral = 40u,        // base's MIS-weighted radiance summed over the pa
     kBindGptModulation = 54u,  // PixelStats per pixel: m at the base paths' first hits (1 where
                                // not demodulated, also on a miss)
     kBindGptEdgeProbe = 55u,   // EdgeProbe per pixel written by edge.comp
-    kBindGptStreamKey = 56u    // uint per pixel: the random stream of its camera samples (read
+    kBindGptStreamKey = 56u    // PixelStream per pixel: where its camera samples come from (read
                                // when GptFrameParams::streamKeys is 1)
     GDPT_ENUM_END();
 
@@ -99,6 +108,7 @@ kBindGptCentral = 40u,        // base's MIS-weighted radiance summed over the pa
 static_assert(sizeof(GptFrameParams) == 40, "GptFrameParams layout");
 static_assert(sizeof(GptResolved) == 96, "GptResolved layout (scalar)");
 static_assert(sizeof(EdgeProbe) == 32, "EdgeProbe layout (scalar)");
+static_assert(sizeof(PixelStream) == 8, "PixelStream layout (scalar)");
 static_assert(std::uint32_t{kBindGptCentral} > std::uint32_t{kBindTestOutput2},
               "G-PT bindings must not collide with gdpt_shared.h's");
 }  // namespace gdpt::gpu

@@ -45,7 +45,7 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     passOptions.emitterSupersampling = options.emitterSupersampling;
     passOptions.edgeSamples = gpt.edgeSamples;
     passOptions.demodulate = demodulates(scene, gpt.demodulate);
-    passOptions.streamKeys = gpt.streamKeys;
+    passOptions.streams = gpt.streams;
     GptPass* pass = nullptr;
     PixelSampling sampling(ctx, scene, options, "gpt", [&](const SceneSpec& spec) {
         auto p = std::make_unique<GptPass>(ctx, spec, options.workgroup, passOptions,

@@ -31,9 +31,9 @@ struct GptSamplingOptions {
     // (render/passes/edge_pass.h); 0 = off.
     std::uint32_t edgeSamples = kDefaultEdgeSamples;
     Demodulation demodulate = Demodulation::Auto;
-    // The random stream of each pixel's camera samples, or null for the pixel's own
-    // (GptPassOptions::streamKeys).
-    std::shared_ptr<const std::vector<std::uint32_t>> streamKeys;
+    // Where each pixel's camera samples come from, or null for the pixel's own stream
+    // (GptPassOptions::streams).
+    std::shared_ptr<const std::vector<gpu::PixelStream>> streams;
 };
 
 struct RenderResultGpt {

@@ -54,10 +54,10 @@ glm::vec3 carried(const Scene& scene, const gpu::SceneConstants& c, const Primar
     return d;
 }
 
-// The pixel (index) that a hit carried into `scene` lands in, or false off the image.
+// The pixel (index) that a hit carried into `scene` lands in, or false off the image; `pos`
+// the continuous position.
 bool landsIn(const Scene& scene, const gpu::SceneConstants& c, const PrimaryHit& h, std::uint32_t& pixel,
-             float& distance, glm::ivec2& at) {
-    glm::vec2 pos;
+             float& distance, glm::ivec2& at, glm::vec2& pos) {
     if (!project(c, carried(scene, c, h, distance), pos)) return false;
     if (!(pos.x >= 0.0f && pos.y >= 0.0f && pos.x < float(c.width) && pos.y < float(c.height))) return false;
     at = glm::ivec2(int(pos.x), int(pos.y));
@@ -105,10 +105,17 @@ MotionMap motionBetween(const Scene& from, const std::vector<PrimaryHit>& fromHi
     // Forward: each pixel's landing pixel in `to` and its distance there.
     std::vector<std::uint32_t> lands(np, kNoTemporalPartner);
     std::vector<float> distance(np, 0.0f);
+    map.subpixel.assign(np, glm::vec2(0.0f));
     parallelRanges(defaultThreads(), np, 4096, [&](std::size_t begin, std::size_t end) {
         for (std::size_t p = begin; p < end; ++p) {
             glm::ivec2 at;
-            if (!landsIn(to, cTo, fromHits[p], lands[p], distance[p], at)) lands[p] = kNoTemporalPartner;
+            glm::vec2 pos;
+            if (!landsIn(to, cTo, fromHits[p], lands[p], distance[p], at, pos)) {
+                lands[p] = kNoTemporalPartner;
+                continue;
+            }
+            // Clamped: a float position just below a pixel's far edge may round onto it.
+            map.subpixel[p] = glm::clamp(pos - glm::vec2(at) - 0.5f, glm::vec2(-0.5f), glm::vec2(0.49999f));
         }
     });
     // The nearest pixel of `from` landing in each pixel of `to` (the lowest index among equals).
@@ -126,7 +133,8 @@ MotionMap motionBetween(const Scene& from, const std::vector<PrimaryHit>& fromHi
         std::uint32_t back;
         float d;
         glm::ivec2 at;
-        if (!landsIn(from, cFrom, toHits[q], back, d, at)) continue;
+        glm::vec2 pos;
+        if (!landsIn(from, cFrom, toHits[q], back, d, at, pos)) continue;
         const glm::ivec2 source(int(p % std::uint32_t(width)), int(p / std::uint32_t(width)));
         if (std::abs(at.x - source.x) > 1 || std::abs(at.y - source.y) > 1) continue;
         map.partner[p] = std::uint32_t(q);
@@ -135,13 +143,21 @@ MotionMap motionBetween(const Scene& from, const std::vector<PrimaryHit>& fromHi
     return map;
 }
 
-std::vector<std::uint32_t> carriedStreams(const MotionMap& map) {
+std::vector<gpu::PixelStream> carriedStreams(const MotionMap& map) {
     const std::size_t np = map.partner.size();
     GDPT_CHECK(np < std::size_t(kNoTemporalPartner) / 2);
-    std::vector<std::uint32_t> streams(np);
-    for (std::size_t q = 0; q < np; ++q) streams[q] = std::uint32_t(np + q);
-    for (std::size_t p = 0; p < np; ++p)
-        if (map.partner[p] != kNoTemporalPartner) streams[map.partner[p]] = std::uint32_t(p);
+    GDPT_CHECK(map.subpixel.empty() || map.subpixel.size() == np);
+    std::vector<gpu::PixelStream> streams(np);
+    for (std::size_t q = 0; q < np; ++q) streams[q] = {std::uint32_t(np + q), 0u};
+    for (std::size_t p = 0; p < np; ++p) {
+        if (map.partner[p] == kNoTemporalPartner) continue;
+        const glm::vec2 d = map.subpixel.empty() ? glm::vec2(0.0f) : map.subpixel[p];
+        // The shift fract(δ) in [0, 1) in 1/65536 pixels (gpt_shared.h); a δ a rounding below 0
+        // is no shift.
+        const glm::vec2 s = d - glm::floor(d);
+        const auto fixed = [](float v) { return std::uint32_t(std::lround(double(v) * 65536.0)) & 0xFFFFu; };
+        streams[map.partner[p]] = {std::uint32_t(p), fixed(s.x) | (fixed(s.y) << 16)};
+    }
     return streams;
 }
 

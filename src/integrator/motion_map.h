@@ -16,7 +16,11 @@
 //      partner, the same-pixel replay.
 //   3. carriedStreams: frame B's pixel q draws the stream of the pixel p of A whose partner
 //      it is, and a stream of its own (W·H + q, used by no pixel of A) otherwise. The streams
-//      of B's pixels are all different, so B's pixels stay independent.
+//      of B's pixels are all different, so B's pixels stay independent. The sub-pixel part δ
+//      of p's motion (where p's centre lands in B, less q's centre) shifts the samples'
+//      positions in q toroidally, u → fract(u + δ): to first order in the motion, a sample
+//      at p + u in A and its replay in B see the same surface point (except the fraction |δ|
+//      that wraps around), and u stays uniform over the pixel.
 //
 // Whatever the map, each pixel's estimate uses a valid stream and stays unbiased; the map
 // decides only which pairs of estimates are correlated (docs/animation.md).
@@ -26,7 +30,7 @@
 #include <glm/glm.hpp>
 #include <vector>
 
-#include "gdpt_shared.h"
+#include "gpt_shared.h"
 #include "scene/scene.h"
 
 namespace gdpt {
@@ -47,6 +51,9 @@ struct MotionMap {
     // Per pixel of the earlier frame: the pixel index of the later frame it moves to, or
     // kNoTemporalPartner (poisson_spacetime.h).
     std::vector<std::uint32_t> partner;
+    // Per pixel with a partner: where its centre lands in the later frame less the partner's
+    // centre, in pixels (each component in [-0.5, 0.5)).
+    std::vector<glm::vec2> subpixel;
     std::size_t partnered = 0;   // pixels with a partner
     bool sameTopology = true;    // false: the frames' triangle lists differ; partner = the same pixel
 };
@@ -56,7 +63,7 @@ struct MotionMap {
 MotionMap motionBetween(const Scene& from, const std::vector<PrimaryHit>& fromHits, const Scene& to,
                         const std::vector<PrimaryHit>& toHits, int camera, int width, int height);
 
-// The random stream of each pixel of the later frame (step 3 of the file comment).
-std::vector<std::uint32_t> carriedStreams(const MotionMap& map);
+// Where each pixel of the later frame draws its samples from (step 3 of the file comment).
+std::vector<gpu::PixelStream> carriedStreams(const MotionMap& map);
 
 }  // namespace gdpt

@@ -209,7 +209,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
                                  "gdpt: warning: frames %d and %d have different triangle lists; their "
                                  "temporal differences replay paths at the same pixel\n",
                                  frame - 1, frame);
-                firstSampling.streamKeys = std::make_shared<const std::vector<std::uint32_t>>(carriedStreams(map));
+                firstSampling.streams = std::make_shared<const std::vector<gpu::PixelStream>>(carriedStreams(map));
                 partnered = map.partnered;
                 fromPrevious = std::move(map.partner);
             }

@@ -69,7 +69,7 @@ std::vector<PixelBuffer> pixelBuffers(const GptPassOptions& options) {
         b.push_back({"the demodulation mask", sizeof(std::uint32_t)});
         b.push_back({"the modulation statistics", sizeof(gpu::PixelStats)});
     }
-    if (options.streamKeys) b.push_back({"the stream keys", sizeof(std::uint32_t)});
+    if (options.streams) b.push_back({"the pixel streams", sizeof(gpu::PixelStream)});
     return b;
 }
 
@@ -157,13 +157,13 @@ GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize w
                  "gpt demodulation mask"),
       modulation_(ctx, options.demodulate ? std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats) : 0,
                   "gpt modulation"),
-      streamKey_(ctx, options.streamKeys ? std::uint64_t{width_} * height_ * sizeof(std::uint32_t) : 0,
-                 "gpt stream keys") {
-    if (options_.streamKeys) {
-        if (options_.streamKeys->size() != std::size_t{width_} * height_)
-            throw Error("gpt stream keys: " + std::to_string(options_.streamKeys->size()) + " entries for " +
+      streams_(ctx, options.streams ? std::uint64_t{width_} * height_ * sizeof(gpu::PixelStream) : 0,
+               "gpt pixel streams") {
+    if (options_.streams) {
+        if (options_.streams->size() != std::size_t{width_} * height_)
+            throw Error("gpt pixel streams: " + std::to_string(options_.streams->size()) + " entries for " +
                         std::to_string(width_) + "x" + std::to_string(height_) + " pixels");
-        streamKey_.uploadVector(*options_.streamKeys);
+        streams_.uploadVector(*options_.streams);
     }
     kernel_.bind(gpu::kBindCounters, counters_);
     for (std::uint32_t i = 0; i < kNumStats; ++i) {
@@ -173,7 +173,7 @@ GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize w
     resolveKernel_.bindAddress(gpu::kBindGptResolved, resolved_);
     kernel_.bindAddress(gpu::kBindGptDemodMask, demodMask_);  // all 0 (no pixel) until findEdges()
     kernel_.bindAddress(gpu::kBindGptModulation, modulation_);
-    kernel_.bindAddress(gpu::kBindGptStreamKey, streamKey_);
+    kernel_.bindAddress(gpu::kBindGptStreamKey, streams_);
     demodMask_.zero();
     emitterSupersampling_.bindTo(kernel_);
     emitterSupersampling_.bindTo(resolveKernel_);
@@ -216,7 +216,7 @@ gpu::GptFrameParams GptPass::frameParams() const {
     p.shiftThreshold = shiftThreshold_;
     p.width = width_;
     p.height = height_;
-    p.streamKeys = options_.streamKeys ? 1u : 0u;
+    p.streamKeys = options_.streams ? 1u : 0u;
     return p;
 }
 

@@ -47,10 +47,11 @@ struct GptPassOptions {
     // saw another surface); GptImages::modulation then holds m̄ and primal/dx/dy are of
     // J = I / m̄.
     bool demodulate = false;
-    // The random stream of each pixel's camera samples (width × height entries, any uint; see
-    // gpt.comp), or null: pixel p draws stream p, as the path tracer does. Temporal G-PT sets
-    // it to carry paths along the scene's motion (integrator/motion_map.h).
-    std::shared_ptr<const std::vector<std::uint32_t>> streamKeys;
+    // Where each pixel's camera samples come from (width × height entries: random stream and
+    // jitter shift, gpt_shared.h), or null: pixel p draws stream p unshifted, as the path
+    // tracer does. Temporal G-PT sets it to carry paths along the scene's motion
+    // (integrator/motion_map.h).
+    std::shared_ptr<const std::vector<gpu::PixelStream>> streams;
 };
 
 // Whether first-hit demodulation can act on a scene: some material has a base-colour texture
@@ -153,7 +154,7 @@ private:
     vk::Buffer resolved_;
     vk::Buffer demodMask_;   // uint per pixel (16-byte placeholder without demodulation)
     vk::Buffer modulation_;  // PixelStats per pixel (placeholder without demodulation)
-    vk::Buffer streamKey_;   // uint per pixel (16-byte placeholder without stream keys)
+    vk::Buffer streams_;     // PixelStream per pixel (16-byte placeholder without)
     std::uint32_t demodulatedPixels_ = 0;
 };
 

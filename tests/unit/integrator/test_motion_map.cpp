@@ -1,13 +1,14 @@
-// The motion between frames (integrator/motion_map.h) on scenes whose motion is known in whole
-// pixels by construction: a still scene (every pixel its own partner, misses included), a
-// camera moved sideways by three pixels (content moves three pixels the other way; the pixels
-// that leave the image have none), a square moved two pixels over a still background (the
+// The motion between frames (integrator/motion_map.h) on scenes whose motion is known by
+// construction: a still scene (every pixel its own partner, misses included, no shift), a
+// camera moved sideways by 3.25 pixels (content moves the other way: three pixels and a
+// quarter-pixel jitter shift; the pixels that leave the image have none), a square moved two pixels over a still background (the
 // background it covers loses to it, the background it uncovers gets fresh streams), a square
 // that comes out from behind a panel (found by carrying back: no source), and frames
 // of different triangle lists (the same pixel). Square edges lie on pixel boundaries, so every
 // pixel centre is half a pixel from an edge.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -46,8 +47,10 @@ MotionMap motion(const Scene& a, const Scene& b) {
                          kSize);
 }
 
-void expectDistinctStreams(const std::vector<std::uint32_t>& streams) {
-    EXPECT_EQ(std::set<std::uint32_t>(streams.begin(), streams.end()).size(), streams.size());
+void expectDistinctStreams(const std::vector<gpu::PixelStream>& streams) {
+    std::set<std::uint32_t> keys;
+    for (const gpu::PixelStream& s : streams) keys.insert(s.key);
+    EXPECT_EQ(keys.size(), streams.size());
 }
 
 TEST(MotionMap, AStillSceneIsItsOwnPartnerMissesIncluded) {
@@ -61,24 +64,38 @@ TEST(MotionMap, AStillSceneIsItsOwnPartnerMissesIncluded) {
     EXPECT_TRUE(m.sameTopology);
     EXPECT_EQ(m.partnered, std::size_t(kSize * kSize));
     for (std::size_t p = 0; p < m.partner.size(); ++p) ASSERT_EQ(m.partner[p], p);
-    const std::vector<std::uint32_t> streams = carriedStreams(m);
-    for (std::size_t q = 0; q < streams.size(); ++q) ASSERT_EQ(streams[q], q);
+    const std::vector<gpu::PixelStream> streams = carriedStreams(m);
+    for (std::size_t q = 0; q < streams.size(); ++q) {
+        ASSERT_EQ(streams[q].key, q);
+        ASSERT_EQ(streams[q].jitterShift, 0u);  // no motion, no shift
+    }
 }
 
-TEST(MotionMap, ACameraMovedThreePixelsMovesTheImageThreePixelsBack) {
+TEST(MotionMap, ACameraMovedThreeAndAQuarterPixelsMovesTheImageBack) {
+    // Pixel x's centre x + 0.5 lands at x - 2.75: in pixel x - 3, a quarter pixel left of its
+    // centre (the jitter shift fract(-0.25) = 0.75).
     const Scene a = makeEmissiveQuad(glm::vec3(1.0f));
     Scene b = a;
-    b.cameras[0].position.x += 3.0f * pixelAt(1.0f);
+    b.cameras[0].position.x += 3.25f * pixelAt(1.0f);
     const MotionMap m = motion(a, b);
     EXPECT_EQ(m.partnered, std::size_t(kSize * (kSize - 3)));
     for (int y = 0; y < kSize; ++y)
-        for (int x = 0; x < kSize; ++x)
+        for (int x = 0; x < kSize; ++x) {
             ASSERT_EQ(m.partner[pixel(x, y)], x >= 3 ? pixel(x - 3, y) : kNoTemporalPartner) << x << "," << y;
-    const std::vector<std::uint32_t> streams = carriedStreams(m);
+            if (x < 3) continue;
+            ASSERT_NEAR(m.subpixel[pixel(x, y)].x, -0.25f, 1e-3f) << x << "," << y;
+            ASSERT_NEAR(m.subpixel[pixel(x, y)].y, 0.0f, 1e-3f) << x << "," << y;
+        }
+    const std::vector<gpu::PixelStream> streams = carriedStreams(m);
     expectDistinctStreams(streams);
-    EXPECT_EQ(streams[pixel(0, 5)], pixel(3, 5));
-    // The columns that enter at the right have no source: streams of their own.
-    EXPECT_EQ(streams[pixel(kSize - 1, 5)], std::uint32_t(kSize * kSize) + pixel(kSize - 1, 5));
+    EXPECT_EQ(streams[pixel(0, 5)].key, pixel(3, 5));
+    const std::uint32_t shift = streams[pixel(0, 5)].jitterShift;
+    EXPECT_NEAR(double(shift & 0xFFFFu) / 65536.0, 0.75, 1e-3);
+    const double dy = double(shift >> 16) / 65536.0;
+    EXPECT_LT(std::min(dy, 1.0 - dy), 1e-3);  // no vertical motion (0, or a rounding below)
+    // The columns that enter at the right have no source: streams of their own, unshifted.
+    EXPECT_EQ(streams[pixel(kSize - 1, 5)].key, std::uint32_t(kSize * kSize) + pixel(kSize - 1, 5));
+    EXPECT_EQ(streams[pixel(kSize - 1, 5)].jitterShift, 0u);
 }
 
 TEST(MotionMap, AMovingSquareCoversAndUncoversTheBackground) {
@@ -97,12 +114,12 @@ TEST(MotionMap, AMovingSquareCoversAndUncoversTheBackground) {
             ASSERT_EQ(m.partner[pixel(x, y)], want) << x << "," << y;
         }
     EXPECT_EQ(m.partnered, std::size_t(kSize * kSize - 16));
-    const std::vector<std::uint32_t> streams = carriedStreams(m);
+    const std::vector<gpu::PixelStream> streams = carriedStreams(m);
     expectDistinctStreams(streams);
-    EXPECT_EQ(streams[pixel(16, 15)], pixel(14, 15));  // the square's paths follow it
-    EXPECT_EQ(streams[pixel(5, 5)], pixel(5, 5));      // the still background keeps its own
+    EXPECT_EQ(streams[pixel(16, 15)].key, pixel(14, 15));  // the square's paths follow it
+    EXPECT_EQ(streams[pixel(5, 5)].key, pixel(5, 5));      // the still background keeps its own
     // Uncovered background (columns 12-13 of B): no pixel of A saw it.
-    EXPECT_EQ(streams[pixel(12, 15)], std::uint32_t(kSize * kSize) + pixel(12, 15));
+    EXPECT_EQ(streams[pixel(12, 15)].key, std::uint32_t(kSize * kSize) + pixel(12, 15));
 }
 
 TEST(MotionMap, WhatComesOutFromBehindAPanelHasNoSource) {
