@@ -27,7 +27,7 @@ while (($#)); do
     --reference-spp) refspp=$2; shift 2 ;;
     --methods) methods=$2; shift 2 ;;
     --repeats) repeats=$2; shift 2 ;;
-    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
     *) echo "bench-temporal.sh: unknown option '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
