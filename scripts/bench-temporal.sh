@@ -12,11 +12,11 @@
 #
 #   scripts/bench-temporal.sh [-o OUT] [--scenes moving_box,camera_move] [--frames 0:15]
 #                             [--size 96] [--seconds-per-frame 1] [--reference-spp 1024]
-#                             [--methods pt,gpt,tgpt,tgpt-replay] [--repeats 1]
+#                             [--methods pt,gpt,tgpt,tgpt-replay] [--repeats 1] [--fps 24]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=bench-temporal scenes=moving_box,camera_move frames=0:15 size=96 perframe=1 refspp=1024
-methods=pt,gpt,tgpt,tgpt-replay repeats=1
+methods=pt,gpt,tgpt,tgpt-replay repeats=1 fps=24
 while (($#)); do
   case "$1" in
     -o) out=$2; shift 2 ;;
@@ -27,6 +27,7 @@ while (($#)); do
     --reference-spp) refspp=$2; shift 2 ;;
     --methods) methods=$2; shift 2 ;;
     --repeats) repeats=$2; shift 2 ;;
+    --fps) fps=$2; shift 2 ;;
     -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
     *) echo "bench-temporal.sh: unknown option '$1' (try --help)" >&2; exit 2 ;;
   esac
@@ -36,7 +37,7 @@ first=${frames%%:*} last=${frames##*:}
 count=$((last - first + 1))
 budget=$(python3 -c "print($perframe * $count)")
 mkdir -p "$out"
-common=(--frames "$frames" --width "$size" --height "$size" --no-video --quiet)
+common=(--frames "$frames" --fps "$fps" --width "$size" --height "$size" --no-video --quiet)
 rows=()
 for scene in ${scenes//,/ }; do
   file=scenes/$scene.gltf

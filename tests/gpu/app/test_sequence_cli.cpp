@@ -209,12 +209,29 @@ TEST_F(SequenceCli, TemporalGptRendersWindowsOfFrames) {
         EXPECT_EQ(s["tgpt"]["temporal_to_previous"], f >= 1) << f;
         EXPECT_EQ(s["spp"], 4);
         EXPECT_EQ(s["reconstructions"][0]["method"], "spacetime_l1");
+        EXPECT_EQ(s["tgpt"]["temporal_shift"], "motion") << f;
+        // The motion map's pixels: none in the first frame, most of the 16x12 after.
+        const int partnered = s["tgpt"]["motion_partnered"];
+        if (f == 0)
+            EXPECT_EQ(partnered, 0);
+        else
+            EXPECT_GT(partnered, 16 * 12 / 2) << f;
+        EXPECT_LE(partnered, 16 * 12) << f;
     }
     const auto layers = readExr(path("t/f_3.exr"));
     std::vector<std::string> names;
     for (const auto& l : layers) names.push_back(l.name);
-    for (const char* want : {"recon_spacetime_l1", "primal", "dx", "dy", "dt", "direct"})
+    for (const char* want : {"recon_spacetime_l1", "primal", "dx", "dy", "dt", "motion", "direct"})
         EXPECT_NE(std::find(names.begin(), names.end(), want), names.end()) << want;
+    // The same-pixel replay: every pixel is its own partner, with no offset in the motion layer.
+    const RunResult replay =
+        runGdpt("render " + kMovingBox + " --method tgpt --temporal-shift replay --frames 0:1 --spp 2 " +
+                "--width 16 --height 12 --no-video -o " + path("r/f_%d.exr") + " --json " + path("r.json"));
+    ASSERT_EQ(replay.code, 0) << replay.output;
+    EXPECT_EQ(readJson(path("r.json"))["frame_summaries"][1]["tgpt"]["temporal_shift"], "replay");
+    const Image motion = readExrLayer(path("r/f_1.exr"), "motion");
+    for (int c = 0; c < 3; ++c)
+        for (float v : motion.plane(c)) ASSERT_EQ(v, c == 2 ? 1.0f : 0.0f);
 }
 
 TEST_F(SequenceCli, TemporalGptRefusesWhatItCannotDo) {
@@ -228,6 +245,7 @@ TEST_F(SequenceCli, TemporalGptRefusesWhatItCannotDo) {
         {"--frames 0:1 --demodulate on -o " + path("f_%d.exr"), "does not demodulate", 2},
         {"--frames 0:1 --window 0 -o " + path("f_%d.exr"), "--window", 2},
         {"--window 3 -o " + path("x.exr"), "--window requires --frames", 2},
+        {"--frames 0:1 --temporal-shift sideways -o " + path("f_%d.exr"), "--temporal-shift", 2},
         {"--frames 0:63 --window 64 --width 4096 --height 4096 -o " + path("f_%d.exr"),
          "needs about 552.0 GiB for its space-time reconstruction", 1},
     };
