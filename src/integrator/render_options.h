@@ -45,6 +45,9 @@ struct RenderOptions {
     std::uint32_t spp = 16;      // samples per pixel (ignored when timeBudget > 0)
     double timeBudget = 0.0;     // seconds for the whole render (0 = use spp)
     double elapsedBefore = 0.0;  // seconds already spent (e.g. loading) counted in the budget
+    // Timed renders may end with a partial pass (one more sample in the top rows); false: whole
+    // samples per pixel only (temporal G-PT pairs every sample of a half with the next frame's).
+    bool partialPass = true;
     // Timed renders: the reservations already taken off timeBudget, as measured. The batch
     // loop carries each to the load it measures on its last batch (atLoad) and takes off the
     // difference too, so that a busier (or idler) machine than the one that measured them

@@ -69,7 +69,7 @@ void runBatchLoop(const RenderOptions& options, const char* label, const Timer& 
     const std::uint32_t height = static_cast<std::uint32_t>(options.scene.height);
     // A partial pass leaves rows with different sample counts: not in a checkpoint (whose
     // state is one sample count), nor in a share of a split render (a shard is one).
-    const bool partialPass = timed && !options.checkpoint && !options.share.split();
+    const bool partialPass = timed && options.partialPass && !options.checkpoint && !options.share.split();
     std::uint32_t rows = height;
     while (true) {
         if (options.cancel && options.cancel->load()) {

@@ -188,6 +188,8 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
     // The frame before the one being sampled, for the motion between them.
     std::shared_ptr<const Scene> previousScene = joined ? carry_->scene : nullptr;
     std::vector<PrimaryHit> previousHits = joined ? carry_->hits : std::vector<PrimaryHit>{};
+    // Samples per pixel of the frame before's second half (0: no frame before).
+    std::uint32_t pairedSpp = joined ? carry_->secondHalfSpp : 0;
 
     // 1. Sampling: two half renders per frame, seeded σ(f) and σ(f+1).
     for (int k = 0; k < window.count; ++k) {
@@ -228,7 +230,12 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
             std::max(1e-3, (options.timeBudget - options.elapsedBefore - frameStart -
                             lastSolveSeconds_ * double(window.count) / double(lastSolveFrames_)) /
                                double(window.count - k));
-        if (timed) half.timeBudget = 0.5 * share;
+        // The first half replays the frame before's second half: the same number of samples,
+        // so that every one of them is paired (timed: whatever the second half reached, and
+        // the second half then gets what is left of this frame's share, in whole samples).
+        const bool paired = pairedSpp > 0;
+        if (timed) half.timeBudget = paired ? 0.0 : 0.5 * share;
+        if (paired) half.spp = pairedSpp;
         half.seed = window.seed(frame);
         RenderResultGpt first = renderGpt(ctx, *scene, half, firstSampling);
         if (first.stats.cancelled) {
@@ -236,6 +243,8 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
             return outputs;
         }
         if (timed) half.timeBudget = std::max(1e-3, share - (timer.seconds() - frameStart));
+        half.spp = std::max<std::uint32_t>(1, options.spp / 2);
+        half.partialPass = false;
         half.seed = window.seed(frame + 1);
         RenderResultGpt second = renderGpt(ctx, *scene, half, options_.sampling);
         if (second.stats.cancelled) {
@@ -260,6 +269,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         f.stats.tgpt.motionPartnered = partnered;
         f.stats.tgpt.motionMs = motionMs;
         f.fromPrevious = std::move(fromPrevious);
+        pairedSpp = second.stats.spp;
         frames.push_back(std::move(f));
     }
 
@@ -350,7 +360,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         outputs.push_back(std::move(out));
     }
     carry_ = Carry{window.first + window.count - 1, {}, std::move(frames.back().secondHalfPrimal),
-                   std::move(previousScene), std::move(previousHits)};
+                   pairedSpp, std::move(previousScene), std::move(previousHits)};
     const std::size_t last = std::size_t(window.count - 1) * std::size_t(width) * std::size_t(height);
     for (int c = 0; c < 3; ++c) carry_->recon[c].assign(x[c].begin() + std::ptrdiff_t(last), x[c].end());
     return outputs;

@@ -6,21 +6,27 @@
 //      published code seeds them). Frame f+1's first half then replays, sample for sample,
 //      the random numbers of frame f's second half in the next frame's scene: the temporal
 //      difference dt_f = primal(f+1, first half) − primal(f, second half) is the mean of
-//      paired differences, unbiased for I_f+1 − I_f, and exactly 0 where nothing moved;
+//      paired differences, unbiased for the difference it pairs (below), and exactly 0 where
+//      nothing moved;
 //   2. reconstruct: a space-time screened Poisson solve of the window from every frame's
 //      primal, dx, dy and the dt between its frames (poisson_spacetime.h; L1 by IRLS by
 //      default), coupled to the previous window's last reconstructed frame through the dt
 //      between the windows, so that a sequence has no seam at window boundaries;
 //   3. compose: final = reconstruction + very-direct light, per frame (as G-PT, §5 of
 //      Kettunen et al. 2015).
-// The temporal shift is random replay at the same pixel (primary-sample space): the path of
-// frame f+1 starts through the same point of the same pixel with the same decisions. The
-// published method also carries the primary hit along the scene's motion (motion vectors);
-// that refinement is not built (docs/animation.md). Texture demodulation is off (a frame's
-// modulation differs from the next one's where something moves).
-// Layers per frame: final, recon_spacetime_<l1|l2>, primal, dx, dy, dt (to the next frame;
-// 0 in the sequence's last frame), direct, var_primal, var_dx, var_dy, var_direct,
-// primal_plus_direct.
+// The temporal shift (TgptOptions::shift): random replay in primary sample space, Jacobian 1.
+// Motion (the default, as Manzi et al. re-seed by motion vectors): frame f+1's first half draws
+// each pixel's samples from the stream of the pixel of frame f whose primary hit the scene's
+// motion carried there, shifted by the motion's sub-pixel part (motion_map.h), so dt_f(p) =
+// primal(f+1, first half)(π(p)) − primal(f, second half)(p) pairs paths that start on the same
+// surface point; the space-time rows follow π. Replay: π = the same pixel. Not built: the
+// paper's reconnection of the temporal offset path at its first rough vertex (docs/animation.md).
+// Texture demodulation is off (a frame's modulation differs from the next one's where something
+// moves).
+// Layers per frame: final, recon_spacetime_<l1|l2>, primal, dx, dy, dt (from the frame before,
+// at this frame's pixels; 0 in the sequence's first frame and where a pixel has no source),
+// motion (offset to the source pixel in R, G; 1 in B where there is one), direct, var_primal,
+// var_dx, var_dy, var_direct, primal_plus_direct.
 #pragma once
 
 #include <array>
@@ -57,6 +63,7 @@ private:
         int frame = -1;
         std::array<std::vector<double>, 3> recon;
         Image secondHalfPrimal;
+        std::uint32_t secondHalfSpp = 0;
         // The motion shift: the last frame's scene and primary hits (motion_map.h).
         std::shared_ptr<const Scene> scene;
         std::vector<PrimaryHit> hits;

@@ -7,6 +7,7 @@
 //     replay shift and along the motion for the motion shift; the test shows its power by
 //     rejecting the difference of the frames the other way round (replay) and the same-pixel
 //     difference (motion);
+//   - a timed sequence pairs every sample of a first half with the frame before's second half;
 //   - the same seed gives the same bits.
 #include <gtest/gtest.h>
 
@@ -182,6 +183,29 @@ TEST_F(TgptRender, TemporalDifferencesAreUnbiased) {
 
 TEST_F(TgptRender, TemporalDifferencesAlongTheMotionAreUnbiased) {
     expectUnbiasedTemporalDifferences(TemporalShift::Motion);
+}
+
+// A timed sequence: each frame's first half takes exactly the samples of the frame before's
+// second half (within a window and across windows), and no half after the first ends with a
+// partial pass, so every sample of dt is paired.
+TEST_F(TgptRender, TimedHalvesArePairedSampleForSample) {
+    const GltfAsset asset(std::string(GDPT_SOURCE_DIR) + "/scenes/moving_box.gltf");
+    const auto sceneAt = [&](int f) { return asset.instance(0, f * 0.25); };
+    TgptOptions o;
+    o.window = 3;
+    TgptIntegrator tgpt(o);
+    RenderOptions options = renderOptions(24, 16, 0, 0);
+    options.timeBudget = 0.6;
+    std::vector<RenderOutput> frames = tgpt.renderWindow(keeping(), windowOf(sceneAt, 0, 3, 5), options);
+    const std::vector<RenderOutput> next = tgpt.renderWindow(keeping(), windowOf(sceneAt, 3, 3, 5, false), options);
+    frames.insert(frames.end(), next.begin(), next.end());
+    ASSERT_EQ(frames.size(), 6u);
+    for (std::size_t k = 1; k < frames.size(); ++k) {
+        const TgptStats& t = frames[k].stats.tgpt;
+        EXPECT_EQ(t.firstHalfSpp, frames[k - 1].stats.tgpt.secondHalfSpp) << "frame " << k;
+        EXPECT_EQ(frames[k].stats.partialPassRows, 0u) << "frame " << k;
+        EXPECT_GE(t.secondHalfSpp, 1u);
+    }
 }
 
 TEST_F(TgptRender, SameSeedSameBits) {
