@@ -4,8 +4,10 @@
 # of each animated scene with the same --time for the whole sequence, and each sequence is
 # compared with a PT reference sequence of REFSPP samples per pixel by `gdpt diff-sequence`:
 # the mean per-frame relMSE and the mean temporal relMSE (the error of the frame-to-frame
-# change: flicker). The reference is rendered twice (seeds 1001, 2002) and
-# the two are compared with each other: their relMSE is twice the reference's noise floor.
+# change: flicker), at the same pixel and along the motion (each pixel paired with the pixel of
+# the frame before its content came from, by the motion layer of a tgpt render, `--motion`).
+# The reference is rendered twice (seeds 1001, 2002) and the two are compared with each other:
+# their relMSE is twice the reference's noise floor.
 # Writes OUT/<scene>/<method>/f_*.exr (+ .json summaries, .diff.json metrics), OUT/results.csv,
 # OUT/results.json and OUT/temporal.png (gnuplot); the table goes to stdout. Not a test: about
 # 15 minutes on 2 cores with the defaults.
@@ -28,7 +30,7 @@ while (($#)); do
     --methods) methods=$2; shift 2 ;;
     --repeats) repeats=$2; shift 2 ;;
     --fps) fps=$2; shift 2 ;;
-    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
     *) echo "bench-temporal.sh: unknown option '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -47,8 +49,16 @@ for scene in ${scenes//,/ }; do
     [ -f "$ref/f_$(printf %04d "$last").exr" ] ||
       build/gdpt render "$file" --method pt --spp "$refspp" --seed "$seed" -o "$ref/f_%04d.exr" "${common[@]}"
   done
+  # The motion layer of a tgpt render of this sequence (the same for every seed) pairs each pixel
+  # with its source in the frame before: the temporal error along the motion as well.
+  motion=()
+  if [[ ",$methods," == *,tgpt,* ]]; then
+    motion=(--motion "$dir/motion/f_%04d.exr")
+    [ -f "$dir/motion/f_$(printf %04d "$last").exr" ] ||
+      build/gdpt render "$file" --method tgpt --spp 2 -o "$dir/motion/f_%04d.exr" "${common[@]}"
+  fi
   build/gdpt diff-sequence "$dir/reference_2002/f_%04d.exr" "$dir/reference_1001/f_%04d.exr" --frames "$frames" \
-    --json "$dir/reference.diff.json" > /dev/null
+    --json "$dir/reference.diff.json" "${motion[@]}" > /dev/null
   for ((r = 1; r <= repeats; r++)); do
     for m in ${methods//,/ }; do  # interleaved: one sequence of each method per round
       run=$dir/${m}_$r
@@ -57,7 +67,7 @@ for scene in ${scenes//,/ }; do
       build/gdpt render "$file" "${method[@]}" --time "$budget" --seed "$((r * 7))" -o "$run/f_%04d.exr" \
         --json "$run.json" "${common[@]}"
       build/gdpt diff-sequence "$run/f_%04d.exr" "$dir/reference_1001/f_%04d.exr" --frames "$frames" \
-        --json "$run.diff.json" > /dev/null
+        --json "$run.diff.json" "${motion[@]}" > /dev/null
       rows+=("$scene,$m,$r,$run")
     done
   done
@@ -74,31 +84,36 @@ for row in rows:
     results.append({"scene": scene, "method": method, "repeat": int(rep), "budget_s": budget,
                     "time_s": s["time_s"], "spp_per_frame": spp, "relmse": d["mean_relmse"],
                     "temporal_relmse": d["mean_temporal_relmse"],
+                    "temporal_along_motion": d.get("mean_temporal_relmse_along_motion", float("nan")),
                     "per_frame": d["per_frame"]})
 floors = {}
 for scene in dict.fromkeys(r["scene"] for r in results):
     f = json.load(open(f"{out}/{scene}/reference.diff.json"))
-    floors[scene] = (f["mean_relmse"] / 2, f["mean_temporal_relmse"] / 2)
+    floors[scene] = (f["mean_relmse"] / 2, f["mean_temporal_relmse"] / 2,
+                     f.get("mean_temporal_relmse_along_motion", float("nan")) / 2)
 json.dump({"results": results, "reference_noise_floor": floors}, open(out + "/results.json", "w"), indent=1)
 with open(out + "/results.csv", "w") as csv:
-    csv.write("scene,method,repeat,budget_s,time_s,spp_per_frame,relmse,temporal_relmse\n")
+    csv.write("scene,method,repeat,budget_s,time_s,spp_per_frame,relmse,temporal_relmse,temporal_along_motion\n")
     for r in results:
         csv.write(f"{r['scene']},{r['method']},{r['repeat']},{r['budget_s']:g},{r['time_s']:.2f},"
-                  f"{r['spp_per_frame']:.1f},{r['relmse']:.6g},{r['temporal_relmse']:.6g}\n")
+                  f"{r['spp_per_frame']:.1f},{r['relmse']:.6g},{r['temporal_relmse']:.6g},"
+                  f"{r['temporal_along_motion']:.6g}\n")
+keys = ("time_s", "spp_per_frame", "relmse", "temporal_relmse", "temporal_along_motion")
 print(f"{'scene':12} {'method':11} {'time s':>7} {'spp/frame':>9} {'relMSE':>10} {'temporal':>10} "
-      f"{'relMSE÷gpt':>10} {'temp.÷gpt':>10}")
+      f"{'along mot.':>10} {'relMSE÷gpt':>10} {'temp.÷gpt':>10} {'along÷gpt':>10}")
 for scene in dict.fromkeys(r["scene"] for r in results):
     med = {}
     for m in dict.fromkeys(r["method"] for r in results if r["scene"] == scene):
         rs = [r for r in results if r["scene"] == scene and r["method"] == m]
-        med[m] = {k: statistics.median(r[k] for r in rs) for k in ("time_s", "spp_per_frame", "relmse", "temporal_relmse")}
+        med[m] = {k: statistics.median(r[k] for r in rs) for k in keys}
     for m, v in med.items():
         g = med.get("gpt")
+        ratio = lambda k: v[k] / g[k] if g else float("nan")
         print(f"{scene:12} {m:11} {v['time_s']:7.1f} {v['spp_per_frame']:9.1f} {v['relmse']:10.4g} "
-              f"{v['temporal_relmse']:10.4g} {v['relmse'] / g['relmse'] if g else float('nan'):10.3f} "
-              f"{v['temporal_relmse'] / g['temporal_relmse'] if g else float('nan'):10.3f}")
-    fr, ft = floors[scene]
-    print(f"{scene:12} reference noise floor: relMSE {fr:.3g}, temporal {ft:.3g}")
+              f"{v['temporal_relmse']:10.4g} {v['temporal_along_motion']:10.4g} {ratio('relmse'):10.3f} "
+              f"{ratio('temporal_relmse'):10.3f} {ratio('temporal_along_motion'):10.3f}")
+    fr, ft, fa = floors[scene]
+    print(f"{scene:12} reference noise floor: relMSE {fr:.3g}, temporal {ft:.3g}, along the motion {fa:.3g}")
 # Per-frame curves of the first repeat: relMSE and temporal relMSE against the frame.
 with open(out + "/per_frame.dat", "w") as dat:
     for r in results:

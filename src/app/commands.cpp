@@ -100,13 +100,14 @@ int runDiff(const DiffArgs& args) {
 
 int runDiffSequence(const DiffSequenceArgs& args) {
     const FrameRange range = parseFrameRange(args.frames, "--frames");
-    if (!hasFrameNumber(args.test, "test") || !hasFrameNumber(args.reference, "reference"))
+    if (!hasFrameNumber(args.test, "test") || !hasFrameNumber(args.reference, "reference") ||
+        (!args.motion.empty() && !hasFrameNumber(args.motion, "--motion")))
         throw UsageError(
-            "diff-sequence compares sequences: both paths take a frame number (e.g. out/f_%04d.exr)");
+            "diff-sequence compares sequences: every path takes a frame number (e.g. out/f_%04d.exr)");
     OutputSet outputs;
     const TextOutput jsonOutput(outputs, args.json, "--json");
     json frames = json::array();
-    double relSum = 0.0, temporalSum = 0.0;
+    double relSum = 0.0, temporalSum = 0.0, alongSum = 0.0;
     Image testBefore, referenceBefore;
     for (int f = range.first; f <= range.last; ++f) {
         const std::string testPath = framePath(args.test, f), referencePath = framePath(args.reference, f);
@@ -121,6 +122,14 @@ int runDiffSequence(const DiffSequenceArgs& args) {
             const double t = temporalRelMse(testBefore, test, referenceBefore, reference);
             j["temporal_relmse"] = t;  // of the change from the frame before
             temporalSum += t;
+            if (!args.motion.empty()) {
+                const std::string motionPath = framePath(args.motion, f);
+                if (!std::filesystem::is_regular_file(motionPath)) throw Error(motionPath + ": no such frame");
+                const Image motion = readExrLayer(motionPath, "motion");
+                const double a = temporalRelMse(testBefore, test, referenceBefore, reference, &motion);
+                j["temporal_relmse_along_motion"] = a;
+                alongSum += a;
+            }
         }
         frames.push_back(std::move(j));
         testBefore = std::move(test);
@@ -128,18 +137,25 @@ int runDiffSequence(const DiffSequenceArgs& args) {
     }
     const double meanRel = relSum / range.count();
     const double meanTemporal = range.count() > 1 ? temporalSum / (range.count() - 1) : 0.0;
-    jsonOutput.write(json{{"test", args.test},
-                          {"reference", args.reference},
-                          {"frames", {{"first", range.first}, {"last", range.last}}},
-                          {"mean_relmse", meanRel},
-                          {"mean_temporal_relmse", meanTemporal},
-                          {"per_frame", std::move(frames)}}
-                         .dump(2) +
-                     "\n");
+    const double meanAlong = range.count() > 1 ? alongSum / (range.count() - 1) : 0.0;
+    json summary{{"test", args.test},
+                 {"reference", args.reference},
+                 {"frames", {{"first", range.first}, {"last", range.last}}},
+                 {"mean_relmse", meanRel},
+                 {"mean_temporal_relmse", meanTemporal}};
+    if (!args.motion.empty()) {
+        summary["motion"] = args.motion;
+        summary["mean_temporal_relmse_along_motion"] = meanAlong;
+    }
+    summary["per_frame"] = std::move(frames);
+    jsonOutput.write(summary.dump(2) + "\n");
     outputs.commit();
-    if (args.json != "-")
-        std::printf("frames %d-%d: mean relMSE %.6g, mean temporal relMSE %.6g\n", range.first, range.last,
-                    meanRel, meanTemporal);
+    if (args.json != "-") {
+        std::printf("frames %d-%d: mean relMSE %.6g, mean temporal relMSE %.6g", range.first, range.last, meanRel,
+                    meanTemporal);
+        if (!args.motion.empty()) std::printf(", along the motion %.6g", meanAlong);
+        std::printf("\n");
+    }
     return 0;
 }
 
@@ -256,6 +272,10 @@ Subcommand addDiffSequenceCommand(CLI::App& app) {
     c->add_option("reference", d.reference, "Reference frames, with a frame number")->required();
     c->add_option("--frames", d.frames, "A:B: the frames to compare")->required();
     c->add_option("--json", d.json, "Write the metrics as JSON to this file ('-' = stdout)");
+    c->add_option("--motion", d.motion,
+                  "Also the temporal relMSE along the motion: frames with a `motion` layer (a tgpt render of "
+                  "the same sequence and size, e.g. tgpt/f_%04d.exr), whose offsets pair each pixel with "
+                  "the pixel of the frame before its content came from");
     return {c, [args] { return runDiffSequence(*args); }};
 }
 

@@ -66,18 +66,30 @@ ImageErrorStats compareImages(const Image& test, const Image& reference) {
     return s;
 }
 
-double temporalRelMse(const Image& test0, const Image& test1, const Image& reference0,
-                      const Image& reference1) {
-    for (const Image* im : {&test1, &reference0, &reference1})
-        if (!im->sameSize(test0)) throw Error("cannot compare frames of different sizes");
+double temporalRelMse(const Image& test0, const Image& test1, const Image& reference0, const Image& reference1,
+                      const Image* motion) {
+    for (const Image* im : {&test1, &reference0, &reference1, motion})
+        if (im && !im->sameSize(test0)) throw Error("cannot compare frames of different sizes");
+    const int width = test0.width(), height = test0.height();
     double sum = 0.0;
     std::size_t pixels = 0;
     for (std::size_t i = 0; i < test0.pixelCount(); ++i) {
+        // The pixel of frame 0 that pixel i of frame 1 is compared with.
+        std::size_t s = i;
+        if (motion) {
+            if (motion->plane(2)[i] != 1.0f) continue;
+            const float dx = motion->plane(0)[i], dy = motion->plane(1)[i];
+            const long sx = long(i % std::size_t(width)) + long(std::lround(dx));
+            const long sy = long(i / std::size_t(width)) + long(std::lround(dy));
+            if (!std::isfinite(dx) || !std::isfinite(dy) || sx < 0 || sy < 0 || sx >= width || sy >= height)
+                continue;
+            s = std::size_t(sy) * std::size_t(width) + std::size_t(sx);
+        }
         double d[3], gray = 0.0;
         bool finite = true;
         for (int c = 0; c < 3; ++c) {
-            const double t0 = test0.plane(c)[i], t1 = test1.plane(c)[i];
-            const double r0 = reference0.plane(c)[i], r1 = reference1.plane(c)[i];
+            const double t0 = test0.plane(c)[s], t1 = test1.plane(c)[i];
+            const double r0 = reference0.plane(c)[s], r1 = reference1.plane(c)[i];
             finite =
                 finite && std::isfinite(t0) && std::isfinite(t1) && std::isfinite(r0) && std::isfinite(r1);
             d[c] = (t1 - t0) - (r1 - r0);

@@ -42,8 +42,14 @@ ImageErrorStats compareImages(const Image& test, const Image& reference);
 // the pixel, as relMSE is). Flicker (independent noise per frame) shows here even where each
 // frame alone is close to its reference. Pixels with a non-finite value in any of the four
 // images are left out. Throws gdpt::Error if the sizes differ.
-double temporalRelMse(const Image& test0, const Image& test1, const Image& reference0,
-                      const Image& reference1);
+//
+// With `motion` (temporal G-PT's `motion` layer of frame 1: per pixel q the offset (R, G) to the
+// pixel s(q) of frame 0 its content came from, and B = 1 where it has one): the same along the
+// motion, T1(q) − T0(s(q)) against R1(q) − R0(s(q)), over the pixels with a source. Under a
+// moving camera this is the flicker of what stays on a surface; the same-pixel form also
+// counts an error pattern that moves with the content.
+double temporalRelMse(const Image& test0, const Image& test1, const Image& reference0, const Image& reference1,
+                      const Image* motion = nullptr);
 
 // Shorthands for compareImages(test, reference).<metric>.
 double relMse(const Image& test, const Image& reference);

@@ -231,8 +231,11 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
                             lastSolveSeconds_ * double(window.count) / double(lastSolveFrames_)) /
                                double(window.count - k));
         // The first half replays the frame before's second half: the same number of samples,
-        // so that every one of them is paired (timed: whatever the second half reached, and
-        // the second half then gets what is left of this frame's share, in whole samples).
+        // so that every one of them is paired (timed: whatever that second half reached). A
+        // second half gets half the frame's share, in whole samples: the next first half will
+        // take as many, and what a frame over- or underspends moves the later frames' shares.
+        // (Giving it the rest of its frame's share instead made the halves alternate between
+        // about 1/3 and 2/3 of the frame's samples.)
         const bool paired = pairedSpp > 0;
         if (timed) half.timeBudget = paired ? 0.0 : 0.5 * share;
         if (paired) half.spp = pairedSpp;
@@ -242,7 +245,9 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
             outputs.push_back({{}, first.stats});
             return outputs;
         }
-        if (timed) half.timeBudget = std::max(1e-3, share - (timer.seconds() - frameStart));
+        if (timed)
+            half.timeBudget =
+                paired ? 0.5 * share : std::max(1e-3, share - (timer.seconds() - frameStart));
         half.spp = std::max<std::uint32_t>(1, options.spp / 2);
         half.partialPass = false;
         half.seed = window.seed(frame + 1);

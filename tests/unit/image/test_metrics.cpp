@@ -133,5 +133,39 @@ TEST(TemporalRelMse, HandComputedValues) {
     EXPECT_THROW((void)temporalRelMse(r0, constantImage(2, 3, 1, 1, 1), r0, r1), Error);
 }
 
+TEST(TemporalRelMse, AlongTheMotionPairsEachPixelWithItsSource) {
+    // A 4x1 ramp (1, 2, 3, 4) moving one pixel right: frame 1 is (x, 1, 2, 3), where pixel 0's
+    // content is new. The motion layer says so: offset -1 and a source for pixels 1..3.
+    const auto ramp = [](float first) {
+        Image im(4, 1);
+        for (int c = 0; c < 3; ++c)
+            for (int x = 0; x < 4; ++x) im.plane(c)[std::size_t(x)] = first + float(x);
+        return im;
+    };
+    const Image r0 = ramp(1.0f), r1 = ramp(0.0f);
+    Image motion(4, 1);
+    for (int x = 1; x < 4; ++x) {
+        motion.plane(0)[std::size_t(x)] = -1.0f;
+        motion.plane(2)[std::size_t(x)] = 1.0f;
+    }
+    // An error that stays on the content (+0.5 on the value 2 in both frames): none along the
+    // motion, but a moving error pattern at the same pixel.
+    Image t0 = r0, t1 = r1;
+    for (int c = 0; c < 3; ++c) t0.plane(c)[1] += 0.5f, t1.plane(c)[2] += 0.5f;
+    EXPECT_EQ(temporalRelMse(t0, t1, r0, r1, &motion), 0.0);
+    EXPECT_GT(temporalRelMse(t0, t1, r0, r1), 0.1);
+    // Flicker on the content: +0.5 on the value 3 in frame 1 only (pixel 3): per channel 0.25,
+    // normalised by the gray of (3 + 3) / 2 and averaged over the 3 pixels with a source.
+    Image f1 = r1;
+    for (int c = 0; c < 3; ++c) f1.plane(c)[3] += 0.5f;
+    EXPECT_NEAR(temporalRelMse(r0, f1, r0, r1, &motion), 3 * 0.25 / (1e-3 + 9.0) / 3.0, 1e-12);
+    // Pixel 0 has no source: a change there is not counted along the motion.
+    Image n1 = r1;
+    for (int c = 0; c < 3; ++c) n1.plane(c)[0] += 7.0f;
+    EXPECT_EQ(temporalRelMse(r0, n1, r0, r1, &motion), 0.0);
+    const Image small(2, 1);
+    EXPECT_THROW((void)temporalRelMse(r0, r1, r0, r1, &small), Error);
+}
+
 }  // namespace
 }  // namespace gdpt
