@@ -69,7 +69,7 @@ struct DiffSequenceArgs {
     std::string reference;  // frame pattern of the reference sequence
     std::string frames;     // "A:B"
     std::string json;
-    std::string motion;     // frame pattern of EXRs with a `motion` layer (tgpt's), or empty
+    std::string motion;  // frame pattern of EXRs with a `motion` layer (tgpt's), or empty
 };
 
 struct InfoArgs {

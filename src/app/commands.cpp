@@ -124,7 +124,8 @@ int runDiffSequence(const DiffSequenceArgs& args) {
             temporalSum += t;
             if (!args.motion.empty()) {
                 const std::string motionPath = framePath(args.motion, f);
-                if (!std::filesystem::is_regular_file(motionPath)) throw Error(motionPath + ": no such frame");
+                if (!std::filesystem::is_regular_file(motionPath))
+                    throw Error(motionPath + ": no such frame");
                 const Image motion = readExrLayer(motionPath, "motion");
                 const double a = temporalRelMse(testBefore, test, referenceBefore, reference, &motion);
                 j["temporal_relmse_along_motion"] = a;
@@ -151,8 +152,8 @@ int runDiffSequence(const DiffSequenceArgs& args) {
     jsonOutput.write(summary.dump(2) + "\n");
     outputs.commit();
     if (args.json != "-") {
-        std::printf("frames %d-%d: mean relMSE %.6g, mean temporal relMSE %.6g", range.first, range.last, meanRel,
-                    meanTemporal);
+        std::printf("frames %d-%d: mean relMSE %.6g, mean temporal relMSE %.6g", range.first, range.last,
+                    meanRel, meanTemporal);
         if (!args.motion.empty()) std::printf(", along the motion %.6g", meanAlong);
         std::printf("\n");
     }

@@ -506,10 +506,11 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->check(CLI::Range(0.0, 1e3))
         ->needs(frames)
         ->group(animation);
-    r->add_option("--temporal-shift", a.temporalShift,
-                  "tgpt: how a frame's paths are paired with the next frame's: motion = replayed in the pixel "
-                  "the scene's motion carries their primary hit to (motion vectors), replay = in the same "
-                  "pixel")
+    r->add_option(
+         "--temporal-shift", a.temporalShift,
+         "tgpt: how a frame's paths are paired with the next frame's: motion = replayed in the pixel "
+         "the scene's motion carries their primary hit to (motion vectors), replay = in the same "
+         "pixel")
         ->capture_default_str()
         ->check(CLI::IsMember({"motion", "replay"}))
         ->needs(frames)

@@ -66,8 +66,8 @@ ImageErrorStats compareImages(const Image& test, const Image& reference) {
     return s;
 }
 
-double temporalRelMse(const Image& test0, const Image& test1, const Image& reference0, const Image& reference1,
-                      const Image* motion) {
+double temporalRelMse(const Image& test0, const Image& test1, const Image& reference0,
+                      const Image& reference1, const Image* motion) {
     for (const Image* im : {&test1, &reference0, &reference1, motion})
         if (im && !im->sameSize(test0)) throw Error("cannot compare frames of different sizes");
     const int width = test0.width(), height = test0.height();

@@ -48,8 +48,8 @@ ImageErrorStats compareImages(const Image& test, const Image& reference);
 // motion, T1(q) − T0(s(q)) against R1(q) − R0(s(q)), over the pixels with a source. Under a
 // moving camera this is the flicker of what stays on a surface; the same-pixel form also
 // counts an error pattern that moves with the content.
-double temporalRelMse(const Image& test0, const Image& test1, const Image& reference0, const Image& reference1,
-                      const Image* motion = nullptr);
+double temporalRelMse(const Image& test0, const Image& test1, const Image& reference0,
+                      const Image& reference1, const Image* motion = nullptr);
 
 // Shorthands for compareImages(test, reference).<metric>.
 double relMse(const Image& test, const Image& reference);

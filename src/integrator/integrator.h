@@ -139,11 +139,11 @@ const char* temporalShiftName(TemporalShift shift);
 struct TgptOptions {
     GptSamplingOptions sampling;  // of each frame's two half renders (demodulation off)
     TemporalShift shift = TemporalShift::Motion;
-    int window = 10;              // frames reconstructed at once (Manzi et al. 2016 use about 10)
-    bool l1 = true;               // the space-time reconstruction: L1 (IRLS) or L2
-    double alpha = 0.2;           // weight of the primal rows
-    double beta = 1.0;            // weight of the temporal rows
-    double tolerance = 1e-4;      // relative residual of the last solve
+    int window = 10;          // frames reconstructed at once (Manzi et al. 2016 use about 10)
+    bool l1 = true;           // the space-time reconstruction: L1 (IRLS) or L2
+    double alpha = 0.2;       // weight of the primal rows
+    double beta = 1.0;        // weight of the temporal rows
+    double tolerance = 1e-4;  // relative residual of the last solve
 };
 
 // Every method's own settings; each integrator reads its part.

@@ -25,7 +25,8 @@ gpu::SceneConstants cameraConstants(const Scene& scene, int camera, int width, i
 glm::vec3 cameraRay(const gpu::SceneConstants& c, glm::vec2 pixelPos) {
     const float nx = 2.0f * pixelPos.x / float(c.width) - 1.0f;
     const float ny = 1.0f - 2.0f * pixelPos.y / float(c.height);
-    return glm::normalize(c.camForward + nx * c.tanHalfFovY * c.aspect * c.camRight + ny * c.tanHalfFovY * c.camUp);
+    return glm::normalize(c.camForward + nx * c.tanHalfFovY * c.aspect * c.camRight +
+                          ny * c.tanHalfFovY * c.camUp);
 }
 
 // The continuous pixel position at which the camera sees a point in direction d from its
@@ -47,8 +48,8 @@ glm::vec3 carried(const Scene& scene, const gpu::SceneConstants& c, const Primar
         return h.direction;
     }
     const glm::uvec3 t = scene.triangles[h.triangle];
-    const glm::vec3 x = (1.0f - h.u - h.v) * scene.positions[t.x] + h.u * scene.positions[t.y] +
-                        h.v * scene.positions[t.z];
+    const glm::vec3 x =
+        (1.0f - h.u - h.v) * scene.positions[t.x] + h.u * scene.positions[t.y] + h.v * scene.positions[t.z];
     const glm::vec3 d = x - c.camPosition;
     distance = glm::length(d);
     return d;
@@ -67,7 +68,8 @@ bool landsIn(const Scene& scene, const gpu::SceneConstants& c, const PrimaryHit&
 
 }  // namespace
 
-std::vector<PrimaryHit> primaryHits(const Scene& scene, int camera, int width, int height, std::uint32_t threads) {
+std::vector<PrimaryHit> primaryHits(const Scene& scene, int camera, int width, int height,
+                                    std::uint32_t threads) {
     const gpu::SceneConstants c = cameraConstants(scene, camera, width, height);
     const SceneBvh bvh = buildSceneBvh(scene);
     const std::vector<gpu::TriangleGeom> geoms =
@@ -123,7 +125,8 @@ MotionMap motionBetween(const Scene& from, const std::vector<PrimaryHit>& fromHi
     for (std::size_t p = 0; p < np; ++p) {
         const std::uint32_t q = lands[p];
         if (q == kNoTemporalPartner) continue;
-        if (winner[q] == kNoTemporalPartner || distance[p] < distance[winner[q]]) winner[q] = std::uint32_t(p);
+        if (winner[q] == kNoTemporalPartner || distance[p] < distance[winner[q]])
+            winner[q] = std::uint32_t(p);
     }
     // Backward: the winner is kept if q's own hit, carried back, lands within a pixel of it.
     map.partner.assign(np, kNoTemporalPartner);

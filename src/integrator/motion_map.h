@@ -54,8 +54,8 @@ struct MotionMap {
     // Per pixel with a partner: where its centre lands in the later frame less the partner's
     // centre, in pixels (each component in [-0.5, 0.5)).
     std::vector<glm::vec2> subpixel;
-    std::size_t partnered = 0;   // pixels with a partner
-    bool sameTopology = true;    // false: the frames' triangle lists differ; partner = the same pixel
+    std::size_t partnered = 0;  // pixels with a partner
+    bool sameTopology = true;   // false: the frames' triangle lists differ; partner = the same pixel
 };
 
 // The motion from frame `from` to frame `to` (steps 2 of the file comment); the hits are

@@ -204,14 +204,15 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         if (motion) {
             std::vector<PrimaryHit> hits = primaryHits(*scene, options.scene.camera, width, height);
             if (previousScene) {
-                MotionMap map = motionBetween(*previousScene, previousHits, *scene, hits, options.scene.camera,
-                                              width, height);
+                MotionMap map = motionBetween(*previousScene, previousHits, *scene, hits,
+                                              options.scene.camera, width, height);
                 if (!map.sameTopology && !options.quiet)
                     std::fprintf(stderr,
                                  "gdpt: warning: frames %d and %d have different triangle lists; their "
                                  "temporal differences replay paths at the same pixel\n",
                                  frame - 1, frame);
-                firstSampling.streams = std::make_shared<const std::vector<gpu::PixelStream>>(carriedStreams(map));
+                firstSampling.streams =
+                    std::make_shared<const std::vector<gpu::PixelStream>>(carriedStreams(map));
                 partnered = map.partnered;
                 fromPrevious = std::move(map.partner);
             }
@@ -246,8 +247,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
             return outputs;
         }
         if (timed)
-            half.timeBudget =
-                paired ? 0.5 * share : std::max(1e-3, share - (timer.seconds() - frameStart));
+            half.timeBudget = paired ? 0.5 * share : std::max(1e-3, share - (timer.seconds() - frameStart));
         half.spp = std::max<std::uint32_t>(1, options.spp / 2);
         half.partialPass = false;
         half.seed = window.seed(frame + 1);
@@ -364,8 +364,12 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         out.layers.push_back({"primal_plus_direct", std::move(primalPlusDirect)});
         outputs.push_back(std::move(out));
     }
-    carry_ = Carry{window.first + window.count - 1, {}, std::move(frames.back().secondHalfPrimal),
-                   pairedSpp, std::move(previousScene), std::move(previousHits)};
+    carry_ = Carry{window.first + window.count - 1,
+                   {},
+                   std::move(frames.back().secondHalfPrimal),
+                   pairedSpp,
+                   std::move(previousScene),
+                   std::move(previousHits)};
     const std::size_t last = std::size_t(window.count - 1) * std::size_t(width) * std::size_t(height);
     for (int c = 0; c < 3; ++c) carry_->recon[c].assign(x[c].begin() + std::ptrdiff_t(last), x[c].end());
     return outputs;

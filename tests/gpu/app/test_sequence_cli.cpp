@@ -232,6 +232,27 @@ TEST_F(SequenceCli, TemporalGptRendersWindowsOfFrames) {
     const Image motion = readExrLayer(path("r/f_1.exr"), "motion");
     for (int c = 0; c < 3; ++c)
         for (float v : motion.plane(c)) ASSERT_EQ(v, c == 2 ? 1.0f : 0.0f);
+
+    // diff-sequence along the motion: a sequence against itself has no error; against the
+    // replay render, some; frames without a number or missing are refused.
+    const std::string motionFlag = " --motion " + path("t/f_%d.exr");
+    const RunResult self = runGdpt("diff-sequence " + path("t/f_%d.exr") + " " + path("t/f_%d.exr") +
+                                   " --frames 0:4 --json " + path("d.json") + motionFlag);
+    ASSERT_EQ(self.code, 0) << self.output;
+    const nlohmann::json d = readJson(path("d.json"));
+    EXPECT_EQ(d["mean_temporal_relmse_along_motion"], 0.0);
+    EXPECT_EQ(d["per_frame"][3]["temporal_relmse_along_motion"], 0.0);
+    const RunResult other = runGdpt("diff-sequence " + path("r/f_%d.exr") + " " + path("t/f_%d.exr") +
+                                    " --frames 0:1 --json " + path("o.json") + motionFlag);
+    ASSERT_EQ(other.code, 0) << other.output;
+    EXPECT_GT(readJson(path("o.json"))["mean_temporal_relmse_along_motion"].get<double>(), 0.0);
+    const RunResult noNumber = runGdpt("diff-sequence " + path("t/f_%d.exr") + " " + path("t/f_%d.exr") +
+                                       " --frames 0:1 --motion " + path("t/f_1.exr"));
+    EXPECT_EQ(noNumber.code, 2) << noNumber.output;
+    const RunResult missing = runGdpt("diff-sequence " + path("t/f_%d.exr") + " " + path("t/f_%d.exr") +
+                                      " --frames 0:1 --motion " + path("none/f_%d.exr"));
+    EXPECT_EQ(missing.code, 1) << missing.output;
+    EXPECT_NE(missing.output.find("no such frame"), std::string::npos) << missing.output;
 }
 
 TEST_F(SequenceCli, TemporalGptRefusesWhatItCannotDo) {

@@ -104,7 +104,8 @@ void TgptRender::expectUnbiasedTemporalDifferences(TemporalShift shift) {
         const Image& dt = frames[1].layer("dt");
         if (seed == 0) motion = frames[1].layer("motion");
         for (int c = 0; c < 3; ++c) {
-            ASSERT_EQ(frames[1].layer("motion").plane(c), motion.plane(c)) << "the motion depends on the seed";
+            ASSERT_EQ(frames[1].layer("motion").plane(c), motion.plane(c))
+                << "the motion depends on the seed";
             for (int b = 0; b < bx * by; ++b) {
                 double sum = 0.0;
                 for (int y = 0; y < block; ++y)
@@ -172,8 +173,9 @@ void TgptRender::expectUnbiasedTemporalDifferences(TemporalShift shift) {
         EXPECT_GE(reversedFails, 3) << "the test cannot tell dt from -dt (worst |t| " << reversedWorst << ")";
     } else {
         const auto [samePixelFails, samePixelWorst] = rejected(1.0, false);
-        EXPECT_GE(samePixelFails, 3) << "the test cannot tell the motion's dt from the same pixel's (worst |t| "
-                                     << samePixelWorst << ")";
+        EXPECT_GE(samePixelFails, 3)
+            << "the test cannot tell the motion's dt from the same pixel's (worst |t| " << samePixelWorst
+            << ")";
     }
 }
 
@@ -197,7 +199,8 @@ TEST_F(TgptRender, TimedHalvesArePairedSampleForSample) {
     RenderOptions options = renderOptions(24, 16, 0, 0);
     options.timeBudget = 0.6;
     std::vector<RenderOutput> frames = tgpt.renderWindow(keeping(), windowOf(sceneAt, 0, 3, 5), options);
-    const std::vector<RenderOutput> next = tgpt.renderWindow(keeping(), windowOf(sceneAt, 3, 3, 5, false), options);
+    const std::vector<RenderOutput> next =
+        tgpt.renderWindow(keeping(), windowOf(sceneAt, 3, 3, 5, false), options);
     frames.insert(frames.end(), next.begin(), next.end());
     ASSERT_EQ(frames.size(), 6u);
     for (std::size_t k = 1; k < frames.size(); ++k) {

@@ -1,11 +1,11 @@
 // The motion between frames (integrator/motion_map.h) on scenes whose motion is known by
 // construction: a still scene (every pixel its own partner, misses included, no shift), a
 // camera moved sideways by 3.25 pixels (content moves the other way: three pixels and a
-// quarter-pixel jitter shift; the pixels that leave the image have none), a square moved two pixels over a still background (the
-// background it covers loses to it, the background it uncovers gets fresh streams), a square
-// that comes out from behind a panel (found by carrying back: no source), and frames
-// of different triangle lists (the same pixel). Square edges lie on pixel boundaries, so every
-// pixel centre is half a pixel from an edge.
+// quarter-pixel jitter shift; the pixels that leave the image have none), a square moved two pixels over a
+// still background (the background it covers loses to it, the background it uncovers gets fresh streams), a
+// square that comes out from behind a panel (found by carrying back: no source), and frames of different
+// triangle lists (the same pixel). Square edges lie on pixel boundaries, so every pixel centre is half a
+// pixel from an edge.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -109,8 +109,9 @@ TEST(MotionMap, AMovingSquareCoversAndUncoversTheBackground) {
     const auto coveredInB = [](int x, int y) { return x >= 20 && x <= 21 && y >= 12 && y <= 19; };
     for (int y = 0; y < kSize; ++y)
         for (int x = 0; x < kSize; ++x) {
-            const std::uint32_t want =
-                inSquareA(x, y) ? pixel(x + 2, y) : coveredInB(x, y) ? kNoTemporalPartner : pixel(x, y);
+            const std::uint32_t want = inSquareA(x, y)    ? pixel(x + 2, y)
+                                       : coveredInB(x, y) ? kNoTemporalPartner
+                                                          : pixel(x, y);
             ASSERT_EQ(m.partner[pixel(x, y)], want) << x << "," << y;
         }
     EXPECT_EQ(m.partnered, std::size_t(kSize * kSize - 16));

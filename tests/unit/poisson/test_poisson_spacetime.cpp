@@ -235,13 +235,13 @@ Field denseLeastSquares(const SpaceTimeProblem& p, int c) {
         if (k + w < np) row({{i + w, 1.0}, {i, -1.0}}, p.dy[c][i]);
         if (f + 1 < std::size_t(p.frames)) {
             const std::uint32_t to = p.temporalPartner.empty() ? std::uint32_t(k) : p.temporalPartner[i];
-            if (to != kNoTemporalPartner) row({{(f + 1) * np + to, p.beta}, {i, -p.beta}}, p.beta * p.dt[c][i]);
+            if (to != kNoTemporalPartner)
+                row({{(f + 1) * np + to, p.beta}, {i, -p.beta}}, p.beta * p.dt[c][i]);
         }
     }
     for (std::size_t j = 0; j < p.previous[c].size(); ++j) {
         const std::uint32_t to = p.previousPartner.empty() ? std::uint32_t(j) : p.previousPartner[j];
-        if (to != kNoTemporalPartner)
-            row({{to, p.beta}}, p.beta * (p.previous[c][j] + p.dtPrevious[c][j]));
+        if (to != kNoTemporalPartner) row({{to, p.beta}}, p.beta * (p.previous[c][j] + p.dtPrevious[c][j]));
     }
     Eigen::MatrixXd a = Eigen::MatrixXd::Zero(Eigen::Index(rows.size()), Eigen::Index(n));
     Eigen::VectorXd b(Eigen::Index(rows.size()));
@@ -274,9 +274,7 @@ SpaceTimeProblem withRandomPartners(unsigned seed) {
         p.dtPrevious[c] = from(all.dt[c], 0, np);
     }
     std::mt19937 rng(seed);
-    const auto partner = [&] {
-        return rng() % 4 == 0 ? kNoTemporalPartner : std::uint32_t(rng() % np);
-    };
+    const auto partner = [&] { return rng() % 4 == 0 ? kNoTemporalPartner : std::uint32_t(rng() % np); };
     for (std::size_t i = 0; i < 2 * np; ++i) p.temporalPartner.push_back(partner());
     for (std::size_t j = 0; j < np; ++j) p.previousPartner.push_back(partner());
     return p;
@@ -292,7 +290,8 @@ TEST(SpaceTimePoisson, MotionPartnersSolveTheLeastSquaresOfTheirRows) {
         for (int c = 0; c < 3; ++c) {
             const Field dense = denseLeastSquares(p, c);
             EXPECT_LT(maxDiff(x[c], dense), 1e-8) << "seed " << seed << " channel " << c;
-            EXPECT_LT(maxDiff(solveSpaceTimeExactL2(p, c), dense), 1e-8) << "seed " << seed << " channel " << c;
+            EXPECT_LT(maxDiff(solveSpaceTimeExactL2(p, c), dense), 1e-8)
+                << "seed " << seed << " channel " << c;
         }
         // The partners matter: the same rows at the same pixel give another answer.
         SpaceTimeProblem same = p;
