@@ -175,34 +175,45 @@ TEST(SpaceTimePoisson, TemporalRowsCutFrameToFrameNoise) {
     EXPECT_LT(joint, 0.3 * separate) << joint << " vs " << separate;
 }
 
-TEST(SpaceTimePoisson, TheFrameBeforeTiesTheWindowToIt) {
-    // Frames 1..4 of a consistent sequence, with frame 0 given as the fixed previous frame:
-    // recovered exactly (L2 and L1) from a zero start.
-    const SpaceTimeProblem all = consistentProblem(8, 6, 5);
-    const std::size_t np = 48;
+// Frames 1.. of `all` as the window, with frame 0 as the fixed previous frame and its dt.
+SpaceTimeProblem afterFirstFrame(const SpaceTimeProblem& all) {
+    const std::size_t np = all.pixels(), frames = std::size_t(all.frames);
     SpaceTimeProblem p;
-    p.width = 8;
-    p.height = 6;
-    p.frames = 4;
+    p.width = all.width;
+    p.height = all.height;
+    p.frames = all.frames - 1;
+    const auto from = [](const Field& f, std::size_t a, std::size_t b) {
+        return Field(f.begin() + std::ptrdiff_t(a), f.begin() + std::ptrdiff_t(b));
+    };
     for (int c = 0; c < 3; ++c) {
-        const auto from = [&](const Field& f, std::size_t a, std::size_t b) {
-            return Field(f.begin() + a, f.begin() + b);
-        };
-        p.primal[c] = from(all.primal[c], np, 5 * np);
-        p.dx[c] = from(all.dx[c], np, 5 * np);
-        p.dy[c] = from(all.dy[c], np, 5 * np);
-        p.dt[c] = from(all.dt[c], np, 4 * np);
+        p.primal[c] = from(all.primal[c], np, frames * np);
+        p.dx[c] = from(all.dx[c], np, frames * np);
+        p.dy[c] = from(all.dy[c], np, frames * np);
+        p.dt[c] = from(all.dt[c], np, (frames - 1) * np);
         p.previous[c] = from(all.primal[c], 0, np);
         p.dtPrevious[c] = from(all.dt[c], 0, np);
-        p.initial[c].assign(p.size(), 0.0);
     }
+    return p;
+}
+
+// Consistent data (the primal is the sequence its rows describe) is recovered exactly by L2
+// and L1 solves started from zero.
+void expectRecoveredFromZero(SpaceTimeProblem p) {
+    for (int c = 0; c < 3; ++c) p.initial[c].assign(p.size(), 0.0);
     for (const bool l1 : {false, true}) {
         SpaceTimeOptions o;
         o.l1 = l1;
         o.tolerance = 1e-10;
         const auto x = solveSpaceTime(p, o);
-        for (int c = 0; c < 3; ++c) EXPECT_LT(maxDiff(x[c], p.primal[c]), 1e-6);
+        for (int c = 0; c < 3; ++c) EXPECT_LT(maxDiff(x[c], p.primal[c]), 1e-6) << (l1 ? "l1 " : "l2 ") << c;
     }
+}
+
+TEST(SpaceTimePoisson, TheFrameBeforeTiesTheWindowToIt) {
+    // Frames 1..4 of a consistent sequence, with frame 0 given as the fixed previous frame:
+    // recovered exactly (L2 and L1) from a zero start.
+    const SpaceTimeProblem p = afterFirstFrame(consistentProblem(8, 6, 5));
+    expectRecoveredFromZero(p);
     // Noisy data: the PCG solve with the boundary rows matches the exact factorisation.
     SpaceTimeProblem q = noisy(p, 0.2, 5);
     for (int c = 0; c < 3; ++c) q.initial[c].clear();
@@ -256,23 +267,8 @@ Field denseLeastSquares(const SpaceTimeProblem& p, int c) {
 // Frames 1..3 of consistentProblem's window as the unknowns and frame 0 as the fixed previous
 // frame; random partners (a quarter of them none) in both kinds of temporal rows.
 SpaceTimeProblem withRandomPartners(unsigned seed) {
-    const SpaceTimeProblem all = noisy(consistentProblem(6, 5, 4), 0.3, seed);
-    const std::size_t np = 30;
-    SpaceTimeProblem p;
-    p.width = 6;
-    p.height = 5;
-    p.frames = 3;
-    for (int c = 0; c < 3; ++c) {
-        const auto from = [&](const Field& f, std::size_t a, std::size_t b) {
-            return Field(f.begin() + a, f.begin() + b);
-        };
-        p.primal[c] = from(all.primal[c], np, 4 * np);
-        p.dx[c] = from(all.dx[c], np, 4 * np);
-        p.dy[c] = from(all.dy[c], np, 4 * np);
-        p.dt[c] = from(all.dt[c], np, 3 * np);
-        p.previous[c] = from(all.primal[c], 0, np);
-        p.dtPrevious[c] = from(all.dt[c], 0, np);
-    }
+    SpaceTimeProblem p = afterFirstFrame(noisy(consistentProblem(6, 5, 4), 0.3, seed));
+    const std::size_t np = p.pixels();
     std::mt19937 rng(seed);
     const auto partner = [&] { return rng() % 4 == 0 ? kNoTemporalPartner : std::uint32_t(rng() % np); };
     for (std::size_t i = 0; i < 2 * np; ++i) p.temporalPartner.push_back(partner());
@@ -345,14 +341,7 @@ TEST(SpaceTimePoisson, DifferencesAlongTheMotionRecoverAMovingPattern) {
                         p.dt[c][i] = 1e3;  // no row: never read
                     }
                 }
-    for (int c = 0; c < 3; ++c) p.initial[c].assign(p.size(), 0.0);
-    for (const bool l1 : {false, true}) {
-        SpaceTimeOptions o;
-        o.l1 = l1;
-        o.tolerance = 1e-10;
-        const auto x = solveSpaceTime(p, o);
-        for (int c = 0; c < 3; ++c) EXPECT_LT(maxDiff(x[c], p.primal[c]), 1e-6) << (l1 ? "l1 " : "l2 ") << c;
-    }
+    expectRecoveredFromZero(p);
 }
 
 TEST(SpaceTimePoisson, BadInputIsRefused) {
