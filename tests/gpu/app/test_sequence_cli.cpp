@@ -153,6 +153,23 @@ TEST_F(SequenceCli, AnInterruptLeavesTheCompleteFramesAndSaysWhereToContinue) {
     EXPECT_EQ(files().size(), 8u);
 }
 
+// A timed sequence compiles its kernels before the frames' shares are set: the first frame gets
+// about the samples of the others (it used to compile G-PT's kernels inside its own share and
+// got one or two samples per pixel).
+TEST_F(SequenceCli, ATimedSequenceGivesTheFirstFrameItsShare) {
+    const RunResult r = runGdpt("render " + kMovingBox +
+                                " --method gpt --frames 0:3 --time 2 --width 16 --height 16 --no-video -o " +
+                                path("f_%d.exr") + " --json " + path("s.json"));
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("kernels ready for the sequence"), std::string::npos) << r.output;
+    const nlohmann::json j = readJson(path("s.json"));
+    ASSERT_EQ(j["frame_summaries"].size(), 4u);
+    std::uint32_t fewest = UINT32_MAX;
+    for (int f = 1; f < 4; ++f)
+        fewest = std::min(fewest, j["frame_summaries"][f]["spp"].get<std::uint32_t>());
+    EXPECT_GE(2 * j["frame_summaries"][0]["spp"].get<std::uint32_t>(), fewest) << r.output;
+}
+
 TEST_F(SequenceCli, UsageErrorsLeaveNothing) {
     const std::string base = "render " + kMovingBox + " --spp 1 --width 8 --height 8 ";
     const struct {
