@@ -213,21 +213,26 @@ int runSequence(const RenderArgs& args) {
         warm.spp = 1;
         warm.timeBudget = 0.0;
         warm.quiet = true;
-        enterPhase("compiling the kernels for");
+        const char* phase = "compiling the kernels for";
         bool cancelled = false;
-        if (window > 0) {
-            FrameWindow w;
-            w.first = frame;
-            w.count = 1;
-            w.scene = [&](int f) { return asset.instance(animation, double(f) / args.fps); };
-            w.seed = [&](int f) { return sequenceFrameSeed(args.seed, f); };
-            const std::vector<RenderOutput> outs = integrator->renderWindow(ctx, w, warm);
-            cancelled = outs.empty() || outs.back().stats.cancelled;
-        } else {
-            cancelled = integrator->render(ctx, asset.instance(animation, double(frame) / args.fps), warm)
-                            .stats.cancelled;
+        try {
+            enterPhase(phase);
+            if (window > 0) {
+                FrameWindow w;
+                w.first = frame;
+                w.count = 1;
+                w.scene = [&](int f) { return asset.instance(animation, double(f) / args.fps); };
+                w.seed = [&](int f) { return sequenceFrameSeed(args.seed, f); };
+                const std::vector<RenderOutput> outs = integrator->renderWindow(ctx, w, warm);
+                cancelled = outs.empty() || outs.back().stats.cancelled;
+            } else {
+                cancelled = integrator->render(ctx, asset.instance(animation, double(frame) / args.fps), warm)
+                                .stats.cancelled;
+            }
+        } catch (const Interrupted&) {
+            cancelled = true;
         }
-        if (cancelled) return interrupted("compiling the kernels for");
+        if (cancelled || interruptRequested()) return interrupted(phase);
         if (!quiet)
             std::fprintf(stderr, "gdpt: kernels ready for the sequence in %s\n",
                          seconds(warmUp.seconds()).c_str());

@@ -168,6 +168,19 @@ TEST_F(SequenceCli, ATimedSequenceGivesTheFirstFrameItsShare) {
     for (int f = 1; f < 4; ++f)
         fewest = std::min(fewest, j["frame_summaries"][f]["spp"].get<std::uint32_t>());
     EXPECT_GE(2 * j["frame_summaries"][0]["spp"].get<std::uint32_t>(), fewest) << r.output;
+    // An interrupt while the kernels compile leaves nothing and says where to continue.
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    const RunResult stopped = runGdpt(
+        "render " + kMovingBox + " --method gpt --frames 0:3 --time 2 --width 16 --height 16 --no-video -o " +
+            path("f_%d.exr"),
+        "GDPT_TEST_SIGNAL_AT='compiling the kernels for'");
+    EXPECT_EQ(stopped.code, 130) << stopped.output;
+    EXPECT_NE(stopped.output.find("interrupted while compiling the kernels for frame 0; no frame written "
+                                  "(continue with --frames 0:3)"),
+              std::string::npos)
+        << stopped.output;
+    EXPECT_TRUE(files().empty());
 }
 
 TEST_F(SequenceCli, UsageErrorsLeaveNothing) {
