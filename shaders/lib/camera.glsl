@@ -1,6 +1,7 @@
 // camera.glsl — the pinhole camera's ray through a continuous pixel position (x right, y
 // down, pixel (i, j) covers [i, i+1) x [j, j+1)), shared by every kernel that starts camera
-// paths. GLSL only; expects the scene constants (scene_buffers.glsl).
+// paths. GLSL only; expects the scene constants (scene_buffers.glsl). The host's copy, and its
+// inverse, is src/render/device_scene/camera_ray.h: change both.
 #ifndef GDPT_LIB_CAMERA
 #define GDPT_LIB_CAMERA
 

@@ -150,6 +150,16 @@ int runSequence(const RenderArgs& args) {
         warned = true;
         return scene;
     };
+    // Frames first .. first + count - 1 as a temporal method's window.
+    const auto windowOf = [&](int first, int count) {
+        FrameWindow w;
+        w.first = first;
+        w.count = count;
+        w.scene = sceneAt;
+        w.seed = [&](int f) { return sequenceFrameSeed(args.seed, f); };
+        w.startsSequence = first == range.first;
+        return w;
+    };
     // Writes frame f's EXR and PNG (together, whole or not at all), its summary and progress.
     // `seconds` is what the frame cost (a window's frames share its time).
     const auto writeFrame = [&](RenderOutput& out, double frameSeconds, double sampledAt) {
@@ -218,16 +228,11 @@ int runSequence(const RenderArgs& args) {
         try {
             enterPhase(phase);
             if (window > 0) {
-                FrameWindow w;
-                w.first = frame;
-                w.count = 1;
-                w.scene = [&](int f) { return asset.instance(animation, double(f) / args.fps); };
-                w.seed = [&](int f) { return sequenceFrameSeed(args.seed, f); };
-                const std::vector<RenderOutput> outs = integrator->renderWindow(ctx, w, warm);
+                const std::vector<RenderOutput> outs =
+                    integrator->renderWindow(ctx, windowOf(frame, 1), warm);
                 cancelled = outs.empty() || outs.back().stats.cancelled;
             } else {
-                cancelled = integrator->render(ctx, asset.instance(animation, double(frame) / args.fps), warm)
-                                .stats.cancelled;
+                cancelled = integrator->render(ctx, sceneAt(frame), warm).stats.cancelled;
             }
         } catch (const Interrupted&) {
             cancelled = true;
@@ -242,12 +247,7 @@ int runSequence(const RenderArgs& args) {
             if (window > 0) {
                 // A temporal method: a window of frames sampled and reconstructed together.
                 Timer windowTimer;
-                FrameWindow w;
-                w.first = frame;
-                w.count = std::min(window, range.last - frame + 1);
-                w.scene = sceneAt;
-                w.seed = [&](int f) { return sequenceFrameSeed(args.seed, f); };
-                w.startsSequence = frame == range.first;
+                const FrameWindow w = windowOf(frame, std::min(window, range.last - frame + 1));
                 RenderOptions windowOptions = options;
                 if (timed) windowOptions.timeBudget = budgetFor(w.count);
                 enterPhase("sampling");

@@ -13,6 +13,7 @@
 #include "lib/ray.glsl"
 #include "lib/rng.glsl"
 #include "lib/sampling.glsl"
+#include "render/device_scene/camera_ray.h"
 
 namespace gdpt {
 
@@ -30,15 +31,6 @@ struct BenchPathCount {
     std::uint64_t hits = 0;
 };
 
-// camera.glsl's cameraRay for the scene constants `c`.
-inline glm::vec3 benchCameraRay(const gpu::SceneConstants& c, glm::vec2 pixelPos) {
-    const glm::vec2 ndc(2.0f * pixelPos.x / float(c.width) - 1.0f,
-                        1.0f - 2.0f * pixelPos.y / float(c.height));
-    const glm::vec3 d =
-        c.camForward + ndc.x * c.tanHalfFovY * c.aspect * c.camRight + ndc.y * c.tanHalfFovY * c.camUp;
-    return glm::normalize(d);
-}
-
 // bench_rays.comp's main() for pixel (x, y): `spp` samples from sample index `sampleBase`, one
 // closest-hit segment each (primary) or up to four (incoherent).
 template <class Trace>
@@ -50,7 +42,7 @@ BenchPathCount benchPixelPaths(const gpu::SceneConstants& c, std::uint32_t x, st
     for (std::uint32_t s = 0; s < spp; ++s) {
         gpu::Rng rng = gpu::rngInit(pixel, sampleBase + s, seed);
         const glm::vec2 pos = glm::vec2(float(x), float(y)) + gpu::rngNext2(rng);
-        glm::vec3 d = benchCameraRay(c, pos);
+        glm::vec3 d = cameraRay(c, pos);
         glm::vec3 o = c.camPosition;
         const std::uint32_t segments = incoherent ? 4u : 1u;
         for (std::uint32_t k = 0; k < segments; ++k) {

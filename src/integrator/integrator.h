@@ -126,7 +126,6 @@ struct MltOptions {
     double tolerance = 1e-4;  // relative residual at which each solve stops
 };
 
-// The settings of temporal G-PT (tgpt; tgpt_integrator.h).
 // How temporal G-PT pairs a frame's paths with the next frame's (tgpt_integrator.h): Motion
 // replays each path in the pixel the scene's motion carries its primary hit to (motion_map.h),
 // Replay in the same pixel.
@@ -136,6 +135,7 @@ enum class TemporalShift { Motion, Replay };
 TemporalShift parseTemporalShift(const std::string& text);
 const char* temporalShiftName(TemporalShift shift);
 
+// The settings of temporal G-PT (tgpt; tgpt_integrator.h).
 struct TgptOptions {
     GptSamplingOptions sampling;  // of each frame's two half renders (demodulation off)
     TemporalShift shift = TemporalShift::Motion;

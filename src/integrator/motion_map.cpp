@@ -3,10 +3,12 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "bvh/builder.h"
 #include "bvh/traverse_cpu.h"
 #include "poisson/poisson_spacetime.h"
+#include "render/device_scene/camera_ray.h"
 #include "render/device_scene/scene_gpu.h"
 #include "render/device_scene/scene_spec.h"
 #include "util/error.h"
@@ -19,25 +21,6 @@ gpu::SceneConstants cameraConstants(const Scene& scene, int camera, int width, i
     gpu::SceneConstants c{};
     setCamera(c, renderCamera(scene, camera), width, height);
     return c;
-}
-
-// camera.glsl's cameraRay for a continuous pixel position.
-glm::vec3 cameraRay(const gpu::SceneConstants& c, glm::vec2 pixelPos) {
-    const float nx = 2.0f * pixelPos.x / float(c.width) - 1.0f;
-    const float ny = 1.0f - 2.0f * pixelPos.y / float(c.height);
-    return glm::normalize(c.camForward + nx * c.tanHalfFovY * c.aspect * c.camRight +
-                          ny * c.tanHalfFovY * c.camUp);
-}
-
-// The continuous pixel position at which the camera sees a point in direction d from its
-// position (the inverse of cameraRay), or false if d points behind the camera.
-bool project(const gpu::SceneConstants& c, glm::vec3 d, glm::vec2& pixelPos) {
-    const float z = glm::dot(d, c.camForward);
-    if (!(z > 0.0f)) return false;
-    const float nx = glm::dot(d, c.camRight) / (z * c.tanHalfFovY * c.aspect);
-    const float ny = glm::dot(d, c.camUp) / (z * c.tanHalfFovY);
-    pixelPos = glm::vec2(0.5f * (nx + 1.0f) * float(c.width), 0.5f * (1.0f - ny) * float(c.height));
-    return std::isfinite(pixelPos.x) && std::isfinite(pixelPos.y);
 }
 
 // Where a hit lies in `scene` (its triangle's vertices there), as the direction from the
@@ -55,15 +38,26 @@ glm::vec3 carried(const Scene& scene, const gpu::SceneConstants& c, const Primar
     return d;
 }
 
-// The pixel (index) that a hit carried into `scene` lands in, or false off the image; `pos`
-// the continuous position.
-bool landsIn(const Scene& scene, const gpu::SceneConstants& c, const PrimaryHit& h, std::uint32_t& pixel,
-             float& distance, glm::ivec2& at, glm::vec2& pos) {
-    if (!project(c, carried(scene, c, h, distance), pos)) return false;
-    if (!(pos.x >= 0.0f && pos.y >= 0.0f && pos.x < float(c.width) && pos.y < float(c.height))) return false;
-    at = glm::ivec2(int(pos.x), int(pos.y));
-    pixel = std::uint32_t(at.y) * c.width + std::uint32_t(at.x);
-    return true;
+// Where a hit carried into `scene` lands in its image.
+struct Landing {
+    glm::vec2 position;  // continuous pixel position
+    glm::ivec2 at;       // the pixel it lies in
+    float distance;      // from the camera (infinite for a miss)
+    [[nodiscard]] std::uint32_t pixel(std::uint32_t width) const {
+        return std::uint32_t(at.y) * width + std::uint32_t(at.x);
+    }
+};
+
+// The landing of a hit carried into `scene`, or nothing if it is behind the camera or off the
+// image.
+std::optional<Landing> landing(const Scene& scene, const gpu::SceneConstants& c, const PrimaryHit& h) {
+    Landing l{};
+    if (!projectToPixel(c, carried(scene, c, h, l.distance), l.position)) return std::nullopt;
+    const glm::vec2 pos = l.position;
+    if (!(pos.x >= 0.0f && pos.y >= 0.0f && pos.x < float(c.width) && pos.y < float(c.height)))
+        return std::nullopt;
+    l.at = glm::ivec2(int(pos.x), int(pos.y));
+    return l;
 }
 
 }  // namespace
@@ -110,14 +104,13 @@ MotionMap motionBetween(const Scene& from, const std::vector<PrimaryHit>& fromHi
     map.subpixel.assign(np, glm::vec2(0.0f));
     parallelRanges(defaultThreads(), np, 4096, [&](std::size_t begin, std::size_t end) {
         for (std::size_t p = begin; p < end; ++p) {
-            glm::ivec2 at;
-            glm::vec2 pos;
-            if (!landsIn(to, cTo, fromHits[p], lands[p], distance[p], at, pos)) {
-                lands[p] = kNoTemporalPartner;
-                continue;
-            }
+            const std::optional<Landing> l = landing(to, cTo, fromHits[p]);
+            if (!l) continue;
+            lands[p] = l->pixel(cTo.width);
+            distance[p] = l->distance;
             // Clamped: a float position just below a pixel's far edge may round onto it.
-            map.subpixel[p] = glm::clamp(pos - glm::vec2(at) - 0.5f, glm::vec2(-0.5f), glm::vec2(0.49999f));
+            map.subpixel[p] =
+                glm::clamp(l->position - glm::vec2(l->at) - 0.5f, glm::vec2(-0.5f), glm::vec2(0.49999f));
         }
     });
     // The nearest pixel of `from` landing in each pixel of `to` (the lowest index among equals).
@@ -133,13 +126,10 @@ MotionMap motionBetween(const Scene& from, const std::vector<PrimaryHit>& fromHi
     for (std::size_t q = 0; q < np; ++q) {
         const std::uint32_t p = winner[q];
         if (p == kNoTemporalPartner) continue;
-        std::uint32_t back;
-        float d;
-        glm::ivec2 at;
-        glm::vec2 pos;
-        if (!landsIn(from, cFrom, toHits[q], back, d, at, pos)) continue;
+        const std::optional<Landing> back = landing(from, cFrom, toHits[q]);
+        if (!back) continue;
         const glm::ivec2 source(int(p % std::uint32_t(width)), int(p / std::uint32_t(width)));
-        if (std::abs(at.x - source.x) > 1 || std::abs(at.y - source.y) > 1) continue;
+        if (std::abs(back->at.x - source.x) > 1 || std::abs(back->at.y - source.y) > 1) continue;
         map.partner[p] = std::uint32_t(q);
         ++map.partnered;
     }
