@@ -1,12 +1,17 @@
-// bench_poisson_command.cpp — `gdpt bench-poisson`: JSON timings of the GPU Poisson solver
-// (not a test). Per size and method (l2-mg-pcg, l2-cg, l2-jacobi, l2-mg, l1): median wall
-// ms over --repeats solves (upload to download; pipelines and buffers are created once per
-// size, outside the timing), iterations, final relative residual and ms per Mpixel.
+// bench_poisson_command.cpp — `gdpt bench-poisson`: JSON timings of the Poisson solvers (not
+// a test). Per size and method (l2-mg-pcg, l2-cg, l2-jacobi, l2-mg, l1: the GPU solver;
+// st-l2, st-l1: the space-time solver of temporal G-PT over --frames frames of that size):
+// median wall ms over --repeats solves (GPU: upload to download; pipelines and buffers are
+// created once per size, outside the timing), iterations, final relative residual and ms per
+// Mpixel (of the whole window for st-*).
 // Input: exact forward differences of a procedural image plus its primal with Gaussian noise
-// (σ = 0.1, fixed seed), so every method solves the same well-defined problem.
+// (σ = 0.1, fixed seed), so every method solves the same well-defined problem; for st-* the
+// image moves one pixel to the right per frame, the temporal rows follow that motion (the
+// last column has none) and their targets are exact.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
@@ -14,7 +19,9 @@
 #include "app/bench_util.h"
 #include "app/subcommand.h"
 #include "poisson/poisson_gpu.h"
+#include "poisson/poisson_spacetime.h"
 #include "util/error.h"
+#include "util/parallel.h"
 #include "vk/context.h"
 
 namespace gdpt {
@@ -34,6 +41,8 @@ struct BenchPoissonArgs {
     std::string device;
     bool profile = false;
     std::string addressing = "auto";
+    int frames = 10;  // st-*: frames of the window
+    int threads = 0;  // st-*: solver threads (0 = the machine's cores)
 };
 
 // Smooth shading, hard-edged discs and fine stripes: content with every frequency.
@@ -53,6 +62,73 @@ Image proceduralImage(int w, int h) {
     return im;
 }
 
+// st-l2 / st-l1: the space-time solve of --frames frames of w x h, the procedural image
+// moving one pixel to the right per frame.
+nlohmann::json benchSpaceTime(const BenchPoissonArgs& a, int w, int h, const std::string& sizeText,
+                              const std::string& method) {
+    if (method != "st-l2" && method != "st-l1")
+        throw UsageError("--methods: unknown method '" + method + "'");
+    const Image truth = proceduralImage(w + a.frames, h);
+    SpaceTimeProblem p;
+    p.width = w;
+    p.height = h;
+    p.frames = a.frames;
+    p.alpha = a.alpha;
+    const std::size_t np = p.pixels();
+    std::mt19937 rng(1234);
+    std::normal_distribution<double> noise(0.0, 0.1);
+    for (int c = 0; c < 3; ++c) {
+        p.primal[c].resize(p.size());
+        p.dx[c].assign(p.size(), 0.0);
+        p.dy[c].assign(p.size(), 0.0);
+        p.dt[c].assign(np * std::size_t(a.frames - 1), 0.0);
+        for (int f = 0; f < a.frames; ++f)
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x) {
+                    // Frame f shows the image shifted right by f pixels.
+                    const auto value = [&](int px, int py) {
+                        return double(truth.at(px - f + a.frames, py, c));
+                    };
+                    const std::size_t i =
+                        std::size_t(f) * np + std::size_t(y) * std::size_t(w) + std::size_t(x);
+                    if (x + 1 < w) p.dx[c][i] = value(x + 1, y) - value(x, y);
+                    if (y + 1 < h) p.dy[c][i] = value(x, y + 1) - value(x, y);
+                    p.primal[c][i] = value(x, y) + noise(rng);
+                }
+    }
+    p.temporalPartner.resize(np * std::size_t(a.frames - 1));
+    for (std::size_t i = 0; i < p.temporalPartner.size(); ++i) {
+        const std::size_t pixel = i % np;
+        p.temporalPartner[i] =
+            pixel % std::size_t(w) + 1 < std::size_t(w) ? std::uint32_t(pixel + 1) : kNoTemporalPartner;
+    }
+    SpaceTimeOptions o;
+    o.l1 = method == "st-l1";
+    o.tolerance = a.tolerance;
+    o.maxIterations = a.maxIterations;
+    o.threads = a.threads;
+    std::fprintf(stderr, "gdpt bench-poisson: %d frames of %dx%d %s\n", a.frames, w, h, method.c_str());
+    std::vector<double> ms;
+    SpaceTimeStats stats;
+    for (int r = 0; r < a.repeats; ++r) {
+        (void)solveSpaceTime(p, o, &stats);
+        ms.push_back(stats.ms);
+    }
+    const double med = median(ms);
+    return {{"size", sizeText},
+            {"width", w},
+            {"height", h},
+            {"frames", a.frames},
+            {"method", method},
+            {"median_ms", med},
+            {"all_ms", ms},
+            {"iterations", stats.iterations},
+            {"irls_iterations", stats.irlsIterations},
+            {"residual", stats.residual},
+            {"converged", stats.converged},
+            {"ms_per_mpixel", med / (double(w) * h * a.frames * 1e-6)}};
+}
+
 int runBenchPoisson(const BenchPoissonArgs& a) {
     using nlohmann::json;
     unsigned gx = 0, gy = 0;
@@ -66,14 +142,22 @@ int runBenchPoisson(const BenchPoissonArgs& a) {
         addressing = PoissonAddressing::DeviceAddress;
     else if (a.addressing != "auto")
         throw UsageError("--addressing must be auto, descriptors or device-address");
-    vk::ContextOptions co;
-    co.device = a.device;
-    vk::Context ctx(co);
-    PoissonKernels kernels(ctx, gx, gy);
+    const std::vector<std::string> methods = splitList(a.methods);
+    const bool gpu = std::any_of(methods.begin(), methods.end(),
+                                 [](const std::string& m) { return m.rfind("st-", 0) != 0; });
+    // The space-time solver runs on the host: no Vulkan device for st-* alone.
+    std::unique_ptr<vk::Context> ctxOwned;
+    std::unique_ptr<PoissonKernels> kernelsOwned;
     std::unique_ptr<vk::GpuTimer> timer;
-    if (a.profile) timer = std::make_unique<vk::GpuTimer>(ctx, 16384);
-    json out = {{"device", ctx.info().name},
-                {"driver", ctx.info().driverInfo},
+    if (gpu) {
+        vk::ContextOptions co;
+        co.device = a.device;
+        ctxOwned = std::make_unique<vk::Context>(co);
+        kernelsOwned = std::make_unique<PoissonKernels>(*ctxOwned, gx, gy);
+        if (a.profile) timer = std::make_unique<vk::GpuTimer>(*ctxOwned, 16384);
+    }
+    json out = {{"device", gpu ? ctxOwned->info().name : std::string("host")},
+                {"driver", gpu ? ctxOwned->info().driverInfo : std::string()},
                 {"repeats", a.repeats},
                 {"alpha", a.alpha},
                 {"tolerance", a.tolerance},
@@ -82,6 +166,8 @@ int runBenchPoisson(const BenchPoissonArgs& a) {
                 {"post_smooth", a.postSmooth},
                 {"smoother", a.jacobiSmoother ? "jacobi" : "rb-gs"},
                 {"addressing", a.addressing},
+                {"frames", a.frames},
+                {"threads", defaultThreads(static_cast<std::uint32_t>(a.threads))},
                 {"results", json::array()}};
     for (const std::string& sizeText : splitList(a.sizes)) {
         const auto [w, h] = parseSize(sizeText);
@@ -96,12 +182,19 @@ int runBenchPoisson(const BenchPoissonArgs& a) {
                     if (y + 1 < h) dy.at(x, y, c) = truth.at(x, y + 1, c) - truth.at(x, y, c);
                     primal.at(x, y, c) += noise(rng);
                 }
-        PoissonSolverGpu solver(ctx, w, h, &kernels, addressing);
+        std::unique_ptr<PoissonSolverGpu> solverOwned;
+        if (gpu)
+            solverOwned = std::make_unique<PoissonSolverGpu>(*ctxOwned, w, h, kernelsOwned.get(), addressing);
         PoissonInput in;
         in.primal = &primal;
         in.dx = &dx;
         in.dy = &dy;
-        for (const std::string& method : splitList(a.methods)) {
+        for (const std::string& method : methods) {
+            if (method.rfind("st-", 0) == 0) {
+                out["results"].push_back(benchSpaceTime(a, w, h, sizeText, method));
+                continue;
+            }
+            PoissonSolverGpu& solver = *solverOwned;
             SolveOptions o;
             o.alpha = a.alpha;
             o.tolerance = a.tolerance;
@@ -146,7 +239,7 @@ int runBenchPoisson(const BenchPoissonArgs& a) {
                 for (const auto& [name, t] : report.kernels)
                     k[name] = {{"count", t.count}, {"total_ms", t.totalMs}};
                 entry["kernels"] = k;
-                timer = std::make_unique<vk::GpuTimer>(ctx, 16384);
+                timer = std::make_unique<vk::GpuTimer>(*ctxOwned, 16384);
             }
             out["results"].push_back(entry);
         }
@@ -162,7 +255,16 @@ Subcommand addBenchPoissonCommand(CLI::App& app) {
     CLI::App* sub =
         app.add_subcommand("bench-poisson", "Time the GPU Poisson solver on synthetic inputs (JSON)");
     sub->add_option("--sizes", args->sizes, "Comma-separated sizes, N or WxH")->capture_default_str();
-    sub->add_option("--methods", args->methods, "Comma-separated: l2-mg-pcg, l2-cg, l2-jacobi, l2-mg, l1")
+    sub->add_option(
+           "--methods", args->methods,
+           "Comma-separated: l2-mg-pcg, l2-cg, l2-jacobi, l2-mg, l1 (GPU); st-l2, st-l1 (the space-time "
+           "solver of temporal G-PT, on the host, over --frames frames of each size)")
+        ->capture_default_str();
+    sub->add_option("--frames", args->frames, "st-*: frames of the space-time window")
+        ->check(CLI::Range(1, 1000))
+        ->capture_default_str();
+    sub->add_option("--threads", args->threads, "st-*: host threads of the space-time solver (0 = all cores)")
+        ->check(CLI::Range(0, 1024))
         ->capture_default_str();
     sub->add_option("--repeats", args->repeats, "Solves per size and method (median reported)")
         ->check(CLI::Range(1, 100))

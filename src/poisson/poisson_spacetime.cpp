@@ -4,24 +4,29 @@
 #include <Eigen/Sparse>
 #include <algorithm>
 #include <cmath>
-#include <future>
-#include <thread>
 #include <vector>
 
 #include "util/error.h"
+#include "util/huge_pages.h"
+#include "util/parallel.h"
 #include "util/timer.h"
 
 namespace gdpt {
 namespace {
 
-// The normal equations A = Pᵀ W P of one channel in graph form: (A x)_i = Σ_j c_ij (x_i − x_j)
-// + cp_i x_i over the x, y and frame neighbours (poisson_problem.h's form, one more axis).
+// The normal equations A = Pᵀ W P (shared by the channels) in graph form: (A x)_i =
+// Σ_j c_ij (x_i − x_j) + cp_i x_i over the x, y and frame neighbours (poisson_problem.h's form,
+// one more axis), applied by gathering over each pixel's neighbours (so disjoint pixel ranges
+// can run on different threads): d_i x_i − Σ_j c_ij x_j with the diagonal d.
 struct Operator {
     int width = 0, height = 0, frames = 0;
     Field cx, cy, ct, cp;  // edge i–(i+1), i–(i+W), i–next(i); screening
     Field cb;              // rows from the fixed previous frame's pixel j to bnext(j) (W·H; empty: none)
-    std::vector<std::size_t> next;   // next(i): the temporal neighbour of i in the window (where ct > 0)
-    std::vector<std::size_t> bnext;  // bnext(j): the pixel of frame 0 of the previous frame's pixel j
+    Field diag;            // d_i: cp_i, the boundary rows at i and every edge at i
+    std::vector<std::uint32_t> next;   // next(i): the temporal neighbour of i in the window, or kNone
+    std::vector<std::uint32_t> bnext;  // bnext(j): the pixel of frame 0 of the previous frame's pixel j
+    // The pixels whose next() is i: back[backStart[i] .. backStart[i+1]).
+    std::vector<std::uint32_t> backStart, back;
     [[nodiscard]] std::size_t pixels() const { return std::size_t(width) * std::size_t(height); }
     [[nodiscard]] std::size_t size() const { return pixels() * std::size_t(frames); }
 };
@@ -30,6 +35,31 @@ struct Operator {
 struct Weights {
     Field primal, dx, dy, dt, boundary;  // boundary: W·H rows to the previous frame, or empty
 };
+
+// Pixels per range of the parallel loops. Sums are taken per range and added in range order,
+// so the result does not depend on the number of threads.
+constexpr std::size_t kGrain = 8192;
+
+std::size_t rangesOf(std::size_t n) {
+    return (n + kGrain - 1) / kGrain;
+}
+
+// f.resize(n), a new buffer advised for huge pages (util/huge_pages.h): the window's fields
+// are tens of MiB, and a page fault per 4 KiB cost a fifth of a solve on a virtual machine.
+void sized(Field& f, std::size_t n) {
+    if (f.capacity() < n) {
+        Field fresh;
+        reserveHuge(fresh, n);
+        f.swap(fresh);
+    }
+    f.resize(n);
+}
+
+// `to` = `from`, in a buffer advised for huge pages.
+void copied(Field& to, const Field& from) {
+    sized(to, from.size());
+    std::copy(from.begin(), from.end(), to.begin());
+}
 
 void check(const SpaceTimeProblem& p) {
     if (p.width < 1 || p.height < 1 || p.frames < 1) throw Error("space-time Poisson: empty window");
@@ -72,37 +102,40 @@ void check(const SpaceTimeProblem& p) {
 }
 
 // The temporal neighbour of every row's pixel in the window (frame f's i → frame f+1's π(i))
-// and of the previous frame's pixels in frame 0; kNoRow where π names none.
-constexpr std::size_t kNoRow = ~std::size_t{0};
+// and of the previous frame's pixels in frame 0; kNone where π names none.
+constexpr std::uint32_t kNone = 0xFFFFFFFFu;
 
-std::vector<std::size_t> nextPixels(const SpaceTimeProblem& p) {
+std::vector<std::uint32_t> nextPixels(const SpaceTimeProblem& p) {
     const std::size_t np = p.pixels(), nt = np * std::size_t(p.frames - 1);
-    std::vector<std::size_t> next(nt);
+    std::vector<std::uint32_t> next(nt);
     for (std::size_t i = 0; i < nt; ++i) {
         const std::size_t frameStart = (i / np + 1) * np;
         if (p.temporalPartner.empty())
-            next[i] = i + np;
+            next[i] = std::uint32_t(i + np);
         else
-            next[i] = p.temporalPartner[i] == kNoTemporalPartner ? kNoRow : frameStart + p.temporalPartner[i];
+            next[i] = p.temporalPartner[i] == kNoTemporalPartner
+                          ? kNone
+                          : std::uint32_t(frameStart + p.temporalPartner[i]);
     }
     return next;
 }
 
-std::vector<std::size_t> previousNext(const SpaceTimeProblem& p) {
+std::vector<std::uint32_t> previousNext(const SpaceTimeProblem& p) {
     if (p.previous[0].empty()) return {};
-    std::vector<std::size_t> next(p.pixels());
+    std::vector<std::uint32_t> next(p.pixels());
     for (std::size_t j = 0; j < next.size(); ++j) {
         if (p.previousPartner.empty())
-            next[j] = j;
+            next[j] = std::uint32_t(j);
         else
-            next[j] = p.previousPartner[j] == kNoTemporalPartner ? kNoRow : p.previousPartner[j];
+            next[j] = p.previousPartner[j] == kNoTemporalPartner ? kNone : p.previousPartner[j];
     }
     return next;
 }
 
 Weights unitWeights(const SpaceTimeProblem& p) {
     const std::size_t n = p.size(), np = p.pixels(), w = std::size_t(p.width);
-    Weights wt{Field(n, 1.0), Field(n, 1.0), Field(n, 1.0), Field(np * std::size_t(p.frames - 1), 1.0),
+    Weights wt{hugeVector(n, 1.0), hugeVector(n, 1.0), hugeVector(n, 1.0),
+               hugeVector(np * std::size_t(p.frames - 1), 1.0),
                p.previous[0].empty() ? Field() : Field(np, 1.0)};
     for (std::size_t i = 0; i < n; ++i) {
         if ((i % np) % w + 1 == w) wt.dx[i] = 0.0;
@@ -115,177 +148,293 @@ Weights unitWeights(const SpaceTimeProblem& p) {
     return wt;
 }
 
-Operator makeOperator(const SpaceTimeProblem& p, const Weights& wt) {
+// The structure of the operator (neighbours), which the weights do not change.
+Operator makeStructure(const SpaceTimeProblem& p) {
     Operator op;
     op.width = p.width;
     op.height = p.height;
     op.frames = p.frames;
-    const std::size_t n = p.size(), np = p.pixels();
-    op.cx = wt.dx;
-    op.cy = wt.dy;
-    op.ct.assign(n, 0.0);
+    const std::size_t n = p.size();
     op.next = nextPixels(p);
-    op.next.resize(n, kNoRow);
+    op.next.resize(n, kNone);
     op.bnext = previousNext(p);
-    for (std::size_t i = 0; i + np < n; ++i)
-        if (op.next[i] != kNoRow) op.ct[i] = p.beta * p.beta * wt.dt[i];
-    op.cp.resize(n);
-    for (std::size_t i = 0; i < n; ++i) op.cp[i] = p.alpha * p.alpha * wt.primal[i];
-    op.cb = wt.boundary;
-    for (double& v : op.cb) v *= p.beta * p.beta;
+    op.backStart.assign(n + 1, 0);
+    for (std::size_t i = 0; i < n; ++i)
+        if (op.next[i] != kNone) ++op.backStart[op.next[i] + 1];
+    for (std::size_t i = 0; i < n; ++i) op.backStart[i + 1] += op.backStart[i];
+    op.back.resize(op.backStart[n]);
+    std::vector<std::uint32_t> fill(op.backStart.begin(), op.backStart.end() - 1);
+    for (std::size_t i = 0; i < n; ++i)
+        if (op.next[i] != kNone) op.back[fill[op.next[i]]++] = std::uint32_t(i);
     return op;
 }
 
-// b = Pᵀ W target: α² wp t minus the weighted divergence of the (dx, dy, dt) field.
-Field rhs(const SpaceTimeProblem& p, const Operator& op, int c) {
-    const std::size_t n = op.size(), w = std::size_t(op.width);
-    Field b(n);
-    for (std::size_t i = 0; i < n; ++i) b[i] = op.cp[i] * p.primal[c][i];
-    for (std::size_t j = 0; j < op.cb.size(); ++j)
-        if (op.cb[j] != 0.0) b[op.bnext[j]] += op.cb[j] * (p.previous[c][j] + p.dtPrevious[c][j]);
-    for (std::size_t i = 0; i < n; ++i) {
-        if (op.cx[i] != 0.0) {
-            b[i] -= op.cx[i] * p.dx[c][i];
-            b[i + 1] += op.cx[i] * p.dx[c][i];
+// The coefficients of the weights `wt` into `op` (made by makeStructure), on `threads`.
+void setWeights(const SpaceTimeProblem& p, const Weights& wt, Operator& op, std::uint32_t threads) {
+    const std::size_t n = p.size(), np = p.pixels(), w = std::size_t(p.width);
+    const double a2 = p.alpha * p.alpha, b2 = p.beta * p.beta;
+    copied(op.cx, wt.dx);
+    copied(op.cy, wt.dy);
+    sized(op.ct, n);
+    sized(op.cp, n);
+    sized(op.diag, n);
+    parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+            op.ct[i] = i + np < n && op.next[i] != kNone ? b2 * wt.dt[i] : 0.0;
+            op.cp[i] = a2 * wt.primal[i];
         }
-        if (op.cy[i] != 0.0) {
-            b[i] -= op.cy[i] * p.dy[c][i];
-            b[i + w] += op.cy[i] * p.dy[c][i];
+    });
+    parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+            double d = op.cp[i] + op.cx[i] + op.cy[i] + op.ct[i];
+            if (i >= 1) d += op.cx[i - 1];
+            if (i >= w) d += op.cy[i - w];
+            for (std::uint32_t k = op.backStart[i]; k < op.backStart[i + 1]; ++k) d += op.ct[op.back[k]];
+            op.diag[i] = d;
         }
-        if (op.ct[i] != 0.0) {
-            b[i] -= op.ct[i] * p.dt[c][i];
-            b[op.next[i]] += op.ct[i] * p.dt[c][i];
-        }
-    }
-    return b;
-}
-
-void apply(const Operator& op, const Field& x, Field& y) {
-    const std::size_t n = op.size(), w = std::size_t(op.width);
-    for (std::size_t i = 0; i < n; ++i) y[i] = op.cp[i] * x[i];
-    for (std::size_t j = 0; j < op.cb.size(); ++j)
-        if (op.cb[j] != 0.0) y[op.bnext[j]] += op.cb[j] * x[op.bnext[j]];
-    for (std::size_t i = 0; i < n; ++i) {
-        const double xi = x[i];
-        if (op.cx[i] != 0.0) {
-            const double f = op.cx[i] * (xi - x[i + 1]);
-            y[i] += f;
-            y[i + 1] -= f;
-        }
-        if (op.cy[i] != 0.0) {
-            const double f = op.cy[i] * (xi - x[i + w]);
-            y[i] += f;
-            y[i + w] -= f;
-        }
-        if (op.ct[i] != 0.0) {
-            const std::size_t j = op.next[i];
-            const double f = op.ct[i] * (xi - x[j]);
-            y[i] += f;
-            y[j] -= f;
-        }
+    });
+    op.cb = wt.boundary;
+    for (std::size_t j = 0; j < op.cb.size(); ++j) {
+        op.cb[j] *= b2;
+        if (op.cb[j] != 0.0) op.diag[op.bnext[j]] += op.cb[j];
     }
 }
 
-Field diagonalOf(const Operator& op) {
+// b = Pᵀ W target for the three channels: α² wp t minus the weighted divergence of the
+// (dx, dy, dt) field, plus the rows from the previous frame.
+void rhs(const SpaceTimeProblem& p, const Operator& op, std::array<Field, 3>& b, std::uint32_t threads) {
     const std::size_t n = op.size(), w = std::size_t(op.width);
-    Field d = op.cp;
-    for (std::size_t j = 0; j < op.cb.size(); ++j)
-        if (op.cb[j] != 0.0) d[op.bnext[j]] += op.cb[j];
-    for (std::size_t i = 0; i < n; ++i) {
-        if (op.cx[i] != 0.0) d[i] += op.cx[i], d[i + 1] += op.cx[i];
-        if (op.cy[i] != 0.0) d[i] += op.cy[i], d[i + w] += op.cy[i];
-        if (op.ct[i] != 0.0) d[i] += op.ct[i], d[op.next[i]] += op.ct[i];
-    }
-    return d;
+    for (Field& f : b) sized(f, n);
+    parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
+        for (int c = 0; c < 3; ++c) {
+            const Field &dx = p.dx[c], &dy = p.dy[c], &dt = p.dt[c];
+            for (std::size_t i = begin; i < end; ++i) {
+                double v = op.cp[i] * p.primal[c][i] - op.cx[i] * dx[i] - op.cy[i] * dy[i];
+                if (op.ct[i] != 0.0) v -= op.ct[i] * dt[i];
+                if (i >= 1) v += op.cx[i - 1] * dx[i - 1];
+                if (i >= w) v += op.cy[i - w] * dy[i - w];
+                for (std::uint32_t k = op.backStart[i]; k < op.backStart[i + 1]; ++k)
+                    v += op.ct[op.back[k]] * dt[op.back[k]];
+                b[c][i] = v;
+            }
+        }
+    });
+    for (int c = 0; c < 3; ++c)
+        for (std::size_t j = 0; j < op.cb.size(); ++j)
+            if (op.cb[j] != 0.0) b[c][op.bnext[j]] += op.cb[j] * (p.previous[c][j] + p.dtPrevious[c][j]);
 }
 
-// Jacobi-preconditioned CG from x until ‖b − A x‖ ≤ tolerance ‖b‖. A is SPD (α > 0).
-SolveStats pcg(const Operator& op, const Field& b, Field& x, double tolerance, int maxIterations) {
-    const std::size_t n = op.size();
-    const Field d = diagonalOf(op);
-    Field r(n), z(n), p(n), q(n);
-    apply(op, x, q);
-    double bb = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-        r[i] = b[i] - q[i];
-        bb += b[i] * b[i];
-    }
-    SolveStats s;
-    s.rhsNorm = std::sqrt(bb);
-    const double target = tolerance * s.rhsNorm;
-    double rz = 0.0, rr = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-        z[i] = r[i] / d[i];
-        p[i] = z[i];
-        rz += r[i] * z[i];
-        rr += r[i] * r[i];
-    }
-    while (std::sqrt(rr) > target && s.iterations < maxIterations) {
-        apply(op, p, q);
-        double pq = 0.0;
-        for (std::size_t i = 0; i < n; ++i) pq += p[i] * q[i];
-        if (!(pq > 0.0)) break;
-        const double a = rz / pq;
-        double rzNew = 0.0;
-        rr = 0.0;
-        for (std::size_t i = 0; i < n; ++i) {
-            x[i] += a * p[i];
-            r[i] -= a * q[i];
-            z[i] = r[i] / d[i];
-            rzNew += r[i] * z[i];
-            rr += r[i] * r[i];
+// (A x)_i for i in [begin, end).
+void applyRange(const Operator& op, const Field& x, Field& y, std::size_t begin, std::size_t end) {
+    const std::size_t n = op.size(), w = std::size_t(op.width);
+    for (std::size_t i = begin; i < end; ++i) {
+        double v = op.diag[i] * x[i];
+        if (i + 1 < n) v -= op.cx[i] * x[i + 1];
+        if (i >= 1) v -= op.cx[i - 1] * x[i - 1];
+        if (i + w < n) v -= op.cy[i] * x[i + w];
+        if (i >= w) v -= op.cy[i - w] * x[i - w];
+        if (op.next[i] != kNone) v -= op.ct[i] * x[op.next[i]];
+        for (std::uint32_t k = op.backStart[i]; k < op.backStart[i + 1]; ++k) {
+            const std::uint32_t j = op.back[k];
+            v -= op.ct[j] * x[j];
         }
-        const double beta = rzNew / rz;
-        rz = rzNew;
-        for (std::size_t i = 0; i < n; ++i) p[i] = z[i] + beta * p[i];
-        ++s.iterations;
+        y[i] = v;
     }
-    s.residualNorm = std::sqrt(rr);
-    s.converged = s.residualNorm <= target;
-    return s;
+}
+
+struct ChannelSolve {
+    int iterations = 0;
+    double rhsNorm = 0.0, residualNorm = 0.0;
+    bool converged = false;
+};
+
+// Jacobi-preconditioned CG from x until ‖b − A x‖ ≤ tolerance ‖b‖, the three channels in
+// lockstep (each stops where it converges), pixel ranges over `threads`. A is SPD (α > 0).
+// z = r / d is not stored: p ← r/d + β p.
+// CG's vectors, kept across the IRLS rounds (allocating them anew each round cost more than
+// the iterations on a machine where page faults are slow).
+struct CgVectors {
+    std::array<Field, 3> r, p, q;
+};
+
+std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& b, std::array<Field, 3>& x,
+                                double tolerance, int maxIterations, std::uint32_t threads, CgVectors& v) {
+    const std::size_t n = op.size(), ranges = rangesOf(n);
+    std::array<Field, 3>&r = v.r, &p = v.p, &q = v.q;
+    // Per range: the partial sums of one pass (three per channel at most), added in range order.
+    std::vector<std::array<double, 9>> partial(ranges);
+    const auto sumOf = [&](int slot) {
+        double s = 0.0;
+        for (const auto& part : partial) s += part[std::size_t(slot)];
+        return s;
+    };
+    for (int c = 0; c < 3; ++c) {
+        sized(r[c], n);
+        sized(p[c], n);
+        sized(q[c], n);
+    }
+    // r = b − A x, p = z = r / d; ‖b‖², r·z and ‖r‖².
+    parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
+        std::array<double, 9> s{};
+        for (int c = 0; c < 3; ++c) {
+            applyRange(op, x[c], q[c], begin, end);
+            double bb = 0.0, rz = 0.0, rr = 0.0;
+            for (std::size_t i = begin; i < end; ++i) {
+                const double ri = b[c][i] - q[c][i];
+                r[c][i] = ri;
+                p[c][i] = ri / op.diag[i];
+                bb += b[c][i] * b[c][i];
+                rz += ri * p[c][i];
+                rr += ri * ri;
+            }
+            s[std::size_t(c)] = bb;
+            s[std::size_t(c) + 3] = rz;
+            s[std::size_t(c) + 6] = rr;
+        }
+        partial[begin / kGrain] = s;
+    });
+    std::array<ChannelSolve, 3> out;
+    std::array<double, 3> rz{}, rr{}, target{}, alpha{}, beta{};
+    std::array<bool, 3> active{};
+    for (int c = 0; c < 3; ++c) {
+        out[c].rhsNorm = std::sqrt(sumOf(c));
+        rz[c] = sumOf(c + 3);
+        rr[c] = sumOf(c + 6);
+        target[c] = tolerance * out[c].rhsNorm;
+        active[c] = std::sqrt(rr[c]) > target[c] && maxIterations > 0;
+    }
+    const auto anyActive = [&] { return active[0] || active[1] || active[2]; };
+    while (anyActive()) {
+        // q = A p and p·q.
+        parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
+            std::array<double, 9> s{};
+            for (int c = 0; c < 3; ++c) {
+                if (!active[c]) continue;
+                applyRange(op, p[c], q[c], begin, end);
+                double pq = 0.0;
+                for (std::size_t i = begin; i < end; ++i) pq += p[c][i] * q[c][i];
+                s[std::size_t(c)] = pq;
+            }
+            partial[begin / kGrain] = s;
+        });
+        for (int c = 0; c < 3; ++c) {
+            if (!active[c]) continue;
+            const double pq = sumOf(c);
+            if (!(pq > 0.0)) {
+                active[c] = false;  // breakdown: keep x
+                continue;
+            }
+            alpha[c] = rz[c] / pq;
+        }
+        // x += α p, r −= α q, and r·z, r·r.
+        parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
+            std::array<double, 9> s{};
+            for (int c = 0; c < 3; ++c) {
+                if (!active[c]) continue;
+                double rzNew = 0.0, rrNew = 0.0;
+                const double a = alpha[c];
+                for (std::size_t i = begin; i < end; ++i) {
+                    x[c][i] += a * p[c][i];
+                    const double ri = r[c][i] - a * q[c][i];
+                    r[c][i] = ri;
+                    rzNew += ri * ri / op.diag[i];
+                    rrNew += ri * ri;
+                }
+                s[std::size_t(c)] = rzNew;
+                s[std::size_t(c) + 3] = rrNew;
+            }
+            partial[begin / kGrain] = s;
+        });
+        for (int c = 0; c < 3; ++c) {
+            if (!active[c]) continue;
+            const double rzNew = sumOf(c);
+            rr[c] = sumOf(c + 3);
+            beta[c] = rzNew / rz[c];
+            rz[c] = rzNew;
+            ++out[c].iterations;
+            active[c] = std::sqrt(rr[c]) > target[c] && out[c].iterations < maxIterations;
+        }
+        if (!anyActive()) break;
+        // p = r / d + β p.
+        parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
+            for (int c = 0; c < 3; ++c) {
+                if (!active[c]) continue;
+                const double bt = beta[c];
+                for (std::size_t i = begin; i < end; ++i) p[c][i] = r[c][i] / op.diag[i] + bt * p[c][i];
+            }
+        });
+    }
+    for (int c = 0; c < 3; ++c) {
+        out[c].residualNorm = std::sqrt(rr[c]);
+        out[c].converged = out[c].residualNorm <= target[c];
+    }
+    return out;
 }
 
 // IRLS weights of the estimate x: 1 / (‖e‖_RGB + reg) for every kept row, mean 1.
-Weights irlsWeights(const SpaceTimeProblem& p, const std::array<Field, 3>& x, double reg) {
-    Weights wt = unitWeights(p);
-    const std::vector<std::size_t> next = nextPixels(p), bnext = previousNext(p);
+// `kept`: the unit weights (0 for dropped rows); `wt` gets the same sizes.
+void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array<Field, 3>& x, double reg,
+                 const Weights& kept, Weights& wt, std::uint32_t threads) {
+    sized(wt.primal, kept.primal.size());
+    sized(wt.dx, kept.dx.size());
+    sized(wt.dy, kept.dy.size());
+    sized(wt.dt, kept.dt.size());
+    sized(wt.boundary, kept.boundary.size());
     const std::size_t n = p.size(), np = p.pixels(), w = std::size_t(p.width);
-    double sum = 0.0;
-    std::size_t rows = 0;
-    const auto weightOf = [&](const double e[3]) {
-        const double v = 1.0 / (std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) + reg);
-        sum += v;
-        ++rows;
-        return v;
-    };
-    double e[3];
-    for (std::size_t i = 0; i < n; ++i) {
-        for (int c = 0; c < 3; ++c) e[c] = p.alpha * (x[c][i] - p.primal[c][i]);
-        wt.primal[i] = weightOf(e);
-        if (wt.dx[i] != 0.0) {
-            for (int c = 0; c < 3; ++c) e[c] = x[c][i + 1] - x[c][i] - p.dx[c][i];
-            wt.dx[i] = weightOf(e);
+    std::vector<std::array<double, 2>> partial(rangesOf(n));  // per range: Σ weights, rows
+    parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
+        double sum = 0.0, rows = 0.0;
+        const auto weightOf = [&](const double e[3]) {
+            const double v = 1.0 / (std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) + reg);
+            sum += v;
+            rows += 1.0;
+            return v;
+        };
+        double e[3];
+        for (std::size_t i = begin; i < end; ++i) {
+            for (int c = 0; c < 3; ++c) e[c] = p.alpha * (x[c][i] - p.primal[c][i]);
+            wt.primal[i] = weightOf(e);
+            wt.dx[i] = 0.0;
+            if (kept.dx[i] != 0.0) {
+                for (int c = 0; c < 3; ++c) e[c] = x[c][i + 1] - x[c][i] - p.dx[c][i];
+                wt.dx[i] = weightOf(e);
+            }
+            wt.dy[i] = 0.0;
+            if (kept.dy[i] != 0.0) {
+                for (int c = 0; c < 3; ++c) e[c] = x[c][i + w] - x[c][i] - p.dy[c][i];
+                wt.dy[i] = weightOf(e);
+            }
+            if (i + np < n) {
+                wt.dt[i] = 0.0;
+                if (kept.dt[i] != 0.0) {
+                    const std::size_t j = op.next[i];
+                    for (int c = 0; c < 3; ++c) e[c] = p.beta * (x[c][j] - x[c][i] - p.dt[c][i]);
+                    wt.dt[i] = weightOf(e);
+                }
+            }
         }
-        if (wt.dy[i] != 0.0) {
-            for (int c = 0; c < 3; ++c) e[c] = x[c][i + w] - x[c][i] - p.dy[c][i];
-            wt.dy[i] = weightOf(e);
-        }
-        if (i + np < n && wt.dt[i] != 0.0) {
-            const std::size_t j = next[i];
-            for (int c = 0; c < 3; ++c) e[c] = p.beta * (x[c][j] - x[c][i] - p.dt[c][i]);
-            wt.dt[i] = weightOf(e);
-        }
-    }
+        partial[begin / kGrain] = {sum, rows};
+    });
+    double sum = 0.0, rows = 0.0;
+    for (const auto& v : partial) sum += v[0], rows += v[1];
     for (std::size_t i = 0; i < wt.boundary.size(); ++i) {
-        if (wt.boundary[i] == 0.0) continue;
-        const std::size_t j = bnext[i];
+        wt.boundary[i] = 0.0;
+        if (kept.boundary[i] == 0.0) continue;
+        const std::size_t j = op.bnext[i];
+        double e[3];
         for (int c = 0; c < 3; ++c) e[c] = p.beta * (x[c][j] - p.previous[c][i] - p.dtPrevious[c][i]);
-        wt.boundary[i] = weightOf(e);
+        const double v = 1.0 / (std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) + reg);
+        wt.boundary[i] = v;
+        sum += v;
+        rows += 1.0;
     }
-    const double scale = double(rows) / sum;
-    for (Field* f : {&wt.primal, &wt.dx, &wt.dy, &wt.dt, &wt.boundary})
-        for (double& v : *f) v *= scale;
-    return wt;
+    const double scale = rows / sum;
+    for (Field* f : {&wt.primal, &wt.dx, &wt.dy, &wt.dt, &wt.boundary}) {
+        Field& v = *f;
+        parallelRanges(threads, v.size(), kGrain, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i) v[i] *= scale;
+        });
+    }
 }
 
 }  // namespace
@@ -295,32 +444,27 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
     check(problem);
     Timer timer;
     std::array<Field, 3> x;
-    for (int c = 0; c < 3; ++c) x[c] = problem.initial[c].empty() ? problem.primal[c] : problem.initial[c];
+    for (int c = 0; c < 3; ++c)
+        copied(x[c], problem.initial[c].empty() ? problem.primal[c] : problem.initial[c]);
     const int rounds = options.l1 ? std::max(1, options.irlsIterations) : 1;
-    const unsigned cores =
-        options.threads > 0 ? unsigned(options.threads) : std::thread::hardware_concurrency();
-    const bool parallel = cores > 1;
+    const std::uint32_t threads = defaultThreads(static_cast<std::uint32_t>(std::max(0, options.threads)));
+    Operator op = makeStructure(problem);
+    const Weights kept = unitWeights(problem);
+    Weights wt;
+    std::array<Field, 3> b;
+    CgVectors vectors;
     SpaceTimeStats s;
     std::array<int, 3> iterations{};
     for (int round = 0; round < rounds; ++round) {
-        const Weights wt =
-            round == 0 ? unitWeights(problem)
-                       : irlsWeights(problem, x, options.regInit * std::pow(options.regIter, round - 1));
-        const Operator op = makeOperator(problem, wt);
+        if (round > 0)
+            irlsWeights(problem, op, x, options.regInit * std::pow(options.regIter, round - 1), kept, wt,
+                        threads);
+        setWeights(problem, round == 0 ? kept : wt, op, threads);
         const bool last = round + 1 == rounds;
         const double tolerance = last ? options.tolerance : options.innerTolerance;
-        std::array<SolveStats, 3> solved;
-        const auto solveChannel = [&](int c) {
-            const Field b = rhs(problem, op, c);
-            solved[c] = pcg(op, b, x[c], tolerance, options.maxIterations);
-        };
-        if (parallel) {
-            std::array<std::future<void>, 3> jobs;
-            for (int c = 0; c < 3; ++c) jobs[c] = std::async(std::launch::async, solveChannel, c);
-            for (auto& j : jobs) j.get();
-        } else {
-            for (int c = 0; c < 3; ++c) solveChannel(c);
-        }
+        rhs(problem, op, b, threads);
+        const std::array<ChannelSolve, 3> solved =
+            pcg(op, b, x, tolerance, options.maxIterations, threads, vectors);
         s.residual = 0.0;
         s.converged = true;
         for (int c = 0; c < 3; ++c) {
@@ -339,9 +483,12 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
 
 Field solveSpaceTimeExactL2(const SpaceTimeProblem& problem, int channel) {
     check(problem);
-    const Operator op = makeOperator(problem, unitWeights(problem));
-    const Field b = rhs(problem, op, channel);
-    const Field d = diagonalOf(op);
+    Operator op = makeStructure(problem);
+    setWeights(problem, unitWeights(problem), op, 1);
+    std::array<Field, 3> rhsAll;
+    rhs(problem, op, rhsAll, 1);
+    const Field& b = rhsAll[std::size_t(channel)];
+    const Field& d = op.diag;
     const std::size_t n = op.size(), w = std::size_t(op.width);
     std::vector<Eigen::Triplet<double>> triplets;
     triplets.reserve(n * 7);

@@ -21,9 +21,12 @@
 // regIter^(k−1), renormalised to mean 1, each round warm-started from the last.
 //
 // Solver: conjugate gradients preconditioned by the diagonal (Jacobi), in double precision on
-// the CPU, the channels in parallel. Why not the device's multigrid-PCG (poisson_gpu.h): it is
-// 2D; a window is F times the pixels of a frame and, warm-started from the frames' own 2D
-// reconstructions, needs few iterations (docs/animation.md has the measurements).
+// the CPU: the three channels in lockstep over one operator (its coefficients are shared), the
+// pixels in ranges over the host's threads, each range's sums added in range order (the same
+// bits for any thread count). Why not the device: on lavapipe a device CG iteration over the
+// same number of unknowns costs about four times a host one (`gdpt bench-poisson`: 10 frames of
+// 256², docs/animation.md has the figures), and the 2D multigrid does not carry the temporal
+// rows; a window, warm-started from its primal, converges in tens of iterations.
 #pragma once
 
 #include <array>
@@ -73,7 +76,7 @@ struct SpaceTimeOptions {
     double innerTolerance = 0.02;  // relative residual of the rounds before the last
     double tolerance = 1e-4;       // relative residual of the last round (and of L2)
     int maxIterations = 4000;      // per solve
-    int threads = 0;               // channels solved at once; 0 = the machine's cores (at most 3)
+    int threads = 0;               // host threads; 0 = the machine's cores
 };
 
 struct SpaceTimeStats {

@@ -13,7 +13,8 @@ namespace gdpt {
 
 // camera.glsl's cameraRay for the scene constants `c`: the unit direction through pixelPos.
 inline glm::vec3 cameraRay(const gpu::SceneConstants& c, glm::vec2 pixelPos) {
-    const glm::vec2 ndc(2.0f * pixelPos.x / float(c.width) - 1.0f, 1.0f - 2.0f * pixelPos.y / float(c.height));
+    const glm::vec2 ndc(2.0f * pixelPos.x / float(c.width) - 1.0f,
+                        1.0f - 2.0f * pixelPos.y / float(c.height));
     const glm::vec3 d =
         c.camForward + ndc.x * c.tanHalfFovY * c.aspect * c.camRight + ndc.y * c.tanHalfFovY * c.camUp;
     return glm::normalize(d);

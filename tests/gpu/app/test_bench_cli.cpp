@@ -1,7 +1,8 @@
 // `gdpt bench` end to end: one JSON record per scene with the BVH figures (build, collapse, SAH
 // cost, nodes) and ray and sample rates, for a built-in scene and a glTF file; refusals of an
 // unknown scene, a missing file, and --embree in a build without the baseline (or, in a build
-// with it, the Embree record and the ratios).
+// with it, the Embree record and the ratios). `gdpt bench-poisson` with the space-time methods:
+// one record per method, converged to the tolerance; an unknown method refused.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -75,6 +76,32 @@ TEST_F(BenchCli, EmbreeBaselineOrWhyNot) {
     EXPECT_GT(s.at("embree").at("incoherent_rays_per_s").get<double>(), 0.0);
     EXPECT_GT(s.at("gdpt_over_embree").at("incoherent_rays").get<double>(), 0.0);
     EXPECT_GT(s.at("gdpt_over_embree").at("build_time").get<double>(), 0.0);
+}
+
+// The space-time solver's figures need no Vulkan device (they run on the host) and report a
+// converged solve of the requested window.
+TEST_F(BenchCli, PoissonBenchTimesTheSpaceTimeSolver) {
+    // The JSON alone (stdout; the progress lines go to stderr).
+    const test::RunResult r = test::runShell("(" + test::gdptBinary() +
+                                             " bench-poisson --sizes 24x16 --methods st-l2,st-l1 --frames 3 "
+                                             "--repeats 1 --threads 2 2>/dev/null)");
+    ASSERT_EQ(r.code, 0) << r.output;
+    const json j = json::parse(r.output);
+    EXPECT_EQ(j.at("frames").get<int>(), 3);
+    EXPECT_EQ(j.at("threads").get<int>(), 2);
+    ASSERT_EQ(j.at("results").size(), 2u);
+    EXPECT_EQ(j["results"][0].at("method"), "st-l2");
+    EXPECT_EQ(j["results"][1].at("method"), "st-l1");
+    for (const json& e : j["results"]) {
+        EXPECT_TRUE(e.at("converged").get<bool>()) << e.dump();
+        EXPECT_LE(e.at("residual").get<double>(), 1e-4) << e.dump();
+        EXPECT_GT(e.at("iterations").get<int>(), 0) << e.dump();
+        EXPECT_GT(e.at("median_ms").get<double>(), 0.0) << e.dump();
+    }
+    EXPECT_EQ(j["results"][1].at("irls_iterations").get<int>(), 6);
+    const test::RunResult bad = test::runGdpt("bench-poisson --sizes 16 --methods st-l3 --repeats 1");
+    EXPECT_EQ(bad.code, 2) << bad.output;
+    EXPECT_NE(bad.output.find("unknown method 'st-l3'"), std::string::npos) << bad.output;
 }
 
 }  // namespace

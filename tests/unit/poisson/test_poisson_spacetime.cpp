@@ -3,7 +3,8 @@
 // frames; consistent data (gradients and temporal differences of one sequence) is recovered
 // exactly by L2 and L1; an L1 solve shrugs off an outlier that L2 smears; temporal rows cut
 // frame-to-frame noise; temporal rows along motion (each pixel's partner in the next frame)
-// solve the least-squares problem they state, built here row by row; bad input is refused.
+// solve the least-squares problem they state, built here row by row; the result is the same bits
+// for any number of threads; bad input is refused.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -342,6 +343,37 @@ TEST(SpaceTimePoisson, DifferencesAlongTheMotionRecoverAMovingPattern) {
                     }
                 }
     expectRecoveredFromZero(p);
+}
+
+// The solver splits the window into ranges of pixels over its threads and adds each range's
+// sums in range order: 1, 2 and 3 threads give the same bits (L1, whose weights depend on every
+// sum), on a window of several ranges with partners and the frame before.
+TEST(SpaceTimePoisson, SameBitsForAnyThreadCount) {
+    SpaceTimeProblem p = noisy(consistentProblem(64, 48, 10), 0.2, 5);
+    const std::size_t np = p.pixels();
+    ASSERT_GT(p.size(), 3u * 8192u) << "fewer ranges than threads";
+    std::mt19937 rng(11);
+    std::uniform_int_distribution<std::uint32_t> pick(0, std::uint32_t(np - 1));
+    p.temporalPartner.resize(np * (p.frames - 1));
+    for (std::size_t i = 0; i < p.temporalPartner.size(); ++i)
+        p.temporalPartner[i] =
+            i % 7 == 0 ? kNoTemporalPartner : (i % 5 == 0 ? pick(rng) : std::uint32_t(i % np));
+    for (int c = 0; c < 3; ++c) {
+        p.previous[c].assign(np, 0.5);
+        p.dtPrevious[c].assign(np, 0.1);
+    }
+    SpaceTimeOptions o;
+    o.threads = 1;
+    SpaceTimeStats one;
+    const auto x1 = solveSpaceTime(p, o, &one);
+    ASSERT_GT(one.iterations, 10);
+    for (const int threads : {2, 3}) {
+        o.threads = threads;
+        SpaceTimeStats s;
+        const auto x = solveSpaceTime(p, o, &s);
+        EXPECT_EQ(s.iterations, one.iterations) << threads << " threads";
+        for (int c = 0; c < 3; ++c) EXPECT_TRUE(x[c] == x1[c]) << threads << " threads, channel " << c;
+    }
 }
 
 TEST(SpaceTimePoisson, BadInputIsRefused) {
