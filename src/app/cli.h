@@ -41,6 +41,7 @@ struct RenderArgs {
     double alpha = 0.2;
     double tolerance = 1e-4;
     int debiasCells = kDefaultDebiasCells;  // poisson/debias.h
+    std::string solver = "auto";            // the reconstructions' linear solver (parseSolverChoice)
     bool allRecon = false;
     std::string checkpoint;        // write the sampler state here on interrupt / periodically / at the end
     double checkpointEvery = 0.0;  // seconds between periodic checkpoints (0 = only at the end)

@@ -438,6 +438,10 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(0, kMaxDebiasCells))
         ->group(gpt);
+    r->add_option("--solver", a.solver, kSolverHelp)
+        ->capture_default_str()
+        ->check(CLI::IsMember(std::vector<std::string>(std::begin(kSolverChoices), std::end(kSolverChoices))))
+        ->group(gpt);
     r->add_option("--shift-threshold", a.shiftThreshold,
                   "Roughness at or below which a vertex takes the half-vector shift instead of reconnection")
         ->capture_default_str()

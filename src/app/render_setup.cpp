@@ -99,6 +99,7 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
     g.alpha = args.alpha;
     g.tolerance = args.tolerance;
     g.debiasCells = args.debiasCells;
+    g.solver = parseSolverChoice(args.solver);
     MltOptions& mlt = m.mlt;
     mlt.chains = args.chains;
     mlt.largeStep = args.largeStep;
@@ -108,6 +109,7 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
     if (args.allRecon && args.recon != "l1") mlt.reconstructions.push_back(Reconstruction::L1);
     mlt.alpha = args.alpha;
     mlt.tolerance = args.tolerance;
+    mlt.solver = parseSolverChoice(args.solver);
     TgptOptions& t = m.tgpt;
     t.sampling = g.sampling;
     t.window = args.window;

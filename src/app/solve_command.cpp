@@ -28,14 +28,14 @@ struct SolveArgs {
     std::string input;
     std::string output = "solved.exr";
     std::string recon = "l2";
-    std::string solver = "mg-pcg";
+    std::string solver = "auto";
     double alpha = 0.2;
     double tolerance = 1e-4;
     int maxIterations = 2000;
     int irlsIterations = SolveOptions{}.irlsIterations;
     double irlsRegInit = SolveOptions{}.irlsRegInit;
     double irlsRegIter = SolveOptions{}.irlsRegIter;
-    double irlsInnerTolerance = SolveOptions{}.irlsInnerTolerance;
+    double irlsInnerTolerance = 0.0;  // 0: the solver's default
     int debiasCells = kDefaultDebiasCells;
     std::string primal, dx, dy;
     std::string device;
@@ -113,14 +113,14 @@ int runSolve(const SolveArgs& a) {
     const StagedFile& outFile = outputs.add(a.output, "-o");
     SolveOptions o;
     o.method = parseReconstruction(a.recon);
-    o.solver = parseGpuSolver(a.solver);
+    const std::optional<GpuSolver> solverChoice = parseSolverChoice(a.solver);
     o.alpha = a.alpha;
     o.tolerance = a.tolerance;
     o.maxIterations = a.maxIterations;
     o.irlsIterations = a.irlsIterations;
     o.irlsRegInit = a.irlsRegInit;
     o.irlsRegIter = a.irlsRegIter;
-    o.irlsInnerTolerance = a.irlsInnerTolerance;
+    if (a.irlsInnerTolerance > 0.0) o.irlsInnerTolerance = a.irlsInnerTolerance;
 
     std::vector<NamedLayer> layers;
     Image primal, dx, dy;
@@ -180,6 +180,7 @@ int runSolve(const SolveArgs& a) {
     vk::ContextOptions co;
     co.device = a.device;
     vk::Context ctx(co);
+    o.solver = resolveSolver(solverChoice, ctx);
     SolveReport report;
     // Progress once a solve has run for 2 s (a 4096x4096 L1 solve takes about a minute).
     Progress progress("gdpt: solve", 1.0, a.quiet);
@@ -246,8 +247,8 @@ Subcommand addSolveCommand(CLI::App& app) {
     sub->add_option("--debias-cells", a->debiasCells, kDebiasCellsHelp)
         ->check(CLI::Range(0, kMaxDebiasCells))
         ->capture_default_str();
-    sub->add_option("--solver", a->solver, "Linear solver: mg-pcg, cg, jacobi or mg")
-        ->check(CLI::IsMember({"mg-pcg", "cg", "jacobi", "mg"}))
+    sub->add_option("--solver", a->solver, kSolverHelp)
+        ->check(CLI::IsMember(std::vector<std::string>(std::begin(kSolverChoices), std::end(kSolverChoices))))
         ->capture_default_str();
     sub->add_option("--alpha", a->alpha, "Weight of the primal rows (energy weight alpha^2)")
         ->check(CLI::Range(0.0, 1e6))
@@ -271,8 +272,9 @@ Subcommand addSolveCommand(CLI::App& app) {
         ->capture_default_str();
     sub->add_option(
            "--irls-inner-tolerance", a->irlsInnerTolerance,
-           "IRLS: relative residual of the inner solves before the last round (the last uses --tolerance)")
-        ->check(CLI::Range(1e-12, 0.5))
+           "IRLS: relative residual of the inner solves before the last round (the last uses --tolerance); "
+           "0 = the solver's default (0.02 on the device, 0.005 for host-pcg)")
+        ->check(CLI::Range(0.0, 0.5))
         ->capture_default_str();
     sub->add_option("--primal", a->primal, "Primal EXR (instead of INPUT)")->check(InputFile);
     sub->add_option("--dx", a->dx, "Horizontal-gradient EXR (instead of INPUT)")->check(InputFile);

@@ -16,7 +16,8 @@ namespace gdpt {
 GptIntegrator::GptIntegrator(std::string name, GptOptions options)
     : name_(std::move(name)),
       options_(std::move(options)),
-      stage_(options_.reconstructions, options_.alpha, options_.tolerance, options_.debiasCells) {}
+      stage_(options_.reconstructions, options_.alpha, options_.tolerance, options_.debiasCells,
+             options_.solver) {}
 
 GptIntegrator::~GptIntegrator() = default;
 

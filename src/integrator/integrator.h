@@ -10,6 +10,7 @@
 #include <functional>
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -107,6 +108,9 @@ struct GptOptions {
     // Cells across the image's shorter side of the coarse grid whose scales the biased
     // reconstructions take from the primal (poisson/debias.h); 0 = the published reconstruction.
     int debiasCells = kDefaultDebiasCells;
+    // The linear solver of the reconstructions; nullopt: the device's default (host-pcg on a CPU
+    // device, mg-pcg on a GPU; poisson_gpu.h resolveSolver).
+    std::optional<GpuSolver> solver;
     // Timed renders: the reconstruction time remembered per configuration (recon_reserve.h);
     // null: measured once per integrator and raised to its longest real reconstruction.
     const ReconTimeCache* reconCache = nullptr;
@@ -122,8 +126,9 @@ struct MltOptions {
     // gmlt: the reconstructions (L1, L2; the variance-weighted ones need per-pixel variances,
     // which a chain's correlated samples do not give), the first gives the final image.
     std::vector<Reconstruction> reconstructions = {Reconstruction::L1};
-    double alpha = 0.2;       // weight of the primal term of the screened Poisson energy
-    double tolerance = 1e-4;  // relative residual at which each solve stops
+    double alpha = 0.2;               // weight of the primal term of the screened Poisson energy
+    double tolerance = 1e-4;          // relative residual at which each solve stops
+    std::optional<GpuSolver> solver;  // as GptOptions::solver
 };
 
 // How temporal G-PT pairs a frame's paths with the next frame's (tgpt_integrator.h): Motion

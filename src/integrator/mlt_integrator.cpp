@@ -38,7 +38,7 @@ MltIntegrator::MltIntegrator(std::string name, MltOptions options)
       options_(std::move(options)),
       // pssmlt has no gradients to reconstruct: its image is the splatted primal.
       stage_(name_ == "gmlt" ? options_.reconstructions : std::vector<Reconstruction>{}, options_.alpha,
-             options_.tolerance) {}
+             options_.tolerance, 0, options_.solver) {}
 
 MltIntegrator::~MltIntegrator() = default;
 

@@ -99,7 +99,7 @@ ReconReservation reserveReconstruction(const vk::Context& ctx, PoissonSolverGpu&
     r.key = reservationKey(ctx, solver.engine().width(), solver.engine().height());
     for (const SolveOptions& so : solves)
         r.key += std::string("|") + toString(so.method) + " alpha " + std::to_string(so.alpha) + " tol " +
-                 std::to_string(so.tolerance);
+                 std::to_string(so.tolerance) + " " + toString(so.solver);
     if (const std::optional<ReservedTime> known = cache.get(r.key)) {
         r.time = *known;
     } else {

@@ -1,6 +1,7 @@
 #include "integrator/reconstruction_stage.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -11,9 +12,13 @@
 
 namespace gdpt {
 
+double rememberedReconSeconds(double measured, double reserved, bool cut) {
+    return cut ? std::max(measured, reserved) : measured;
+}
+
 ReconstructionStage::ReconstructionStage(std::vector<Reconstruction> reconstructions, double alpha,
-                                         double tolerance, int debiasCells)
-    : debiasCells_(debiasCells) {
+                                         double tolerance, int debiasCells, std::optional<GpuSolver> solver)
+    : debiasCells_(debiasCells), solverChoice_(solver) {
     for (Reconstruction r : reconstructions) {
         SolveOptions so;
         so.method = r;
@@ -28,6 +33,7 @@ ReconstructionStage::~ReconstructionStage() = default;
 PoissonSolverGpu& ReconstructionStage::solver(const vk::Context& ctx, int width, int height) {
     if (!solver_ || solverCtx_ != &ctx || solverWidth_ != width || solverHeight_ != height) {
         solver_ = std::make_unique<PoissonSolverGpu>(ctx, width, height);
+        for (SolveOptions& so : solves_) so.solver = resolveSolver(solverChoice_, ctx);
         solverCtx_ = &ctx;
         solverWidth_ = width;
         solverHeight_ = height;
@@ -44,6 +50,7 @@ ReservedTime ReconstructionStage::reserve(const vk::Context& ctx, int width, int
     if (cache) {
         const ReconReservation r = reserveReconstruction(ctx, solverGpu, solves_, *cache);
         reserveKey_ = r.key;
+        reservedSeconds_ = r.time.seconds;
         return r.time;
     }
     if (calibratedSeconds_ < 0.0) {
@@ -59,6 +66,7 @@ std::vector<NamedLayer> ReconstructionStage::run(const PoissonInput& input, cons
     std::vector<NamedLayer> recons;
     if (solves_.empty()) return recons;
     Timer reconTimer;
+    bool cut = false;  // a solve stopped at its deadline
     enterPhase("reconstruction");
     // An interrupt stops the reconstruction after the solver's current batch of iterations.
     const auto stopIfCancelled = [&options] {
@@ -67,13 +75,19 @@ std::vector<NamedLayer> ReconstructionStage::run(const PoissonInput& input, cons
     for (SolveOptions so : solves_) {
         stopIfCancelled();
         so.progress = [&](int, int, int) { stopIfCancelled(); };
+        // The output's reservation, remembered as everything after sampling but the solves,
+        // includes the readback, which ran before them: it is not the solves' to lose.
         so.deadline = options.reconstructionDeadline;
+        if (so.deadline)
+            *so.deadline += std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                std::chrono::duration<double, std::milli>(stats.readbackMs));
         Image recon;
         const SolveReport report = solver_->solve(input, so, recon);
         ReconstructionStats rs{
             toString(so.method), report.iterations, report.irlsIterations, report.residual, so.tolerance,
             report.converged,    report.ms};
         rs.stoppedAtDeadline = report.stoppedAtDeadline;
+        rs.solver = toString(so.solver);
         std::string debiased;
         if (debiases(so.method, debiasCells_)) {
             // The coarse scales from the primal (poisson/debias.h): a few ms on the host.
@@ -94,18 +108,21 @@ std::vector<NamedLayer> ReconstructionStage::run(const PoissonInput& input, cons
                 report.stoppedAtDeadline
                     ? " of " + std::to_string(so.irlsIterations) + ", stopped for the budget"
                     : "";
-            std::fprintf(stderr,
-                         "gdpt: %s reconstruction: %d iterations (%d IRLS%s), residual %.2g%s%s, %.1f ms%s\n",
-                         toString(so.method), report.iterations, report.irlsIterations, stopped.c_str(),
-                         report.residual, report.converged ? "" : " NOT converged", scaled.c_str(), rs.ms,
-                         debiased.c_str());
+            std::fprintf(
+                stderr,
+                "gdpt: %s reconstruction (%s): %d iterations (%d IRLS%s), residual %.2g%s%s, %.1f ms%s\n",
+                toString(so.method), toString(so.solver), report.iterations, report.irlsIterations,
+                stopped.c_str(), report.residual, report.converged ? "" : " NOT converged", scaled.c_str(),
+                rs.ms, debiased.c_str());
         }
+        cut = cut || rs.stoppedAtDeadline;
         stats.reconstructions.push_back(rs);
         stats.reconstructionMs += rs.ms;
         recons.push_back({std::string("recon_") + toString(so.method), std::move(recon)});
     }
     if (cache && !reserveKey_.empty())
-        cache->put(reserveKey_, {stats.reconstructionMs * 1e-3, stats.samplingLoad});
+        cache->put(reserveKey_, {rememberedReconSeconds(stats.reconstructionMs * 1e-3, reservedSeconds_, cut),
+                                 stats.samplingLoad});
     longestSeconds_ = std::max(longestSeconds_, reconTimer.seconds());
     return recons;
 }
@@ -123,6 +140,7 @@ nlohmann::json reconstructionsJson(const RenderStats& s) {
                           {"debias_mean_change", r.debiasMeanChange},
                           {"debias_ms", r.debiasMs},
                           {"stopped_at_deadline", r.stoppedAtDeadline},
+                          {"solver", r.solver},
                           {"ms", r.ms}});
     return recons;
 }

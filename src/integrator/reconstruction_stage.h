@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,8 +26,10 @@ public:
     // The reconstructions in order (the first gives the final image), with the primal weight
     // alpha, the relative residual at which each solve stops, and the cells of the coarse grid
     // at which the biased ones are debiased against the primal (poisson/debias.h; 0 = not).
+    // `solver`: the linear solver of every solve, or nullopt for the device's default
+    // (resolveSolver, poisson_gpu.h).
     ReconstructionStage(std::vector<Reconstruction> reconstructions, double alpha, double tolerance,
-                        int debiasCells = 0);
+                        int debiasCells = 0, std::optional<GpuSolver> solver = std::nullopt);
     ~ReconstructionStage();
 
     [[nodiscard]] const std::vector<SolveOptions>& solves() const { return solves_; }
@@ -51,13 +54,22 @@ public:
 private:
     std::vector<SolveOptions> solves_;
     int debiasCells_ = 0;
+    std::optional<GpuSolver> solverChoice_;
     std::unique_ptr<PoissonSolverGpu> solver_;
     const vk::Context* solverCtx_ = nullptr;
     int solverWidth_ = 0, solverHeight_ = 0;
     std::string reserveKey_;           // the cache key of the last reservation (with a cache)
+    double reservedSeconds_ = 0.0;     // the remembered or calibrated time of that reservation
     double calibratedSeconds_ = -1.0;  // without a cache: the warm calibration (< 0: not yet)
     double longestSeconds_ = 0.0;      // without a cache: the longest reconstruction so far
 };
+
+// The reconstruction time a timed render remembers for the next one: what it measured, but
+// never less than what it had reserved when a solve was cut at its deadline (`cut`): the cut
+// time says only that the full solve takes longer, and remembering it made the next render
+// reserve as little, stop again, and stay at one IRLS round for good (bench/RESULTS.md, "The
+// reconstruction on the host").
+double rememberedReconSeconds(double measured, double reserved, bool cut);
 
 // The reports of a render's reconstructions as `render --json` writes them.
 nlohmann::json reconstructionsJson(const RenderStats& stats);

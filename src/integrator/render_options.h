@@ -54,8 +54,9 @@ struct RenderOptions {
     // moves the end of sampling accordingly.
     std::vector<ReservedTime> reservedAfterSampling;
     // Timed renders: when the reconstruction must end (the budget's end less the time reserved
-    // for the output); an L1 reconstruction starts no reweighting round that would end later
-    // (SolveOptions::deadline). None: no limit.
+    // for the output, which as remembered includes the readback before the reconstruction:
+    // ReconstructionStage gives the solves this plus the readback's time); an L1 reconstruction
+    // stops reweighting by then (SolveOptions::deadline). None: no limit.
     std::optional<std::chrono::steady_clock::time_point> reconstructionDeadline;
     // Measure the load during sampling (stats.samplingLoad); set by the sampler on CPU devices,
     // where other processes compete with the device's threads.
@@ -109,6 +110,7 @@ struct ReconstructionStats {
     double debiasMeanChange = 0.0;   // the debiasing's change of the image mean, relative
     double debiasMs = 0.0;           // of ms: the debiasing (host)
     bool stoppedAtDeadline = false;  // IRLS rounds left out to end within a timed render's budget
+    std::string solver;              // the linear solver: "mg-pcg", "host-pcg", ... (poisson_gpu.h)
 };
 
 // A render split across processes (sample_share.h): how its parts were merged.

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <string>
 
+#include "poisson/poisson_spacetime.h"
 #include "poisson_shared.h"
 #include "util/error.h"
 #include "util/timer.h"
@@ -161,7 +162,8 @@ GpuSolver parseGpuSolver(const std::string& t) {
     if (t == "cg") return GpuSolver::Cg;
     if (t == "jacobi") return GpuSolver::Jacobi;
     if (t == "mg") return GpuSolver::Mg;
-    throw UsageError("unknown solver '" + t + "' (expected mg-pcg, cg, jacobi or mg)");
+    if (t == "host-pcg") return GpuSolver::HostPcg;
+    throw UsageError("unknown solver '" + t + "' (expected mg-pcg, cg, jacobi, mg or host-pcg)");
 }
 
 const char* toString(Reconstruction r) {
@@ -178,6 +180,16 @@ const char* toString(Reconstruction r) {
     return "?";
 }
 
+std::optional<GpuSolver> parseSolverChoice(const std::string& text) {
+    if (text == "auto") return std::nullopt;
+    return parseGpuSolver(text);
+}
+
+GpuSolver resolveSolver(std::optional<GpuSolver> choice, const vk::Context& ctx) {
+    if (choice) return *choice;
+    return ctx.info().isCpu ? GpuSolver::HostPcg : GpuSolver::MgPcg;
+}
+
 const char* toString(GpuSolver s) {
     switch (s) {
         case GpuSolver::MgPcg:
@@ -188,6 +200,8 @@ const char* toString(GpuSolver s) {
             return "jacobi";
         case GpuSolver::Mg:
             return "mg";
+        case GpuSolver::HostPcg:
+            return "host-pcg";
     }
     return "?";
 }
@@ -369,6 +383,111 @@ void PoissonSolverGpu::preparePipelines(const std::vector<SolveOptions>& solves)
     engine_.bind();  // the shared variants now point at the small engine's buffers
 }
 
+std::vector<float> PoissonSolverGpu::solveOnDevice(const std::vector<float>& primal,
+                                                   const std::vector<float>& dx, const std::vector<float>& dy,
+                                                   const std::vector<float>& weights, const SolveOptions& o,
+                                                   bool singular, std::size_t rows, SolveReport& report) {
+    const std::size_t n = engine_.pixels();
+    engine_.bind();
+    engine_.primal.uploadVector(primal);
+    engine_.dx.uploadVector(dx);
+    engine_.dy.uploadVector(dy);
+    engine_.weights.uploadVector(weights);
+    if (o.warmStart)
+        engine_.sol.uploadVector(primal);  // warm start from the primal, as the published solver
+    else
+        engine_.sol.zero();
+
+    VkCommandBuffer cmd = stream_.begin();
+    if (o.timer) o.timer->reset(cmd);
+    roundsDone_ = 0;
+    rounds_ = isIrls(o.method) ? std::max(1, o.irlsIterations) : 1;
+    if (!isIrls(o.method)) {
+        const InnerResult r = innerSolve(o, o.tolerance, false, singular, true, report);
+        report.iterations = r.iterations;
+        report.converged = r.converged;
+        report.irlsIterations = 1;
+    } else {
+        double reg = std::ldexp(o.irlsRegInit, -report.scaleExponent);  // radiance units, scaled
+        const auto started = std::chrono::steady_clock::now();
+        for (int k = 0; k < rounds_; ++k) {
+            if (k > 0 && o.deadline) {
+                const auto now = std::chrono::steady_clock::now();
+                if (now + (now - started) / k > *o.deadline) {
+                    report.stoppedAtDeadline = true;
+                    break;
+                }
+            }
+            const bool last = k + 1 == rounds_;
+            const double tol =
+                last ? o.tolerance
+                     : std::max(o.tolerance, o.irlsInnerTolerance.value_or(kDeviceIrlsInnerTolerance));
+            if (k > 0) {
+                // The previous inner solve submitted its buffers: open a new one for the
+                // weights, their mean-1 scale and the next solve's set-up.
+                cmd = stream_.begin();
+                if (o.timer) o.timer->reset(cmd);
+                engine_.recordIrlsWeights(cmd, static_cast<float>(o.alpha * o.alpha), static_cast<float>(reg),
+                                          o.timer);
+                engine_.recordScalars(cmd, kPoissonModeIrls, 0u, 0u, 0.0f, static_cast<float>(rows), o.timer);
+                reg *= o.irlsRegIter;
+            }
+            const InnerResult r = innerSolve(o, tol, k > 0, false, last, report);
+            report.iterations += r.iterations;
+            report.converged = r.converged;
+            ++report.irlsIterations;
+            roundsDone_ = k + 1;
+        }
+    }
+    return engine_.sol.downloadVector<float>(3 * n);
+}
+
+std::vector<float> PoissonSolverGpu::solveOnHost(const std::vector<float>& primal,
+                                                 const std::vector<float>& dx, const std::vector<float>& dy,
+                                                 const std::vector<float>& weights, const SolveOptions& o,
+                                                 SolveReport& report) const {
+    const std::size_t n = engine_.pixels();
+    SpaceTimeProblem p;
+    p.width = engine_.width();
+    p.height = engine_.height();
+    p.frames = 1;
+    p.alpha = o.alpha;
+    const auto plane = [n](const std::vector<float>& v, std::size_t k) {
+        return Field(v.begin() + static_cast<std::ptrdiff_t>(k * n),
+                     v.begin() + static_cast<std::ptrdiff_t>((k + 1) * n));
+    };
+    for (std::size_t c = 0; c < 3; ++c) {
+        p.primal[c] = plane(primal, c);
+        p.dx[c] = plane(dx, c);
+        p.dy[c] = plane(dy, c);
+        if (!o.warmStart) p.initial[c].assign(n, 0.0);  // else the solver starts from the primal
+    }
+    p.weightPrimal = plane(weights, 0);
+    p.weightDx = plane(weights, 1);
+    p.weightDy = plane(weights, 2);
+    SpaceTimeOptions so;
+    so.l1 = isIrls(o.method);
+    so.irlsIterations = o.irlsIterations;
+    so.regInit = std::ldexp(o.irlsRegInit, -report.scaleExponent);  // radiance units, scaled
+    so.regIter = o.irlsRegIter;
+    so.innerTolerance = std::max(o.tolerance, o.irlsInnerTolerance.value_or(kHostIrlsInnerTolerance));
+    so.tolerance = o.tolerance;
+    so.maxIterations = o.maxIterations;
+    so.deadline = o.deadline;
+    so.progress = o.progress;
+    SpaceTimeStats st;
+    const std::array<Field, 3> x = solveSpaceTime(p, so, &st);
+    report.iterations = st.iterations;
+    report.irlsIterations = st.irlsIterations;
+    report.residual = st.residual;
+    report.converged = st.converged;
+    report.stoppedAtDeadline = st.stoppedAtDeadline;
+    std::vector<float> sol(3 * n);
+    for (std::size_t c = 0; c < 3; ++c)
+        for (std::size_t i = 0; i < n; ++i) sol[c * n + i] = static_cast<float>(x[c][i]);
+    return sol;
+}
+
 SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& o, Image& out) {
     Timer wall;
     if (!in.primal || !in.dx || !in.dy) throw Error("Poisson solve: primal, dx and dy are required");
@@ -470,54 +589,14 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
         for (std::size_t i = 0; i < n && singular; ++i) singular = !(weights[i] > 0.0f);
     }
 
-    engine_.bind();
-    engine_.primal.uploadVector(primal);
-    engine_.dx.uploadVector(dx);
-    engine_.dy.uploadVector(dy);
-    engine_.weights.uploadVector(weights);
-    if (o.warmStart)
-        engine_.sol.uploadVector(primal);  // warm start from the primal, as the published solver
-    else
-        engine_.sol.zero();
-
-    VkCommandBuffer cmd = stream_.begin();
-    if (o.timer) o.timer->reset(cmd);
-    roundsDone_ = 0;
-    rounds_ = isIrls(o.method) ? std::max(1, o.irlsIterations) : 1;
-    if (!isIrls(o.method)) {
-        const InnerResult r = innerSolve(o, o.tolerance, false, singular, true, report);
-        report.iterations = r.iterations;
-        report.converged = r.converged;
-        report.irlsIterations = 1;
+    std::vector<float> sol;
+    if (o.solver == GpuSolver::HostPcg && !singular) {
+        sol = solveOnHost(primal, dx, dy, weights, o, report);
     } else {
-        double reg = std::ldexp(o.irlsRegInit, -report.scaleExponent);  // radiance units, scaled
-        const auto started = std::chrono::steady_clock::now();
-        for (int k = 0; k < rounds_; ++k) {
-            if (k > 0 && o.deadline) {
-                const auto now = std::chrono::steady_clock::now();
-                if (now + (now - started) / k > *o.deadline) {
-                    report.stoppedAtDeadline = true;
-                    break;
-                }
-            }
-            const bool last = k + 1 == rounds_;
-            const double tol = last ? o.tolerance : std::max(o.tolerance, o.irlsInnerTolerance);
-            if (k > 0) {
-                // The previous inner solve submitted its buffers: open a new one for the
-                // weights, their mean-1 scale and the next solve's set-up.
-                cmd = stream_.begin();
-                if (o.timer) o.timer->reset(cmd);
-                engine_.recordIrlsWeights(cmd, static_cast<float>(o.alpha * o.alpha), static_cast<float>(reg),
-                                          o.timer);
-                engine_.recordScalars(cmd, kPoissonModeIrls, 0u, 0u, 0.0f, static_cast<float>(rows), o.timer);
-                reg *= o.irlsRegIter;
-            }
-            const InnerResult r = innerSolve(o, tol, k > 0, false, last, report);
-            report.iterations += r.iterations;
-            report.converged = r.converged;
-            ++report.irlsIterations;
-            roundsDone_ = k + 1;
-        }
+        // The host solver needs α > 0 and a primal row: a singular problem goes to the device.
+        SolveOptions od = o;
+        if (od.solver == GpuSolver::HostPcg) od.solver = GpuSolver::MgPcg;
+        sol = solveOnDevice(primal, dx, dy, weights, od, singular, rows, report);
     }
     // Download and fix the weighted mean from the primal. Summing the rows of A x = b gives
     // Σ cp_i x_i = Σ cp_i t_i exactly for every α > 0 (the Laplacian's columns sum to 0), so
@@ -526,7 +605,6 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
     // primal weights live on the device (IRLS), so there the shift is for α = 0 only, which
     // L1 rejects anyway.
     out = Image(w, h);
-    std::vector<float> sol = engine_.sol.downloadVector<float>(3 * n);
     const bool shiftMean = singular || !isIrls(o.method);
     for (int c = 0; c < 3; ++c) {
         const std::size_t o0 = static_cast<std::size_t>(c) * n;

@@ -3,7 +3,9 @@
 
 #include <Eigen/Sparse>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <functional>
 #include <vector>
 
 #include "util/error.h"
@@ -97,6 +99,17 @@ void check(const SpaceTimeProblem& p) {
                 throw Error(std::string("space-time Poisson: ") + what + " names pixel " + std::to_string(j) +
                             " of a frame of " + std::to_string(p.pixels()));
     };
+    for (const auto& [field, what] : {std::pair<const Field*, const char*>{&p.weightPrimal, "weightPrimal"},
+                                      {&p.weightDx, "weightDx"},
+                                      {&p.weightDy, "weightDy"}}) {
+        if (field->empty()) continue;
+        if (field->size() != n)
+            throw Error(std::string("space-time Poisson: ") + what + " has " + std::to_string(field->size()) +
+                        " values, expected " + std::to_string(n));
+        for (double v : *field)
+            if (!std::isfinite(v) || v < 0.0)
+                throw Error(std::string("space-time Poisson: ") + what + " must be finite and >= 0");
+    }
     partners(p.temporalPartner, nt, "temporalPartner");
     partners(p.previousPartner, p.previous[0].empty() ? 0 : p.pixels(), "previousPartner");
 }
@@ -138,6 +151,9 @@ Weights unitWeights(const SpaceTimeProblem& p) {
                hugeVector(np * std::size_t(p.frames - 1), 1.0),
                p.previous[0].empty() ? Field() : Field(np, 1.0)};
     for (std::size_t i = 0; i < n; ++i) {
+        if (!p.weightPrimal.empty()) wt.primal[i] = p.weightPrimal[i];
+        if (!p.weightDx.empty()) wt.dx[i] = p.weightDx[i];
+        if (!p.weightDy.empty()) wt.dy[i] = p.weightDy[i];
         if ((i % np) % w + 1 == w) wt.dx[i] = 0.0;
         if ((i % np) + w >= np) wt.dy[i] = 0.0;
     }
@@ -246,6 +262,7 @@ struct ChannelSolve {
     int iterations = 0;
     double rhsNorm = 0.0, residualNorm = 0.0;
     bool converged = false;
+    bool stoppedAtDeadline = false;
 };
 
 // Jacobi-preconditioned CG from x until ‖b − A x‖ ≤ tolerance ‖b‖, the three channels in
@@ -257,8 +274,11 @@ struct CgVectors {
     std::array<Field, 3> r, p, q;
 };
 
+// `every16`: called after every 16th iteration with the iterations so far (may throw).
 std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& b, std::array<Field, 3>& x,
-                                double tolerance, int maxIterations, std::uint32_t threads, CgVectors& v) {
+                                double tolerance, int maxIterations, std::uint32_t threads, CgVectors& v,
+                                const std::function<void(int)>& every16,
+                                std::optional<std::chrono::steady_clock::time_point> deadline) {
     const std::size_t n = op.size(), ranges = rangesOf(n);
     std::array<Field, 3>&r = v.r, &p = v.p, &q = v.q;
     // Per range: the partial sums of one pass (three per channel at most), added in range order.
@@ -304,7 +324,15 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
         active[c] = std::sqrt(rr[c]) > target[c] && maxIterations > 0;
     }
     const auto anyActive = [&] { return active[0] || active[1] || active[2]; };
+    int k = 0;
+    bool cut = false;
     while (anyActive()) {
+        if (every16 && k > 0 && k % 16 == 0) every16(k);
+        if (deadline && std::chrono::steady_clock::now() >= *deadline) {
+            cut = true;  // the iterate so far: every CG iterate is an image of lower energy
+            break;
+        }
+        ++k;
         // q = A p and p·q.
         parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
             std::array<double, 9> s{};
@@ -367,11 +395,13 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
     for (int c = 0; c < 3; ++c) {
         out[c].residualNorm = std::sqrt(rr[c]);
         out[c].converged = out[c].residualNorm <= target[c];
+        out[c].stoppedAtDeadline = cut;
     }
     return out;
 }
 
-// IRLS weights of the estimate x: 1 / (‖e‖_RGB + reg) for every kept row, mean 1.
+// IRLS weights of the estimate x: the row's weight times 1 / (‖e‖_RGB + reg) for every kept
+// row, the IRLS factors renormalised to mean 1 over the kept rows (as poisson_irls_weights.comp).
 // `kept`: the unit weights (0 for dropped rows); `wt` gets the same sizes.
 void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array<Field, 3>& x, double reg,
                  const Weights& kept, Weights& wt, std::uint32_t threads) {
@@ -392,17 +422,20 @@ void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array
         };
         double e[3];
         for (std::size_t i = begin; i < end; ++i) {
-            for (int c = 0; c < 3; ++c) e[c] = p.alpha * (x[c][i] - p.primal[c][i]);
-            wt.primal[i] = weightOf(e);
+            wt.primal[i] = 0.0;
+            if (kept.primal[i] != 0.0) {
+                for (int c = 0; c < 3; ++c) e[c] = p.alpha * (x[c][i] - p.primal[c][i]);
+                wt.primal[i] = kept.primal[i] * weightOf(e);
+            }
             wt.dx[i] = 0.0;
             if (kept.dx[i] != 0.0) {
                 for (int c = 0; c < 3; ++c) e[c] = x[c][i + 1] - x[c][i] - p.dx[c][i];
-                wt.dx[i] = weightOf(e);
+                wt.dx[i] = kept.dx[i] * weightOf(e);
             }
             wt.dy[i] = 0.0;
             if (kept.dy[i] != 0.0) {
                 for (int c = 0; c < 3; ++c) e[c] = x[c][i + w] - x[c][i] - p.dy[c][i];
-                wt.dy[i] = weightOf(e);
+                wt.dy[i] = kept.dy[i] * weightOf(e);
             }
             if (i + np < n) {
                 wt.dt[i] = 0.0;
@@ -428,7 +461,7 @@ void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array
         sum += v;
         rows += 1.0;
     }
-    const double scale = rows / sum;
+    const double scale = sum > 0.0 ? rows / sum : 1.0;
     for (Field* f : {&wt.primal, &wt.dx, &wt.dy, &wt.dt, &wt.boundary}) {
         Field& v = *f;
         parallelRanges(threads, v.size(), kGrain, [&](std::size_t begin, std::size_t end) {
@@ -455,7 +488,13 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
     CgVectors vectors;
     SpaceTimeStats s;
     std::array<int, 3> iterations{};
+    const auto iterationsSoFar = [&] { return *std::max_element(iterations.begin(), iterations.end()); };
+    int roundsDone = 0;
     for (int round = 0; round < rounds; ++round) {
+        if (round > 0 && options.deadline && std::chrono::steady_clock::now() >= *options.deadline) {
+            s.stoppedAtDeadline = true;
+            break;
+        }
         if (round > 0)
             irlsWeights(problem, op, x, options.regInit * std::pow(options.regIter, round - 1), kept, wt,
                         threads);
@@ -463,8 +502,14 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
         const bool last = round + 1 == rounds;
         const double tolerance = last ? options.tolerance : options.innerTolerance;
         rhs(problem, op, b, threads);
+        std::function<void(int)> every16;
+        if (options.progress)
+            every16 = [&](int k) { options.progress(roundsDone, rounds, iterationsSoFar() + k); };
+        // The first round (the L2 solve) always runs to its tolerance; later ones stop at the
+        // deadline, mid-round if need be.
         const std::array<ChannelSolve, 3> solved =
-            pcg(op, b, x, tolerance, options.maxIterations, threads, vectors);
+            pcg(op, b, x, tolerance, options.maxIterations, threads, vectors, every16,
+                round > 0 ? options.deadline : std::nullopt);
         s.residual = 0.0;
         s.converged = true;
         for (int c = 0; c < 3; ++c) {
@@ -473,9 +518,15 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
             s.residual = std::max(s.residual, rel);
             s.converged = s.converged && solved[c].converged;
         }
+        roundsDone = round + 1;
+        if (solved[0].stoppedAtDeadline) {
+            s.stoppedAtDeadline = true;
+            break;
+        }
+        if (options.progress) options.progress(roundsDone, rounds, iterationsSoFar());
     }
-    s.iterations = *std::max_element(iterations.begin(), iterations.end());
-    s.irlsIterations = rounds;
+    s.iterations = iterationsSoFar();
+    s.irlsIterations = roundsDone;
     s.ms = timer.ms();
     if (stats) *stats = s;
     return x;

@@ -30,8 +30,11 @@
 #pragma once
 
 #include <array>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <vector>
 
 #include "poisson/poisson_cpu.h"
@@ -53,6 +56,10 @@ struct SpaceTimeProblem {
     // Warm start (F·W·H per channel), e.g. each frame's own 2D reconstruction; empty: the
     // primal.
     std::array<Field, 3> initial;
+    // Optional row weights (F·W·H each, finite and ≥ 0, shared by the channels), multiplying
+    // the primal, dx and dy rows (0 drops a row; poisson_gpu.h's weights for WL2, WL1 and
+    // non-finite input). L1's IRLS weights multiply them, renormalised over the rows kept.
+    Field weightPrimal, weightDx, weightDy;
     // Optional: the frame before the window, already reconstructed (W·H per channel), and the
     // target of I_0 − previous: temporal rows β (I_0 − previous − dtPrevious) that tie the
     // window to the one before it (a sequence reconstructed window by window has no seam).
@@ -77,13 +84,20 @@ struct SpaceTimeOptions {
     double tolerance = 1e-4;       // relative residual of the last round (and of L2)
     int maxIterations = 4000;      // per solve
     int threads = 0;               // host threads; 0 = the machine's cores
+    // IRLS: the rounds after the first stop at this time (a timed render's budget), mid-round
+    // if need be: the result is the iterate reached, which every CG step brings closer.
+    std::optional<std::chrono::steady_clock::time_point> deadline;
+    // Called after each round (rounds finished, rounds in all, iterations so far) and every 16
+    // iterations within a round (rounds finished so far). It may throw to stop the solve.
+    std::function<void(int roundsDone, int rounds, int iterations)> progress;
 };
 
 struct SpaceTimeStats {
-    int iterations = 0;      // PCG iterations, summed over rounds, max over channels
-    int irlsIterations = 0;  // 1 for L2
-    double residual = 0.0;   // relative residual of the last solve, max over channels
-    bool converged = false;  // every channel's last solve reached the tolerance
+    int iterations = 0;              // PCG iterations, summed over rounds, max over channels
+    int irlsIterations = 0;          // rounds run (the last possibly cut at the deadline); 1 for L2
+    double residual = 0.0;           // relative residual of the last solve, max over channels
+    bool converged = false;          // every channel's last solve reached the tolerance
+    bool stoppedAtDeadline = false;  // rounds cut or left out for SpaceTimeOptions::deadline
     double ms = 0.0;
 };
 

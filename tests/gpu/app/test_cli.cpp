@@ -192,8 +192,11 @@ TEST_F(Cli, TimedGptRenderReservesTheRememberedReconstructionTime) {
             e[sceneKey] = 0.125;
             e[sceneFinishKey] = 0.0625;
         }
-        e[key] = 0.5;
-        e[finishKey] = 0.25;
+        // Below any real solve's time (a 16x16 solve takes about 0.2 ms): the set-up takes the
+        // whole 1 s budget, so the solve is cut at its deadline, and a cut solve keeps the
+        // reserved value unless it ran longer (reconstruction_stage.h, rememberedReconSeconds).
+        e[key] = 1.0 / 65536.0;
+        e[finishKey] = 0.03125;
         std::ofstream(cached) << e.dump();
         const RunResult rr = runWithEnv(env, cmd);
         EXPECT_EQ(rr.code, 0) << rr.output;
@@ -202,12 +205,13 @@ TEST_F(Cli, TimedGptRenderReservesTheRememberedReconstructionTime) {
                               times["finish_reserved"].get<double>());
     };
     EXPECT_EQ(reservedWith(true), std::make_pair(0.125, 0.0625));
-    EXPECT_EQ(reservedWith(false), std::make_pair(0.5, 0.25));
+    EXPECT_EQ(reservedWith(false), std::make_pair(1.0 / 65536.0, 0.03125));
     // The real times replace them, each with the load its render's sampling felt (0 here: a
     // sampling this short is not measured; test_time_budget_cli.cpp measures one).
     entries = readJson(cached);
-    EXPECT_NE(entries[key]["seconds"].get<double>(), 0.5) << "the real reconstruction time replaces it";
-    EXPECT_NE(entries[finishKey]["seconds"].get<double>(), 0.25) << "the real finishing time replaces it";
+    EXPECT_NE(entries[key]["seconds"].get<double>(), 1.0 / 65536.0)
+        << "the real reconstruction time replaces it";
+    EXPECT_NE(entries[finishKey]["seconds"].get<double>(), 0.03125) << "the real finishing time replaces it";
     EXPECT_EQ(entries[sceneKey], entries[key]);
     EXPECT_GE(entries[key]["load"].get<double>(), 0.0);
     EXPECT_GE(entries[finishKey]["load"].get<double>(), 0.0);

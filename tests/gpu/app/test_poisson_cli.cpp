@@ -95,28 +95,33 @@ TEST_F(PoissonCli, SolveIrlsScheduleFlags) {
     writeExr(path("in.exr"), {{"primal", readExrLayer(path("clean.exr"), "primal")},
                               {"dx", dx},
                               {"dy", readExrLayer(path("clean.exr"), "dy")}});
-    // The published L1 (--debias-cells 0): the flags under test act on the solve.
-    const std::string in = path("in.exr") + " --tolerance 1e-6 --debias-cells 0 ";
-    ASSERT_EQ(runGdpt("solve " + in + "--recon l2 -o " + path("l2.exr")).code, 0);
-    ASSERT_EQ(runGdpt("solve " + in + "--recon l1 -o " + path("l1.exr")).code, 0);
-    ASSERT_EQ(runGdpt("solve " + in +
-                      "--recon l1 --irls-iterations 6 --irls-reg-init 0.05 --irls-reg-iter 0.4 "
-                      "--irls-inner-tolerance 0.02 -o " +
-                      path("l1_explicit.exr"))
-                  .code,
-              0);
-    ASSERT_EQ(
-        runGdpt("solve " + in + "--recon l1 --irls-reg-init 1e6 --irls-reg-iter 1 -o " + path("l1_reg.exr"))
-            .code,
-        0);
-    EXPECT_EQ(maxReconDifference(path("l1.exr"), path("l1_explicit.exr")), 0.0);
-    const double l1ToL2 = maxReconDifference(path("l1.exr"), path("l2.exr"));
-    const double regToL2 = maxReconDifference(path("l1_reg.exr"), path("l2.exr"));
-    EXPECT_GT(l1ToL2, 0.05);
-    EXPECT_LT(regToL2, 0.1 * l1ToL2) << "L1 default to L2: " << l1ToL2;
-    for (const char* bad :
-         {"--irls-reg-iter 0", "--irls-reg-iter 1.5", "--irls-reg-init 0", "--irls-inner-tolerance 0.9"})
-        EXPECT_EQ(runGdpt("solve " + in + "--recon l1 " + bad + " -o " + path("bad.exr")).code, 2) << bad;
+    // The published L1 (--debias-cells 0): the flags under test act on the solve, on the device
+    // and on the host, each with its default inner tolerance spelt out.
+    for (const auto& [solver, innerTolerance] :
+         {std::pair<std::string, std::string>{"mg-pcg", "0.02"}, {"host-pcg", "0.005"}}) {
+        SCOPED_TRACE(solver);
+        const std::string in = path("in.exr") + " --tolerance 1e-6 --debias-cells 0 --solver " + solver + " ";
+        ASSERT_EQ(runGdpt("solve " + in + "--recon l2 -o " + path("l2.exr")).code, 0);
+        ASSERT_EQ(runGdpt("solve " + in + "--recon l1 -o " + path("l1.exr")).code, 0);
+        ASSERT_EQ(runGdpt("solve " + in +
+                          "--recon l1 --irls-iterations 6 --irls-reg-init 0.05 --irls-reg-iter 0.4 "
+                          "--irls-inner-tolerance " +
+                          innerTolerance + " -o " + path("l1_explicit.exr"))
+                      .code,
+                  0);
+        ASSERT_EQ(runGdpt("solve " + in + "--recon l1 --irls-reg-init 1e6 --irls-reg-iter 1 -o " +
+                          path("l1_reg.exr"))
+                      .code,
+                  0);
+        EXPECT_EQ(maxReconDifference(path("l1.exr"), path("l1_explicit.exr")), 0.0);
+        const double l1ToL2 = maxReconDifference(path("l1.exr"), path("l2.exr"));
+        const double regToL2 = maxReconDifference(path("l1_reg.exr"), path("l2.exr"));
+        EXPECT_GT(l1ToL2, 0.05);
+        EXPECT_LT(regToL2, 0.1 * l1ToL2) << "L1 default to L2: " << l1ToL2;
+        for (const char* bad : {"--irls-reg-iter 0", "--irls-reg-iter 1.5", "--irls-reg-init 0",
+                                "--irls-inner-tolerance 0.9", "--solver mg-pcgx"})
+            EXPECT_EQ(runGdpt("solve " + in + "--recon l1 " + bad + " -o " + path("bad.exr")).code, 2) << bad;
+    }
     EXPECT_FALSE(fs::exists(path("bad.exr")));
 }
 

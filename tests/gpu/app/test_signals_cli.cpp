@@ -50,7 +50,7 @@ TEST_P(SignalsCli, EveryPhaseStopsWith130AndNoOutput) {
     EXPECT_NE(r.output.find("no output written"), std::string::npos) << r.output;
     // Interrupted before its first solve, a render runs none.
     if (std::string(c.phase) != "writing") {
-        EXPECT_EQ(r.output.find("reconstruction:"), std::string::npos) << r.output;
+        EXPECT_EQ(r.output.find(" reconstruction ("), std::string::npos) << r.output;
     }
     EXPECT_TRUE(fs::is_empty(dir_)) << "left behind: " << fs::directory_iterator(dir_)->path();
 }
@@ -95,7 +95,7 @@ TEST(SignalsCliReal, TermDuringTheReconstructionStopsWithinASolverBatch) {
     char line[1024];
     while (std::fgets(line, sizeof line, in)) {
         output += line;
-        if (std::string(line).find("reconstruction:") == std::string::npos) continue;
+        if (std::string(line).find(" reconstruction (") == std::string::npos) continue;
         ++solves;
         if (!sent) {
             ::kill(pid, SIGTERM);

@@ -1,7 +1,8 @@
 // test_poisson_gpu.cpp — the GPU screened-Poisson solver against the double-precision CPU
 // reference (src/poisson/poisson_cpu.h): every kernel on its own, then whole solves
 // (exact gradients, CPU exact solve, solver agreement, CG monotonicity, L1 robustness,
-// extreme inputs, non-finite inputs, determinism).
+// extreme inputs, non-finite inputs, determinism), and the host's solver (host-pcg) against the
+// CPU exact solve and the device's L1.
 //
 // Float tolerances: a kernel output is a sum of ≤ 10 products of float inputs, so its
 // rounding error is ≤ ~10·2⁻²⁴·Σ|terms| ≈ 6e-7 Σ|terms|; we allow 1e-5 of the magnitude
@@ -573,6 +574,12 @@ TEST_F(PoissonGpu, AlphaZeroFixesTheMeanFromThePrimal) {
         const Field exact = solvePoissonL2(channelProblem(primal, dx, dy, 0.0, c), L2Method::Exact);
         EXPECT_LT(relError(channel(out, c), exact), 1e-4) << c;
     }
+    // host-pcg needs a primal row: the singular problem goes to the device, the same solve.
+    o.solver = GpuSolver::HostPcg;
+    Image host;
+    const SolveReport hr = solve(primal, dx, dy, o, host);
+    EXPECT_GT(hr.batches, 0);
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(channel(host, c), channel(out, c)) << c;
 }
 
 // Random primal, gradients and variances (primal variance in [0.01, 1], the gradients'
@@ -701,23 +708,114 @@ TEST_F(PoissonGpu, NonFiniteInputsAreCountedAndContained) {
     primal.at(6, 5, 1) = INFINITY;
     dx.at(10, 10, 2) = -INFINITY;
     dy.at(20, 3, 0) = std::nanf("");
-    for (Reconstruction m : {Reconstruction::L2, Reconstruction::L1}) {
+    for (GpuSolver s : {GpuSolver::MgPcg, GpuSolver::HostPcg})
+        for (Reconstruction m : {Reconstruction::L2, Reconstruction::L1}) {
+            SolveOptions o;
+            o.method = m;
+            o.solver = s;
+            Image out;
+            const SolveReport r = solve(primal, dx, dy, o, out);
+            EXPECT_EQ(r.nonFinite.primal, 2u);
+            EXPECT_EQ(r.nonFinite.dx, 1u);
+            EXPECT_EQ(r.nonFinite.dy, 1u);
+            double worst = 0.0;
+            for (int c = 0; c < 3; ++c)
+                for (std::size_t i = 0; i < out.pixelCount(); ++i) {
+                    ASSERT_TRUE(std::isfinite(out.plane(c)[i]));
+                    worst = std::max(worst, double(std::abs(out.plane(c)[i] - truth.plane(c)[i])));
+                }
+            // Exact data elsewhere: the dropped rows lose nothing the other rows do not pin down.
+            EXPECT_LT(worst, 1e-2) << toString(m) << " " << toString(s);
+        }
+}
+
+// host-pcg (the host's threads, double precision) is the same least-squares solve: L2 and WL2
+// against the CPU exact solve (1e-6: a double CG at a relative residual of 1e-9, cond(A) ≲ 100).
+TEST_F(PoissonGpu, HostPcgMatchesTheCpuExactSolve) {
+    const VarianceProblem v = varianceProblem(26, 19, 91, {0.01, 1.0}, {0.01, 1.0});
+    const PoissonInput vars = v.variances();
+    for (Reconstruction m : {Reconstruction::L2, Reconstruction::WeightedL2}) {
+        SolveOptions o;
+        o.solver = GpuSolver::HostPcg;
+        o.method = m;
+        o.tolerance = 1e-9;
+        Image out;
+        const SolveReport r = solve(v.primal, v.dx, v.dy, o, out, &vars);
+        EXPECT_TRUE(r.converged) << toString(m);
+        EXPECT_EQ(r.batches, 0) << "host-pcg ran on the device";
+        auto inv = [&](const Image& var) {
+            Field f(var.pixelCount());
+            for (std::size_t i = 0; i < f.size(); ++i)
+                f[i] = 1.0 / ((double(var.plane(0)[i]) + var.plane(1)[i] + var.plane(2)[i]) / 3.0 +
+                              o.varianceEpsilon);
+            return f;
+        };
+        for (int c = 0; c < 3; ++c) {
+            PoissonProblem p = channelProblem(v.primal, v.dx, v.dy, o.alpha, c);
+            if (m == Reconstruction::WeightedL2) {
+                // The solver renormalises the weights to mean 1: the same minimiser.
+                p.weightPrimal = inv(v.vp);
+                p.weightDx = inv(v.vx);
+                p.weightDy = inv(v.vy);
+            }
+            EXPECT_LT(relError(channel(out, c), solvePoissonL2(p, L2Method::Exact)), 1e-6)
+                << toString(m) << c;
+        }
+    }
+}
+
+// L1 and WL1 by host-pcg and by the device's mg-pcg: with every IRLS round solved tightly
+// both follow the same rounds to the same minimiser (float32 on the device: 1e-3).
+TEST_F(PoissonGpu, HostPcgL1IsTheDeviceL1) {
+    const VarianceProblem v = varianceProblem(40, 28, 93, {0.001, 0.1}, {0.01, 2.0});
+    const PoissonInput vars = v.variances();
+    for (Reconstruction m : {Reconstruction::L1, Reconstruction::WeightedL1}) {
         SolveOptions o;
         o.method = m;
-        Image out;
-        const SolveReport r = solve(primal, dx, dy, o, out);
-        EXPECT_EQ(r.nonFinite.primal, 2u);
-        EXPECT_EQ(r.nonFinite.dx, 1u);
-        EXPECT_EQ(r.nonFinite.dy, 1u);
-        double worst = 0.0;
+        o.tolerance = 1e-6;
+        o.irlsInnerTolerance = 1e-6;
+        Image device, host;
+        solve(v.primal, v.dx, v.dy, o, device, &vars);
+        o.solver = GpuSolver::HostPcg;
+        const SolveReport r = solve(v.primal, v.dx, v.dy, o, host, &vars);
+        EXPECT_EQ(r.irlsIterations, o.irlsIterations);
+        EXPECT_TRUE(r.converged);
         for (int c = 0; c < 3; ++c)
-            for (std::size_t i = 0; i < out.pixelCount(); ++i) {
-                ASSERT_TRUE(std::isfinite(out.plane(c)[i]));
-                worst = std::max(worst, double(std::abs(out.plane(c)[i] - truth.plane(c)[i])));
-            }
-        // Exact data elsewhere: the dropped rows lose nothing the other rows do not pin down.
-        EXPECT_LT(worst, 1e-2) << toString(m);
+            EXPECT_LT(relError(channel(host, c), channel(device, c)), 1e-3)
+                << toString(m) << " channel " << c;
     }
+    // Power: the same comparison tells L1 from L2.
+    SolveOptions l2;
+    l2.solver = GpuSolver::HostPcg;
+    l2.tolerance = 1e-6;
+    SolveOptions l1 = l2;
+    l1.method = Reconstruction::L1;
+    Image a, b;
+    solve(v.primal, v.dx, v.dy, l2, a);
+    solve(v.primal, v.dx, v.dy, l1, b);
+    EXPECT_GT(relError(channel(a, 0), channel(b, 0)), 1e-2);
+}
+
+// host-pcg stops IRLS at a deadline, and its progress reports may stop the solve (an
+// interrupt) by throwing.
+TEST_F(PoissonGpu, HostPcgStopsAtItsDeadlineAndOnProgress) {
+    const NoisyProblem p = noisyProblem(32, 32, 5);
+    SolveOptions o;
+    o.solver = GpuSolver::HostPcg;
+    o.method = Reconstruction::L1;
+    o.deadline = std::chrono::steady_clock::now() - std::chrono::seconds(1);
+    Image out;
+    const SolveReport cut = solve(p.primal, p.dx, p.dy, o, out);
+    EXPECT_EQ(cut.irlsIterations, 1);
+    EXPECT_TRUE(cut.stoppedAtDeadline);
+    o.deadline.reset();
+    int calls = 0;
+    o.progress = [&](int roundsDone, int rounds, int) {
+        EXPECT_EQ(rounds, 6);
+        if (++calls == 2) throw Error("stop at round " + std::to_string(roundsDone));
+    };
+    EXPECT_THROW(solve(p.primal, p.dx, p.dy, o, out), Error);
+    EXPECT_EQ(calls, 2);
 }
 
 TEST_F(PoissonGpu, SolvesAreBitReproducible) {

@@ -11,6 +11,7 @@
 
 #include "integrator/budget_report.h"
 #include "integrator/recon_reserve.h"
+#include "integrator/reconstruction_stage.h"
 #include "integrator/sampling_loop.h"
 #include "temp_dir.h"
 
@@ -90,6 +91,14 @@ TEST(BudgetReport, NoteOnlyBeyondTheTolerance) {
 // The cache holds {"seconds", "load"} per key and still reads the bare seconds that earlier
 // versions wrote (load not known); entries of any other form are ignored.
 class ReconTimeCacheFile : public test::TempDirTest {};
+
+// A reconstruction cut at its deadline does not lower the remembered time (which made every
+// later timed render reserve as little and stop after one round again); a full one sets it.
+TEST(ReconstructionTime, ACutSolveDoesNotLowerTheRememberedTime) {
+    EXPECT_DOUBLE_EQ(rememberedReconSeconds(0.07, 0.13, true), 0.13);
+    EXPECT_DOUBLE_EQ(rememberedReconSeconds(0.20, 0.13, true), 0.20) << "cut, yet longer than reserved";
+    EXPECT_DOUBLE_EQ(rememberedReconSeconds(0.07, 0.13, false), 0.07) << "a full solve is what it took";
+}
 
 TEST_F(ReconTimeCacheFile, ReadsBothFormsAndWritesTheLoad) {
     const std::string file = path("recon_times.json");
