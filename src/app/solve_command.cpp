@@ -1,6 +1,6 @@
 // solve_command.cpp — `gdpt solve`: screened Poisson reconstruction of a gradient-domain
-// render on the GPU. Reads the primal/dx/dy (and optional direct, var_*) layers of a gdpt
-// EXR, or separate --primal/--dx/--dy EXR files, and writes the final image (reconstruction
+// render, on the device or the host's threads (--solver). Reads the primal/dx/dy (and optional direct, var_*)
+// layers of a gdpt EXR, or separate --primal/--dx/--dy EXR files, and writes the final image (reconstruction
 // + direct; modulation × reconstruction + direct where the EXR has the `modulation` layer of a
 // demodulated render) in the default channels plus a `recon` layer (tmp + rename).
 #include <cmath>
@@ -231,8 +231,8 @@ int runSolve(const SolveArgs& a) {
 
 Subcommand addSolveCommand(CLI::App& app) {
     auto a = std::make_shared<SolveArgs>();
-    CLI::App* sub =
-        app.add_subcommand("solve", "Screened Poisson reconstruction of a gradient-domain EXR (GPU)");
+    CLI::App* sub = app.add_subcommand(
+        "solve", "Screened Poisson reconstruction of a gradient-domain EXR (device or host: --solver)");
     sub->add_option("input", a->input,
                     "gdpt EXR with layers primal, dx, dy [, direct, var_primal, var_dx, var_dy]")
         ->check(InputFile);
