@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <numeric>
 #include <vector>
 
 #include "util/error.h"
@@ -25,7 +26,8 @@ struct Operator {
     Field cx, cy, ct, cp;  // edge i–(i+1), i–(i+W), i–next(i); screening
     Field cb;              // rows from the fixed previous frame's pixel j to bnext(j) (W·H; empty: none)
     Field diag;            // d_i: cp_i, the boundary rows at i and every edge at i
-    std::vector<std::uint32_t> next;   // next(i): the temporal neighbour of i in the window, or kNone
+    std::vector<std::uint32_t>
+        next;  // next(i): the temporal neighbour of i in the window, or kNoTemporalPartner
     std::vector<std::uint32_t> bnext;  // bnext(j): the pixel of frame 0 of the previous frame's pixel j
     // The pixels whose next() is i: back[backStart[i] .. backStart[i+1]).
     std::vector<std::uint32_t> backStart, back;
@@ -114,10 +116,8 @@ void check(const SpaceTimeProblem& p) {
     partners(p.previousPartner, p.previous[0].empty() ? 0 : p.pixels(), "previousPartner");
 }
 
-// The temporal neighbour of every row's pixel in the window (frame f's i → frame f+1's π(i))
-// and of the previous frame's pixels in frame 0; kNone where π names none.
-constexpr std::uint32_t kNone = 0xFFFFFFFFu;
-
+// The temporal neighbour of every row's pixel in the window (frame f's i → frame f+1's π(i)),
+// a window index, or kNoTemporalPartner where π names none.
 std::vector<std::uint32_t> nextPixels(const SpaceTimeProblem& p) {
     const std::size_t np = p.pixels(), nt = np * std::size_t(p.frames - 1);
     std::vector<std::uint32_t> next(nt);
@@ -127,21 +127,19 @@ std::vector<std::uint32_t> nextPixels(const SpaceTimeProblem& p) {
             next[i] = std::uint32_t(i + np);
         else
             next[i] = p.temporalPartner[i] == kNoTemporalPartner
-                          ? kNone
+                          ? kNoTemporalPartner
                           : std::uint32_t(frameStart + p.temporalPartner[i]);
     }
     return next;
 }
 
+// The pixel of frame 0 that each pixel of the previous frame joins (the same pixel without
+// previousPartner); empty without a previous frame.
 std::vector<std::uint32_t> previousNext(const SpaceTimeProblem& p) {
     if (p.previous[0].empty()) return {};
+    if (!p.previousPartner.empty()) return p.previousPartner;
     std::vector<std::uint32_t> next(p.pixels());
-    for (std::size_t j = 0; j < next.size(); ++j) {
-        if (p.previousPartner.empty())
-            next[j] = std::uint32_t(j);
-        else
-            next[j] = p.previousPartner[j] == kNoTemporalPartner ? kNone : p.previousPartner[j];
-    }
+    std::iota(next.begin(), next.end(), 0u);
     return next;
 }
 
@@ -172,16 +170,16 @@ Operator makeStructure(const SpaceTimeProblem& p) {
     op.frames = p.frames;
     const std::size_t n = p.size();
     op.next = nextPixels(p);
-    op.next.resize(n, kNone);
+    op.next.resize(n, kNoTemporalPartner);
     op.bnext = previousNext(p);
     op.backStart.assign(n + 1, 0);
     for (std::size_t i = 0; i < n; ++i)
-        if (op.next[i] != kNone) ++op.backStart[op.next[i] + 1];
+        if (op.next[i] != kNoTemporalPartner) ++op.backStart[op.next[i] + 1];
     for (std::size_t i = 0; i < n; ++i) op.backStart[i + 1] += op.backStart[i];
     op.back.resize(op.backStart[n]);
     std::vector<std::uint32_t> fill(op.backStart.begin(), op.backStart.end() - 1);
     for (std::size_t i = 0; i < n; ++i)
-        if (op.next[i] != kNone) op.back[fill[op.next[i]]++] = std::uint32_t(i);
+        if (op.next[i] != kNoTemporalPartner) op.back[fill[op.next[i]]++] = std::uint32_t(i);
     return op;
 }
 
@@ -196,7 +194,7 @@ void setWeights(const SpaceTimeProblem& p, const Weights& wt, Operator& op, std:
     sized(op.diag, n);
     parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) {
-            op.ct[i] = i + np < n && op.next[i] != kNone ? b2 * wt.dt[i] : 0.0;
+            op.ct[i] = i + np < n && op.next[i] != kNoTemporalPartner ? b2 * wt.dt[i] : 0.0;
             op.cp[i] = a2 * wt.primal[i];
         }
     });
@@ -249,7 +247,7 @@ void applyRange(const Operator& op, const Field& x, Field& y, std::size_t begin,
         if (i >= 1) v -= op.cx[i - 1] * x[i - 1];
         if (i + w < n) v -= op.cy[i] * x[i + w];
         if (i >= w) v -= op.cy[i - w] * x[i - w];
-        if (op.next[i] != kNone) v -= op.ct[i] * x[op.next[i]];
+        if (op.next[i] != kNoTemporalPartner) v -= op.ct[i] * x[op.next[i]];
         for (std::uint32_t k = op.backStart[i]; k < op.backStart[i + 1]; ++k) {
             const std::uint32_t j = op.back[k];
             v -= op.ct[j] * x[j];
