@@ -15,7 +15,7 @@
 namespace gdpt {
 
 double calibrateReconSeconds(PoissonSolverGpu& solver, const SolveOptions& options, bool warmUp) {
-    const SyntheticReconProblem p = syntheticReconProblem(solver.engine().width(), solver.engine().height());
+    const SyntheticReconProblem p = syntheticReconProblem(solver.width(), solver.height());
     PoissonInput in;
     in.primal = &p.primal;
     in.dx = &p.dx;
@@ -96,7 +96,7 @@ std::string reservationKey(const vk::Context& ctx, std::uint32_t width, std::uin
 ReconReservation reserveReconstruction(const vk::Context& ctx, PoissonSolverGpu& solver,
                                        const std::vector<SolveOptions>& solves, const ReconTimeCache& cache) {
     ReconReservation r;
-    r.key = reservationKey(ctx, solver.engine().width(), solver.engine().height());
+    r.key = reservationKey(ctx, solver.width(), solver.height());
     for (const SolveOptions& so : solves)
         r.key += std::string("|") + toString(so.method) + " alpha " + std::to_string(so.alpha) + " tol " +
                  std::to_string(so.tolerance) + " " + toString(so.solver);

@@ -208,14 +208,27 @@ const char* toString(GpuSolver s) {
 
 PoissonSolverGpu::PoissonSolverGpu(const vk::Context& ctx, int width, int height, PoissonKernels* kernels,
                                    std::optional<PoissonAddressing> addressing)
-    : engine_(ctx, width, height, kernels, addressing), stream_(ctx, "poisson solve") {}
+    : ctx_(ctx), width_(width), height_(height), kernels_(kernels), addressing_(addressing) {
+    if (width <= 0 || height <= 0)
+        throw Error("Poisson solver: invalid size " + std::to_string(width) + "x" + std::to_string(height));
+}
+
+PoissonGpuEngine& PoissonSolverGpu::engine() {
+    if (!engine_) engine_ = std::make_unique<PoissonGpuEngine>(ctx_, width_, height_, kernels_, addressing_);
+    return *engine_;
+}
+
+vk::CommandStream& PoissonSolverGpu::stream() {
+    if (!stream_) stream_ = std::make_unique<vk::CommandStream>(ctx_, "poisson solve");
+    return *stream_;
+}
 
 void PoissonSolverGpu::readHistory(int count, SolveReport& report) {
     const int entries = std::min(count + 1, static_cast<int>(kPoissonMaxHistory));
     std::vector<float> raw(static_cast<std::size_t>(entries) * 3);
-    engine_.scalars.download(raw.data(), raw.size() * sizeof(float), sizeof(PoissonScalars));
+    engine().scalars.download(raw.data(), raw.size() * sizeof(float), sizeof(PoissonScalars));
     PoissonScalars sc{};
-    engine_.scalars.download(&sc, sizeof(sc));
+    engine().scalars.download(&sc, sizeof(sc));
     report.history.clear();
     for (int k = 0; k < entries; ++k) {
         std::array<double, 3> rel{};
@@ -233,14 +246,14 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
                                                            SolveReport& report) {
     // irls: the IRLS weights and their scale have been recorded/computed already by the caller
     // into this batch's command buffer (see solve()).
-    PoissonGpuEngine& e = engine_;
+    PoissonGpuEngine& e = engine();
     vk::GpuTimer* timer = o.timer;
     const float tol = static_cast<float>(tolerance);
     const std::uint64_t fine = 3ull * e.pixels();
     const bool cgFamily = o.solver == GpuSolver::MgPcg || o.solver == GpuSolver::Cg;
     const bool pcg = o.solver == GpuSolver::MgPcg;
     const std::uint32_t zIsR = pcg ? 0u : kPoissonFlagZIsR;
-    VkCommandBuffer cmd = stream_.cmd();
+    VkCommandBuffer cmd = stream().cmd();
 
     e.recordSetup(cmd, static_cast<float>(o.alpha * o.alpha), irls, timer);
     if (o.solver != GpuSolver::Cg && o.solver != GpuSolver::Jacobi) e.recordCoarsenAll(cmd, timer);
@@ -297,15 +310,15 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
         }
         e.setGated(false);
         // Run the open command buffer (set-up and/or iterations) and check the flags.
-        stream_.submit();
-        stream_.waitAll();
+        stream().submit();
+        stream().waitAll();
         ++report.batches;
         if (timer) timer->collect();
         e.scalars.download(&sc, sizeof(sc));
         if (o.progress) o.progress(roundsDone_, rounds_, report.iterations + k);
         const bool done = sc.done[0] && sc.done[1] && sc.done[2];
         if (done || k >= o.maxIterations) break;
-        cmd = stream_.begin();
+        cmd = stream().begin();
         if (timer) timer->reset(cmd);
         batch = growBatch(batch, cap);
     }
@@ -313,15 +326,15 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
     // for the returned x (the recursion drifts from it by float rounding); IRLS rounds before
     // the last skip that pass, their residual is the recursive one.
     if (!cgFamily || trueResidual) {
-        cmd = stream_.begin();
+        cmd = stream().begin();
         if (timer) timer->reset(cmd);
         if (!cgFamily) PoissonGpuEngine::recordCopy(cmd, e.x, e.sol, fine);
         if (trueResidual) {
             e.recordResidual(cmd, 0, kPoissonFlagFromSol | kPoissonFlagDot | project, timer);
             e.recordScalars(cmd, kPoissonModeFinal, zIsR, 0, tol, 0.0f, timer);
         }
-        stream_.submit();
-        stream_.waitAll();
+        stream().submit();
+        stream().waitAll();
         ++report.batches;
         if (timer) timer->collect();
         e.scalars.download(&sc, sizeof(sc));
@@ -365,8 +378,13 @@ SyntheticReconProblem syntheticReconProblem(int width, int height) {
 }
 
 void PoissonSolverGpu::preparePipelines(const std::vector<SolveOptions>& solves) {
+    // Solves on the host dispatch nothing (a singular one, alpha 0, goes to the device).
+    const bool device = std::any_of(solves.begin(), solves.end(), [](const SolveOptions& o) {
+        return o.solver != GpuSolver::HostPcg || !(o.alpha > 0.0);
+    });
+    if (!device) return;
     constexpr int kSize = 16;  // two levels: every per-level variant of a V-cycle occurs
-    PoissonSolverGpu small(engine_.context(), kSize, kSize, &engine_.kernels(), engine_.addressing());
+    PoissonSolverGpu small(ctx_, kSize, kSize, &engine().kernels(), engine().addressing());
     const SyntheticReconProblem p = syntheticReconProblem(kSize, kSize);
     PoissonInput in;
     in.primal = &p.primal;
@@ -380,25 +398,25 @@ void PoissonSolverGpu::preparePipelines(const std::vector<SolveOptions>& solves)
         Image out;
         (void)small.solve(in, o, out);
     }
-    engine_.bind();  // the shared variants now point at the small engine's buffers
+    engine().bind();  // the shared variants now point at the small engine's buffers
 }
 
 std::vector<float> PoissonSolverGpu::solveOnDevice(const std::vector<float>& primal,
                                                    const std::vector<float>& dx, const std::vector<float>& dy,
                                                    const std::vector<float>& weights, const SolveOptions& o,
                                                    bool singular, std::size_t rows, SolveReport& report) {
-    const std::size_t n = engine_.pixels();
-    engine_.bind();
-    engine_.primal.uploadVector(primal);
-    engine_.dx.uploadVector(dx);
-    engine_.dy.uploadVector(dy);
-    engine_.weights.uploadVector(weights);
+    const std::size_t n = engine().pixels();
+    engine().bind();
+    engine().primal.uploadVector(primal);
+    engine().dx.uploadVector(dx);
+    engine().dy.uploadVector(dy);
+    engine().weights.uploadVector(weights);
     if (o.warmStart)
-        engine_.sol.uploadVector(primal);  // warm start from the primal, as the published solver
+        engine().sol.uploadVector(primal);  // warm start from the primal, as the published solver
     else
-        engine_.sol.zero();
+        engine().sol.zero();
 
-    VkCommandBuffer cmd = stream_.begin();
+    VkCommandBuffer cmd = stream().begin();
     if (o.timer) o.timer->reset(cmd);
     roundsDone_ = 0;
     rounds_ = isIrls(o.method) ? std::max(1, o.irlsIterations) : 1;
@@ -425,11 +443,12 @@ std::vector<float> PoissonSolverGpu::solveOnDevice(const std::vector<float>& pri
             if (k > 0) {
                 // The previous inner solve submitted its buffers: open a new one for the
                 // weights, their mean-1 scale and the next solve's set-up.
-                cmd = stream_.begin();
+                cmd = stream().begin();
                 if (o.timer) o.timer->reset(cmd);
-                engine_.recordIrlsWeights(cmd, static_cast<float>(o.alpha * o.alpha), static_cast<float>(reg),
-                                          o.timer);
-                engine_.recordScalars(cmd, kPoissonModeIrls, 0u, 0u, 0.0f, static_cast<float>(rows), o.timer);
+                engine().recordIrlsWeights(cmd, static_cast<float>(o.alpha * o.alpha),
+                                           static_cast<float>(reg), o.timer);
+                engine().recordScalars(cmd, kPoissonModeIrls, 0u, 0u, 0.0f, static_cast<float>(rows),
+                                       o.timer);
                 reg *= o.irlsRegIter;
             }
             const InnerResult r = innerSolve(o, tol, k > 0, false, last, report);
@@ -439,17 +458,17 @@ std::vector<float> PoissonSolverGpu::solveOnDevice(const std::vector<float>& pri
             roundsDone_ = k + 1;
         }
     }
-    return engine_.sol.downloadVector<float>(3 * n);
+    return engine().sol.downloadVector<float>(3 * n);
 }
 
 std::vector<float> PoissonSolverGpu::solveOnHost(const std::vector<float>& primal,
                                                  const std::vector<float>& dx, const std::vector<float>& dy,
                                                  const std::vector<float>& weights, const SolveOptions& o,
                                                  SolveReport& report) const {
-    const std::size_t n = engine_.pixels();
+    const std::size_t n = std::size_t(width_) * std::size_t(height_);
     SpaceTimeProblem p;
-    p.width = engine_.width();
-    p.height = engine_.height();
+    p.width = width_;
+    p.height = height_;
     p.frames = 1;
     p.alpha = o.alpha;
     const auto plane = [n](const std::vector<float>& v, std::size_t k) {
@@ -491,7 +510,7 @@ std::vector<float> PoissonSolverGpu::solveOnHost(const std::vector<float>& prima
 SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& o, Image& out) {
     Timer wall;
     if (!in.primal || !in.dx || !in.dy) throw Error("Poisson solve: primal, dx and dy are required");
-    const int w = engine_.width(), h = engine_.height();
+    const int w = width_, h = height_;
     for (const Image* im : {in.primal, in.dx, in.dy, in.varPrimal, in.varDx, in.varDy})
         if (im && (im->width() != w || im->height() != h))
             throw Error("Poisson solve: input of size " + std::to_string(im->width()) + "x" +
@@ -507,7 +526,7 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
         throw Error(std::string("Poisson solve: ") + toString(o.method) +
                     " needs the variance layers var_primal, var_dx and var_dy");
     if (o.varianceFilterRadius < 0) throw Error("Poisson solve: the variance filter radius must be >= 0");
-    const std::size_t n = engine_.pixels();
+    const std::size_t n = std::size_t(w) * std::size_t(h);
     for (const std::vector<float>* wv : {in.weightPrimal, in.weightDx, in.weightDy})
         if (wv && wv->size() != n) throw Error("Poisson solve: weight vector size does not match the image");
 

@@ -199,7 +199,10 @@ public:
     // reconstruction after sampling (RenderOptions::whileCompiling).
     void preparePipelines(const std::vector<SolveOptions>& solves);
 
-    [[nodiscard]] PoissonGpuEngine& engine() { return engine_; }
+    // The device's fields and kernels, made by the first call (a host-pcg solve needs none).
+    [[nodiscard]] PoissonGpuEngine& engine();
+    [[nodiscard]] int width() const { return width_; }
+    [[nodiscard]] int height() const { return height_; }
 
 private:
     struct InnerResult {
@@ -220,8 +223,17 @@ private:
                                    const std::vector<float>& dy, const std::vector<float>& weights,
                                    const SolveOptions& o, SolveReport& report) const;
 
-    PoissonGpuEngine engine_;
-    vk::CommandStream stream_;
+    vk::CommandStream& stream();
+
+    const vk::Context& ctx_;
+    int width_, height_;
+    PoissonKernels* kernels_;
+    std::optional<PoissonAddressing> addressing_;
+    // Made on first use by a device solve (engine()), not by the constructor: a host-pcg
+    // reconstruction uses neither, and the multigrid fields of a 3840x2160 image take about
+    // 1.4 GB of device memory.
+    std::unique_ptr<PoissonGpuEngine> engine_;
+    std::unique_ptr<vk::CommandStream> stream_;
     int roundsDone_ = 0, rounds_ = 1;  // for SolveOptions::progress
 };
 
