@@ -818,6 +818,34 @@ TEST_F(PoissonGpu, HostPcgStopsAtItsDeadlineAndOnProgress) {
     EXPECT_EQ(calls, 2);
 }
 
+// A solver whose solves run on the host allocates no device memory (the multigrid fields of
+// a 3840x2160 image are about 1.4 GB); the first device solve allocates them, a singular
+// host-pcg solve (alpha 0) too, since it goes to the device.
+TEST_F(PoissonGpu, HostSolvesAllocateNoDeviceFields) {
+    const NoisyProblem p = noisyProblem(48, 40, 9);
+    PoissonInput in;
+    in.primal = &p.primal;
+    in.dx = &p.dx;
+    in.dy = &p.dy;
+    SolveOptions host;
+    host.solver = GpuSolver::HostPcg;
+    host.method = Reconstruction::L1;
+    SolveOptions l2 = host;
+    l2.method = Reconstruction::L2;
+    const std::uint64_t before = ctx().deviceBytesNow();
+    PoissonSolverGpu solver(ctx(), 48, 40, &sharedKernels());
+    solver.preparePipelines({host, l2});
+    Image out;
+    (void)solver.solve(in, host, out);
+    (void)solver.solve(in, l2, out);
+    EXPECT_EQ(ctx().deviceBytesNow(), before);
+    SolveOptions singular = l2;
+    singular.alpha = 0.0;
+    (void)solver.solve(in, singular, out);
+    // 3 channels x 48 x 40 floats, several fields of them.
+    EXPECT_GT(ctx().deviceBytesNow(), before + 4 * 3 * 48 * 40 * sizeof(float));
+}
+
 TEST_F(PoissonGpu, SolvesAreBitReproducible) {
     const Image primal = randomImage(57, 43, 61, 0.0, 1.0);
     const Image dx = randomImage(57, 43, 62, -0.3, 0.3), dy = randomImage(57, 43, 63, -0.3, 0.3);
