@@ -161,7 +161,7 @@ struct TextureInfo {
 // Emissive triangle, sampled in proportion to power = area * luminance(emission) * pi.
 struct LightTriangle {
     uint triangle;  // index into TriangleGeom
-    float cdf;      // inclusive CDF of the power distribution (last entry == 1)
+    float cdf;      // inclusive CDF of the selection (last entry == 1; light_table.h)
     float pmf;      // probability of choosing this triangle
     float pad;
 };

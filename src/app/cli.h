@@ -32,7 +32,8 @@ struct RenderArgs {
     std::string method = "gpt";
     std::string workgroup = "8x8";
     float shiftThreshold = 0.001f;
-    std::string splitBounce = "auto";  // G-PT: auto, on, off (GptPassOptions::SplitBounce)
+    std::string lightSelection = "mixed";  // power, uniform, mixed (LightSelection)
+    std::string splitBounce = "auto";      // G-PT: auto, on, off (GptPassOptions::SplitBounce)
     std::uint32_t emitterSupersampling =
         kDefaultEmitterSupersampling;                 // render/passes/emitter_supersampling_pass.h
     std::uint32_t edgeSamples = kDefaultEdgeSamples;  // G-PT: render/passes/edge_pass.h

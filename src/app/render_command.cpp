@@ -60,6 +60,7 @@ std::string renderArgsJson(const RenderArgs& a) {
                     {"seed", a.seed},
                     {"max_depth", a.maxDepth},
                     {"emitter_supersampling", a.emitterSupersampling},
+                    {"light_selection", a.lightSelection},
                     {"shift_threshold", a.shiftThreshold},
                     {"edge_samples", a.edgeSamples},
                     {"demodulate", a.demodulate},
@@ -87,6 +88,8 @@ RenderArgs renderArgsFromJson(const std::string& text, const std::string& where)
         a.seed = j.at("seed").get<std::uint32_t>();
         a.maxDepth = j.at("max_depth").get<std::uint32_t>();
         a.emitterSupersampling = j.at("emitter_supersampling").get<std::uint32_t>();
+        // Renders written before the choice picked lights by power.
+        a.lightSelection = j.value("light_selection", std::string("power"));
         a.shiftThreshold = j.at("shift_threshold").get<float>();
         a.edgeSamples = j.at("edge_samples").get<std::uint32_t>();
         a.demodulate = j.at("demodulate").get<std::string>();
@@ -416,6 +419,14 @@ Subcommand addRenderCommand(CLI::App& app) {
                   "Rays per camera sample for directly seen emission at the edges of lights (0 = off)")
         ->capture_default_str()
         ->check(CLI::Range(0u, kMaxEmitterSupersampling))
+        ->group(sampling);
+    r->add_option(
+         "--light-selection", a.lightSelection,
+         "How next-event estimation picks an emitter (the triangles of one emissive material; within it, "
+         "by power): power (in proportion to emitted power), uniform (each emitter alike), mixed (half "
+         "of each: robust where most power is far away, e.g. a sky beside a lamp)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"power", "uniform", "mixed"}))
         ->group(sampling);
 
     const char* gpt = "G-PT";

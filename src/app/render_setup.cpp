@@ -131,6 +131,7 @@ RenderOptions renderOptionsFor(const RenderArgs& args) {
     o.scene.envRadiance = parseColor(args.env, "--env");
     o.scene.camera = args.camera;
     o.scene.shiftThreshold = args.shiftThreshold;
+    o.scene.lightSelection = parseLightSelection(args.lightSelection).value_or(LightSelection::Mixed);
     o.spp = args.spp;
     o.timeBudget = args.time;
     o.seed = args.seed;

@@ -170,6 +170,17 @@ Scene makeFurnaceSphere(float albedo, glm::vec3 emission, int subdivisions) {
     return s;
 }
 
+Scene makeTwoEmitterFurnace(float albedo, glm::vec3 emission, int subdivisions) {
+    Scene s = makeFurnaceSphere(albedo, emission, subdivisions);
+    s.materials.push_back(s.materials[0]);
+    for (std::size_t t = 0; t < s.triangles.size(); ++t) {
+        const glm::uvec3 v = s.triangles[t];
+        if ((s.positions[v.x].y + s.positions[v.y].y + s.positions[v.z].y) / 3.0f > 0.6f)
+            s.triangleMaterial[t] = 1;
+    }
+    return s;
+}
+
 Scene makeEmissiveQuad(glm::vec3 radiance) {
     Scene s;
     s.materials.push_back(lambertian(glm::vec3(0.0f), radiance));

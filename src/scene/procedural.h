@@ -24,6 +24,10 @@ namespace gdpt {
 // `albedo` and uniform emitted radiance `emission`; camera at the centre looking -Z.
 // In such a furnace every path sees radiance emission / (1 - albedo).
 [[nodiscard]] Scene makeFurnaceSphere(float albedo, glm::vec3 emission, int subdivisions);
+// The same furnace whose cap above y = 0.6 (about a fifth of the area) is a second material,
+// identical to the first: two emitters of unequal power and the same exact image, for
+// the rules that pick among emitters (render/device_scene/light_table.h).
+[[nodiscard]] Scene makeTwoEmitterFurnace(float albedo, glm::vec3 emission, int subdivisions);
 
 // One black emissive quad of radiance `radiance` at z = -1 facing a camera at the origin
 // (looking -Z, yfov 45°); it is large enough to fill the view at any aspect ratio < 20.

@@ -7,6 +7,7 @@
 
 #include "bvh/builder.h"
 #include "bvh/wide_bvh.h"
+#include "render/device_scene/light_table.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
 #include "util/memory.h"
@@ -66,44 +67,6 @@ vk::Buffer makeFilledBuffer(const vk::Context& ctx, std::size_t count, const std
         b.uploadVector(v);
     }
     return b;
-}
-
-// Emissive triangles in leaf order (LightTriangle::triangle = the leaf position), with a CDF
-// proportional to power = area * luminance(Le) * pi (x2 for double-sided emitters; emitterPower).
-// Emissive textures are not in the weight (factor only).
-struct LightTable {
-    std::vector<gpu::LightTriangle> lights;
-    double total = 0.0;
-};
-
-LightTable makeLightTable(const Scene& scene, const std::vector<std::uint32_t>& order) {
-    // Each range's emitters (leaf position, power), found in parallel and joined in order.
-    std::vector<std::vector<std::pair<std::uint32_t, double>>> found((order.size() + kTableGrain - 1) /
-                                                                     kTableGrain);
-    parallelRanges(0, order.size(), kTableGrain, [&](std::size_t begin, std::size_t end) {
-        auto& range = found[begin / kTableGrain];
-        for (std::size_t i = begin; i < end; ++i) {
-            if (!materialIsEmissive(scene, order[i])) continue;
-            const double p = emitterPower(scene, order[i], triangleArea(scene, order[i]));
-            if (p > 0.0) range.emplace_back(static_cast<std::uint32_t>(i), p);
-        }
-    });
-    LightTable t;
-    std::vector<double> power;
-    for (const auto& range : found) {
-        for (const auto& [i, p] : range) {
-            t.lights.push_back({i, 0.0f, 0.0f, 0.0f});
-            power.push_back(p);
-            t.total += p;
-        }
-    }
-    double running = 0.0;
-    for (std::size_t k = 0; k < t.lights.size(); ++k) {
-        running += power[k];
-        t.lights[k].pmf = static_cast<float>(power[k] / t.total);
-        t.lights[k].cdf = k + 1 == t.lights.size() ? 1.0f : static_cast<float>(running / t.total);
-    }
-    return t;
 }
 
 // Triangle shading records for leaf positions [begin, end); `lights` gives each emitter's
@@ -251,9 +214,9 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     bvhInfo_.buildMs = built->buildMs;
     bvhInfo_.nodes = static_cast<std::uint32_t>(bvh.nodes.size());
     bvhInfo_.maxDepth = bvh.stats.maxDepth;
-    const LightTable lightTable = makeLightTable(scene, bvh.triangleOrder);
+    const LightTable lightTable = makeLightTable(scene, bvh.triangleOrder, options.lightSelection);
     const std::vector<gpu::LightTriangle>& lights = lightTable.lights;
-    const double total = lightTable.total;
+    const double total = lightTable.totalPower;
     // The spec counted the same lights (emitterPower) to specialise the kernels.
     GDPT_CHECK(lights.size() == spec_.features().emissiveTriangles);
 

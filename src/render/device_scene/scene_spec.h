@@ -17,6 +17,7 @@
 #include "bvh/wide_bvh.h"
 #include "gdpt_shared.h"
 #include "render/device_scene/features.h"
+#include "render/device_scene/light_table.h"
 #include "scene/scene.h"
 #include "vk/kernel.h"
 
@@ -38,6 +39,8 @@ struct SceneGpuOptions {
     // G-PT: perceptual roughness at or below which a vertex is glossy (half-vector shift)
     // instead of reconnectable; the one place this setting is held.
     float shiftThreshold = 0.001f;
+    // How next-event estimation picks among the emitters (light_table.h).
+    LightSelection lightSelection = LightSelection::Mixed;
     // Bits (1u << kSpec*) of scene features to compile in whatever the scene needs (the
     // generic kernel; kSpecMaxDepth: the 1024-bounce cap; kSpecBvhRegisterStack: the stack
     // in memory, which every tree fits). For `gdpt bench-features`, which

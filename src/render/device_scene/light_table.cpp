@@ -1,0 +1,84 @@
+#include "render/device_scene/light_table.h"
+
+#include <map>
+
+#include "render/device_scene/features.h"
+#include "util/parallel.h"
+
+namespace gdpt {
+namespace {
+constexpr std::size_t kGrain = std::size_t{1} << 16;  // leaf positions per range of the scan
+
+// The share of the selection probability spread uniformly over the emitters.
+double uniformShare(LightSelection s) {
+    switch (s) {
+        case LightSelection::Power:
+            return 0.0;
+        case LightSelection::Uniform:
+            return 1.0;
+        case LightSelection::Mixed:
+            return 0.5;
+    }
+    return 0.5;
+}
+
+struct Emissive {
+    std::uint32_t leaf;
+    std::uint32_t material;
+    double power;
+};
+}  // namespace
+
+std::optional<LightSelection> parseLightSelection(const std::string& text) {
+    if (text == "power") return LightSelection::Power;
+    if (text == "uniform") return LightSelection::Uniform;
+    if (text == "mixed") return LightSelection::Mixed;
+    return std::nullopt;
+}
+
+const char* toString(LightSelection s) {
+    switch (s) {
+        case LightSelection::Power:
+            return "power";
+        case LightSelection::Uniform:
+            return "uniform";
+        case LightSelection::Mixed:
+            return "mixed";
+    }
+    return "?";
+}
+
+LightTable makeLightTable(const Scene& scene, const std::vector<std::uint32_t>& order, LightSelection selection) {
+    // Each range's emitters, found in parallel and joined in leaf order.
+    std::vector<std::vector<Emissive>> found((order.size() + kGrain - 1) / kGrain);
+    parallelRanges(0, order.size(), kGrain, [&](std::size_t begin, std::size_t end) {
+        auto& range = found[begin / kGrain];
+        for (std::size_t i = begin; i < end; ++i) {
+            if (!materialIsEmissive(scene, order[i])) continue;
+            const double p = emitterPower(scene, order[i], triangleArea(scene, order[i]));
+            if (p > 0.0)
+                range.push_back({static_cast<std::uint32_t>(i), scene.triangleMaterial[order[i]], p});
+        }
+    });
+    LightTable t;
+    std::map<std::uint32_t, double> emitterPowers;  // material -> its triangles' power
+    for (const auto& range : found)
+        for (const Emissive& e : range) {
+            t.totalPower += e.power;
+            emitterPowers[e.material] += e.power;
+        }
+    t.emitters = static_cast<std::uint32_t>(emitterPowers.size());
+    const double u = uniformShare(selection);
+    double running = 0.0;
+    for (const auto& range : found)
+        for (const Emissive& e : range) {
+            const double pmf = (1.0 - u) * e.power / t.totalPower +
+                               u * e.power / (emitterPowers[e.material] * double(t.emitters));
+            running += pmf;
+            t.lights.push_back({e.leaf, static_cast<float>(running), static_cast<float>(pmf), 0.0f});
+        }
+    if (!t.lights.empty()) t.lights.back().cdf = 1.0f;
+    return t;
+}
+
+}  // namespace gdpt

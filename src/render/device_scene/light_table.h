@@ -1,0 +1,40 @@
+// light_table.h — the emissive triangles as next-event estimation chooses among them: one
+// record per emissive triangle (in the BVH's leaf order) with its selection probability and
+// the running CDF that shaders/lib/scene_access.glsl searches.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gdpt_shared.h"
+#include "scene/scene.h"
+
+namespace gdpt {
+
+// How NEE picks an emissive triangle. An emitter is the set of triangles of one emissive
+// material; within an emitter a triangle is always picked in proportion to its power.
+//  - Power: every triangle in proportion to its power (area · luminance · π), over the whole
+//    scene. Optimal for one emitter, poor when most of the power leaves the scene: a sky dome
+//    holding 99 % of it takes 99 % of the samples from a lamp that outshines it locally.
+//  - Uniform: each emitter with the same probability, as Mitsuba 0.5 picks its emitters.
+//  - Mixed (the default): half of each, a defensive mixture (Hesterberg 1995): no triangle
+//    gets less than half the probability either rule gives it, so it costs at most 2x the
+//    variance of the better rule and avoids the worse one's failures.
+enum class LightSelection { Power, Uniform, Mixed };
+
+std::optional<LightSelection> parseLightSelection(const std::string& text);
+const char* toString(LightSelection s);
+
+struct LightTable {
+    std::vector<gpu::LightTriangle> lights;  // triangle = leaf position; pmf, cdf
+    double totalPower = 0.0;                 // of every emissive triangle
+    std::uint32_t emitters = 0;              // emissive materials with a light triangle
+};
+
+// `order`: the BVH's leaf order (leaf position -> scene triangle). Triangles without area or
+// power are no lights.
+LightTable makeLightTable(const Scene& scene, const std::vector<std::uint32_t>& order, LightSelection selection);
+
+}  // namespace gdpt
