@@ -131,7 +131,10 @@ RenderOptions renderOptionsFor(const RenderArgs& args) {
     o.scene.envRadiance = parseColor(args.env, "--env");
     o.scene.camera = args.camera;
     o.scene.shiftThreshold = args.shiftThreshold;
-    o.scene.lightSelection = parseLightSelection(args.lightSelection).value_or(LightSelection::Mixed);
+    const std::optional<LightSelection> selection = parseLightSelection(args.lightSelection);
+    if (!selection)
+        throw Error("--light-selection: '" + args.lightSelection + "' is not power, uniform or mixed");
+    o.scene.lightSelection = *selection;
     o.spp = args.spp;
     o.timeBudget = args.time;
     o.seed = args.seed;
@@ -159,6 +162,7 @@ json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrato
               {"seed", args.seed},
               {"batches", s.batches},
               {"bvh_register_stack", s.bvhRegisterStack},
+              {"light_selection", args.lightSelection},
               {"time_s",
                {{"total", seconds},
                 {"bvh_build", s.bvhBuildMs * 1e-3},

@@ -48,7 +48,8 @@ const char* toString(LightSelection s) {
     return "?";
 }
 
-LightTable makeLightTable(const Scene& scene, const std::vector<std::uint32_t>& order, LightSelection selection) {
+LightTable makeLightTable(const Scene& scene, const std::vector<std::uint32_t>& order,
+                          LightSelection selection) {
     // Each range's emitters, found in parallel and joined in leaf order.
     std::vector<std::vector<Emissive>> found((order.size() + kGrain - 1) / kGrain);
     parallelRanges(0, order.size(), kGrain, [&](std::size_t begin, std::size_t end) {

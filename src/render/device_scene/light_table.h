@@ -35,6 +35,7 @@ struct LightTable {
 
 // `order`: the BVH's leaf order (leaf position -> scene triangle). Triangles without area or
 // power are no lights.
-LightTable makeLightTable(const Scene& scene, const std::vector<std::uint32_t>& order, LightSelection selection);
+LightTable makeLightTable(const Scene& scene, const std::vector<std::uint32_t>& order,
+                          LightSelection selection);
 
 }  // namespace gdpt

@@ -138,6 +138,7 @@ TEST_F(Cli, SmallValidatedRenderWritesExrPngAndJson) {
     EXPECT_GT(j["rays_traced"].get<double>(), 0.0);
     EXPECT_TRUE(j["kernels"].contains("pt"));
     EXPECT_EQ(j["bvh_register_stack"].get<int>(), 8) << "cornell_box's tree needs 4 stack entries";
+    EXPECT_EQ(j["light_selection"].get<std::string>(), "mixed");
     EXPECT_NE(r.output.find("pt"), std::string::npos) << "--profile prints the kernel table";
     // The wait for the background-created pipelines is part of the set-up it reports.
     const auto& t = j["time_s"];
@@ -145,6 +146,25 @@ TEST_F(Cli, SmallValidatedRenderWritesExrPngAndJson) {
     EXPECT_LE(t["pipeline_wait"].get<double>(),
               t["upload"].get<double>() + t["bvh_build"].get<double>() + 1e-6);
     EXPECT_LE(t["upload"].get<double>() + t["sampling"].get<double>(), t["total"].get<double>());
+}
+
+// --light-selection: each rule renders and is reported; any other value is refused before
+// anything is written.
+TEST_F(Cli, LightSelectionIsChosenAndReported) {
+    for (const char* rule : {"power", "uniform"}) {
+        const std::string json = path(std::string(rule) + ".json");
+        const RunResult r =
+            run("render " + kScene + " --method pt --width 8 --height 8 --spp 1 --quiet -o " +
+                path(std::string(rule) + ".exr") + " --light-selection " + rule + " --json " + json);
+        ASSERT_EQ(r.code, 0) << r.output;
+        std::ifstream in(json);
+        EXPECT_EQ(nlohmann::json::parse(in)["light_selection"].get<std::string>(), rule);
+    }
+    const RunResult bad =
+        run("render " + kScene + " --spp 1 -o " + path("bad.exr") + " --light-selection area");
+    EXPECT_NE(bad.code, 0);
+    EXPECT_NE(bad.output.find("--light-selection"), std::string::npos) << bad.output;
+    EXPECT_FALSE(fs::exists(path("bad.exr")));
 }
 
 // A timed G-PT render reserves its reconstruction time: the first run of a configuration
