@@ -426,7 +426,8 @@ Subcommand addRenderCommand(CLI::App& app) {
          "by power): power (in proportion to emitted power), uniform (each emitter alike), mixed (half "
          "of each: robust where most power is far away, e.g. a sky beside a lamp)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"power", "uniform", "mixed"}))
+        ->check(CLI::IsMember(
+            std::vector<std::string>(std::begin(kLightSelectionChoices), std::end(kLightSelectionChoices))))
         ->group(sampling);
 
     const char* gpt = "G-PT";

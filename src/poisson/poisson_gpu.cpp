@@ -226,9 +226,10 @@ vk::CommandStream& PoissonSolverGpu::stream() {
 void PoissonSolverGpu::readHistory(int count, SolveReport& report) {
     const int entries = std::min(count + 1, static_cast<int>(kPoissonMaxHistory));
     std::vector<float> raw(static_cast<std::size_t>(entries) * 3);
-    engine().scalars.download(raw.data(), raw.size() * sizeof(float), sizeof(PoissonScalars));
+    const vk::Buffer& scalars = engine().scalars;
+    scalars.download(raw.data(), raw.size() * sizeof(float), sizeof(PoissonScalars));
     PoissonScalars sc{};
-    engine().scalars.download(&sc, sizeof(sc));
+    scalars.download(&sc, sizeof(sc));
     report.history.clear();
     for (int k = 0; k < entries; ++k) {
         std::array<double, 3> rel{};
@@ -253,7 +254,8 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
     const bool cgFamily = o.solver == GpuSolver::MgPcg || o.solver == GpuSolver::Cg;
     const bool pcg = o.solver == GpuSolver::MgPcg;
     const std::uint32_t zIsR = pcg ? 0u : kPoissonFlagZIsR;
-    VkCommandBuffer cmd = stream().cmd();
+    vk::CommandStream& st = stream();
+    VkCommandBuffer cmd = st.cmd();
 
     e.recordSetup(cmd, static_cast<float>(o.alpha * o.alpha), irls, timer);
     if (o.solver != GpuSolver::Cg && o.solver != GpuSolver::Jacobi) e.recordCoarsenAll(cmd, timer);
@@ -310,15 +312,15 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
         }
         e.setGated(false);
         // Run the open command buffer (set-up and/or iterations) and check the flags.
-        stream().submit();
-        stream().waitAll();
+        st.submit();
+        st.waitAll();
         ++report.batches;
         if (timer) timer->collect();
         e.scalars.download(&sc, sizeof(sc));
         if (o.progress) o.progress(roundsDone_, rounds_, report.iterations + k);
         const bool done = sc.done[0] && sc.done[1] && sc.done[2];
         if (done || k >= o.maxIterations) break;
-        cmd = stream().begin();
+        cmd = st.begin();
         if (timer) timer->reset(cmd);
         batch = growBatch(batch, cap);
     }
@@ -326,15 +328,15 @@ PoissonSolverGpu::InnerResult PoissonSolverGpu::innerSolve(const SolveOptions& o
     // for the returned x (the recursion drifts from it by float rounding); IRLS rounds before
     // the last skip that pass, their residual is the recursive one.
     if (!cgFamily || trueResidual) {
-        cmd = stream().begin();
+        cmd = st.begin();
         if (timer) timer->reset(cmd);
         if (!cgFamily) PoissonGpuEngine::recordCopy(cmd, e.x, e.sol, fine);
         if (trueResidual) {
             e.recordResidual(cmd, 0, kPoissonFlagFromSol | kPoissonFlagDot | project, timer);
             e.recordScalars(cmd, kPoissonModeFinal, zIsR, 0, tol, 0.0f, timer);
         }
-        stream().submit();
-        stream().waitAll();
+        st.submit();
+        st.waitAll();
         ++report.batches;
         if (timer) timer->collect();
         e.scalars.download(&sc, sizeof(sc));
@@ -377,11 +379,18 @@ SyntheticReconProblem syntheticReconProblem(int width, int height) {
     return p;
 }
 
+namespace {
+// Where solve() solves: host-pcg on the host unless the problem is singular (alpha 0 or no
+// primal row), which needs the device's solvers.
+bool solvesOnHost(const SolveOptions& o, bool singular) {
+    return o.solver == GpuSolver::HostPcg && !singular;
+}
+}  // namespace
+
 void PoissonSolverGpu::preparePipelines(const std::vector<SolveOptions>& solves) {
-    // Solves on the host dispatch nothing (a singular one, alpha 0, goes to the device).
-    const bool device = std::any_of(solves.begin(), solves.end(), [](const SolveOptions& o) {
-        return o.solver != GpuSolver::HostPcg || !(o.alpha > 0.0);
-    });
+    // Solves on the host dispatch nothing. (The synthetic problem below has every primal row.)
+    const bool device = std::any_of(solves.begin(), solves.end(),
+                                    [](const SolveOptions& o) { return !solvesOnHost(o, !(o.alpha > 0.0)); });
     if (!device) return;
     constexpr int kSize = 16;  // two levels: every per-level variant of a V-cycle occurs
     PoissonSolverGpu small(ctx_, kSize, kSize, &engine().kernels(), engine().addressing());
@@ -405,16 +414,17 @@ std::vector<float> PoissonSolverGpu::solveOnDevice(const std::vector<float>& pri
                                                    const std::vector<float>& dx, const std::vector<float>& dy,
                                                    const std::vector<float>& weights, const SolveOptions& o,
                                                    bool singular, std::size_t rows, SolveReport& report) {
-    const std::size_t n = engine().pixels();
-    engine().bind();
-    engine().primal.uploadVector(primal);
-    engine().dx.uploadVector(dx);
-    engine().dy.uploadVector(dy);
-    engine().weights.uploadVector(weights);
+    PoissonGpuEngine& e = engine();
+    const std::size_t n = e.pixels();
+    e.bind();
+    e.primal.uploadVector(primal);
+    e.dx.uploadVector(dx);
+    e.dy.uploadVector(dy);
+    e.weights.uploadVector(weights);
     if (o.warmStart)
-        engine().sol.uploadVector(primal);  // warm start from the primal, as the published solver
+        e.sol.uploadVector(primal);  // warm start from the primal, as the published solver
     else
-        engine().sol.zero();
+        e.sol.zero();
 
     VkCommandBuffer cmd = stream().begin();
     if (o.timer) o.timer->reset(cmd);
@@ -445,10 +455,9 @@ std::vector<float> PoissonSolverGpu::solveOnDevice(const std::vector<float>& pri
                 // weights, their mean-1 scale and the next solve's set-up.
                 cmd = stream().begin();
                 if (o.timer) o.timer->reset(cmd);
-                engine().recordIrlsWeights(cmd, static_cast<float>(o.alpha * o.alpha),
-                                           static_cast<float>(reg), o.timer);
-                engine().recordScalars(cmd, kPoissonModeIrls, 0u, 0u, 0.0f, static_cast<float>(rows),
-                                       o.timer);
+                e.recordIrlsWeights(cmd, static_cast<float>(o.alpha * o.alpha), static_cast<float>(reg),
+                                    o.timer);
+                e.recordScalars(cmd, kPoissonModeIrls, 0u, 0u, 0.0f, static_cast<float>(rows), o.timer);
                 reg *= o.irlsRegIter;
             }
             const InnerResult r = innerSolve(o, tol, k > 0, false, last, report);
@@ -458,7 +467,7 @@ std::vector<float> PoissonSolverGpu::solveOnDevice(const std::vector<float>& pri
             roundsDone_ = k + 1;
         }
     }
-    return engine().sol.downloadVector<float>(3 * n);
+    return e.sol.downloadVector<float>(3 * n);
 }
 
 std::vector<float> PoissonSolverGpu::solveOnHost(const std::vector<float>& primal,
@@ -609,7 +618,7 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
     }
 
     std::vector<float> sol;
-    if (o.solver == GpuSolver::HostPcg && !singular) {
+    if (solvesOnHost(o, singular)) {
         sol = solveOnHost(primal, dx, dy, weights, o, report);
     } else {
         // The host solver needs α > 0 and a primal row: a singular problem goes to the device.

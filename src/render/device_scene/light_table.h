@@ -24,6 +24,8 @@ namespace gdpt {
 //    variance of the better rule and avoids the worse one's failures.
 enum class LightSelection { Power, Uniform, Mixed };
 
+// The names of the rules (toString), for --light-selection.
+inline constexpr const char* kLightSelectionChoices[] = {"power", "uniform", "mixed"};
 std::optional<LightSelection> parseLightSelection(const std::string& text);
 const char* toString(LightSelection s);
 

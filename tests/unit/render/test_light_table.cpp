@@ -52,6 +52,8 @@ TEST(LightTable, NamesRoundTrip) {
     for (LightSelection sel : {LightSelection::Power, LightSelection::Uniform, LightSelection::Mixed})
         EXPECT_EQ(parseLightSelection(toString(sel)), sel);
     EXPECT_FALSE(parseLightSelection("area").has_value());
+    for (const char* name : kLightSelectionChoices)
+        EXPECT_EQ(toString(*parseLightSelection(name)), std::string(name));
 }
 
 }  // namespace
