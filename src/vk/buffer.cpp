@@ -1,5 +1,6 @@
 #include "vk/buffer.h"
 
+#include <algorithm>
 #include <cstring>
 
 #include "util/huge_pages.h"
@@ -56,6 +57,9 @@ Buffer::Buffer(const Context& ctx, std::uint64_t bytes, const std::string& name)
     buffer_ = std::move(bufferOwner);
     if ((flags & kMappable) == kMappable) {
         VK_CHECK(vkMapMemory(device, memory, 0, VK_WHOLE_SIZE, 0, &mapped_));
+        hostCached_ =
+            (ctx.memoryTypeFlags(alloc.memoryTypeIndex) & VK_MEMORY_PROPERTY_HOST_CACHED_BIT) != 0 &&
+            !ctx.stagedTransfers();
         // A CPU device's memory is the process's own anonymous memory, first touched when it
         // is written: huge pages spare most of the page faults of a large buffer (a 5M-triangle
         // scene's tables, a 4K image's statistics; util/huge_pages.h).
@@ -72,7 +76,8 @@ std::uint64_t Buffer::deviceAddress() const {
 
 void Buffer::upload(const void* data, std::uint64_t bytes, std::uint64_t offset) {
     GDPT_CHECK(offset + bytes <= size_);
-    if (mapped_)
+    // Writes through a write-combined mapping run at the bus's speed: only reads are staged.
+    if (mapped_ && !ctx_->stagedTransfers())
         std::memcpy(static_cast<char*>(mapped_) + offset, data, bytes);
     else
         stagedCopy(const_cast<void*>(data), bytes, offset, true);
@@ -80,14 +85,14 @@ void Buffer::upload(const void* data, std::uint64_t bytes, std::uint64_t offset)
 
 void Buffer::download(void* data, std::uint64_t bytes, std::uint64_t offset) const {
     GDPT_CHECK(offset + bytes <= size_);
-    if (mapped_)
+    if (hostCached_)
         std::memcpy(data, static_cast<const char*>(mapped_) + offset, bytes);
     else
         stagedCopy(data, bytes, offset, false);
 }
 
 void Buffer::zero() {
-    if (mapped_) {
+    if (hostCached_) {
         std::memset(mapped_, 0, size_);
         return;
     }
@@ -96,51 +101,87 @@ void Buffer::zero() {
     cmd.submitAndWait();
 }
 
-void Buffer::stagedCopy(void* hostData, std::uint64_t bytes, std::uint64_t offset, bool toDevice) const {
+Buffer Buffer::makeStaging(const Context& ctx, std::uint64_t bytes, bool forReading) {
+    // Built by hand because the constructor prefers device-local memory.
     Buffer staging;
-    {
-        // A host-visible staging buffer: built by hand because Buffer() prefers device-local.
-        staging.ctx_ = ctx_;
-        staging.size_ = bytes;
-        VkDevice device = ctx_->device();
-        VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-        info.size = bytes;
-        info.usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-        VkBuffer b = VK_NULL_HANDLE;
-        VK_CHECK(vkCreateBuffer(device, &info, nullptr, &b));
-        staging.buffer_ = Handle<VkBuffer>(b, [device](VkBuffer x) { vkDestroyBuffer(device, x, nullptr); });
-        VkMemoryRequirements req{};
-        vkGetBufferMemoryRequirements(device, b, &req);
-        VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-        alloc.allocationSize = req.size;
-        alloc.memoryTypeIndex = ctx_->findMemoryType(req.memoryTypeBits, kMappable);
-        VkDeviceMemory m = VK_NULL_HANDLE;
-        VK_CHECK(vkAllocateMemory(device, &alloc, nullptr, &m));
-        ctx_->noteAllocation(req.size);
-        Handle<VkDeviceMemory> mem(m, [device, ctxp = ctx_, bytes = req.size](VkDeviceMemory x) {
-            vkFreeMemory(device, x, nullptr);
-            ctxp->noteFree(bytes);
-        });
-        VK_CHECK(vkBindBufferMemory(device, b, m, 0));
-        VK_CHECK(vkMapMemory(device, m, 0, VK_WHOLE_SIZE, 0, &staging.mapped_));
-        // Keep the memory alive as long as the buffer: destroy order buffer -> memory.
-        Handle<VkBuffer> keep = std::move(staging.buffer_);
-        staging.memory_ = std::move(mem);
-        staging.buffer_ = std::move(keep);
+    staging.ctx_ = &ctx;
+    staging.name_ = "staging";
+    staging.size_ = bytes;
+    VkDevice device = ctx.device();
+    VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    info.size = bytes;
+    info.usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    VkBuffer b = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateBuffer(device, &info, nullptr, &b));
+    Handle<VkBuffer> bufferOwner(b, [device](VkBuffer x) { vkDestroyBuffer(device, x, nullptr); });
+    VkMemoryRequirements req{};
+    vkGetBufferMemoryRequirements(device, b, &req);
+    // Reading: host-cached memory (coherent if there is such, else invalidated before reads);
+    // writing: any mappable memory (write-combined is what writes want).
+    constexpr VkMemoryPropertyFlags cached =
+        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
+    VkMemoryPropertyFlags flags = kMappable;
+    if (forReading && ctx.hasMemoryType(req.memoryTypeBits, cached | kMappable))
+        flags = cached | kMappable;
+    else if (forReading && ctx.hasMemoryType(req.memoryTypeBits, cached))
+        flags = cached;
+    VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    alloc.allocationSize = req.size;
+    alloc.memoryTypeIndex = ctx.findMemoryType(req.memoryTypeBits, flags);
+    VkDeviceMemory m = VK_NULL_HANDLE;
+    const VkResult r = vkAllocateMemory(device, &alloc, nullptr, &m);
+    if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY)
+        throw Error("out of host-visible memory allocating a staging buffer (" + std::to_string(bytes >> 20) +
+                    " MiB)");
+    VK_CHECK(r);
+    ctx.noteAllocation(req.size);
+    staging.memory_ = Handle<VkDeviceMemory>(m, [device, ctxp = &ctx, size = req.size](VkDeviceMemory x) {
+        vkFreeMemory(device, x, nullptr);
+        ctxp->noteFree(size);
+    });
+    VK_CHECK(vkBindBufferMemory(device, b, m, 0));
+    staging.buffer_ = std::move(bufferOwner);
+    VK_CHECK(vkMapMemory(device, m, 0, VK_WHOLE_SIZE, 0, &staging.mapped_));
+    staging.coherent_ =
+        (ctx.memoryTypeFlags(alloc.memoryTypeIndex) & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
+    return staging;
+}
+
+void Buffer::stagedCopy(void* hostData, std::uint64_t bytes, std::uint64_t offset, bool toDevice) const {
+    if (bytes == 0) return;
+    const Buffer staging = makeStaging(*ctx_, std::min(bytes, kStagingChunk), !toDevice);
+    auto* host = static_cast<char*>(hostData);
+    for (std::uint64_t done = 0; done < bytes;) {
+        const std::uint64_t n = std::min(bytes - done, kStagingChunk);
+        if (toDevice) std::memcpy(staging.mapped_, host + done, n);
+        CommandStream cmd(*ctx_, "copy " + name_);
+        VkBufferCopy region{};
+        region.size = n;
+        if (toDevice) {
+            region.dstOffset = offset + done;
+            vkCmdCopyBuffer(cmd.begin(), staging.get(), buffer_.get(), 1, &region);
+        } else {
+            region.srcOffset = offset + done;
+            vkCmdCopyBuffer(cmd.begin(), buffer_.get(), staging.get(), 1, &region);
+            // The copy's writes become visible to the host once the queue is waited on.
+            VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+            barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+            barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+            vkCmdPipelineBarrier(cmd.cmd(), VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
+                                 &barrier, 0, nullptr, 0, nullptr);
+        }
+        cmd.submitAndWait();
+        if (!toDevice) {
+            if (!staging.coherent_) {
+                VkMappedMemoryRange range{VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE};
+                range.memory = staging.memory_.get();
+                range.size = VK_WHOLE_SIZE;
+                VK_CHECK(vkInvalidateMappedMemoryRanges(ctx_->device(), 1, &range));
+            }
+            std::memcpy(host + done, staging.mapped_, n);
+        }
+        done += n;
     }
-    if (toDevice) std::memcpy(staging.mapped_, hostData, bytes);
-    CommandStream cmd(*ctx_, "copy " + name_);
-    VkBufferCopy region{};
-    region.size = bytes;
-    if (toDevice) {
-        region.dstOffset = offset;
-        vkCmdCopyBuffer(cmd.begin(), staging.get(), buffer_.get(), 1, &region);
-    } else {
-        region.srcOffset = offset;
-        vkCmdCopyBuffer(cmd.begin(), buffer_.get(), staging.get(), 1, &region);
-    }
-    cmd.submitAndWait();
-    if (!toDevice) std::memcpy(hostData, staging.mapped_, bytes);
 }
 
 }  // namespace gdpt::vk

@@ -200,7 +200,9 @@ std::vector<DeviceInfo> Context::listDevices() {
 }
 
 Context::Context(const ContextOptions& options)
-    : validation_(options.validation), printValidation_(options.printValidation) {
+    : validation_(options.validation),
+      printValidation_(options.printValidation),
+      stagedTransfers_(options.stagedTransfers) {
     if (validation_ && !layerAvailable(kValidationLayer))
         throw Error(
             "validation requested but VK_LAYER_KHRONOS_validation is not installed "
@@ -297,6 +299,11 @@ bool Context::hasMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags requir
         if ((typeBits & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & required) == required)
             return true;
     return false;
+}
+
+VkMemoryPropertyFlags Context::memoryTypeFlags(std::uint32_t index) const {
+    GDPT_CHECK(index < memory_.memoryTypeCount);
+    return memory_.memoryTypes[index].propertyFlags;
 }
 
 std::uint32_t Context::findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required) const {

@@ -24,6 +24,10 @@ struct ContextOptions {
     // same description (pipeline_cache.h): for many renders in one process, e.g. the frames
     // of a sequence. Off: each Kernel creates and owns its pipeline.
     bool keepPipelines = false;
+    // Reads and clears of buffers go through the device (a copy into host-cached staging
+    // memory, vkCmdFillBuffer) even where the buffer's memory is host-cached: the path a
+    // discrete GPU takes, for tests on a CPU device (vk/buffer.h).
+    bool stagedTransfers = false;
 };
 
 // What `gdpt devices` prints and what the limits check reads.
@@ -83,6 +87,10 @@ public:
     // Memory type with all `required` flags among `typeBits`; throws if none.
     [[nodiscard]] std::uint32_t findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required) const;
     [[nodiscard]] bool hasMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required) const;
+    // The property flags of memory type `index`.
+    [[nodiscard]] VkMemoryPropertyFlags memoryTypeFlags(std::uint32_t index) const;
+    // ContextOptions::stagedTransfers.
+    [[nodiscard]] bool stagedTransfers() const { return stagedTransfers_; }
     // Debug name shown by validation messages and tools (no-op without debug utils).
     void setName(VkObjectType type, std::uint64_t handle, const std::string& name) const;
 
@@ -113,6 +121,7 @@ private:
 
     bool validation_ = false;
     bool printValidation_ = true;
+    bool stagedTransfers_ = false;
     std::atomic<std::uint32_t> validationErrors_{0};
     mutable std::atomic<std::uint64_t> deviceBytesNow_{0};
     mutable std::atomic<std::uint64_t> deviceBytesPeak_{0};
