@@ -239,7 +239,7 @@ void rhs(const SpaceTimeProblem& p, const Operator& op, std::array<Field, 3>& b,
 }
 
 // (A x)_i for i in [begin, end).
-void applyRange(const Operator& op, const Field& x, Field& y, std::size_t begin, std::size_t end) {
+void applyRangeGeneral(const Operator& op, const Field& x, Field& y, std::size_t begin, std::size_t end) {
     const std::size_t n = op.size(), w = std::size_t(op.width);
     for (std::size_t i = begin; i < end; ++i) {
         double v = op.diag[i] * x[i];
@@ -254,6 +254,35 @@ void applyRange(const Operator& op, const Field& x, Field& y, std::size_t begin,
         }
         y[i] = v;
     }
+}
+
+// (A x)_i for i in [begin, end): one frame (no temporal rows) takes the 5-point stencil
+// without a test per neighbour at the pixels that have all four in the field (rows 1 .. H−2,
+// and the neighbours across a row's end, whose coefficient is 0); the same operations in the
+// same order as applyRangeGeneral, so the same bits. The one-frame solve is G-PT's
+// reconstruction on a CPU device, where this loop is most of the time.
+void applyRange(const Operator& op, const Field& x, Field& y, std::size_t begin, std::size_t end) {
+    const std::size_t n = op.size(), w = std::size_t(op.width);
+    if (op.frames != 1 || n <= 2 * w) {
+        applyRangeGeneral(op, x, y, begin, end);
+        return;
+    }
+    const std::size_t lo = std::clamp(w, begin, end), hi = std::clamp(n - w, lo, end);
+    applyRangeGeneral(op, x, y, begin, lo);
+    const double* __restrict xs = x.data();
+    const double* __restrict d = op.diag.data();
+    const double* __restrict cx = op.cx.data();
+    const double* __restrict cy = op.cy.data();
+    double* __restrict ys = y.data();
+    for (std::size_t i = lo; i < hi; ++i) {
+        double v = d[i] * xs[i];
+        v -= cx[i] * xs[i + 1];
+        v -= cx[i - 1] * xs[i - 1];
+        v -= cy[i] * xs[i + w];
+        v -= cy[i - w] * xs[i - w];
+        ys[i] = v;
+    }
+    applyRangeGeneral(op, x, y, hi, end);
 }
 
 struct ChannelSolve {
