@@ -41,8 +41,9 @@ struct BenchPoissonArgs {
     std::string device;
     bool profile = false;
     std::string addressing = "auto";
-    int frames = 10;  // st-*: frames of the window
-    int threads = 0;  // st-*: solver threads (0 = the machine's cores)
+    int frames = 10;                               // st-*: frames of the window
+    int threads = 0;                               // st-*: solver threads (0 = the machine's cores)
+    std::string hostPreconditioner = "multigrid";  // st-*, one frame: multigrid or jacobi
 };
 
 // Smooth shading, hard-edged discs and fine stripes: content with every frequency.
@@ -107,6 +108,7 @@ nlohmann::json benchSpaceTime(const BenchPoissonArgs& a, int w, int h, const std
     o.tolerance = a.tolerance;
     o.maxIterations = a.maxIterations;
     o.threads = a.threads;
+    o.multigrid = a.hostPreconditioner == "multigrid";
     std::fprintf(stderr, "gdpt bench-poisson: %d frames of %dx%d %s\n", a.frames, w, h, method.c_str());
     std::vector<double> ms;
     SpaceTimeStats stats;
@@ -120,6 +122,7 @@ nlohmann::json benchSpaceTime(const BenchPoissonArgs& a, int w, int h, const std
             {"height", h},
             {"frames", a.frames},
             {"method", method},
+            {"preconditioner", o.multigrid && a.frames == 1 ? "multigrid" : "jacobi"},
             {"median_ms", med},
             {"all_ms", ms},
             {"iterations", stats.iterations},
@@ -265,6 +268,11 @@ Subcommand addBenchPoissonCommand(CLI::App& app) {
         ->capture_default_str();
     sub->add_option("--threads", args->threads, "st-*: host threads of the space-time solver (0 = all cores)")
         ->check(CLI::Range(0, 1024))
+        ->capture_default_str();
+    sub->add_option("--host-preconditioner", args->hostPreconditioner,
+                    "st-*: CG's preconditioner for one frame (more frames always take jacobi): multigrid "
+                    "(a V-cycle) or jacobi (the diagonal)")
+        ->check(CLI::IsMember({"multigrid", "jacobi"}))
         ->capture_default_str();
     sub->add_option("--repeats", args->repeats, "Solves per size and method (median reported)")
         ->check(CLI::Range(1, 100))

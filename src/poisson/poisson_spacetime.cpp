@@ -9,6 +9,7 @@
 #include <numeric>
 #include <vector>
 
+#include "poisson/host_vcycle.h"
 #include "util/error.h"
 #include "util/huge_pages.h"
 #include "util/parallel.h"
@@ -294,18 +295,20 @@ struct ChannelSolve {
 
 // Jacobi-preconditioned CG from x until ‖b − A x‖ ≤ tolerance ‖b‖, the three channels in
 // lockstep (each stops where it converges), pixel ranges over `threads`. A is SPD (α > 0).
-// z = r / d is not stored: p ← r/d + β p.
+// Jacobi: z = r / d is not stored (p ← r/d + β p). Multigrid (`mg`, one-frame windows): z =
+// M⁻¹ r by one V-cycle (host_vcycle.h), p ← z + β p.
 // CG's vectors, kept across the IRLS rounds (allocating them anew each round cost more than
 // the iterations on a machine where page faults are slow).
 struct CgVectors {
-    std::array<Field, 3> r, p, q;
+    std::array<Field, 3> r, p, q, z;  // z: multigrid only
 };
 
 // `every16`: called after every 16th iteration with the iterations so far (may throw).
 std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& b, std::array<Field, 3>& x,
                                 double tolerance, int maxIterations, std::uint32_t threads, CgVectors& v,
                                 const std::function<void(int)>& every16,
-                                std::optional<std::chrono::steady_clock::time_point> deadline) {
+                                std::optional<std::chrono::steady_clock::time_point> deadline,
+                                HostVcycle* mg) {
     const std::size_t n = op.size(), ranges = rangesOf(n);
     std::array<Field, 3>&r = v.r, &p = v.p, &q = v.q;
     // Per range: the partial sums of one pass (three per channel at most), added in range order.
@@ -319,7 +322,22 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
         sized(r[c], n);
         sized(p[c], n);
         sized(q[c], n);
+        if (mg) sized(v.z[c], n);
     }
+    // z = M⁻¹ r and r·z for the channels in `which` (multigrid).
+    const auto precondition = [&](const std::array<bool, 3>& which) {
+        mg->apply({&r[0], &r[1], &r[2]}, {&v.z[0], &v.z[1], &v.z[2]}, which, threads);
+        parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
+            std::array<double, 9> s{};
+            for (int c = 0; c < 3; ++c) {
+                if (!which[c]) continue;
+                double rz = 0.0;
+                for (std::size_t i = begin; i < end; ++i) rz += r[c][i] * v.z[c][i];
+                s[std::size_t(c)] = rz;
+            }
+            partial[begin / kGrain] = s;
+        });
+    };
     // r = b − A x, p = z = r / d; ‖b‖², r·z and ‖r‖².
     parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
         std::array<double, 9> s{};
@@ -349,6 +367,14 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
         rr[c] = sumOf(c + 6);
         target[c] = tolerance * out[c].rhsNorm;
         active[c] = std::sqrt(rr[c]) > target[c] && maxIterations > 0;
+    }
+    if (mg && (active[0] || active[1] || active[2])) {
+        precondition(active);
+        for (int c = 0; c < 3; ++c)
+            if (active[c]) {
+                rz[c] = sumOf(c);
+                std::copy(v.z[c].begin(), v.z[c].end(), p[c].begin());
+            }
     }
     const auto anyActive = [&] { return active[0] || active[1] || active[2]; };
     int k = 0;
@@ -388,34 +414,54 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
                 if (!active[c]) continue;
                 double rzNew = 0.0, rrNew = 0.0;
                 const double a = alpha[c];
-                for (std::size_t i = begin; i < end; ++i) {
-                    x[c][i] += a * p[c][i];
-                    const double ri = r[c][i] - a * q[c][i];
-                    r[c][i] = ri;
-                    rzNew += ri * ri / op.diag[i];
-                    rrNew += ri * ri;
-                }
+                if (mg)
+                    for (std::size_t i = begin; i < end; ++i) {
+                        x[c][i] += a * p[c][i];
+                        const double ri = r[c][i] - a * q[c][i];
+                        r[c][i] = ri;
+                        rrNew += ri * ri;
+                    }
+                else
+                    for (std::size_t i = begin; i < end; ++i) {
+                        x[c][i] += a * p[c][i];
+                        const double ri = r[c][i] - a * q[c][i];
+                        r[c][i] = ri;
+                        rzNew += ri * ri / op.diag[i];
+                        rrNew += ri * ri;
+                    }
                 s[std::size_t(c)] = rzNew;
                 s[std::size_t(c) + 3] = rrNew;
             }
             partial[begin / kGrain] = s;
         });
+        std::array<double, 3> rzNew{};
         for (int c = 0; c < 3; ++c) {
             if (!active[c]) continue;
-            const double rzNew = sumOf(c);
+            rzNew[c] = sumOf(c);
             rr[c] = sumOf(c + 3);
-            beta[c] = rzNew / rz[c];
-            rz[c] = rzNew;
             ++out[c].iterations;
             active[c] = std::sqrt(rr[c]) > target[c] && out[c].iterations < maxIterations;
         }
         if (!anyActive()) break;
+        if (mg) {
+            precondition(active);
+            for (int c = 0; c < 3; ++c)
+                if (active[c]) rzNew[c] = sumOf(c);
+        }
+        for (int c = 0; c < 3; ++c) {
+            if (!active[c]) continue;
+            beta[c] = rzNew[c] / rz[c];
+            rz[c] = rzNew[c];
+        }
         // p = r / d + β p.
         parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
             for (int c = 0; c < 3; ++c) {
                 if (!active[c]) continue;
                 const double bt = beta[c];
-                for (std::size_t i = begin; i < end; ++i) p[c][i] = r[c][i] / op.diag[i] + bt * p[c][i];
+                if (mg)
+                    for (std::size_t i = begin; i < end; ++i) p[c][i] = v.z[c][i] + bt * p[c][i];
+                else
+                    for (std::size_t i = begin; i < end; ++i) p[c][i] = r[c][i] / op.diag[i] + bt * p[c][i];
             }
         });
     }
@@ -517,6 +563,10 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
     std::array<int, 3> iterations{};
     const auto iterationsSoFar = [&] { return *std::max_element(iterations.begin(), iterations.end()); };
     int roundsDone = 0;
+    // One frame: the 2D operator the V-cycle is made for (rows to a previous frame only add to
+    // the diagonal, which the V-cycle takes as it is).
+    const bool multigrid = options.multigrid && problem.frames == 1;
+    HostVcycle vcycle;
     for (int round = 0; round < rounds; ++round) {
         if (round > 0 && options.deadline && std::chrono::steady_clock::now() >= *options.deadline) {
             s.stoppedAtDeadline = true;
@@ -534,9 +584,14 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
             every16 = [&](int k) { options.progress(roundsDone, rounds, iterationsSoFar() + k); };
         // The first round (the L2 solve) always runs to its tolerance; later ones stop at the
         // deadline, mid-round if need be.
+        HostVcycle* mg = nullptr;
+        if (multigrid) {
+            vcycle.build(problem.width, problem.height, op.cx, op.cy, op.diag, threads);
+            mg = &vcycle;
+        }
         const std::array<ChannelSolve, 3> solved =
             pcg(op, b, x, tolerance, options.maxIterations, threads, vectors, every16,
-                round > 0 ? options.deadline : std::nullopt);
+                round > 0 ? options.deadline : std::nullopt, mg);
         s.residual = 0.0;
         s.converged = true;
         for (int c = 0; c < 3; ++c) {

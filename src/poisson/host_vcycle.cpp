@@ -1,0 +1,231 @@
+#include "poisson/host_vcycle.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+
+#include "util/error.h"
+#include "util/parallel.h"
+
+namespace gdpt {
+
+namespace {
+
+// Levels of fewer pixels run on the calling thread (starting threads costs more than their
+// work); the others in ranges of whole rows of at least this many pixels.
+constexpr std::size_t kParallelPixels = std::size_t{1} << 15;
+constexpr std::size_t kRangePixels = std::size_t{1} << 13;
+
+// fn(begin, end) over rows [0, rows) of a level of `pixels` pixels, `width` wide.
+template <class Fn>
+void overRows(std::size_t pixels, std::size_t width, std::size_t rows, std::uint32_t threads, const Fn& fn) {
+    if (pixels < kParallelPixels || threads <= 1) {
+        fn(std::size_t{0}, rows);
+        return;
+    }
+    parallelRanges(threads, rows, std::max<std::size_t>(1, kRangePixels / width), fn);
+}
+
+// (A x)_i of the 5-point operator with diagonal d at pixel (px, y), index i.
+inline double applyAt(const double* d, const double* cx, const double* cy, const double* x, std::size_t i,
+                      std::size_t px, std::size_t y, std::size_t w, std::size_t h) {
+    double v = d[i] * x[i];
+    if (px + 1 < w) v -= cx[i] * x[i + 1];
+    if (px > 0) v -= cx[i - 1] * x[i - 1];
+    if (y + 1 < h) v -= cy[i] * x[i + w];
+    if (y > 0) v -= cy[i - w] * x[i - w];
+    return v;
+}
+
+}  // namespace
+
+void HostVcycle::build(int width, int height, const Field& cx, const Field& cy, const Field& diag,
+                       std::uint32_t threads) {
+    GDPT_CHECK(width > 0 && height > 0);
+    const std::size_t n = std::size_t(width) * std::size_t(height);
+    GDPT_CHECK(cx.size() == n && cy.size() == n && diag.size() == n);
+    // Levels down to 2×2 or less (poisson_multigrid.cpp's hierarchy).
+    std::size_t count = 1;
+    for (std::size_t w = std::size_t(width), h = std::size_t(height); w > 2 || h > 2; ++count)
+        w = (w + 1) / 2, h = (h + 1) / 2;
+    levels_.resize(count);
+    for (std::size_t l = 0; l < count; ++l) {
+        Level& L = levels_[l];
+        if (l == 0) {
+            L.width = std::size_t(width);
+            L.height = std::size_t(height);
+            L.cx = cx.data();
+            L.cy = cy.data();
+            L.diag = diag.data();
+        } else {
+            // Galerkin: ¼ Pᵀ A P with piecewise-constant P (poisson_multigrid.cpp's
+            // coarsenOperator): an edge between two aggregates adds ¼ of its weight to theirs;
+            // the diagonal of aggregate I is ¼ (Σ_{i∈I} d_i − 2 Σ_{edges inside I} c).
+            const Level& F = levels_[l - 1];
+            const std::size_t fw = F.width, fh = F.height, w = (fw + 1) / 2, h = (fh + 1) / 2;
+            L.width = w;
+            L.height = h;
+            L.ownCx.resize(w * h);
+            L.ownCy.resize(w * h);
+            L.ownDiag.resize(w * h);
+            for (int c = 0; c < 3; ++c) {
+                L.b[c].resize(w * h);
+                L.x[c].resize(w * h);
+            }
+            double *ccx = L.ownCx.data(), *ccy = L.ownCy.data(), *cd = L.ownDiag.data();
+            overRows(fw * fh, fw, h, threads, [&](std::size_t y0, std::size_t y1) {
+                for (std::size_t Y = y0; Y < y1; ++Y)
+                    for (std::size_t X = 0; X < w; ++X) {
+                        double ex = 0.0, ey = 0.0, d = 0.0;
+                        for (std::size_t y = 2 * Y; y < std::min(2 * Y + 2, fh); ++y)
+                            for (std::size_t x = 2 * X; x < std::min(2 * X + 2, fw); ++x) {
+                                const std::size_t i = y * fw + x;
+                                d += F.diag[i];
+                                if (x == 2 * X + 1 && x + 1 < fw) ex += F.cx[i];  // crosses to X + 1
+                                if (x == 2 * X && x + 1 < fw) d -= 2.0 * F.cx[i];  // inside
+                                if (y == 2 * Y + 1 && y + 1 < fh) ey += F.cy[i];
+                                if (y == 2 * Y && y + 1 < fh) d -= 2.0 * F.cy[i];
+                            }
+                        const std::size_t I = Y * w + X;
+                        ccx[I] = 0.25 * ex;
+                        ccy[I] = 0.25 * ey;
+                        cd[I] = 0.25 * d;
+                    }
+            });
+            L.cx = ccx;
+            L.cy = ccy;
+            L.diag = cd;
+        }
+        const std::size_t size = L.width * L.height;
+        L.invDiag.resize(size);
+        for (std::size_t i = 0; i < size; ++i) L.invDiag[i] = 1.0 / L.diag[i];
+    }
+    // The coarsest level's pseudo-inverse (minimum-norm: a singular operator, no screening, gets
+    // the zero-mean solution), as buildHierarchy.
+    const Level& last = levels_.back();
+    const int m = static_cast<int>(last.width * last.height);
+    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(m, m);
+    for (int i = 0; i < m; ++i) {
+        const std::size_t px = std::size_t(i) % last.width, y = std::size_t(i) / last.width;
+        a(i, i) = last.diag[i];
+        if (px + 1 < last.width) a(i, i + 1) = a(i + 1, i) = -last.cx[i];
+        if (y + 1 < last.height) {
+            const int j = i + static_cast<int>(last.width);
+            a(i, j) = a(j, i) = -last.cy[i];
+        }
+    }
+    const Eigen::MatrixXd pinv = a.completeOrthogonalDecomposition().pseudoInverse();
+    coarsestPseudoInverse_.resize(std::size_t(m) * std::size_t(m));
+    for (int i = 0; i < m; ++i)
+        for (int j = 0; j < m; ++j) coarsestPseudoInverse_[std::size_t(i) * std::size_t(m) + std::size_t(j)] = pinv(i, j);
+}
+
+void HostVcycle::apply(const std::array<const Field*, 3>& r, const std::array<Field*, 3>& z,
+                       const std::array<bool, 3>& active, std::uint32_t threads) {
+    GDPT_CHECK(!levels_.empty());
+    std::array<const double*, 3> b{};
+    std::array<double*, 3> x{};
+    for (int c = 0; c < 3; ++c)
+        if (active[c]) {
+            const std::size_t n = levels_[0].width * levels_[0].height;
+            GDPT_CHECK(r[c]->size() == n && z[c]->size() == n);
+            b[c] = r[c]->data();
+            x[c] = z[c]->data();
+        }
+    cycle(0, b, x, active, threads);
+}
+
+void HostVcycle::cycle(std::size_t level, const std::array<const double*, 3>& b, const std::array<double*, 3>& x,
+                       const std::array<bool, 3>& active, std::uint32_t threads) {
+    Level& L = levels_[level];
+    const std::size_t w = L.width, h = L.height, n = w * h;
+    if (level + 1 == levels_.size()) {
+        for (int c = 0; c < 3; ++c) {
+            if (!active[c]) continue;
+            for (std::size_t i = 0; i < n; ++i) {
+                double v = 0.0;
+                for (std::size_t j = 0; j < n; ++j) v += coarsestPseudoInverse_[i * n + j] * b[c][j];
+                x[c][i] = v;
+            }
+        }
+        return;
+    }
+    const double* cx = L.cx;
+    const double* cy = L.cy;
+    const double* inv = L.invDiag.data();
+    // One colour's Gauss-Seidel update, rows [y0, y1): x_i = (b_i + Σ_j c_ij x_j) / d_i at the
+    // pixels with (px + y) % 2 == colour. fromZero: x was 0 (the first sweep of a cycle), so the
+    // red pixels are b_i / d_i and the black ones are set to 0.
+    const auto sweep = [&](int colour, bool fromZero) {
+        overRows(n, w, h, threads, [&](std::size_t y0, std::size_t y1) {
+            for (int c = 0; c < 3; ++c) {
+                if (!active[c]) continue;
+                const double* bc = b[c];
+                double* xc = x[c];
+                for (std::size_t y = y0; y < y1; ++y) {
+                    const std::size_t row = y * w;
+                    if (fromZero) {
+                        for (std::size_t px = (y + std::size_t(colour)) & 1u; px < w; px += 2)
+                            xc[row + px] = bc[row + px] * inv[row + px];
+                        for (std::size_t px = (y + std::size_t(colour) + 1) & 1u; px < w; px += 2) xc[row + px] = 0.0;
+                        continue;
+                    }
+                    const bool top = y == 0, bottom = y + 1 == h;
+                    for (std::size_t px = (y + std::size_t(colour)) & 1u; px < w; px += 2) {
+                        const std::size_t i = row + px;
+                        double s = bc[i];
+                        if (px + 1 < w) s += cx[i] * xc[i + 1];
+                        if (px > 0) s += cx[i - 1] * xc[i - 1];
+                        if (!bottom) s += cy[i] * xc[i + w];
+                        if (!top) s += cy[i - w] * xc[i - w];
+                        xc[i] = s * inv[i];
+                    }
+                }
+            }
+        });
+    };
+    sweep(0, true);
+    sweep(1, false);
+
+    // The residual b − A x, restricted (¼ of the sum over each 2×2 aggregate) into the next
+    // level's right-hand side, by coarse rows.
+    Level& C = levels_[level + 1];
+    const std::size_t cw = C.width, ch = C.height;
+    const double* diag = L.diag;
+    overRows(n, w, ch, threads, [&](std::size_t Y0, std::size_t Y1) {
+        for (int c = 0; c < 3; ++c) {
+            if (!active[c]) continue;
+            double* cb = C.b[c].data();
+            for (std::size_t Y = Y0; Y < Y1; ++Y) {
+                std::fill(cb + Y * cw, cb + (Y + 1) * cw, 0.0);
+                for (std::size_t y = 2 * Y; y < std::min(2 * Y + 2, h); ++y)
+                    for (std::size_t px = 0; px < w; ++px) {
+                        const std::size_t i = y * w + px;
+                        const double res = b[c][i] - applyAt(diag, cx, cy, x[c], i, px, y, w, h);
+                        cb[Y * cw + px / 2] += 0.25 * res;
+                    }
+            }
+        }
+    });
+    std::array<const double*, 3> cbp{};
+    std::array<double*, 3> cxp{};
+    for (int c = 0; c < 3; ++c)
+        if (active[c]) {
+            cbp[c] = C.b[c].data();
+            cxp[c] = C.x[c].data();
+        }
+    cycle(level + 1, cbp, cxp, active, threads);
+
+    // x += P e (piecewise constant), then the sweep in the other order.
+    overRows(n, w, h, threads, [&](std::size_t y0, std::size_t y1) {
+        for (int c = 0; c < 3; ++c) {
+            if (!active[c]) continue;
+            const double* e = C.x[c].data();
+            for (std::size_t y = y0; y < y1; ++y)
+                for (std::size_t px = 0; px < w; ++px) x[c][y * w + px] += e[(y / 2) * cw + px / 2];
+        }
+    });
+    sweep(1, false);
+    sweep(0, false);
+}
+
+}  // namespace gdpt
