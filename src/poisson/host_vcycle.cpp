@@ -80,7 +80,7 @@ void HostVcycle::build(int width, int height, const Field& cx, const Field& cy, 
                             for (std::size_t x = 2 * X; x < std::min(2 * X + 2, fw); ++x) {
                                 const std::size_t i = y * fw + x;
                                 d += F.diag[i];
-                                if (x == 2 * X + 1 && x + 1 < fw) ex += F.cx[i];  // crosses to X + 1
+                                if (x == 2 * X + 1 && x + 1 < fw) ex += F.cx[i];   // crosses to X + 1
                                 if (x == 2 * X && x + 1 < fw) d -= 2.0 * F.cx[i];  // inside
                                 if (y == 2 * Y + 1 && y + 1 < fh) ey += F.cy[i];
                                 if (y == 2 * Y && y + 1 < fh) d -= 2.0 * F.cy[i];
@@ -116,7 +116,8 @@ void HostVcycle::build(int width, int height, const Field& cx, const Field& cy, 
     const Eigen::MatrixXd pinv = a.completeOrthogonalDecomposition().pseudoInverse();
     coarsestPseudoInverse_.resize(std::size_t(m) * std::size_t(m));
     for (int i = 0; i < m; ++i)
-        for (int j = 0; j < m; ++j) coarsestPseudoInverse_[std::size_t(i) * std::size_t(m) + std::size_t(j)] = pinv(i, j);
+        for (int j = 0; j < m; ++j)
+            coarsestPseudoInverse_[std::size_t(i) * std::size_t(m) + std::size_t(j)] = pinv(i, j);
 }
 
 void HostVcycle::apply(const std::array<const Field*, 3>& r, const std::array<Field*, 3>& z,
@@ -134,8 +135,9 @@ void HostVcycle::apply(const std::array<const Field*, 3>& r, const std::array<Fi
     cycle(0, b, x, active, threads);
 }
 
-void HostVcycle::cycle(std::size_t level, const std::array<const double*, 3>& b, const std::array<double*, 3>& x,
-                       const std::array<bool, 3>& active, std::uint32_t threads) {
+void HostVcycle::cycle(std::size_t level, const std::array<const double*, 3>& b,
+                       const std::array<double*, 3>& x, const std::array<bool, 3>& active,
+                       std::uint32_t threads) {
     Level& L = levels_[level];
     const std::size_t w = L.width, h = L.height, n = w * h;
     if (level + 1 == levels_.size()) {
@@ -166,7 +168,8 @@ void HostVcycle::cycle(std::size_t level, const std::array<const double*, 3>& b,
                     if (fromZero) {
                         for (std::size_t px = (y + std::size_t(colour)) & 1u; px < w; px += 2)
                             xc[row + px] = bc[row + px] * inv[row + px];
-                        for (std::size_t px = (y + std::size_t(colour) + 1) & 1u; px < w; px += 2) xc[row + px] = 0.0;
+                        for (std::size_t px = (y + std::size_t(colour) + 1) & 1u; px < w; px += 2)
+                            xc[row + px] = 0.0;
                         continue;
                     }
                     const bool top = y == 0, bottom = y + 1 == h;

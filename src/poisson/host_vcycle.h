@@ -22,7 +22,8 @@ public:
     // The fine level: the 5-point weights cx (0 in the last column), cy (0 in the last row) and
     // the diagonal d of the CG operator (the screening and any other diagonal term is d minus
     // the edges), which must outlive the uses of apply. Builds the coarse levels.
-    void build(int width, int height, const Field& cx, const Field& cy, const Field& diag, std::uint32_t threads);
+    void build(int width, int height, const Field& cx, const Field& cy, const Field& diag,
+               std::uint32_t threads);
 
     // z[c] = M⁻¹ r[c] for the channels with active[c]: one V-cycle from zero.
     void apply(const std::array<const Field*, 3>& r, const std::array<Field*, 3>& z,

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "util/error.h"
 #include "vk/handle.h"
 
 namespace gdpt::vk {
@@ -59,6 +60,37 @@ public:
         std::vector<T> v(count);
         if (count) download(v.data(), count * sizeof(T));
         return v;
+    }
+
+    // The buffer's first `count` records as the host reads them: the mapping itself where the
+    // host reads it directly (no copy of a 4K image's statistics, hundreds of MiB), else a
+    // downloaded copy. The caller has waited for the GPU work that wrote them; the view lives
+    // no longer than the buffer.
+    template <typename T>
+    class ReadView {
+    public:
+        [[nodiscard]] const T* data() const { return data_; }
+        [[nodiscard]] std::size_t size() const { return size_; }
+        const T& operator[](std::size_t i) const { return data_[i]; }
+
+    private:
+        friend class Buffer;
+        std::vector<T> copy_;
+        const T* data_ = nullptr;
+        std::size_t size_ = 0;
+    };
+    template <typename T>
+    ReadView<T> read(std::size_t count) const {
+        GDPT_CHECK(count * sizeof(T) <= size_);
+        ReadView<T> view;
+        view.size_ = count;
+        if (hostCached_) {
+            view.data_ = static_cast<const T*>(mapped_);
+        } else {
+            view.copy_ = downloadVector<T>(count);
+            view.data_ = view.copy_.data();
+        }
+        return view;
     }
 
     // The most bytes one staged copy moves at once (the staging buffer's size).

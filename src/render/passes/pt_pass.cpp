@@ -5,6 +5,7 @@
 #include "pt.spv.h"
 #include "render/device_scene/scene_gpu.h"
 #include "util/error.h"
+#include "util/parallel.h"
 #include "vk/commands.h"
 #include "vk/context.h"
 
@@ -126,18 +127,21 @@ void PtPass::uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats)
 }
 
 void PtPass::readback(Image& mean, Image& varianceOfMean) const {
-    const auto stats = accum_.downloadVector<gpu::PixelStats>(std::size_t{width_} * height_);
+    const std::size_t pixels = std::size_t{width_} * height_;
+    const auto stats = accum_.read<gpu::PixelStats>(pixels);
     mean = Image(static_cast<int>(width_), static_cast<int>(height_));
     varianceOfMean = Image(static_cast<int>(width_), static_cast<int>(height_));
-    for (std::size_t i = 0; i < stats.size(); ++i) {
-        const auto& s = stats[i];
-        const float n = static_cast<float>(s.count);
-        for (int c = 0; c < 3; ++c) {
-            mean.plane(c)[i] = s.mean[c];
-            // Unbiased sample variance divided by n = variance of the mean estimate.
-            varianceOfMean.plane(c)[i] = s.count > 1 ? s.m2[c] / (n - 1.0f) / n : 0.0f;
+    parallelRanges(0, pixels, std::size_t{1} << 14, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+            const auto& s = stats[i];
+            const float n = static_cast<float>(s.count);
+            for (int c = 0; c < 3; ++c) {
+                mean.plane(c)[i] = s.mean[c];
+                // Unbiased sample variance divided by n = variance of the mean estimate.
+                varianceOfMean.plane(c)[i] = s.count > 1 ? s.m2[c] / (n - 1.0f) / n : 0.0f;
+            }
         }
-    }
+    });
     // Independent estimates of two parts of the pixel: their means and variances add.
     emitterSupersampling_.addTo(&mean, &varianceOfMean);
 }

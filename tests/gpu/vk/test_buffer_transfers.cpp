@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "gpu_fixture.h"
+#include "integrator/gpt_sampler.h"
 #include "integrator/pt_sampler.h"
 #include "same_bits.h"
 #include "scene/gltf_loader.h"
@@ -100,6 +101,7 @@ TEST_F(BufferTransfers, ARenderReadThroughStagingIsTheSameImage) {
     const Image direct = renderPt(ctx(), scene, o).image;
     const Image viaStaging = renderPt(staged(), scene, o).image;
     test::expectSameBits(direct, viaStaging, "pt");
+    test::expectSameGptBits(renderGpt(ctx(), scene, o), renderGpt(staged(), scene, o), "gpt");
 }
 
 }  // namespace
