@@ -20,12 +20,29 @@ constexpr VkMemoryPropertyFlags kMappable =
 
 Buffer::Buffer(const Context& ctx, std::uint64_t bytes, const std::string& name)
     : ctx_(&ctx), name_(name), size_(bytes < 16 ? 16 : (bytes + 3) & ~std::uint64_t{3}) {
-    VkDevice device = ctx.device();
-    VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-    info.size = size_;
     // Every buffer can be read through its device address (shaders that need ranges beyond
     // maxStorageBufferRange use that; the feature is required, core in Vulkan 1.3).
-    info.usage = kUsage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+    const VkMemoryPropertyFlags deviceLocal = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+    const VkMemoryPropertyFlags flags =
+        allocate(kUsage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT, {deviceLocal | kMappable, deviceLocal},
+                 "device memory allocating buffer '" + name + "'");
+    if (mapped_) {
+        hostCached_ = (flags & VK_MEMORY_PROPERTY_HOST_CACHED_BIT) != 0 && !ctx.stagedTransfers();
+        // A CPU device's memory is the process's own anonymous memory, first touched when it
+        // is written: huge pages spare most of the page faults of a large buffer (a 5M-triangle
+        // scene's tables, a 4K image's statistics; util/huge_pages.h).
+        if (ctx.info().isCpu) adviseHugePages(mapped_, size_);
+    }
+    ctx.setName(VK_OBJECT_TYPE_BUFFER, reinterpret_cast<std::uint64_t>(buffer_.get()), name);
+}
+
+VkMemoryPropertyFlags Buffer::allocate(VkBufferUsageFlags usage,
+                                       std::initializer_list<VkMemoryPropertyFlags> preferred,
+                                       const std::string& what) {
+    VkDevice device = ctx_->device();
+    VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    info.size = size_;
+    info.usage = usage;
     info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
     VkBuffer buffer = VK_NULL_HANDLE;
     VK_CHECK(vkCreateBuffer(device, &info, nullptr, &buffer));
@@ -33,39 +50,37 @@ Buffer::Buffer(const Context& ctx, std::uint64_t bytes, const std::string& name)
 
     VkMemoryRequirements req{};
     vkGetBufferMemoryRequirements(device, buffer, &req);
-    const VkMemoryPropertyFlags deviceLocal = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
-    VkMemoryPropertyFlags flags = deviceLocal | kMappable;
-    if (!ctx.hasMemoryType(req.memoryTypeBits, flags)) flags = deviceLocal;
+    // The first of the preferred kinds the device has (findMemoryType names the last if none).
+    VkMemoryPropertyFlags flags = *(preferred.end() - 1);
+    for (VkMemoryPropertyFlags f : preferred)
+        if (ctx_->hasMemoryType(req.memoryTypeBits, f)) {
+            flags = f;
+            break;
+        }
     VkMemoryAllocateFlagsInfo allocFlags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
     allocFlags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
     VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    alloc.pNext = &allocFlags;
+    if (usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) alloc.pNext = &allocFlags;
     alloc.allocationSize = req.size;
-    alloc.memoryTypeIndex = ctx.findMemoryType(req.memoryTypeBits, flags);
+    alloc.memoryTypeIndex = ctx_->findMemoryType(req.memoryTypeBits, flags);
     VkDeviceMemory memory = VK_NULL_HANDLE;
     const VkResult r = vkAllocateMemory(device, &alloc, nullptr, &memory);
     if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY)
-        throw Error("out of device memory allocating buffer '" + name + "' (" + std::to_string(size_ >> 20) +
-                    " MiB)");
+        throw Error("out of " + what + " (" + std::to_string(size_ >> 20) + " MiB)");
     VK_CHECK(r);
-    ctx.noteAllocation(req.size);
-    memory_ = Handle<VkDeviceMemory>(memory, [device, ctxp = &ctx, bytes = req.size](VkDeviceMemory m) {
+    ctx_->noteAllocation(req.size);
+    memory_ = Handle<VkDeviceMemory>(memory, [device, ctxp = ctx_, bytes = req.size](VkDeviceMemory m) {
         vkFreeMemory(device, m, nullptr);
         ctxp->noteFree(bytes);
     });
     VK_CHECK(vkBindBufferMemory(device, buffer, memory, 0));
     buffer_ = std::move(bufferOwner);
-    if ((flags & kMappable) == kMappable) {
+    const VkMemoryPropertyFlags type = ctx_->memoryTypeFlags(alloc.memoryTypeIndex);
+    if (flags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT) {  // asked for, not merely what the type has
         VK_CHECK(vkMapMemory(device, memory, 0, VK_WHOLE_SIZE, 0, &mapped_));
-        hostCached_ =
-            (ctx.memoryTypeFlags(alloc.memoryTypeIndex) & VK_MEMORY_PROPERTY_HOST_CACHED_BIT) != 0 &&
-            !ctx.stagedTransfers();
-        // A CPU device's memory is the process's own anonymous memory, first touched when it
-        // is written: huge pages spare most of the page faults of a large buffer (a 5M-triangle
-        // scene's tables, a 4K image's statistics; util/huge_pages.h).
-        if (ctx.info().isCpu) adviseHugePages(mapped_, req.size);
+        coherent_ = (type & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
     }
-    ctx.setName(VK_OBJECT_TYPE_BUFFER, reinterpret_cast<std::uint64_t>(buffer), name);
+    return type;
 }
 
 std::uint64_t Buffer::deviceAddress() const {
@@ -102,48 +117,20 @@ void Buffer::zero() {
 }
 
 Buffer Buffer::makeStaging(const Context& ctx, std::uint64_t bytes, bool forReading) {
-    // Built by hand because the constructor prefers device-local memory.
     Buffer staging;
     staging.ctx_ = &ctx;
     staging.name_ = "staging";
     staging.size_ = bytes;
-    VkDevice device = ctx.device();
-    VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-    info.size = bytes;
-    info.usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-    VkBuffer b = VK_NULL_HANDLE;
-    VK_CHECK(vkCreateBuffer(device, &info, nullptr, &b));
-    Handle<VkBuffer> bufferOwner(b, [device](VkBuffer x) { vkDestroyBuffer(device, x, nullptr); });
-    VkMemoryRequirements req{};
-    vkGetBufferMemoryRequirements(device, b, &req);
     // Reading: host-cached memory (coherent if there is such, else invalidated before reads);
     // writing: any mappable memory (write-combined is what writes want).
     constexpr VkMemoryPropertyFlags cached =
         VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
-    VkMemoryPropertyFlags flags = kMappable;
-    if (forReading && ctx.hasMemoryType(req.memoryTypeBits, cached | kMappable))
-        flags = cached | kMappable;
-    else if (forReading && ctx.hasMemoryType(req.memoryTypeBits, cached))
-        flags = cached;
-    VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    alloc.allocationSize = req.size;
-    alloc.memoryTypeIndex = ctx.findMemoryType(req.memoryTypeBits, flags);
-    VkDeviceMemory m = VK_NULL_HANDLE;
-    const VkResult r = vkAllocateMemory(device, &alloc, nullptr, &m);
-    if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY)
-        throw Error("out of host-visible memory allocating a staging buffer (" + std::to_string(bytes >> 20) +
-                    " MiB)");
-    VK_CHECK(r);
-    ctx.noteAllocation(req.size);
-    staging.memory_ = Handle<VkDeviceMemory>(m, [device, ctxp = &ctx, size = req.size](VkDeviceMemory x) {
-        vkFreeMemory(device, x, nullptr);
-        ctxp->noteFree(size);
-    });
-    VK_CHECK(vkBindBufferMemory(device, b, m, 0));
-    staging.buffer_ = std::move(bufferOwner);
-    VK_CHECK(vkMapMemory(device, m, 0, VK_WHOLE_SIZE, 0, &staging.mapped_));
-    staging.coherent_ =
-        (ctx.memoryTypeFlags(alloc.memoryTypeIndex) & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
+    const auto usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    const std::string what = "host-visible memory allocating a staging buffer";
+    if (forReading)
+        staging.allocate(usage, {cached | kMappable, cached, kMappable}, what);
+    else
+        staging.allocate(usage, {kMappable}, what);
     return staging;
 }
 

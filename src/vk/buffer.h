@@ -11,6 +11,7 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -97,6 +98,14 @@ public:
     static constexpr std::uint64_t kStagingChunk = std::uint64_t{64} << 20;
 
 private:
+    // Creates buffer_ (size_ bytes, `usage`) and its memory, of the first of the `preferred`
+    // property flags the device has, and maps it when those ask for host-visible memory
+    // (setting coherent_ from the memory type); both
+    // the constructor's buffers and staging buffers. `what` completes "out of ..." when the
+    // memory is exhausted. Returns the memory type's flags.
+    VkMemoryPropertyFlags allocate(VkBufferUsageFlags usage,
+                                   std::initializer_list<VkMemoryPropertyFlags> preferred,
+                                   const std::string& what);
     // A host-visible buffer for staged copies: host-cached when `forReading` and the device
     // has such memory (then `coherent_` says whether reads need an invalidate).
     static Buffer makeStaging(const Context& ctx, std::uint64_t bytes, bool forReading);
