@@ -338,7 +338,7 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
             partial[begin / kGrain] = s;
         });
     };
-    // r = b − A x, p = z = r / d; ‖b‖², r·z and ‖r‖².
+    // r = b − A x, ‖b‖² and ‖r‖²; Jacobi: p = z = r / d and r·z (multigrid: below).
     parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
         std::array<double, 9> s{};
         for (int c = 0; c < 3; ++c) {
@@ -347,9 +347,11 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
             for (std::size_t i = begin; i < end; ++i) {
                 const double ri = b[c][i] - q[c][i];
                 r[c][i] = ri;
-                p[c][i] = ri / op.diag[i];
+                if (!mg) {
+                    p[c][i] = ri / op.diag[i];
+                    rz += ri * p[c][i];
+                }
                 bb += b[c][i] * b[c][i];
-                rz += ri * p[c][i];
                 rr += ri * ri;
             }
             s[std::size_t(c)] = bb;
@@ -414,21 +416,13 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
                 if (!active[c]) continue;
                 double rzNew = 0.0, rrNew = 0.0;
                 const double a = alpha[c];
-                if (mg)
-                    for (std::size_t i = begin; i < end; ++i) {
-                        x[c][i] += a * p[c][i];
-                        const double ri = r[c][i] - a * q[c][i];
-                        r[c][i] = ri;
-                        rrNew += ri * ri;
-                    }
-                else
-                    for (std::size_t i = begin; i < end; ++i) {
-                        x[c][i] += a * p[c][i];
-                        const double ri = r[c][i] - a * q[c][i];
-                        r[c][i] = ri;
-                        rzNew += ri * ri / op.diag[i];
-                        rrNew += ri * ri;
-                    }
+                for (std::size_t i = begin; i < end; ++i) {
+                    x[c][i] += a * p[c][i];
+                    const double ri = r[c][i] - a * q[c][i];
+                    r[c][i] = ri;
+                    if (!mg) rzNew += ri * ri / op.diag[i];  // multigrid: r·z after the cycle
+                    rrNew += ri * ri;
+                }
                 s[std::size_t(c)] = rzNew;
                 s[std::size_t(c) + 3] = rrNew;
             }
