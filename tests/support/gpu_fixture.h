@@ -54,30 +54,42 @@ private:
     std::uint32_t errorsBefore_ = 0;
 };
 
-// For tests of many short renders of the same kernels: a second context that keeps its
-// pipelines (as a sequence's does), validation on, its errors checked after every test.
-class KeptPipelinesTest : public GpuTest {
+// A second context besides the default one, made with the options `Configure` sets on top of
+// validation (on), its validation errors checked after every test like the default's.
+template <void (*Configure)(vk::ContextOptions&)>
+class SecondContextTest : public GpuTest {
 protected:
-    static vk::Context& keeping() {
+    static vk::Context& second() {
         static std::unique_ptr<vk::Context> ctx = [] {
             vk::ContextOptions o;
             o.validation = true;
-            o.keepPipelines = true;
+            Configure(o);
             return std::make_unique<vk::Context>(o);
         }();
         return *ctx;
     }
     void SetUp() override {
         GpuTest::SetUp();
-        keptErrorsBefore_ = keeping().validationErrors();
+        secondErrorsBefore_ = second().validationErrors();
     }
     void TearDown() override {
-        EXPECT_EQ(keeping().validationErrors(), keptErrorsBefore_) << "Vulkan validation reported errors";
+        EXPECT_EQ(second().validationErrors(), secondErrorsBefore_) << "Vulkan validation reported errors";
         GpuTest::TearDown();
     }
 
 private:
-    std::uint32_t keptErrorsBefore_ = 0;
+    std::uint32_t secondErrorsBefore_ = 0;
+};
+
+inline void keepPipelines(vk::ContextOptions& o) {
+    o.keepPipelines = true;
+}
+
+// For tests of many short renders of the same kernels: a second context that keeps its
+// pipelines (as a sequence's does).
+class KeptPipelinesTest : public SecondContextTest<keepPipelines> {
+protected:
+    static vk::Context& keeping() { return second(); }
 };
 
 }  // namespace gdpt::test

@@ -6,7 +6,6 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
-#include <memory>
 #include <random>
 #include <vector>
 
@@ -20,28 +19,13 @@
 namespace gdpt {
 namespace {
 
-class BufferTransfers : public test::GpuTest {
-protected:
-    static vk::Context& staged() {
-        static std::unique_ptr<vk::Context> c = [] {
-            vk::ContextOptions o;
-            o.validation = true;
-            o.stagedTransfers = true;
-            return std::make_unique<vk::Context>(o);
-        }();
-        return *c;
-    }
-    void SetUp() override {
-        GpuTest::SetUp();
-        stagedErrorsBefore_ = staged().validationErrors();
-    }
-    void TearDown() override {
-        EXPECT_EQ(staged().validationErrors(), stagedErrorsBefore_) << "Vulkan validation reported errors";
-        GpuTest::TearDown();
-    }
+void stageTransfers(vk::ContextOptions& o) {
+    o.stagedTransfers = true;
+}
 
-private:
-    std::uint32_t stagedErrorsBefore_ = 0;
+class BufferTransfers : public test::SecondContextTest<stageTransfers> {
+protected:
+    static vk::Context& staged() { return second(); }
 };
 
 std::vector<std::uint8_t> randomBytes(std::size_t n, std::uint32_t seed) {
