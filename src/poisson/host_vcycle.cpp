@@ -1,6 +1,5 @@
 #include "poisson/host_vcycle.h"
 
-#include <Eigen/Dense>
 #include <algorithm>
 
 #include "util/error.h"
@@ -100,24 +99,23 @@ void HostVcycle::build(int width, int height, const Field& cx, const Field& cy, 
         for (std::size_t i = 0; i < size; ++i) L.invDiag[i] = 1.0 / L.diag[i];
     }
     // The coarsest level's pseudo-inverse (minimum-norm: a singular operator, no screening, gets
-    // the zero-mean solution), as buildHierarchy.
+    // the zero-mean solution): buildHierarchy's, of that level as a PoissonOperator (≤ 2×2, so
+    // it is its own coarsest level), whose screening is the diagonal less the edges.
     const Level& last = levels_.back();
-    const int m = static_cast<int>(last.width * last.height);
-    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(m, m);
-    for (int i = 0; i < m; ++i) {
-        const std::size_t px = std::size_t(i) % last.width, y = std::size_t(i) / last.width;
-        a(i, i) = last.diag[i];
-        if (px + 1 < last.width) a(i, i + 1) = a(i + 1, i) = -last.cx[i];
-        if (y + 1 < last.height) {
-            const int j = i + static_cast<int>(last.width);
-            a(i, j) = a(j, i) = -last.cy[i];
-        }
+    PoissonOperator coarsest;
+    coarsest.width = static_cast<int>(last.width);
+    coarsest.height = static_cast<int>(last.height);
+    const std::size_t m = last.width * last.height;
+    coarsest.cx.assign(last.cx, last.cx + m);
+    coarsest.cy.assign(last.cy, last.cy + m);
+    coarsest.cp.resize(m);
+    for (std::size_t i = 0; i < m; ++i) {
+        double e = last.cx[i] + last.cy[i];
+        if (i % last.width > 0) e += last.cx[i - 1];
+        if (i >= last.width) e += last.cy[i - last.width];
+        coarsest.cp[i] = last.diag[i] - e;
     }
-    const Eigen::MatrixXd pinv = a.completeOrthogonalDecomposition().pseudoInverse();
-    coarsestPseudoInverse_.resize(std::size_t(m) * std::size_t(m));
-    for (int i = 0; i < m; ++i)
-        for (int j = 0; j < m; ++j)
-            coarsestPseudoInverse_[std::size_t(i) * std::size_t(m) + std::size_t(j)] = pinv(i, j);
+    coarsestPseudoInverse_ = buildHierarchy(coarsest).coarsestPseudoInverse;
 }
 
 void HostVcycle::apply(const std::array<const Field*, 3>& r, const std::array<Field*, 3>& z,
