@@ -27,6 +27,12 @@ struct Operator {
     Field cx, cy, ct, cp;  // edge i–(i+1), i–(i+W), i–next(i); screening
     Field cb;              // rows from the fixed previous frame's pixel j to bnext(j) (W·H; empty: none)
     Field diag;            // d_i: cp_i, the boundary rows at i and every edge at i
+    // Mixed rows (γ > 0): γ² w of the row at frame f's pixel i, (F − 1)·W·H each (x: s = 1, y:
+    // s = W), 0 where there is none; empty without mixed rows. pdiag: diag plus every mixed
+    // row's coefficient at each of its four pixels (the diagonal of A, for Jacobi); = diag
+    // without mixed rows.
+    Field cmx, cmy;
+    Field pdiag;
     std::vector<std::uint32_t>
         next;  // next(i): the temporal neighbour of i in the window, or kNoTemporalPartner
     std::vector<std::uint32_t> bnext;  // bnext(j): the pixel of frame 0 of the previous frame's pixel j
@@ -39,7 +45,36 @@ struct Operator {
 // Row weights shared by the channels (IRLS; all 1 for L2). Dropped rows are 0.
 struct Weights {
     Field primal, dx, dy, dt, boundary;  // boundary: W·H rows to the previous frame, or empty
+    Field mx, my;                        // mixed rows ((F − 1)·W·H), or empty without them
 };
+
+// The residual of the mixed row at m (step s = 1 or W) for the iterate x:
+// (x_π(m)+s − x_π(m)) − (x_m+s − x_m).
+inline double mixedResidual(const Operator& op, const Field& x, std::size_t m, std::size_t s) {
+    const std::size_t b = op.next[m];
+    return (x[b + s] - x[b]) - (x[m + s] - x[m]);
+}
+
+// Calls visit(m, s, c, σ) for every mixed row m (step s, coefficient c ≠ 0) that pixel k is one
+// of the four pixels of, σ = ±1 its sign in the row: +1 at m and π(m)+s, −1 at m+s and π(m).
+template <class Visit>
+void forMixedRowsAt(const Operator& op, std::size_t k, Visit&& visit) {
+    const std::size_t nt = op.cmx.size(), w = std::size_t(op.width);
+    for (const auto& [cm, s] : {std::pair<const Field*, std::size_t>{&op.cmx, 1}, {&op.cmy, w}}) {
+        const Field& c = *cm;
+        if (k < nt && c[k] != 0.0) visit(k, s, c[k], 1.0);
+        if (k >= s && k - s < nt && c[k - s] != 0.0) visit(k - s, s, c[k - s], -1.0);
+        for (std::uint32_t r = op.backStart[k]; r < op.backStart[k + 1]; ++r) {
+            const std::uint32_t m = op.back[r];
+            if (m < nt && c[m] != 0.0) visit(std::size_t(m), s, c[m], -1.0);
+        }
+        if (k >= s)
+            for (std::uint32_t r = op.backStart[k - s]; r < op.backStart[k - s + 1]; ++r) {
+                const std::uint32_t m = op.back[r];
+                if (m < nt && c[m] != 0.0) visit(std::size_t(m), s, c[m], 1.0);
+            }
+    }
+}
 
 // Pixels per range of the parallel loops. Sums are taken per range and added in range order,
 // so the result does not depend on the number of threads.
@@ -70,6 +105,7 @@ void check(const SpaceTimeProblem& p) {
     if (p.width < 1 || p.height < 1 || p.frames < 1) throw Error("space-time Poisson: empty window");
     if (!(p.alpha > 0.0) || !std::isfinite(p.alpha)) throw Error("space-time Poisson: alpha must be > 0");
     if (!(p.beta >= 0.0) || !std::isfinite(p.beta)) throw Error("space-time Poisson: beta must be >= 0");
+    if (!(p.gamma >= 0.0) || !std::isfinite(p.gamma)) throw Error("space-time Poisson: gamma must be >= 0");
     const std::size_t n = p.size(), nt = p.pixels() * std::size_t(p.frames - 1);
     for (int c = 0; c < 3; ++c) {
         const auto sized = [&](const Field& f, std::size_t want, const char* what) {
@@ -84,6 +120,10 @@ void check(const SpaceTimeProblem& p) {
         sized(p.dx[c], n, "dx");
         sized(p.dy[c], n, "dy");
         sized(p.dt[c], nt, "dt");
+        if (p.gamma > 0.0) {
+            sized(p.dxt[c], nt, "dxt");
+            sized(p.dyt[c], nt, "dyt");
+        }
         if (!p.initial[c].empty()) sized(p.initial[c], n, "initial");
         if (!p.previous[c].empty() || !p.dtPrevious[c].empty()) {
             sized(p.previous[c], p.pixels(), "previous");
@@ -160,6 +200,23 @@ Weights unitWeights(const SpaceTimeProblem& p) {
         if (p.temporalPartner[i] == kNoTemporalPartner) wt.dt[i] = 0.0;
     for (std::size_t j = 0; j < p.previousPartner.size() && !wt.boundary.empty(); ++j)
         if (p.previousPartner[j] == kNoTemporalPartner) wt.boundary[j] = 0.0;
+    if (p.gamma > 0.0) {
+        // A mixed row where i and i+s both have partners, carried rigidly: π(i+s) = π(i) + s,
+        // with π(i) + s in π(i)'s row (x) or frame (y).
+        const std::size_t nt = np * std::size_t(p.frames - 1), h = std::size_t(p.height);
+        const auto partner = [&](std::size_t i) {
+            return p.temporalPartner.empty() ? std::uint32_t(i % np) : p.temporalPartner[i];
+        };
+        wt.mx = hugeVector(nt, 0.0);
+        wt.my = hugeVector(nt, 0.0);
+        for (std::size_t i = 0; i < nt; ++i) {
+            const std::uint32_t to = partner(i);
+            if (to == kNoTemporalPartner) continue;
+            const std::size_t k = i % np;
+            if (k % w + 1 < w && std::size_t(to) % w + 1 < w && partner(i + 1) == to + 1) wt.mx[i] = 1.0;
+            if (k / w + 1 < h && std::size_t(to) / w + 1 < h && partner(i + w) == to + w) wt.my[i] = 1.0;
+        }
+    }
     return wt;
 }
 
@@ -213,6 +270,23 @@ void setWeights(const SpaceTimeProblem& p, const Weights& wt, Operator& op, std:
         op.cb[j] *= b2;
         if (op.cb[j] != 0.0) op.diag[op.bnext[j]] += op.cb[j];
     }
+    copied(op.pdiag, op.diag);
+    if (wt.mx.empty()) {
+        op.cmx.clear();
+        op.cmy.clear();
+        return;
+    }
+    const double g2 = p.gamma * p.gamma;
+    sized(op.cmx, wt.mx.size());
+    sized(op.cmy, wt.my.size());
+    for (std::size_t i = 0; i < wt.mx.size(); ++i) {
+        op.cmx[i] = g2 * wt.mx[i];
+        op.cmy[i] = g2 * wt.my[i];
+    }
+    parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t k = begin; k < end; ++k)
+            forMixedRowsAt(op, k, [&](std::size_t, std::size_t, double c, double) { op.pdiag[k] += c; });
+    });
 }
 
 // b = Pᵀ W target for the three channels: α² wp t minus the weighted divergence of the
@@ -230,6 +304,10 @@ void rhs(const SpaceTimeProblem& p, const Operator& op, std::array<Field, 3>& b,
                 if (i >= w) v += op.cy[i - w] * dy[i - w];
                 for (std::uint32_t k = op.backStart[i]; k < op.backStart[i + 1]; ++k)
                     v += op.ct[op.back[k]] * dt[op.back[k]];
+                if (!op.cmx.empty())
+                    forMixedRowsAt(op, i, [&](std::size_t m, std::size_t s, double cm, double sign) {
+                        v += sign * cm * (s == 1 ? p.dxt[c][m] : p.dyt[c][m]);
+                    });
                 b[c][i] = v;
             }
         }
@@ -253,6 +331,10 @@ void applyRangeGeneral(const Operator& op, const Field& x, Field& y, std::size_t
             const std::uint32_t j = op.back[k];
             v -= op.ct[j] * x[j];
         }
+        if (!op.cmx.empty())
+            forMixedRowsAt(op, i, [&](std::size_t m, std::size_t s, double cm, double sign) {
+                v += sign * cm * mixedResidual(op, x, m, s);
+            });
         y[i] = v;
     }
 }
@@ -264,7 +346,7 @@ void applyRangeGeneral(const Operator& op, const Field& x, Field& y, std::size_t
 // reconstruction on a CPU device, where this loop is most of the time.
 void applyRange(const Operator& op, const Field& x, Field& y, std::size_t begin, std::size_t end) {
     const std::size_t n = op.size(), w = std::size_t(op.width);
-    if (op.frames != 1 || n <= 2 * w) {
+    if (op.frames != 1 || n <= 2 * w) {  // (mixed rows need two frames)
         applyRangeGeneral(op, x, y, begin, end);
         return;
     }
@@ -348,7 +430,7 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
                 const double ri = b[c][i] - q[c][i];
                 r[c][i] = ri;
                 if (!mg) {
-                    p[c][i] = ri / op.diag[i];
+                    p[c][i] = ri / op.pdiag[i];
                     rz += ri * p[c][i];
                 }
                 bb += b[c][i] * b[c][i];
@@ -420,7 +502,7 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
                     x[c][i] += a * p[c][i];
                     const double ri = r[c][i] - a * q[c][i];
                     r[c][i] = ri;
-                    if (!mg) rzNew += ri * ri / op.diag[i];  // multigrid: r·z after the cycle
+                    if (!mg) rzNew += ri * ri / op.pdiag[i];  // multigrid: r·z after the cycle
                     rrNew += ri * ri;
                 }
                 s[std::size_t(c)] = rzNew;
@@ -455,7 +537,7 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
                 if (mg)
                     for (std::size_t i = begin; i < end; ++i) p[c][i] = v.z[c][i] + bt * p[c][i];
                 else
-                    for (std::size_t i = begin; i < end; ++i) p[c][i] = r[c][i] / op.diag[i] + bt * p[c][i];
+                    for (std::size_t i = begin; i < end; ++i) p[c][i] = r[c][i] / op.pdiag[i] + bt * p[c][i];
             }
         });
     }
@@ -477,6 +559,8 @@ void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array
     sized(wt.dy, kept.dy.size());
     sized(wt.dt, kept.dt.size());
     sized(wt.boundary, kept.boundary.size());
+    sized(wt.mx, kept.mx.size());
+    sized(wt.my, kept.my.size());
     const std::size_t n = p.size(), np = p.pixels(), w = std::size_t(p.width);
     std::vector<std::array<double, 2>> partial(rangesOf(n));  // per range: Σ weights, rows
     parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
@@ -511,6 +595,19 @@ void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array
                     for (int c = 0; c < 3; ++c) e[c] = p.beta * (x[c][j] - x[c][i] - p.dt[c][i]);
                     wt.dt[i] = weightOf(e);
                 }
+                if (!kept.mx.empty()) {
+                    wt.mx[i] = wt.my[i] = 0.0;
+                    if (kept.mx[i] != 0.0) {
+                        for (int c = 0; c < 3; ++c)
+                            e[c] = p.gamma * (mixedResidual(op, x[c], i, 1) - p.dxt[c][i]);
+                        wt.mx[i] = weightOf(e);
+                    }
+                    if (kept.my[i] != 0.0) {
+                        for (int c = 0; c < 3; ++c)
+                            e[c] = p.gamma * (mixedResidual(op, x[c], i, w) - p.dyt[c][i]);
+                        wt.my[i] = weightOf(e);
+                    }
+                }
             }
         }
         partial[begin / kGrain] = {sum, rows};
@@ -529,7 +626,7 @@ void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array
         rows += 1.0;
     }
     const double scale = sum > 0.0 ? rows / sum : 1.0;
-    for (Field* f : {&wt.primal, &wt.dx, &wt.dy, &wt.dt, &wt.boundary}) {
+    for (Field* f : {&wt.primal, &wt.dx, &wt.dy, &wt.dt, &wt.boundary, &wt.mx, &wt.my}) {
         Field& v = *f;
         parallelRanges(threads, v.size(), kGrain, [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i) v[i] *= scale;
@@ -630,6 +727,16 @@ Field solveSpaceTimeExactL2(const SpaceTimeProblem& problem, int channel) {
         edge(i + 1, op.cx[i]);
         edge(i + w, op.cy[i]);
         if (op.ct[i] != 0.0) edge(op.next[i], op.ct[i]);
+        // Mixed rows: c σ_u σ_v for every pair of the row's four pixels (the diagonal too).
+        for (const auto& [cm, s] : {std::pair<const Field*, std::size_t>{&op.cmx, 1}, {&op.cmy, w}}) {
+            if (i >= cm->size() || (*cm)[i] == 0.0) continue;
+            const std::size_t at[4] = {i, i + s, op.next[i], op.next[i] + s};
+            const double sign[4] = {1.0, -1.0, -1.0, 1.0};
+            for (int u = 0; u < 4; ++u)
+                for (int v = 0; v < 4; ++v)
+                    triplets.emplace_back(static_cast<int>(at[u]), static_cast<int>(at[v]),
+                                          (*cm)[i] * sign[u] * sign[v]);
+        }
     }
     Eigen::SparseMatrix<double> a(static_cast<int>(n), static_cast<int>(n));
     a.setFromTriplets(triplets.begin(), triplets.end());

@@ -8,12 +8,20 @@
 //                + Σ_i wdy (I_f,i+W − I_f,i − dy_f,i)² ]           (y < H−1)
 //          + β² Σ_{f<F−1} Σ_i wdt (I_f+1,π(i) − I_f,i − dt_f,i)²   temporal rows
 //          [+ β² Σ_i wdb (I_0,π(i) − previous_i − dtPrevious_i)²    the frame before, fixed]
+//          [+ γ² Σ_{f<F−1} Σ_i Σ_{s∈{1,W}} wm ((I_f+1,π(i)+s − I_f+1,π(i))
+//                                              − (I_f,i+s − I_f,i) − dst_f,i)²]   mixed rows
 // which is poisson_problem.h's energy of each frame plus the temporal rows: a weighted graph
 // Laplacian over the pixels' x, y and temporal neighbours plus the screening diagonal. π(i) is
 // the pixel of the next frame that pixel i's temporal difference ends at: i itself (the
 // same pixel: a 7-point Laplacian in (x, y, f)), or where the scene's motion carries i's
 // surface point (integrator/motion_map.h); a pixel without one has no temporal row. One frame
 // (F = 1) is exactly the 2D problem (tested against poisson_cpu.h).
+// Mixed rows (γ > 0; Manzi et al. 2016's second-order, mixed spatio-temporal differences): the
+// change of a spatial difference along the motion, dxt = ∂x∂t and dyt = ∂y∂t, where the motion
+// carries the pair of pixels i, i+s rigidly (π(i+s) = π(i) + s in the same row or column). Each
+// such row couples four unknowns, so it is not an edge of the graph Laplacian: the operator adds
+// it in gather form. Rows to the fixed previous frame carry only dt (no mixed rows across a
+// window boundary).
 //
 // L2: the weights are 1. L1 (the default of G-PT): iteratively reweighted least squares as the
 // 2D device solver does it (poisson_irls.h, poisson_gpu.h's schedule): round 0 is the L2
@@ -51,9 +59,13 @@ struct SpaceTimeProblem {
     int frames = 0;
     double alpha = 0.2;  // primal rows α (I − t), as poisson_problem.h
     double beta = 1.0;   // temporal rows β (I_f+1 − I_f − dt)
+    double gamma = 0.0;  // mixed rows γ (the change of dx, dy along the motion − dxt, dyt); 0: none
     // Frame-major planar fields: frame f's pixel i at f·W·H + i. dt has F − 1 frames (the
     // target of I_f+1 − I_f at each pixel).
     std::array<Field, 3> primal, dx, dy, dt;
+    // With γ > 0: the targets of the mixed rows at frame f's pixel i ((F − 1)·W·H each, as dt):
+    // dxt_f,i of (I_f+1,π(i)+1 − I_f+1,π(i)) − (I_f,i+1 − I_f,i), dyt the same with +W.
+    std::array<Field, 3> dxt, dyt;
     // Warm start (F·W·H per channel), e.g. each frame's own 2D reconstruction; empty: the
     // primal.
     std::array<Field, 3> initial;
@@ -111,9 +123,11 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
                                     SpaceTimeStats* stats = nullptr);
 
 // Bytes solveSpaceTime holds for a window: about 17 doubles per pixel, channel and frame (the
-// targets, the iterate, CG's vectors, the operator's weights).
-[[nodiscard]] constexpr std::uint64_t spaceTimeSolveBytes(int width, int height, int frames) {
-    return std::uint64_t(width) * std::uint64_t(height) * std::uint64_t(frames) * 3u * 17u * 8u;
+// targets, the iterate, CG's vectors, the operator's weights), 20 with mixed rows.
+[[nodiscard]] constexpr std::uint64_t spaceTimeSolveBytes(int width, int height, int frames,
+                                                          bool mixed = false) {
+    return std::uint64_t(width) * std::uint64_t(height) * std::uint64_t(frames) * 3u * (mixed ? 20u : 17u) *
+           8u;
 }
 
 // The exact L2 minimiser of one channel (Eigen's sparse LDLT on the normal equations): the

@@ -4,7 +4,8 @@
 // exactly by L2 and L1; an L1 solve shrugs off an outlier that L2 smears; temporal rows cut
 // frame-to-frame noise; temporal rows along motion (each pixel's partner in the next frame)
 // solve the least-squares problem they state, built here row by row; the result is the same bits
-// for any number of threads; bad input is refused.
+// for any number of threads; mixed rows (the change of dx, dy along the motion) solve the
+// least-squares problem of their rows and recover consistent data; bad input is refused.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -246,9 +247,20 @@ Field denseLeastSquares(const SpaceTimeProblem& p, int c) {
         if (k % w + 1 < w) row({{i + 1, 1.0}, {i, -1.0}}, p.dx[c][i]);
         if (k + w < np) row({{i + w, 1.0}, {i, -1.0}}, p.dy[c][i]);
         if (f + 1 < std::size_t(p.frames)) {
-            const std::uint32_t to = p.temporalPartner.empty() ? std::uint32_t(k) : p.temporalPartner[i];
+            const auto partnerOf = [&](std::size_t at) {
+                return p.temporalPartner.empty() ? std::uint32_t(at % np) : p.temporalPartner[at];
+            };
+            const std::uint32_t to = partnerOf(i);
             if (to != kNoTemporalPartner)
                 row({{(f + 1) * np + to, p.beta}, {i, -p.beta}}, p.beta * p.dt[c][i]);
+            // Mixed rows where i and its neighbour i+s are carried side by side.
+            const double g = p.gamma;
+            const std::size_t next = (f + 1) * np + to, x = k % w, y = k / w, tx = to % w, ty = to / w;
+            const std::size_t h = np / w;
+            if (g > 0.0 && to != kNoTemporalPartner && x + 1 < w && tx + 1 < w && partnerOf(i + 1) == to + 1)
+                row({{next + 1, g}, {next, -g}, {i + 1, -g}, {i, g}}, g * p.dxt[c][i]);
+            if (g > 0.0 && to != kNoTemporalPartner && y + 1 < h && ty + 1 < h && partnerOf(i + w) == to + w)
+                row({{next + w, g}, {next, -g}, {i + w, -g}, {i, g}}, g * p.dyt[c][i]);
         }
     }
     for (std::size_t j = 0; j < p.previous[c].size(); ++j) {
@@ -345,6 +357,95 @@ TEST(SpaceTimePoisson, DifferencesAlongTheMotionRecoverAMovingPattern) {
     expectRecoveredFromZero(p);
 }
 
+// Partners one pixel to the right (the motion of a pattern), with a few missing and a few
+// elsewhere, so that some pairs of neighbours are carried rigidly and some are not; noisy mixed
+// targets.
+SpaceTimeProblem withMixedRows(unsigned seed) {
+    SpaceTimeProblem p = noisy(consistentProblem(7, 6, 4), 0.3, seed);
+    const std::size_t np = p.pixels(), w = 7;
+    std::mt19937 rng(seed);
+    p.temporalPartner.resize(np * 3);
+    for (std::size_t i = 0; i < p.temporalPartner.size(); ++i) {
+        const std::size_t k = i % np;
+        const unsigned r = rng() % 8;
+        p.temporalPartner[i] = r == 0 || k % w + 1 == w ? kNoTemporalPartner
+                               : r == 1                 ? std::uint32_t(rng() % np)
+                                                        : std::uint32_t(k + 1);
+    }
+    std::normal_distribution<double> n(0.0, 0.3);
+    p.gamma = 0.7;
+    for (int c = 0; c < 3; ++c) {
+        p.dxt[c].resize(np * 3);
+        p.dyt[c].resize(np * 3);
+        for (double& v : p.dxt[c]) v = n(rng);
+        for (double& v : p.dyt[c]) v = n(rng);
+    }
+    return p;
+}
+
+TEST(SpaceTimePoisson, MixedRowsSolveTheLeastSquaresOfTheirRows) {
+    for (const unsigned seed : {1u, 2u}) {
+        const SpaceTimeProblem p = withMixedRows(seed);
+        SpaceTimeOptions o;
+        o.l1 = false;
+        o.tolerance = 1e-12;
+        const auto x = solveSpaceTime(p, o);
+        for (int c = 0; c < 3; ++c) {
+            const Field dense = denseLeastSquares(p, c);
+            EXPECT_LT(maxDiff(x[c], dense), 1e-8) << "seed " << seed << " channel " << c;
+            EXPECT_LT(maxDiff(solveSpaceTimeExactL2(p, c), dense), 1e-8)
+                << "seed " << seed << " channel " << c;
+        }
+        // The mixed rows matter: without them the answer moves.
+        SpaceTimeProblem without = p;
+        without.gamma = 0.0;
+        EXPECT_GT(maxDiff(solveSpaceTime(without, o)[0], x[0]), 1e-3);
+    }
+}
+
+TEST(SpaceTimePoisson, MixedRowsKeepConsistentDataExact) {
+    // The moving pattern's own mixed differences: every row holds exactly, L2 and L1.
+    const int w = 9, h = 6, frames = 4;
+    SpaceTimeProblem p = consistentProblem(w, h, frames);
+    const std::size_t np = p.pixels();
+    p.temporalPartner.assign(np * (frames - 1), 0u);
+    for (std::size_t i = 0; i < p.temporalPartner.size(); ++i)
+        p.temporalPartner[i] =
+            (i % np) % w + 1 < std::size_t(w) ? std::uint32_t(i % np + 1) : kNoTemporalPartner;
+    p.gamma = 1.5;
+    const auto at = [&](const Field& f, std::size_t frame, std::size_t k) { return f[frame * np + k]; };
+    for (int c = 0; c < 3; ++c) {
+        p.dxt[c].assign(np * (frames - 1), 0.0);
+        p.dyt[c].assign(np * (frames - 1), 0.0);
+        for (std::size_t i = 0; i < p.temporalPartner.size(); ++i) {
+            const std::uint32_t to = p.temporalPartner[i];
+            if (to == kNoTemporalPartner) continue;
+            const std::size_t f = i / np;
+            p.dt[c][i] = at(p.primal[c], f + 1, to) - p.primal[c][i];
+            p.dxt[c][i] = at(p.dx[c], f + 1, to) - p.dx[c][i];
+            p.dyt[c][i] = at(p.dy[c], f + 1, to) - p.dy[c][i];
+        }
+    }
+    for (const bool l1 : {false, true}) {
+        SpaceTimeOptions o;
+        o.l1 = l1;
+        o.tolerance = 1e-10;
+        SpaceTimeProblem start = p;
+        for (int c = 0; c < 3; ++c) start.initial[c].assign(p.size(), 0.0);
+        const auto x = solveSpaceTime(start, o);
+        for (int c = 0; c < 3; ++c)
+            EXPECT_LT(maxDiff(x[c], p.primal[c]), 1e-6) << "l1 " << l1 << " channel " << c;
+    }
+    // A wrong mixed target (the sign of ∂x∂t flipped) no longer fits: the data is not recovered.
+    SpaceTimeProblem wrong = p;
+    for (int c = 0; c < 3; ++c)
+        for (double& v : wrong.dxt[c]) v = -v;
+    SpaceTimeOptions o;
+    o.l1 = false;
+    o.tolerance = 1e-10;
+    EXPECT_GT(maxDiff(solveSpaceTime(wrong, o)[0], p.primal[0]), 1e-3);
+}
+
 // The solver splits the window into ranges of pixels over its threads and adds each range's
 // sums in range order: 1, 2 and 3 threads give the same bits (L1, whose weights depend on every
 // sum), on a window of several ranges with partners and the frame before.
@@ -358,9 +459,12 @@ TEST(SpaceTimePoisson, SameBitsForAnyThreadCount) {
     for (std::size_t i = 0; i < p.temporalPartner.size(); ++i)
         p.temporalPartner[i] =
             i % 7 == 0 ? kNoTemporalPartner : (i % 5 == 0 ? pick(rng) : std::uint32_t(i % np));
+    p.gamma = 0.5;
     for (int c = 0; c < 3; ++c) {
         p.previous[c].assign(np, 0.5);
         p.dtPrevious[c].assign(np, 0.1);
+        p.dxt[c].assign(np * (p.frames - 1), 0.01 * c);
+        p.dyt[c].assign(np * (p.frames - 1), -0.02);
     }
     SpaceTimeOptions o;
     o.threads = 1;
@@ -394,6 +498,12 @@ TEST(SpaceTimePoisson, BadInputIsRefused) {
     EXPECT_THROW((void)solveSpaceTime(p), Error);
     p.temporalPartner[7] = kNoTemporalPartner;
     EXPECT_NO_THROW((void)solveSpaceTime(p));
+    p.gamma = 0.5;  // mixed rows without their targets
+    EXPECT_THROW((void)solveSpaceTime(p), Error);
+    for (int c = 0; c < 3; ++c) p.dxt[c].assign(32, 0.0), p.dyt[c].assign(32, 0.0);
+    EXPECT_NO_THROW((void)solveSpaceTime(p));
+    p.gamma = -1.0;
+    EXPECT_THROW((void)solveSpaceTime(p), Error);
 }
 
 }  // namespace
