@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Animations at equal time: PT, per-frame G-PT and temporal G-PT (docs/animation.md; `tgpt` with
 # its default motion shift, `tgpt-replay` with --temporal-shift replay) render the same frames
-# of each animated scene with the same --time for the whole sequence, and each sequence is
+# of each animated scene with the same --time for the whole sequence (`tgpt-gammaG` and
+# `tgpt-betaB`: tgpt with --gamma G or --beta B), and each sequence is
 # compared with a PT reference sequence of REFSPP samples per pixel by `gdpt diff-sequence`:
 # the mean per-frame relMSE and the mean temporal relMSE (the error of the frame-to-frame
 # change: flicker), at the same pixel and along the motion (each pixel paired with the pixel of
@@ -30,7 +31,7 @@ while (($#)); do
     --methods) methods=$2; shift 2 ;;
     --repeats) repeats=$2; shift 2 ;;
     --fps) fps=$2; shift 2 ;;
-    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
     *) echo "bench-temporal.sh: unknown option '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -63,7 +64,11 @@ for scene in ${scenes//,/ }; do
     for m in ${methods//,/ }; do  # interleaved: one sequence of each method per round
       run=$dir/${m}_$r
       method=(--method "$m")
-      [ "$m" = tgpt-replay ] && method=(--method tgpt --temporal-shift replay)
+      case "$m" in
+        tgpt-replay) method=(--method tgpt --temporal-shift replay) ;;
+        tgpt-gamma*) method=(--method tgpt --gamma "${m#tgpt-gamma}") ;;  # e.g. tgpt-gamma1
+        tgpt-beta*) method=(--method tgpt --beta "${m#tgpt-beta}") ;;
+      esac
       build/gdpt render "$file" "${method[@]}" --time "$budget" --seed "$((r * 7))" -o "$run/f_%04d.exr" \
         --json "$run.json" "${common[@]}"
       build/gdpt diff-sequence "$run/f_%04d.exr" "$dir/reference_1001/f_%04d.exr" --frames "$frames" \

@@ -522,6 +522,13 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->check(CLI::Range(0.0, 1e3))
         ->needs(frames)
         ->group(animation);
+    r->add_option("--gamma", a.gamma,
+                  "tgpt: weight of the mixed rows of the space-time solve (the change of dx and dy along "
+                  "the motion, Manzi et al. 2016's mixed differences); 0 = none")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1e3))
+        ->needs(frames)
+        ->group(animation);
     r->add_option(
          "--temporal-shift", a.temporalShift,
          "tgpt: how a frame's paths are paired with the next frame's: motion = replayed in the pixel "

@@ -116,6 +116,7 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
     t.l1 = args.recon == "l1";
     t.alpha = args.alpha;
     t.beta = args.beta;
+    t.gamma = args.gamma;
     t.shift = parseTemporalShift(args.temporalShift);
     t.tolerance = args.tolerance;
     // Timed renders remember each configuration's reconstruction time.

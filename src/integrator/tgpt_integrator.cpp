@@ -24,6 +24,8 @@ struct FrameSamples {
     Image primal, dx, dy, direct, varPrimal, varDx, varDy, varDirect;
     Image firstHalfPrimal;   // seeded σ(f): pairs with the previous frame's second half
     Image secondHalfPrimal;  // seeded σ(f+1): pairs with the next frame's first half
+    // The halves' spatial differences, for the mixed rows (γ > 0 only; else empty).
+    Image firstHalfDx, firstHalfDy, secondHalfDx, secondHalfDy;
     // Where each pixel of the frame before moved to in this one (its first half's streams
     // follow it); empty for the replay shift or without a frame before.
     std::vector<std::uint32_t> fromPrevious;
@@ -118,19 +120,21 @@ Image frameOf(const std::array<Field, 3>& x, std::size_t frame, int width, int h
 }
 
 // What a window keeps: the solver's fields, and per frame twelve float RGB images (the halves'
-// primals, the combined estimates and variances) until it is written.
-std::uint64_t windowBytes(int width, int height, int frames) {
-    return spaceTimeSolveBytes(width, height, frames) +
-           std::uint64_t(width) * std::uint64_t(height) * std::uint64_t(frames) * 12u * 3u * 4u;
+// primals, the combined estimates and variances; sixteen with the halves' dx, dy for mixed
+// rows) until it is written.
+std::uint64_t windowBytes(int width, int height, int frames, bool mixed) {
+    return spaceTimeSolveBytes(width, height, frames, mixed) + std::uint64_t(width) * std::uint64_t(height) *
+                                                                   std::uint64_t(frames) *
+                                                                   (mixed ? 16u : 12u) * 3u * 4u;
 }
 
 // Refuses a window larger than the machine's memory, before it is sampled.
-void checkWindowMemory(int width, int height, int frames) {
+void checkWindowMemory(int width, int height, int frames, bool mixed) {
     const std::uint64_t memory = physicalMemory();
     if (memory == 0) return;
-    const std::uint64_t need = windowBytes(width, height, frames);
+    const std::uint64_t need = windowBytes(width, height, frames, mixed);
     if (need <= memory) return;
-    const std::uint64_t perFrame = windowBytes(width, height, 1);
+    const std::uint64_t perFrame = windowBytes(width, height, 1, mixed);
     throw Error("a tgpt window of " + std::to_string(frames) + " frames of " + std::to_string(width) + "x" +
                 std::to_string(height) + " needs about " + gibibytes(need) +
                 " for its space-time reconstruction, more than this machine's " + gibibytes(memory) +
@@ -177,7 +181,8 @@ RenderOutput TgptIntegrator::render(const vk::Context& ctx, const Scene& scene,
 std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, const FrameWindow& window,
                                                        const RenderOptions& options) {
     const int width = options.scene.width, height = options.scene.height;
-    checkWindowMemory(width, height, window.count);
+    const bool mixed = options_.gamma > 0.0;
+    checkWindowMemory(width, height, window.count, mixed);
     const bool timed = options.timeBudget > 0.0;
     Timer timer;
     std::vector<RenderOutput> outputs;
@@ -268,6 +273,12 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         f.varDirect = weighted(first.varDirect, na, second.varDirect, nb, 2);
         f.firstHalfPrimal = std::move(first.primal);
         f.secondHalfPrimal = std::move(second.primal);
+        if (mixed) {
+            f.firstHalfDx = std::move(first.dx);
+            f.firstHalfDy = std::move(first.dy);
+            f.secondHalfDx = std::move(second.dx);
+            f.secondHalfDy = std::move(second.dy);
+        }
         f.stats = addStats(first.stats, second.stats);
         f.stats.tgpt.firstHalfSpp = first.stats.spp;
         f.stats.tgpt.secondHalfSpp = second.stats.spp;
@@ -286,6 +297,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
     problem.frames = window.count;
     problem.alpha = options_.alpha;
     problem.beta = options_.beta;
+    problem.gamma = options_.gamma;
     // dt at the earlier frame's pixels, as the solve takes it; the layers hold it at the
     // later frame's pixels.
     std::vector<Image> dtToPrevious(frames.size());
@@ -297,6 +309,14 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
             const Image dt = differenceAlong(frames[k].firstHalfPrimal, frames[k - 1].secondHalfPrimal,
                                              frames[k].fromPrevious);
             append(problem.dt, dt);
+            if (mixed) {
+                // The change of each spatial difference along the motion, from the paired halves
+                // (the same random numbers): the mixed rows' targets.
+                append(problem.dxt, differenceAlong(frames[k].firstHalfDx, frames[k - 1].secondHalfDx,
+                                                    frames[k].fromPrevious));
+                append(problem.dyt, differenceAlong(frames[k].firstHalfDy, frames[k - 1].secondHalfDy,
+                                                    frames[k].fromPrevious));
+            }
             if (motion)
                 problem.temporalPartner.insert(problem.temporalPartner.end(), frames[k].fromPrevious.begin(),
                                                frames[k].fromPrevious.end());
@@ -388,7 +408,8 @@ void TgptIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
                  {"motion_partnered", s.tgpt.motionPartnered},
                  {"motion_ms", s.tgpt.motionMs},
                  {"alpha", options_.alpha},
-                 {"beta", options_.beta}};
+                 {"beta", options_.beta},
+                 {"gamma", options_.gamma}};
 }
 
 std::string TgptIntegrator::summary(const RenderStats& s) const {
