@@ -43,6 +43,7 @@ struct BenchPoissonArgs {
     std::string addressing = "auto";
     int frames = 10;                               // st-*: frames of the window
     int threads = 0;                               // st-*: solver threads (0 = the machine's cores)
+    double gamma = 0.0;                            // st-*: weight of the mixed rows (0: none)
     std::string hostPreconditioner = "multigrid";  // st-*, one frame: multigrid or jacobi
 };
 
@@ -103,6 +104,13 @@ nlohmann::json benchSpaceTime(const BenchPoissonArgs& a, int w, int h, const std
         p.temporalPartner[i] =
             pixel % std::size_t(w) + 1 < std::size_t(w) ? std::uint32_t(pixel + 1) : kNoTemporalPartner;
     }
+    // Mixed rows: the translation keeps every spatial difference along the motion (targets 0).
+    p.gamma = a.gamma;
+    if (p.gamma > 0.0)
+        for (int c = 0; c < 3; ++c) {
+            p.dxt[c].assign(p.dt[c].size(), 0.0);
+            p.dyt[c].assign(p.dt[c].size(), 0.0);
+        }
     SpaceTimeOptions o;
     o.l1 = method == "st-l1";
     o.tolerance = a.tolerance;
@@ -121,8 +129,9 @@ nlohmann::json benchSpaceTime(const BenchPoissonArgs& a, int w, int h, const std
             {"width", w},
             {"height", h},
             {"frames", a.frames},
+            {"gamma", a.gamma},
             {"method", method},
-            {"preconditioner", o.multigrid && a.frames == 1 ? "multigrid" : "jacobi"},
+            {"preconditioner", o.multigrid && (a.frames == 1 || a.gamma > 0.0) ? "multigrid" : "jacobi"},
             {"median_ms", med},
             {"all_ms", ms},
             {"iterations", stats.iterations},
@@ -266,12 +275,16 @@ Subcommand addBenchPoissonCommand(CLI::App& app) {
     sub->add_option("--frames", args->frames, "st-*: frames of the space-time window")
         ->check(CLI::Range(1, 1000))
         ->capture_default_str();
+    sub->add_option("--gamma", args->gamma,
+                    "st-*: weight of the mixed rows (the change of dx, dy along the motion)")
+        ->check(CLI::Range(0.0, 1e3))
+        ->capture_default_str();
     sub->add_option("--threads", args->threads, "st-*: host threads of the space-time solver (0 = all cores)")
         ->check(CLI::Range(0, 1024))
         ->capture_default_str();
     sub->add_option("--host-preconditioner", args->hostPreconditioner,
-                    "st-*: CG's preconditioner for one frame (more frames always take jacobi): multigrid "
-                    "(a V-cycle) or jacobi (the diagonal)")
+                    "st-*: CG's preconditioner for one frame and for windows with mixed rows (others always "
+                    "take jacobi): multigrid (a V-cycle per frame) or jacobi (the diagonal)")
         ->check(CLI::IsMember({"multigrid", "jacobi"}))
         ->capture_default_str();
     sub->add_option("--repeats", args->repeats, "Solves per size and method (median reported)")

@@ -130,7 +130,13 @@ void HostVcycle::apply(const std::array<const Field*, 3>& r, const std::array<Fi
             b[c] = r[c]->data();
             x[c] = z[c]->data();
         }
-    cycle(0, b, x, active, threads);
+    applyTo(b, x, active, threads);
+}
+
+void HostVcycle::applyTo(const std::array<const double*, 3>& r, const std::array<double*, 3>& z,
+                         const std::array<bool, 3>& active, std::uint32_t threads) {
+    GDPT_CHECK(!levels_.empty());
+    cycle(0, r, z, active, threads);
 }
 
 void HostVcycle::cycle(std::size_t level, const std::array<const double*, 3>& b,

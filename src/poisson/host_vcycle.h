@@ -28,6 +28,9 @@ public:
     // z[c] = M⁻¹ r[c] for the channels with active[c]: one V-cycle from zero.
     void apply(const std::array<const Field*, 3>& r, const std::array<Field*, 3>& z,
                const std::array<bool, 3>& active, std::uint32_t threads);
+    // The same on W·H values at each pointer (e.g. one frame of a window's fields).
+    void applyTo(const std::array<const double*, 3>& r, const std::array<double*, 3>& z,
+                 const std::array<bool, 3>& active, std::uint32_t threads);
 
     [[nodiscard]] int levels() const { return static_cast<int>(levels_.size()); }
 

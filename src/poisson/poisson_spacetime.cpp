@@ -48,34 +48,6 @@ struct Weights {
     Field mx, my;                        // mixed rows ((F − 1)·W·H), or empty without them
 };
 
-// The residual of the mixed row at m (step s = 1 or W) for the iterate x:
-// (x_π(m)+s − x_π(m)) − (x_m+s − x_m).
-inline double mixedResidual(const Operator& op, const Field& x, std::size_t m, std::size_t s) {
-    const std::size_t b = op.next[m];
-    return (x[b + s] - x[b]) - (x[m + s] - x[m]);
-}
-
-// Calls visit(m, s, c, σ) for every mixed row m (step s, coefficient c ≠ 0) that pixel k is one
-// of the four pixels of, σ = ±1 its sign in the row: +1 at m and π(m)+s, −1 at m+s and π(m).
-template <class Visit>
-void forMixedRowsAt(const Operator& op, std::size_t k, Visit&& visit) {
-    const std::size_t nt = op.cmx.size(), w = std::size_t(op.width);
-    for (const auto& [cm, s] : {std::pair<const Field*, std::size_t>{&op.cmx, 1}, {&op.cmy, w}}) {
-        const Field& c = *cm;
-        if (k < nt && c[k] != 0.0) visit(k, s, c[k], 1.0);
-        if (k >= s && k - s < nt && c[k - s] != 0.0) visit(k - s, s, c[k - s], -1.0);
-        for (std::uint32_t r = op.backStart[k]; r < op.backStart[k + 1]; ++r) {
-            const std::uint32_t m = op.back[r];
-            if (m < nt && c[m] != 0.0) visit(std::size_t(m), s, c[m], -1.0);
-        }
-        if (k >= s)
-            for (std::uint32_t r = op.backStart[k - s]; r < op.backStart[k - s + 1]; ++r) {
-                const std::uint32_t m = op.back[r];
-                if (m < nt && c[m] != 0.0) visit(std::size_t(m), s, c[m], 1.0);
-            }
-    }
-}
-
 // Pixels per range of the parallel loops. Sums are taken per range and added in range order,
 // so the result does not depend on the number of threads.
 constexpr std::size_t kGrain = 8192;
@@ -99,6 +71,54 @@ void sized(Field& f, std::size_t n) {
 void copied(Field& to, const Field& from) {
     sized(to, from.size());
     std::copy(from.begin(), from.end(), to.begin());
+}
+
+// The residual of the mixed row at m (step s = 1 or W) for the iterate x:
+// (x_π(m)+s − x_π(m)) − (x_m+s − x_m).
+inline double mixedResidual(const Operator& op, const Field& x, std::size_t m, std::size_t s) {
+    const std::size_t b = op.next[m];
+    return (x[b + s] - x[b]) - (x[m + s] - x[m]);
+}
+
+// The mixed rows' part of A x is Mᵀ C M x (M: four ±1 per row). A pass before the operator
+// stores C M x per row (0 where there is none), so that the operator only gathers each pixel's
+// rows, instead of evaluating every row at each of its four pixels.
+struct MixedRowValues {
+    std::array<Field, 3> x, y;  // per channel, (F − 1)·W·H
+};
+
+void mixedRowValues(const Operator& op, const std::array<Field, 3>& v, const std::array<bool, 3>& which,
+                    MixedRowValues& out, std::uint32_t threads) {
+    const std::size_t nt = op.cmx.size(), w = std::size_t(op.width);
+    for (int c = 0; c < 3; ++c) {
+        if (!which[c]) continue;
+        sized(out.x[c], nt);
+        sized(out.y[c], nt);
+    }
+    parallelRanges(threads, nt, kGrain, [&](std::size_t begin, std::size_t end) {
+        for (int c = 0; c < 3; ++c) {
+            if (!which[c]) continue;
+            for (std::size_t m = begin; m < end; ++m) {
+                out.x[c][m] = op.cmx[m] != 0.0 ? op.cmx[m] * mixedResidual(op, v[c], m, 1) : 0.0;
+                out.y[c][m] = op.cmy[m] != 0.0 ? op.cmy[m] * mixedResidual(op, v[c], m, w) : 0.0;
+            }
+        }
+    });
+}
+
+// (Mᵀ r)_k for the row values r of one direction (step s): + at m and π(m)+s, − at m+s and π(m);
+// `unsign`: every sign +, the sum of the values of the rows at k.
+inline double gatherMixed(const Operator& op, const Field& r, std::size_t k, std::size_t s,
+                          bool unsign = false) {
+    const std::size_t nt = r.size();
+    const double minus = unsign ? 1.0 : -1.0;
+    double v = 0.0;
+    if (k < nt) v += r[k];
+    if (k >= s && k - s < nt) v += minus * r[k - s];
+    for (std::uint32_t j = op.backStart[k]; j < op.backStart[k + 1]; ++j) v += minus * r[op.back[j]];
+    if (k >= s)
+        for (std::uint32_t j = op.backStart[k - s]; j < op.backStart[k - s + 1]; ++j) v += r[op.back[j]];
+    return v;
 }
 
 void check(const SpaceTimeProblem& p) {
@@ -283,17 +303,34 @@ void setWeights(const SpaceTimeProblem& p, const Weights& wt, Operator& op, std:
         op.cmx[i] = g2 * wt.mx[i];
         op.cmy[i] = g2 * wt.my[i];
     }
+    // Each row adds its coefficient to the diagonal at its four pixels (σ² = 1).
     parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
         for (std::size_t k = begin; k < end; ++k)
-            forMixedRowsAt(op, k, [&](std::size_t, std::size_t, double c, double) { op.pdiag[k] += c; });
+            op.pdiag[k] += gatherMixed(op, op.cmx, k, 1, true) + gatherMixed(op, op.cmy, k, w, true);
     });
 }
 
 // b = Pᵀ W target for the three channels: α² wp t minus the weighted divergence of the
 // (dx, dy, dt) field, plus the rows from the previous frame.
-void rhs(const SpaceTimeProblem& p, const Operator& op, std::array<Field, 3>& b, std::uint32_t threads) {
+// `targets`: scratch for the mixed rows' C t per row, gathered as the operator gathers C M x.
+void rhs(const SpaceTimeProblem& p, const Operator& op, std::array<Field, 3>& b, MixedRowValues& targets,
+         std::uint32_t threads) {
     const std::size_t n = op.size(), w = std::size_t(op.width);
     for (Field& f : b) sized(f, n);
+    const bool mixed = !op.cmx.empty();
+    if (mixed) {
+        for (int c = 0; c < 3; ++c) {
+            sized(targets.x[c], op.cmx.size());
+            sized(targets.y[c], op.cmy.size());
+        }
+        parallelRanges(threads, op.cmx.size(), kGrain, [&](std::size_t begin, std::size_t end) {
+            for (int c = 0; c < 3; ++c)
+                for (std::size_t m = begin; m < end; ++m) {
+                    targets.x[c][m] = op.cmx[m] * p.dxt[c][m];
+                    targets.y[c][m] = op.cmy[m] * p.dyt[c][m];
+                }
+        });
+    }
     parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
         for (int c = 0; c < 3; ++c) {
             const Field &dx = p.dx[c], &dy = p.dy[c], &dt = p.dt[c];
@@ -304,10 +341,7 @@ void rhs(const SpaceTimeProblem& p, const Operator& op, std::array<Field, 3>& b,
                 if (i >= w) v += op.cy[i - w] * dy[i - w];
                 for (std::uint32_t k = op.backStart[i]; k < op.backStart[i + 1]; ++k)
                     v += op.ct[op.back[k]] * dt[op.back[k]];
-                if (!op.cmx.empty())
-                    forMixedRowsAt(op, i, [&](std::size_t m, std::size_t s, double cm, double sign) {
-                        v += sign * cm * (s == 1 ? p.dxt[c][m] : p.dyt[c][m]);
-                    });
+                if (mixed) v += gatherMixed(op, targets.x[c], i, 1) + gatherMixed(op, targets.y[c], i, w);
                 b[c][i] = v;
             }
         }
@@ -317,7 +351,7 @@ void rhs(const SpaceTimeProblem& p, const Operator& op, std::array<Field, 3>& b,
             if (op.cb[j] != 0.0) b[c][op.bnext[j]] += op.cb[j] * (p.previous[c][j] + p.dtPrevious[c][j]);
 }
 
-// (A x)_i for i in [begin, end).
+// (A x)_i for i in [begin, end), without mixed rows (one frame: applyRange's edges).
 void applyRangeGeneral(const Operator& op, const Field& x, Field& y, std::size_t begin, std::size_t end) {
     const std::size_t n = op.size(), w = std::size_t(op.width);
     for (std::size_t i = begin; i < end; ++i) {
@@ -331,11 +365,41 @@ void applyRangeGeneral(const Operator& op, const Field& x, Field& y, std::size_t
             const std::uint32_t j = op.back[k];
             v -= op.ct[j] * x[j];
         }
-        if (!op.cmx.empty())
-            forMixedRowsAt(op, i, [&](std::size_t m, std::size_t s, double cm, double sign) {
-                v += sign * cm * mixedResidual(op, x, m, s);
-            });
         y[i] = v;
+    }
+}
+
+// (A x)_i of the channels in `active` for i in [begin, end), windows of several frames: each
+// pixel's neighbours and coefficients read once for the three channels (the loop is bound by
+// memory); per channel the operations and their order are applyRangeGeneral's, so the same bits.
+void applyRangeChannels(const Operator& op, const std::array<Field, 3>& x, std::array<Field, 3>& y,
+                        const std::array<bool, 3>& active, std::size_t begin, std::size_t end,
+                        const MixedRowValues* rows) {
+    const std::size_t n = op.size(), w = std::size_t(op.width);
+    for (std::size_t i = begin; i < end; ++i) {
+        const double d = op.diag[i];
+        const bool right = i + 1 < n, left = i >= 1, down = i + w < n, up = i >= w;
+        const double cr = right ? op.cx[i] : 0.0, cl = left ? op.cx[i - 1] : 0.0;
+        const double cd = down ? op.cy[i] : 0.0, cu = up ? op.cy[i - w] : 0.0;
+        const std::uint32_t next = op.next[i];
+        const double ct = next != kNoTemporalPartner ? op.ct[i] : 0.0;
+        const std::uint32_t b0 = op.backStart[i], b1 = op.backStart[i + 1];
+        for (int c = 0; c < 3; ++c) {
+            if (!active[c]) continue;
+            const double* xs = x[c].data();
+            double v = d * xs[i];
+            if (right) v -= cr * xs[i + 1];
+            if (left) v -= cl * xs[i - 1];
+            if (down) v -= cd * xs[i + w];
+            if (up) v -= cu * xs[i - w];
+            if (next != kNoTemporalPartner) v -= ct * xs[next];
+            for (std::uint32_t k = b0; k < b1; ++k) {
+                const std::uint32_t j = op.back[k];
+                v -= op.ct[j] * xs[j];
+            }
+            if (rows) v += gatherMixed(op, rows->x[c], i, 1) + gatherMixed(op, rows->y[c], i, w);
+            y[c][i] = v;
+        }
     }
 }
 
@@ -346,7 +410,7 @@ void applyRangeGeneral(const Operator& op, const Field& x, Field& y, std::size_t
 // reconstruction on a CPU device, where this loop is most of the time.
 void applyRange(const Operator& op, const Field& x, Field& y, std::size_t begin, std::size_t end) {
     const std::size_t n = op.size(), w = std::size_t(op.width);
-    if (op.frames != 1 || n <= 2 * w) {  // (mixed rows need two frames)
+    if (op.frames != 1 || n <= 2 * w) {
         applyRangeGeneral(op, x, y, begin, end);
         return;
     }
@@ -368,6 +432,61 @@ void applyRange(const Operator& op, const Field& x, Field& y, std::size_t begin,
     applyRangeGeneral(op, x, y, hi, end);
 }
 
+// CG's multigrid preconditioner: block Jacobi over the frames with one V-cycle per frame
+// (host_vcycle.h). Each frame's diagonal block of A is a 5-point graph Laplacian (its dx, dy
+// rows, and the halves of the mixed rows inside one frame: a mixed row joins m with m+s and
+// π(m) with π(m)+s by edges of its weight) plus the diagonal; the rows between frames (dt, the
+// mixed rows' cross terms) are left to CG. One frame is HostVcycle on the operator itself.
+class FrameBlocks {
+public:
+    void build(const Operator& op, std::uint32_t threads) {
+        const std::size_t np = op.pixels(), frames = std::size_t(op.frames), w = std::size_t(op.width);
+        cycles_.resize(frames);
+        if (frames == 1) {
+            cycles_[0].build(op.width, op.height, op.cx, op.cy, op.diag, threads);
+            return;
+        }
+        cx_.resize(frames);
+        cy_.resize(frames);
+        diag_.resize(frames);
+        const std::size_t nt = op.cmx.size();
+        for (std::size_t f = 0; f < frames; ++f) {
+            const std::size_t at = f * np;
+            cx_[f].assign(op.cx.begin() + std::ptrdiff_t(at), op.cx.begin() + std::ptrdiff_t(at + np));
+            cy_[f].assign(op.cy.begin() + std::ptrdiff_t(at), op.cy.begin() + std::ptrdiff_t(at + np));
+            diag_[f].assign(op.pdiag.begin() + std::ptrdiff_t(at),
+                            op.pdiag.begin() + std::ptrdiff_t(at + np));
+            if (nt == 0) continue;
+            for (std::size_t i = 0; i < np; ++i) {
+                const std::size_t k = at + i;
+                if (k < nt) cx_[f][i] += op.cmx[k], cy_[f][i] += op.cmy[k];
+                for (std::uint32_t j = op.backStart[k]; j < op.backStart[k + 1]; ++j)
+                    cx_[f][i] += op.cmx[op.back[j]], cy_[f][i] += op.cmy[op.back[j]];
+            }
+            (void)w;
+        }
+        for (std::size_t f = 0; f < frames; ++f)
+            cycles_[f].build(op.width, op.height, cx_[f], cy_[f], diag_[f], threads);
+    }
+
+    // z = M⁻¹ r for the channels in `which`.
+    void apply(const std::array<Field, 3>& r, std::array<Field, 3>& z, const std::array<bool, 3>& which,
+               std::uint32_t threads) {
+        const std::size_t np = r[0].size() / cycles_.size();
+        for (std::size_t f = 0; f < cycles_.size(); ++f) {
+            std::array<const double*, 3> rf{};
+            std::array<double*, 3> zf{};
+            for (int c = 0; c < 3; ++c)
+                if (which[c]) rf[c] = r[c].data() + f * np, zf[c] = z[c].data() + f * np;
+            cycles_[f].applyTo(rf, zf, which, threads);
+        }
+    }
+
+private:
+    std::vector<HostVcycle> cycles_;
+    std::vector<Field> cx_, cy_, diag_;  // the frames' blocks (several frames only)
+};
+
 struct ChannelSolve {
     int iterations = 0;
     double rhsNorm = 0.0, residualNorm = 0.0;
@@ -383,6 +502,7 @@ struct ChannelSolve {
 // the iterations on a machine where page faults are slow).
 struct CgVectors {
     std::array<Field, 3> r, p, q, z;  // z: multigrid only
+    MixedRowValues rows;              // with mixed rows only
 };
 
 // `every16`: called after every 16th iteration with the iterations so far (may throw).
@@ -390,7 +510,7 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
                                 double tolerance, int maxIterations, std::uint32_t threads, CgVectors& v,
                                 const std::function<void(int)>& every16,
                                 std::optional<std::chrono::steady_clock::time_point> deadline,
-                                HostVcycle* mg) {
+                                FrameBlocks* mg) {
     const std::size_t n = op.size(), ranges = rangesOf(n);
     std::array<Field, 3>&r = v.r, &p = v.p, &q = v.q;
     // Per range: the partial sums of one pass (three per channel at most), added in range order.
@@ -408,7 +528,7 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
     }
     // z = M⁻¹ r and r·z for the channels in `which` (multigrid).
     const auto precondition = [&](const std::array<bool, 3>& which) {
-        mg->apply({&r[0], &r[1], &r[2]}, {&v.z[0], &v.z[1], &v.z[2]}, which, threads);
+        mg->apply(r, v.z, which, threads);
         parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
             std::array<double, 9> s{};
             for (int c = 0; c < 3; ++c) {
@@ -420,11 +540,16 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
             partial[begin / kGrain] = s;
         });
     };
+    const bool mixed = !op.cmx.empty();
     // r = b − A x, ‖b‖² and ‖r‖²; Jacobi: p = z = r / d and r·z (multigrid: below).
+    if (mixed) mixedRowValues(op, x, {true, true, true}, v.rows, threads);
+    // Several frames: the three channels' A x in one pass (applyRangeChannels).
+    const bool together = op.frames > 1;
     parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
         std::array<double, 9> s{};
+        if (together) applyRangeChannels(op, x, q, {true, true, true}, begin, end, mixed ? &v.rows : nullptr);
         for (int c = 0; c < 3; ++c) {
-            applyRange(op, x[c], q[c], begin, end);
+            if (!together) applyRange(op, x[c], q[c], begin, end);
             double bb = 0.0, rz = 0.0, rr = 0.0;
             for (std::size_t i = begin; i < end; ++i) {
                 const double ri = b[c][i] - q[c][i];
@@ -471,11 +596,13 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
         }
         ++k;
         // q = A p and p·q.
+        if (mixed) mixedRowValues(op, p, active, v.rows, threads);
         parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
             std::array<double, 9> s{};
+            if (together) applyRangeChannels(op, p, q, active, begin, end, mixed ? &v.rows : nullptr);
             for (int c = 0; c < 3; ++c) {
                 if (!active[c]) continue;
-                applyRange(op, p[c], q[c], begin, end);
+                if (!together) applyRange(op, p[c], q[c], begin, end);
                 double pq = 0.0;
                 for (std::size_t i = begin; i < end; ++i) pq += p[c][i] * q[c][i];
                 s[std::size_t(c)] = pq;
@@ -654,10 +781,13 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
     std::array<int, 3> iterations{};
     const auto iterationsSoFar = [&] { return *std::max_element(iterations.begin(), iterations.end()); };
     int roundsDone = 0;
-    // One frame: the 2D operator the V-cycle is made for (rows to a previous frame only add to
-    // the diagonal, which the V-cycle takes as it is).
-    const bool multigrid = options.multigrid && problem.frames == 1;
-    HostVcycle vcycle;
+    // Multigrid: a V-cycle per frame (FrameBlocks; rows to a previous frame only add to the
+    // diagonal, which the V-cycle takes as it is), where it pays (measured, `gdpt bench-poisson
+    // --methods st-l1 --gamma G`, 10 frames of 256²): one frame, and windows with mixed rows
+    // (133 -> 46 iterations at γ = 1). Without mixed rows the diagonal takes 52 iterations where
+    // the V-cycles take 31, each iteration costing more than twice as much.
+    const bool multigrid = options.multigrid && (problem.frames == 1 || problem.gamma > 0.0);
+    FrameBlocks vcycle;
     for (int round = 0; round < rounds; ++round) {
         if (round > 0 && options.deadline && std::chrono::steady_clock::now() >= *options.deadline) {
             s.stoppedAtDeadline = true;
@@ -669,15 +799,15 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
         setWeights(problem, round == 0 ? kept : wt, op, threads);
         const bool last = round + 1 == rounds;
         const double tolerance = last ? options.tolerance : options.innerTolerance;
-        rhs(problem, op, b, threads);
+        rhs(problem, op, b, vectors.rows, threads);  // (the rows' scratch is free until pcg)
         std::function<void(int)> every16;
         if (options.progress)
             every16 = [&](int k) { options.progress(roundsDone, rounds, iterationsSoFar() + k); };
         // The first round (the L2 solve) always runs to its tolerance; later ones stop at the
         // deadline, mid-round if need be.
-        HostVcycle* mg = nullptr;
+        FrameBlocks* mg = nullptr;
         if (multigrid) {
-            vcycle.build(problem.width, problem.height, op.cx, op.cy, op.diag, threads);
+            vcycle.build(op, threads);
             mg = &vcycle;
         }
         const std::array<ChannelSolve, 3> solved =
@@ -710,7 +840,8 @@ Field solveSpaceTimeExactL2(const SpaceTimeProblem& problem, int channel) {
     Operator op = makeStructure(problem);
     setWeights(problem, unitWeights(problem), op, 1);
     std::array<Field, 3> rhsAll;
-    rhs(problem, op, rhsAll, 1);
+    MixedRowValues scratch;
+    rhs(problem, op, rhsAll, scratch, 1);
     const Field& b = rhsAll[std::size_t(channel)];
     const Field& d = op.diag;
     const std::size_t n = op.size(), w = std::size_t(op.width);

@@ -28,8 +28,9 @@
 // solve, round k ≥ 1 weights every row by 1 / (‖RGB residual‖ + ε_k), ε_k = regInit ·
 // regIter^(k−1), renormalised to mean 1, each round warm-started from the last.
 //
-// Solver: conjugate gradients preconditioned by the diagonal (Jacobi), or for one frame by a
-// multigrid V-cycle (host_vcycle.h: 188 -> 24 iterations on a 1080p render), in double precision on
+// Solver: conjugate gradients preconditioned by the diagonal (Jacobi), or for one frame and for
+// windows with mixed rows by multigrid V-cycles (host_vcycle.h; one frame: 188 -> 24 iterations
+// on a 1080p render; a V-cycle per frame as block Jacobi over the frames), in double precision on
 // the CPU: the three channels in lockstep over one operator (its coefficients are shared), the
 // pixels in ranges over the host's threads, each range's sums added in range order (the same
 // bits for any thread count). Why not the device: on lavapipe a device CG iteration over the
@@ -97,8 +98,9 @@ struct SpaceTimeOptions {
     double tolerance = 1e-4;       // relative residual of the last round (and of L2)
     int maxIterations = 4000;      // per solve
     int threads = 0;               // host threads; 0 = the machine's cores
-    // One-frame windows (G-PT's reconstruction): CG preconditioned by a multigrid V-cycle
-    // (host_vcycle.h) instead of the diagonal.
+    // CG preconditioned by multigrid V-cycles (host_vcycle.h, one per frame: block Jacobi over
+    // the frames) instead of the diagonal, where that pays: one-frame windows (G-PT's
+    // reconstruction) and windows with mixed rows (γ > 0).
     bool multigrid = true;
     // IRLS: the rounds after the first stop at this time (a timed render's budget), mid-round
     // if need be: the result is the iterate reached, which every CG step brings closer.
