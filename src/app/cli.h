@@ -57,7 +57,7 @@ struct RenderArgs {
     bool noVideo = false;       // no MP4 of the sequence even when ffmpeg is installed
     int window = 10;            // tgpt: frames reconstructed together
     double beta = 1.0;          // tgpt: weight of the temporal rows
-    double gamma = 0.0;         // tgpt: weight of the mixed rows
+    double gamma = 1.0;         // tgpt: weight of the mixed rows
     std::string temporalShift = "motion";  // tgpt: motion | replay
 };
 

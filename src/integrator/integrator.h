@@ -148,7 +148,7 @@ struct TgptOptions {
     bool l1 = true;           // the space-time reconstruction: L1 (IRLS) or L2
     double alpha = 0.2;       // weight of the primal rows
     double beta = 1.0;        // weight of the temporal rows
-    double gamma = 0.0;       // weight of the mixed rows (∂x∂t, ∂y∂t); 0: none
+    double gamma = 1.0;       // weight of the mixed rows (∂x∂t, ∂y∂t); 0: none
     double tolerance = 1e-4;  // relative residual of the last solve
 };
 
