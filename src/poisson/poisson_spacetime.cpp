@@ -384,6 +384,13 @@ void applyRangeChannels(const Operator& op, const std::array<Field, 3>& x, std::
         const std::uint32_t next = op.next[i];
         const double ct = next != kNoTemporalPartner ? op.ct[i] : 0.0;
         const std::uint32_t b0 = op.backStart[i], b1 = op.backStart[i + 1];
+        // Mixed rows (gatherMixed's terms, the lists read once for the channels): i's own rows
+        // (+), the rows at i−1 and i−W whose m+s is i (−), those whose π(m) is i (−, the dt
+        // rows' list) and those whose π(m)+s is i (+).
+        const std::size_t nt = rows ? rows->x[0].size() : 0;
+        const bool own = i < nt, fromLeft = left && i - 1 < nt, fromUp = up && i - w < nt;
+        const std::uint32_t bl0 = left ? op.backStart[i - 1] : 0, bl1 = left ? op.backStart[i] : 0;
+        const std::uint32_t bu0 = up ? op.backStart[i - w] : 0, bu1 = up ? op.backStart[i - w + 1] : 0;
         for (int c = 0; c < 3; ++c) {
             if (!active[c]) continue;
             const double* xs = x[c].data();
@@ -393,12 +400,28 @@ void applyRangeChannels(const Operator& op, const std::array<Field, 3>& x, std::
             if (down) v -= cd * xs[i + w];
             if (up) v -= cu * xs[i - w];
             if (next != kNoTemporalPartner) v -= ct * xs[next];
+            if (!rows) {
+                for (std::uint32_t k = b0; k < b1; ++k) {
+                    const std::uint32_t j = op.back[k];
+                    v -= op.ct[j] * xs[j];
+                }
+                y[c][i] = v;
+                continue;
+            }
+            const double* rx = rows->x[c].data();
+            const double* ry = rows->y[c].data();
+            double mixed = 0.0;
             for (std::uint32_t k = b0; k < b1; ++k) {
                 const std::uint32_t j = op.back[k];
                 v -= op.ct[j] * xs[j];
+                mixed -= rx[j] + ry[j];
             }
-            if (rows) v += gatherMixed(op, rows->x[c], i, 1) + gatherMixed(op, rows->y[c], i, w);
-            y[c][i] = v;
+            if (own) mixed += rx[i] + ry[i];
+            if (fromLeft) mixed -= rx[i - 1];
+            if (fromUp) mixed -= ry[i - w];
+            for (std::uint32_t k = bl0; k < bl1; ++k) mixed += rx[op.back[k]];
+            for (std::uint32_t k = bu0; k < bu1; ++k) mixed += ry[op.back[k]];
+            y[c][i] = v + mixed;
         }
     }
 }
