@@ -131,7 +131,7 @@ nlohmann::json benchSpaceTime(const BenchPoissonArgs& a, int w, int h, const std
             {"frames", a.frames},
             {"gamma", a.gamma},
             {"method", method},
-            {"preconditioner", o.multigrid && (a.frames == 1 || a.gamma > 0.0) ? "multigrid" : "jacobi"},
+            {"preconditioner", stats.multigrid ? "multigrid" : "jacobi"},
             {"median_ms", med},
             {"all_ms", ms},
             {"iterations", stats.iterations},

@@ -116,6 +116,7 @@ struct SpaceTimeStats {
     double residual = 0.0;           // relative residual of the last solve, max over channels
     bool converged = false;          // every channel's last solve reached the tolerance
     bool stoppedAtDeadline = false;  // rounds cut or left out for SpaceTimeOptions::deadline
+    bool multigrid = false;          // CG was preconditioned by V-cycles (else the diagonal)
     double ms = 0.0;
 };
 
