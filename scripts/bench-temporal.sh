@@ -2,7 +2,7 @@
 # Animations at equal time: PT, per-frame G-PT and temporal G-PT (docs/animation.md; `tgpt` with
 # its default motion shift, `tgpt-replay` with --temporal-shift replay) render the same frames
 # of each animated scene with the same --time for the whole sequence (`tgpt-gammaG` and
-# `tgpt-betaB`: tgpt with --gamma G or --beta B), and each sequence is
+# `tgpt-betaB`, `tgpt-reconR`: tgpt with --gamma G, --beta B or --recon R), and each sequence is
 # compared with a PT reference sequence of REFSPP samples per pixel by `gdpt diff-sequence`:
 # the mean per-frame relMSE and the mean temporal relMSE (the error of the frame-to-frame
 # change: flicker), at the same pixel and along the motion (each pixel paired with the pixel of
@@ -68,6 +68,7 @@ for scene in ${scenes//,/ }; do
         tgpt-replay) method=(--method tgpt --temporal-shift replay) ;;
         tgpt-gamma*) method=(--method tgpt --gamma "${m#tgpt-gamma}") ;;  # e.g. tgpt-gamma1
         tgpt-beta*) method=(--method tgpt --beta "${m#tgpt-beta}") ;;
+        tgpt-recon*) method=(--method tgpt --recon "${m#tgpt-recon}") ;;  # e.g. tgpt-reconwl1
       esac
       build/gdpt render "$file" "${method[@]}" --time "$budget" --seed "$((r * 7))" -o "$run/f_%04d.exr" \
         --json "$run.json" "${common[@]}"

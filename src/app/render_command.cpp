@@ -432,7 +432,9 @@ Subcommand addRenderCommand(CLI::App& app) {
 
     const char* gpt = "G-PT";
     r->add_option("--recon", a.recon,
-                  "Reconstruction of the final image: l1, l2, wl2 or wl1 (docs/reconstruction.md)")
+                  "Reconstruction of the final image: l1, l2, wl2 or wl1 (docs/reconstruction.md; for tgpt "
+                  "the space-time solve's, its wl* weighting dt by the paired samples' variance: "
+                  "docs/animation.md)")
         ->capture_default_str()
         ->check(CLI::IsMember({"l1", "l2", "wl2", "wl1"}))
         ->group(gpt);

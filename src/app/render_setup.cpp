@@ -113,7 +113,8 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
     TgptOptions& t = m.tgpt;
     t.sampling = g.sampling;
     t.window = args.window;
-    t.l1 = args.recon == "l1";
+    t.l1 = args.recon == "l1" || args.recon == "wl1";
+    t.weighted = args.recon == "wl1" || args.recon == "wl2";
     t.alpha = args.alpha;
     t.beta = args.beta;
     t.gamma = args.gamma;
@@ -235,9 +236,10 @@ void checkArgs(const RenderArgs& args) {
         if (args.frames.empty())
             throw UsageError(
                 "--method tgpt renders a sequence (temporal differences between frames): add --frames A:B");
-        if (args.recon == "wl1" || args.recon == "wl2" || args.allRecon)
+        if (args.allRecon)
             throw UsageError(
-                "--method tgpt reconstructs with --recon l1 or l2 (one space-time solve per window)");
+                "--method tgpt reconstructs with one --recon (l1, l2, wl1 or wl2): one space-time solve per "
+                "window");
         if (args.demodulate == "on")
             throw UsageError(
                 "--method tgpt does not demodulate (a frame's texture modulation differs from the next one's "

@@ -59,12 +59,26 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
         sampling.submitAndWait("gpt resolve",
                                [&](VkCommandBuffer cmd) { pass->resolve(cmd, sampling.timer()); });
     };
-    sampling.run([&] {
+    const auto recordGroup = [&](std::uint32_t done) {
+        if (!gpt.groups->wants(done)) return;
         resolveNow();
-        const GptImages images = pass->readback();
-        return gptFinal(images.primal, images.modulation.empty() ? nullptr : &images.modulation,
-                        &images.direct);
-    });
+        GptImages images = pass->readback();
+        std::vector<Image> means;
+        means.push_back(std::move(images.primal));
+        if (gpt.groupGradients) {
+            means.push_back(std::move(images.dx));
+            means.push_back(std::move(images.dy));
+        }
+        gpt.groups->record(done, std::move(means));
+    };
+    sampling.run(
+        [&] {
+            resolveNow();
+            const GptImages images = pass->readback();
+            return gptFinal(images.primal, images.modulation.empty() ? nullptr : &images.modulation,
+                            &images.direct);
+        },
+        gpt.groups ? std::function<void(std::uint32_t)>(recordGroup) : std::function<void(std::uint32_t)>());
 
     RenderResultGpt result;
     if (sampling.stats().handedOff) {  // the statistics went to another process (or a shard file)

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "integrator/render_options.h"
+#include "integrator/sample_groups.h"
 #include "render/passes/gpt_pass.h"
 
 namespace gdpt {
@@ -34,6 +35,10 @@ struct GptSamplingOptions {
     // Where each pixel's camera samples come from, or null for the pixel's own stream
     // (GptPassOptions::streams).
     std::shared_ptr<const std::vector<gpu::PixelStream>> streams;
+    // If set, the resolved primal (and with groupGradients dx, dy) is recorded at the batch
+    // ends it wants (sample_groups.h: tgpt's groups of paired samples); not owned.
+    SampleGroupRecorder* groups = nullptr;
+    bool groupGradients = false;
 };
 
 struct RenderResultGpt {

@@ -146,6 +146,7 @@ struct TgptOptions {
     TemporalShift shift = TemporalShift::Motion;
     int window = 10;          // frames reconstructed at once (Manzi et al. 2016 use about 10)
     bool l1 = true;           // the space-time reconstruction: L1 (IRLS) or L2
+    bool weighted = false;    // rows weighted by their inverse variances (wl1, wl2; spacetime_weights.h)
     double alpha = 0.2;       // weight of the primal rows
     double beta = 1.0;        // weight of the temporal rows
     double gamma = 1.0;       // weight of the mixed rows (∂x∂t, ∂y∂t); 0: none

@@ -52,7 +52,8 @@ void PixelSampling::submitAndWait(const std::string& what, const std::function<v
     if (options_.profile) timer_.collect();
 }
 
-void PixelSampling::run(const std::function<Image()>& preview) {
+void PixelSampling::run(const std::function<Image()>& preview,
+                        const std::function<void(std::uint32_t done)>& afterBatch) {
     Timer phase;
     // The pass's own set-up waits only for its small pipelines and runs while the main
     // kernel still compiles.
@@ -99,7 +100,10 @@ void PixelSampling::run(const std::function<Image()>& preview) {
                                       options_.seed, timer(), rows);
                 },
                 onWait);
-            return pass_->takeCounters();
+            const gpu::Counters counters = pass_->takeCounters();
+            if (afterBatch && !share.split() && rows == static_cast<std::uint32_t>(options_.scene.height))
+                afterBatch(first + n);
+            return counters;
         },
         snapshot);
     if (options_.combine) {

@@ -33,8 +33,11 @@ public:
                   const MakePass& makePass);
 
     // Set-up after the upload, then the batch loop. `preview` returns a viewable image of the
-    // samples so far for a checkpoint (called after a batch's fence).
-    void run(const std::function<Image()>& preview);
+    // samples so far for a checkpoint (called after a batch's fence). `afterBatch`, if set, is
+    // called after each batch that covered every row, with the samples per pixel done so far
+    // (a render split across processes has none: its batches are not the render's).
+    void run(const std::function<Image()>& preview,
+             const std::function<void(std::uint32_t done)>& afterBatch = {});
 
     [[nodiscard]] SamplingPass& pass() { return *pass_; }
     [[nodiscard]] vk::CommandStream& stream() { return stream_; }

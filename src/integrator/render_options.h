@@ -71,6 +71,10 @@ struct RenderOptions {
     // Largest batch (samples per pixel per submission); 0 = the method's default for the
     // image size (maxBatchSppFor), what the command line uses.
     std::uint32_t maxBatchSpp = 0;
+    // Sample counts (increasing) at which a batch must end: a batch never runs across one, so
+    // that a caller reading the sums at batch ends sees these counts (tgpt's groups of
+    // paired samples, integrator/sample_groups.h). Empty: the schedule alone decides.
+    std::vector<std::uint32_t> batchStops;
     const std::atomic<bool>* cancel = nullptr;  // set asynchronously to stop between batches
     // Continue from this state (its statistics and batch-schedule position) instead of from
     // zero samples; the caller has checked that it belongs to this scene, size, seed and
@@ -146,6 +150,9 @@ struct TgptStats {
     // frame (motion_map.h), and the host time of its primary hits and the map.
     std::uint64_t motionPartnered = 0;
     double motionMs = 0.0;
+    // Groups of paired samples behind the variance of dt from the frame before (var_dt,
+    // sample_groups.h): its degrees of freedom per pixel are one fewer; 0 without a dt.
+    int dtVarianceGroups = 0;
 };
 
 struct RenderStats {

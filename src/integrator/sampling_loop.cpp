@@ -88,6 +88,9 @@ void runBatchLoop(const RenderOptions& options, const char* label, const Timer& 
             n = next.spp;
             rows = next.rows;
         }
+        // A batch ends at the next stop, if one comes before it would.
+        const auto stop = std::upper_bound(options.batchStops.begin(), options.batchStops.end(), done);
+        if (stop != options.batchStops.end()) n = std::min(n, *stop - done);
         Timer batchTimer;
         CpuShareMeter batchShare;
         const gpu::Counters c = traceBatch(done, n, rows, [&] {

@@ -11,6 +11,8 @@
 #include "integrator/motion_map.h"
 #include "integrator/reconstruction_stage.h"
 #include "integrator/render_identity.h"
+#include "integrator/sample_groups.h"
+#include "integrator/spacetime_weights.h"
 #include "poisson/poisson_spacetime.h"
 #include "util/error.h"
 #include "util/memory.h"
@@ -29,13 +31,18 @@ struct FrameSamples {
     // Where each pixel of the frame before moved to in this one (its first half's streams
     // follow it); empty for the replay shift or without a frame before.
     std::vector<std::uint32_t> fromPrevious;
+    // The variances of the paired differences from the frame before (at its pixels, as the
+    // solve's rows), from the sample groups of its second half and this first half; empty
+    // without a frame before (or with fewer than two groups); dxt, dyt for weighted mixed rows.
+    Image varDt, varDxt, varDyt;
+    int dtGroups = 0;
     RenderStats stats;
 };
 
 // Two estimates of n_a and n_b samples combined with the weights w = n / (n_a + n_b), each
 // value raised to `power`: 1 for the spp-weighted mean of the estimates, 2 for the variance of
 // that mean from theirs.
-Image weighted(const Image& a, double na, const Image& b, double nb, int power) {
+Image combineHalves(const Image& a, double na, const Image& b, double nb, int power) {
     Image out = a;
     const double wa = std::pow(na / (na + nb), power), wb = std::pow(nb / (na + nb), power);
     for (int c = 0; c < 3; ++c)
@@ -119,22 +126,28 @@ Image frameOf(const std::array<Field, 3>& x, std::size_t frame, int width, int h
     return out;
 }
 
-// What a window keeps: the solver's fields, and per frame twelve float RGB images (the halves'
-// primals, the combined estimates and variances; sixteen with the halves' dx, dy for mixed
-// rows) until it is written.
-std::uint64_t windowBytes(int width, int height, int frames, bool mixed) {
-    return spaceTimeSolveBytes(width, height, frames, mixed) + std::uint64_t(width) * std::uint64_t(height) *
-                                                                   std::uint64_t(frames) *
-                                                                   (mixed ? 16u : 12u) * 3u * 4u;
+// Groups of paired samples kept per half render (sample_groups.h): between 8 and 16, so that a
+// pixel's var_dt has 7 to 15 degrees of freedom.
+constexpr std::size_t kSampleGroups = 16;
+
+// What a window keeps: the solver's fields, and per frame thirteen float RGB images (the halves'
+// primals, the combined estimates and variances, var_dt; seventeen with the halves' dx, dy for
+// mixed rows, nineteen with their weights' variances) until it is written, plus the sample
+// groups of two half renders (one image per group, three for weighted mixed rows).
+std::uint64_t windowBytes(int width, int height, int frames, bool mixed, bool weighted) {
+    const std::uint64_t image = std::uint64_t(width) * std::uint64_t(height) * 3u * 4u;
+    const std::uint64_t perFrame = mixed ? (weighted ? 19u : 17u) : 13u;
+    const std::uint64_t groups = 2u * kSampleGroups * (mixed && weighted ? 3u : 1u);
+    return spaceTimeSolveBytes(width, height, frames, mixed) + image * (std::uint64_t(frames) * perFrame + groups);
 }
 
 // Refuses a window larger than the machine's memory, before it is sampled.
-void checkWindowMemory(int width, int height, int frames, bool mixed) {
+void checkWindowMemory(int width, int height, int frames, bool mixed, bool weighted) {
     const std::uint64_t memory = physicalMemory();
     if (memory == 0) return;
-    const std::uint64_t need = windowBytes(width, height, frames, mixed);
+    const std::uint64_t need = windowBytes(width, height, frames, mixed, weighted);
     if (need <= memory) return;
-    const std::uint64_t perFrame = windowBytes(width, height, 1, mixed);
+    const std::uint64_t perFrame = windowBytes(width, height, 1, mixed, weighted);
     throw Error("a tgpt window of " + std::to_string(frames) + " frames of " + std::to_string(width) + "x" +
                 std::to_string(height) + " needs about " + gibibytes(need) +
                 " for its space-time reconstruction, more than this machine's " + gibibytes(memory) +
@@ -182,7 +195,10 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
                                                        const RenderOptions& options) {
     const int width = options.scene.width, height = options.scene.height;
     const bool mixed = options_.gamma > 0.0;
-    checkWindowMemory(width, height, window.count, mixed);
+    const bool weighted = options_.weighted;
+    // The mixed rows' variances only weight them.
+    const bool groupGradients = weighted && mixed;
+    checkWindowMemory(width, height, window.count, mixed, weighted);
     const bool timed = options.timeBudget > 0.0;
     Timer timer;
     std::vector<RenderOutput> outputs;
@@ -195,6 +211,9 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
     std::vector<PrimaryHit> previousHits = joined ? carry_->hits : std::vector<PrimaryHit>{};
     // Samples per pixel of the frame before's second half (0: no frame before).
     std::uint32_t pairedSpp = joined ? carry_->secondHalfSpp : 0;
+    // The sample groups of the frame before's second half, which this frame's first half
+    // repeats (for the variance of dt).
+    SampleGroups previousGroups = joined ? std::move(carry_->secondHalfGroups) : SampleGroups{};
 
     // 1. Sampling: two half renders per frame, seeded σ(f) and σ(f+1).
     for (int k = 0; k < window.count; ++k) {
@@ -246,31 +265,61 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         if (timed) half.timeBudget = paired ? 0.0 : 0.5 * share;
         if (paired) half.spp = pairedSpp;
         half.seed = window.seed(frame);
+        // Paired: the same groups of samples as the second half it repeats (batches end there).
+        SampleGroupRecorder firstGroups = SampleGroupRecorder::atEnds(paired ? previousGroups.ends
+                                                                             : std::vector<std::uint32_t>{});
+        if (paired) {
+            firstSampling.groups = &firstGroups;
+            firstSampling.groupGradients = groupGradients;
+            half.batchStops = previousGroups.ends;
+        }
         RenderResultGpt first = renderGpt(ctx, *scene, half, firstSampling);
         if (first.stats.cancelled) {
             outputs.push_back({{}, first.stats});
             return outputs;
+        }
+        half.batchStops.clear();
+        FrameSamples f;
+        if (paired) {
+            const SampleGroups groups = firstGroups.take();
+            f.dtGroups = int(groups.ends.size());
+            f.varDt = pairedDifferenceVariance(groups, previousGroups, 0, fromPrevious);
+            if (groupGradients) {
+                f.varDxt = pairedDifferenceVariance(groups, previousGroups, 1, fromPrevious);
+                f.varDyt = pairedDifferenceVariance(groups, previousGroups, 2, fromPrevious);
+            }
+            previousGroups = {};
         }
         if (timed)
             half.timeBudget = paired ? 0.5 * share : std::max(1e-3, share - (timer.seconds() - frameStart));
         half.spp = std::max<std::uint32_t>(1, options.spp / 2);
         half.partialPass = false;
         half.seed = window.seed(frame + 1);
-        RenderResultGpt second = renderGpt(ctx, *scene, half, options_.sampling);
+        // Its sample groups, which the next frame's first half repeats: equal ones where its
+        // samples are known in advance, else its batch ends, merged in pairs past 16.
+        const bool secondTimed = half.timeBudget > 0.0;
+        if (!secondTimed) half.batchStops = equalGroupEnds(half.spp, kSampleGroups);
+        SampleGroupRecorder secondGroups = secondTimed ? SampleGroupRecorder::everyBatch(kSampleGroups)
+                                                       : SampleGroupRecorder::atEnds(half.batchStops);
+        GptSamplingOptions secondSampling = options_.sampling;
+        secondSampling.groups = &secondGroups;
+        secondSampling.groupGradients = groupGradients;
+        RenderResultGpt second = renderGpt(ctx, *scene, half, secondSampling);
         if (second.stats.cancelled) {
             outputs.push_back({{}, addStats(first.stats, second.stats)});
             return outputs;
         }
-        FrameSamples f;
+        half.batchStops.clear();
+        previousGroups = secondGroups.take();
         const double na = first.stats.spp, nb = second.stats.spp;
-        f.primal = weighted(first.primal, na, second.primal, nb, 1);
-        f.dx = weighted(first.dx, na, second.dx, nb, 1);
-        f.dy = weighted(first.dy, na, second.dy, nb, 1);
-        f.direct = weighted(first.direct, na, second.direct, nb, 1);
-        f.varPrimal = weighted(first.varPrimal, na, second.varPrimal, nb, 2);
-        f.varDx = weighted(first.varDx, na, second.varDx, nb, 2);
-        f.varDy = weighted(first.varDy, na, second.varDy, nb, 2);
-        f.varDirect = weighted(first.varDirect, na, second.varDirect, nb, 2);
+        f.primal = combineHalves(first.primal, na, second.primal, nb, 1);
+        f.dx = combineHalves(first.dx, na, second.dx, nb, 1);
+        f.dy = combineHalves(first.dy, na, second.dy, nb, 1);
+        f.direct = combineHalves(first.direct, na, second.direct, nb, 1);
+        f.varPrimal = combineHalves(first.varPrimal, na, second.varPrimal, nb, 2);
+        f.varDx = combineHalves(first.varDx, na, second.varDx, nb, 2);
+        f.varDy = combineHalves(first.varDy, na, second.varDy, nb, 2);
+        f.varDirect = combineHalves(first.varDirect, na, second.varDirect, nb, 2);
         f.firstHalfPrimal = std::move(first.primal);
         f.secondHalfPrimal = std::move(second.primal);
         if (mixed) {
@@ -284,6 +333,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         f.stats.tgpt.secondHalfSpp = second.stats.spp;
         f.stats.tgpt.motionPartnered = partnered;
         f.stats.tgpt.motionMs = motionMs;
+        f.stats.tgpt.dtVarianceGroups = f.dtGroups;
         f.fromPrevious = std::move(fromPrevious);
         pairedSpp = second.stats.spp;
         frames.push_back(std::move(f));
@@ -331,6 +381,26 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         if (motion) problem.previousPartner = frames[0].fromPrevious;
         dtToPrevious[0] = atLaterPixels(dt, frames[0].fromPrevious);
     }
+    if (weighted) {
+        // Rows weighted by their inverse variances; a pair without a variance of dt (fewer
+        // than two groups: one sample per half) has 0 there, as a one-sample half's own.
+        const auto orZero = [&](const Image& v) { return v.empty() ? Image(width, height) : v; };
+        RowVariances v;
+        for (std::size_t k = 0; k < frames.size(); ++k) {
+            v.primal.push_back(frames[k].varPrimal);
+            v.dx.push_back(frames[k].varDx);
+            v.dy.push_back(frames[k].varDy);
+            if (k == 0) continue;
+            v.dt.push_back(orZero(frames[k].varDt));
+            if (mixed) {
+                v.dxt.push_back(orZero(frames[k].varDxt));
+                v.dyt.push_back(orZero(frames[k].varDyt));
+            }
+        }
+        if (joined) v.dtPrevious = orZero(frames[0].varDt);
+        const SolveOptions defaults;
+        setVarianceWeights(problem, v, options_.l1, defaults.varianceEpsilon, defaults.varianceFilterRadius);
+    }
     SpaceTimeOptions solve;
     solve.l1 = options_.l1;
     solve.tolerance = options_.tolerance;
@@ -342,11 +412,11 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         std::fprintf(stderr,
                      "gdpt: space-time %s reconstruction of frames %d-%d: %d iterations (%d IRLS), "
                      "residual %.2g, %.1f ms\n",
-                     options_.l1 ? "l1" : "l2", window.first, window.first + window.count - 1,
+                     reconstructionName().c_str(), window.first, window.first + window.count - 1,
                      solved.iterations, solved.irlsIterations, solved.residual, solved.ms);
 
     // 3. Compose each frame: reconstruction + very-direct light.
-    const std::string solveName = std::string("spacetime_") + (options_.l1 ? "l1" : "l2");
+    const std::string solveName = "spacetime_" + reconstructionName();
     for (std::size_t k = 0; k < frames.size(); ++k) {
         FrameSamples& f = frames[k];
         Image recon = frameOf(x, k, width, height);
@@ -375,6 +445,8 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         out.layers.push_back({"dx", std::move(f.dx)});
         out.layers.push_back({"dy", std::move(f.dy)});
         out.layers.push_back({"dt", std::move(dtToPrevious[k])});
+        out.layers.push_back({"var_dt", f.varDt.empty() ? Image(width, height)
+                                                        : atLaterPixels(f.varDt, f.fromPrevious)});
         out.layers.push_back({"motion", motionLayer(f.fromPrevious, hasPrevious, width, height)});
         out.layers.push_back({"direct", std::move(f.direct)});
         out.layers.push_back({"var_primal", std::move(f.varPrimal)});
@@ -388,6 +460,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
                    {},
                    std::move(frames.back().secondHalfPrimal),
                    pairedSpp,
+                   std::move(previousGroups),
                    std::move(previousScene),
                    std::move(previousHits)};
     const std::size_t last = std::size_t(window.count - 1) * std::size_t(width) * std::size_t(height);
@@ -407,9 +480,14 @@ void TgptIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
                  {"temporal_shift", temporalShiftName(options_.shift)},
                  {"motion_partnered", s.tgpt.motionPartnered},
                  {"motion_ms", s.tgpt.motionMs},
+                 {"dt_variance_groups", s.tgpt.dtVarianceGroups},
                  {"alpha", options_.alpha},
                  {"beta", options_.beta},
                  {"gamma", options_.gamma}};
+}
+
+std::string TgptIntegrator::reconstructionName() const {
+    return std::string(options_.weighted ? "w" : "") + (options_.l1 ? "l1" : "l2");
 }
 
 std::string TgptIntegrator::summary(const RenderStats& s) const {

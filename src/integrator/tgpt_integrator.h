@@ -10,7 +10,8 @@
 //      nothing moved;
 //   2. reconstruct: a space-time screened Poisson solve of the window from every frame's
 //      primal, dx, dy and the dt between its frames (poisson_spacetime.h; L1 by IRLS by
-//      default), coupled to the previous window's last reconstructed frame through the dt
+//      default; wl1, wl2 weight every row by its inverse variance, spacetime_weights.h, dt's
+//      from the paired samples' groups, sample_groups.h), coupled to the previous window's last reconstructed frame through the dt
 //      between the windows, so that a sequence has no seam at window boundaries;
 //   3. compose: final = reconstruction + very-direct light, per frame (as G-PT, §5 of
 //      Kettunen et al. 2015).
@@ -23,8 +24,9 @@
 // paper's reconnection of the temporal offset path at its first rough vertex (docs/animation.md).
 // Texture demodulation is off (a frame's modulation differs from the next one's where something
 // moves).
-// Layers per frame: final, recon_spacetime_<l1|l2>, primal, dx, dy, dt (from the frame before,
-// at this frame's pixels; 0 in the sequence's first frame and where a pixel has no source),
+// Layers per frame: final, recon_spacetime_<l1|l2|wl1|wl2>, primal, dx, dy, dt (from the frame
+// before, at this frame's pixels; 0 in the sequence's first frame and where a pixel has no
+// source), var_dt (its variance, from the paired samples' groups: sample_groups.h),
 // motion (offset to the source pixel in R, G; 1 in B where there is one), direct, var_primal,
 // var_dx, var_dy, var_direct, primal_plus_direct.
 #pragma once
@@ -37,6 +39,7 @@
 
 #include "integrator/integrator.h"
 #include "integrator/motion_map.h"
+#include "integrator/sample_groups.h"
 
 namespace gdpt {
 
@@ -56,6 +59,9 @@ public:
     [[nodiscard]] std::string summary(const RenderStats& stats) const override;
 
 private:
+    // "l1", "l2", "wl1", "wl2".
+    [[nodiscard]] std::string reconstructionName() const;
+
     TgptOptions options_;
     // From the last window: its last frame's reconstruction and its second half's primal
     // (seeded like the next window's first frame's first half).
@@ -64,6 +70,7 @@ private:
         std::array<std::vector<double>, 3> recon;
         Image secondHalfPrimal;
         std::uint32_t secondHalfSpp = 0;
+        SampleGroups secondHalfGroups;  // its sample groups (the next first half repeats them)
         // The motion shift: the last frame's scene and primary hits (motion_map.h).
         std::shared_ptr<const Scene> scene;
         std::vector<PrimaryHit> hits;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <functional>
 #include <numeric>
+#include <tuple>
 #include <vector>
 
 #include "poisson/host_vcycle.h"
@@ -164,13 +165,19 @@ void check(const SpaceTimeProblem& p) {
                 throw Error(std::string("space-time Poisson: ") + what + " names pixel " + std::to_string(j) +
                             " of a frame of " + std::to_string(p.pixels()));
     };
-    for (const auto& [field, what] : {std::pair<const Field*, const char*>{&p.weightPrimal, "weightPrimal"},
-                                      {&p.weightDx, "weightDx"},
-                                      {&p.weightDy, "weightDy"}}) {
+    const std::size_t nb = p.previous[0].empty() ? 0 : p.pixels();
+    for (const auto& [field, what, want] :
+         {std::tuple<const Field*, const char*, std::size_t>{&p.weightPrimal, "weightPrimal", n},
+          {&p.weightDx, "weightDx", n},
+          {&p.weightDy, "weightDy", n},
+          {&p.weightDt, "weightDt", nt},
+          {&p.weightDxt, "weightDxt", p.gamma > 0.0 ? nt : 0},
+          {&p.weightDyt, "weightDyt", p.gamma > 0.0 ? nt : 0},
+          {&p.weightDtPrevious, "weightDtPrevious", nb}}) {
         if (field->empty()) continue;
-        if (field->size() != n)
+        if (field->size() != want)
             throw Error(std::string("space-time Poisson: ") + what + " has " + std::to_string(field->size()) +
-                        " values, expected " + std::to_string(n));
+                        " values, expected " + std::to_string(want));
         for (double v : *field)
             if (!std::isfinite(v) || v < 0.0)
                 throw Error(std::string("space-time Poisson: ") + what + " must be finite and >= 0");
@@ -218,6 +225,9 @@ Weights unitWeights(const SpaceTimeProblem& p) {
         if ((i % np) % w + 1 == w) wt.dx[i] = 0.0;
         if ((i % np) + w >= np) wt.dy[i] = 0.0;
     }
+    if (!p.weightDt.empty()) std::copy(p.weightDt.begin(), p.weightDt.end(), wt.dt.begin());
+    if (!p.weightDtPrevious.empty() && !wt.boundary.empty())
+        std::copy(p.weightDtPrevious.begin(), p.weightDtPrevious.end(), wt.boundary.begin());
     for (std::size_t i = 0; i < p.temporalPartner.size(); ++i)
         if (p.temporalPartner[i] == kNoTemporalPartner) wt.dt[i] = 0.0;
     for (std::size_t j = 0; j < p.previousPartner.size() && !wt.boundary.empty(); ++j)
@@ -235,8 +245,10 @@ Weights unitWeights(const SpaceTimeProblem& p) {
             const std::uint32_t to = partner(i);
             if (to == kNoTemporalPartner) continue;
             const std::size_t k = i % np;
-            if (k % w + 1 < w && std::size_t(to) % w + 1 < w && partner(i + 1) == to + 1) wt.mx[i] = 1.0;
-            if (k / w + 1 < h && std::size_t(to) / w + 1 < h && partner(i + w) == to + w) wt.my[i] = 1.0;
+            if (k % w + 1 < w && std::size_t(to) % w + 1 < w && partner(i + 1) == to + 1)
+                wt.mx[i] = p.weightDxt.empty() ? 1.0 : p.weightDxt[i];
+            if (k / w + 1 < h && std::size_t(to) / w + 1 < h && partner(i + w) == to + w)
+                wt.my[i] = p.weightDyt.empty() ? 1.0 : p.weightDyt[i];
         }
     }
     return wt;
@@ -692,19 +704,19 @@ void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array
                 if (kept.dt[i] != 0.0) {
                     const std::size_t j = op.next[i];
                     for (int c = 0; c < 3; ++c) e[c] = p.beta * (x[c][j] - x[c][i] - p.dt[c][i]);
-                    wt.dt[i] = weightOf(e);
+                    wt.dt[i] = kept.dt[i] * weightOf(e);
                 }
                 if (!kept.mx.empty()) {
                     wt.mx[i] = wt.my[i] = 0.0;
                     if (kept.mx[i] != 0.0) {
                         for (int c = 0; c < 3; ++c)
                             e[c] = p.gamma * (mixedResidual(op, x[c], i, 1) - p.dxt[c][i]);
-                        wt.mx[i] = weightOf(e);
+                        wt.mx[i] = kept.mx[i] * weightOf(e);
                     }
                     if (kept.my[i] != 0.0) {
                         for (int c = 0; c < 3; ++c)
                             e[c] = p.gamma * (mixedResidual(op, x[c], i, w) - p.dyt[c][i]);
-                        wt.my[i] = weightOf(e);
+                        wt.my[i] = kept.my[i] * weightOf(e);
                     }
                 }
             }
@@ -720,7 +732,7 @@ void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array
         double e[3];
         for (int c = 0; c < 3; ++c) e[c] = p.beta * (x[c][j] - p.previous[c][i] - p.dtPrevious[c][i]);
         const double v = 1.0 / (std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) + reg);
-        wt.boundary[i] = v;
+        wt.boundary[i] = kept.boundary[i] * v;
         sum += v;
         rows += 1.0;
     }

@@ -74,6 +74,10 @@ struct SpaceTimeProblem {
     // the primal, dx and dy rows (0 drops a row; poisson_gpu.h's weights for WL2, WL1 and
     // non-finite input). L1's IRLS weights multiply them, renormalised over the rows kept.
     Field weightPrimal, weightDx, weightDy;
+    // The same for the temporal rows ((F − 1)·W·H, at the earlier frame's pixel, as dt), the
+    // mixed rows (as dxt, dyt; with γ > 0) and the rows to the previous frame (W·H, with
+    // `previous`): the variance-weighted reconstructions (tgpt --recon wl1|wl2).
+    Field weightDt, weightDxt, weightDyt, weightDtPrevious;
     // Optional: the frame before the window, already reconstructed (W·H per channel), and the
     // target of I_0 − previous: temporal rows β (I_0 − previous − dtPrevious) that tie the
     // window to the one before it (a sequence reconstructed window by window has no seam).

@@ -251,7 +251,7 @@ TEST_F(SequenceCli, TemporalGptRendersWindowsOfFrames) {
     const auto layers = readExr(path("t/f_3.exr"));
     std::vector<std::string> names;
     for (const auto& l : layers) names.push_back(l.name);
-    for (const char* want : {"recon_spacetime_l1", "primal", "dx", "dy", "dt", "motion", "direct"})
+    for (const char* want : {"recon_spacetime_l1", "primal", "dx", "dy", "dt", "var_dt", "motion", "direct"})
         EXPECT_NE(std::find(names.begin(), names.end(), want), names.end()) << want;
     // The same-pixel replay: every pixel is its own partner, with no offset in the motion layer.
     const RunResult replay =
@@ -274,6 +274,22 @@ TEST_F(SequenceCli, TemporalGptRendersWindowsOfFrames) {
               readExrLayer(path("r/f_1.exr"), "primal").plane(0));
     EXPECT_NE(readExrLayer(path("m/f_1.exr"), "recon_spacetime_l1").plane(0),
               readExrLayer(path("r/f_1.exr"), "recon_spacetime_l1").plane(0));
+    // The variance-weighted reconstruction: named, from the same samples, and another image; the
+    // variance of dt from the halves' two groups of one sample (4 spp).
+    const RunResult weighted =
+        runGdpt("render " + kMovingBox + " --method tgpt --frames 0:1 --spp 4 --recon wl1 " +
+                "--width 16 --height 12 --no-video -o " + path("w/f_%d.exr") + " --json " + path("w.json"));
+    ASSERT_EQ(weighted.code, 0) << weighted.output;
+    const nlohmann::json wj = readJson(path("w.json"))["frame_summaries"][1];
+    EXPECT_EQ(wj["reconstructions"][0]["method"], "spacetime_wl1");
+    EXPECT_EQ(wj["tgpt"]["dt_variance_groups"], 2);
+    EXPECT_EQ(readJson(path("t.json"))["frame_summaries"][0]["tgpt"]["dt_variance_groups"], 0);
+    EXPECT_EQ(readExrLayer(path("w/f_1.exr"), "primal").plane(0), readExrLayer(path("t/f_1.exr"), "primal").plane(0));
+    EXPECT_NE(readExrLayer(path("w/f_1.exr"), "recon_spacetime_wl1").plane(0),
+              readExrLayer(path("t/f_1.exr"), "recon_spacetime_l1").plane(0));
+    double varDt = 0.0;
+    for (float v : readExrLayer(path("w/f_1.exr"), "var_dt").plane(1)) varDt += v;
+    EXPECT_GT(varDt, 0.0);
 
     // diff-sequence along the motion: a sequence against itself has no error; against the
     // replay render, some; frames without a number or missing are refused.
@@ -304,14 +320,14 @@ TEST_F(SequenceCli, TemporalGptRefusesWhatItCannotDo) {
         int code;
     } cases[] = {
         {"-o " + path("x.exr"), "--method tgpt renders a sequence", 2},
-        {"--frames 0:1 --recon wl2 -o " + path("f_%d.exr"), "reconstructs with --recon l1 or l2", 2},
+        {"--frames 0:1 --all-recon -o " + path("f_%d.exr"), "reconstructs with one --recon", 2},
         {"--frames 0:1 --demodulate on -o " + path("f_%d.exr"), "does not demodulate", 2},
         {"--frames 0:1 --window 0 -o " + path("f_%d.exr"), "--window", 2},
         {"--window 3 -o " + path("x.exr"), "--window requires --frames", 2},
         {"--frames 0:1 --temporal-shift sideways -o " + path("f_%d.exr"), "--temporal-shift", 2},
         {"--frames 0:1 --gamma -1 -o " + path("f_%d.exr"), "--gamma", 2},
         {"--frames 0:63 --window 64 --width 4096 --height 4096 -o " + path("f_%d.exr"),
-         "needs about 672.0 GiB for its space-time reconstruction", 1},
+         "needs about 690.0 GiB for its space-time reconstruction", 1},
     };
     for (const auto& c : cases) {
         const RunResult r = runGdpt(base + c.flags);

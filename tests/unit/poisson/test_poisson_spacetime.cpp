@@ -239,35 +239,40 @@ Field denseLeastSquares(const SpaceTimeProblem& p, int c) {
     const std::size_t np = p.pixels(), n = p.size(), w = std::size_t(p.width);
     std::vector<std::vector<std::pair<std::size_t, double>>> rows;
     std::vector<double> targets;
-    const auto row = [&](std::vector<std::pair<std::size_t, double>> r, double t) {
+    // A row of weight u enters as √u times itself (energy u·e²).
+    const auto row = [&](std::vector<std::pair<std::size_t, double>> r, double t, const Field& weights,
+                         std::size_t at) {
+        const double s = weights.empty() ? 1.0 : std::sqrt(weights[at]);
+        for (auto& entry : r) entry.second *= s;
         rows.push_back(std::move(r));
-        targets.push_back(t);
+        targets.push_back(s * t);
     };
     for (std::size_t i = 0; i < n; ++i) {
         const std::size_t f = i / np, k = i % np;
-        row({{i, p.alpha}}, p.alpha * p.primal[c][i]);
-        if (k % w + 1 < w) row({{i + 1, 1.0}, {i, -1.0}}, p.dx[c][i]);
-        if (k + w < np) row({{i + w, 1.0}, {i, -1.0}}, p.dy[c][i]);
+        row({{i, p.alpha}}, p.alpha * p.primal[c][i], p.weightPrimal, i);
+        if (k % w + 1 < w) row({{i + 1, 1.0}, {i, -1.0}}, p.dx[c][i], p.weightDx, i);
+        if (k + w < np) row({{i + w, 1.0}, {i, -1.0}}, p.dy[c][i], p.weightDy, i);
         if (f + 1 < std::size_t(p.frames)) {
             const auto partnerOf = [&](std::size_t at) {
                 return p.temporalPartner.empty() ? std::uint32_t(at % np) : p.temporalPartner[at];
             };
             const std::uint32_t to = partnerOf(i);
             if (to != kNoTemporalPartner)
-                row({{(f + 1) * np + to, p.beta}, {i, -p.beta}}, p.beta * p.dt[c][i]);
+                row({{(f + 1) * np + to, p.beta}, {i, -p.beta}}, p.beta * p.dt[c][i], p.weightDt, i);
             // Mixed rows where i and its neighbour i+s are carried side by side.
             const double g = p.gamma;
             const std::size_t next = (f + 1) * np + to, x = k % w, y = k / w, tx = to % w, ty = to / w;
             const std::size_t h = np / w;
             if (g > 0.0 && to != kNoTemporalPartner && x + 1 < w && tx + 1 < w && partnerOf(i + 1) == to + 1)
-                row({{next + 1, g}, {next, -g}, {i + 1, -g}, {i, g}}, g * p.dxt[c][i]);
+                row({{next + 1, g}, {next, -g}, {i + 1, -g}, {i, g}}, g * p.dxt[c][i], p.weightDxt, i);
             if (g > 0.0 && to != kNoTemporalPartner && y + 1 < h && ty + 1 < h && partnerOf(i + w) == to + w)
-                row({{next + w, g}, {next, -g}, {i + w, -g}, {i, g}}, g * p.dyt[c][i]);
+                row({{next + w, g}, {next, -g}, {i + w, -g}, {i, g}}, g * p.dyt[c][i], p.weightDyt, i);
         }
     }
     for (std::size_t j = 0; j < p.previous[c].size(); ++j) {
         const std::uint32_t to = p.previousPartner.empty() ? std::uint32_t(j) : p.previousPartner[j];
-        if (to != kNoTemporalPartner) row({{to, p.beta}}, p.beta * (p.previous[c][j] + p.dtPrevious[c][j]));
+        if (to != kNoTemporalPartner)
+            row({{to, p.beta}}, p.beta * (p.previous[c][j] + p.dtPrevious[c][j]), p.weightDtPrevious, j);
     }
     Eigen::MatrixXd a = Eigen::MatrixXd::Zero(Eigen::Index(rows.size()), Eigen::Index(n));
     Eigen::VectorXd b(Eigen::Index(rows.size()));
@@ -402,6 +407,61 @@ TEST(SpaceTimePoisson, MixedRowsSolveTheLeastSquaresOfTheirRows) {
         SpaceTimeProblem without = p;
         without.gamma = 0.0;
         EXPECT_GT(maxDiff(solveSpaceTime(without, o)[0], x[0]), 1e-3);
+    }
+}
+
+// Every kind of row weighted (the variance-weighted reconstructions, tgpt --recon wl1|wl2):
+// random weights in [0, 2), a tenth of them 0, on the mixed-row problem tied to a previous frame.
+TEST(SpaceTimePoisson, RowWeightsSolveTheWeightedLeastSquares) {
+    for (const unsigned seed : {3u, 4u}) {
+        SpaceTimeProblem p = withMixedRows(seed);
+        const std::size_t np = p.pixels(), n = p.size(), nt = np * std::size_t(p.frames - 1);
+        std::mt19937 rng(seed);
+        std::uniform_real_distribution<double> u(0.0, 2.0);
+        std::normal_distribution<double> noise(0.0, 0.3);
+        for (int c = 0; c < 3; ++c) {
+            p.previous[c].resize(np);
+            p.dtPrevious[c].resize(np);
+            for (std::size_t j = 0; j < np; ++j) p.previous[c][j] = 1.0 + noise(rng), p.dtPrevious[c][j] = noise(rng);
+        }
+        for (std::size_t j = 0; j < np; ++j)
+            p.previousPartner.push_back(rng() % 5 == 0 ? kNoTemporalPartner : std::uint32_t(rng() % np));
+        const auto weights = [&](std::size_t count) {
+            Field f(count);
+            for (double& v : f) v = rng() % 10 == 0 ? 0.0 : u(rng);
+            return f;
+        };
+        p.weightPrimal = weights(n);
+        p.weightDx = weights(n);
+        p.weightDy = weights(n);
+        p.weightDt = weights(nt);
+        p.weightDxt = weights(nt);
+        p.weightDyt = weights(nt);
+        p.weightDtPrevious = weights(np);
+        const SpaceTimeOptions o = tightL2();
+        SpaceTimeOptions diagonal = o;
+        diagonal.multigrid = false;
+        const auto x = solveSpaceTime(p, o), xj = solveSpaceTime(p, diagonal);
+        for (int c = 0; c < 3; ++c) {
+            const Field dense = denseLeastSquares(p, c);
+            EXPECT_LT(maxDiff(x[c], dense), 1e-8) << "seed " << seed << " channel " << c;
+            EXPECT_LT(maxDiff(xj[c], dense), 1e-8) << "seed " << seed << " channel " << c;
+            EXPECT_LT(maxDiff(solveSpaceTimeExactL2(p, c), dense), 1e-8) << "seed " << seed << " channel " << c;
+        }
+        // Each kind of weight moves the answer.
+        for (Field SpaceTimeProblem::*weight : {&SpaceTimeProblem::weightDt, &SpaceTimeProblem::weightDxt,
+                                                &SpaceTimeProblem::weightDyt, &SpaceTimeProblem::weightDtPrevious}) {
+            SpaceTimeProblem unit = p;
+            (unit.*weight).clear();
+            EXPECT_GT(maxDiff(solveSpaceTime(unit, o)[0], x[0]), 1e-4) << "seed " << seed;
+        }
+        // Sizes and values are checked.
+        SpaceTimeProblem bad = p;
+        bad.weightDt.pop_back();
+        EXPECT_THROW((void)solveSpaceTime(bad, o), Error);
+        bad = p;
+        bad.weightDtPrevious[0] = -1.0;
+        EXPECT_THROW((void)solveSpaceTime(bad, o), Error);
     }
 }
 

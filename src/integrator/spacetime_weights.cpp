@@ -1,0 +1,78 @@
+// spacetime_weights.cpp — the variance-weighted space-time reconstructions' row weights.
+#include "integrator/spacetime_weights.h"
+
+#include <cmath>
+#include <string>
+
+#include "poisson/poisson_gpu.h"
+#include "util/error.h"
+
+namespace gdpt {
+namespace {
+
+// The weights of `images` (frame-major, W·H each) appended to `to`.
+void appendWeights(Field& to, const std::vector<Image>& images, std::size_t pixels, bool filtered,
+                   double epsilon, int radius, const char* what) {
+    for (const Image& var : images) {
+        if (var.pixelCount() != pixels)
+            throw Error(std::string("space-time weights: a ") + what + " variance has " +
+                        std::to_string(var.pixelCount()) + " pixels, expected " + std::to_string(pixels));
+        if (filtered) {
+            std::size_t nonFinite = 0, negative = 0;
+            for (float v : boxFilteredVariance(var, radius, nonFinite, negative))
+                to.push_back(v < 0.0f ? 0.0 : 1.0 / (double(v) + epsilon));
+            continue;
+        }
+        for (std::size_t i = 0; i < pixels; ++i) {
+            const double r = var.plane(0)[i], g = var.plane(1)[i], b = var.plane(2)[i];
+            const bool usable = std::isfinite(r) && std::isfinite(g) && std::isfinite(b) && r >= 0.0 &&
+                                g >= 0.0 && b >= 0.0;
+            to.push_back(usable ? 1.0 / ((r + g + b) / 3.0 + epsilon) : 0.0);
+        }
+    }
+}
+
+}  // namespace
+
+void setVarianceWeights(SpaceTimeProblem& problem, const RowVariances& v, bool filtered, double epsilon,
+                        int radius) {
+    const std::size_t frames = std::size_t(problem.frames), pixels = problem.pixels();
+    const bool mixed = problem.gamma > 0.0, previous = !problem.previous[0].empty();
+    const auto count = [&](const std::vector<Image>& images, std::size_t want, const char* what) {
+        if (images.size() != want)
+            throw Error(std::string("space-time weights: ") + std::to_string(images.size()) + " " + what +
+                        " variances for a window of " + std::to_string(frames) + " frames");
+    };
+    count(v.primal, frames, "primal");
+    count(v.dx, frames, "dx");
+    count(v.dy, frames, "dy");
+    count(v.dt, frames - 1, "dt");
+    if (mixed) {
+        count(v.dxt, frames - 1, "dxt");
+        count(v.dyt, frames - 1, "dyt");
+    }
+    if (previous && v.dtPrevious.pixelCount() != pixels)
+        throw Error("space-time weights: the window joins a previous frame but has no variance for its dt");
+    std::vector<Field*> fields = {&problem.weightPrimal, &problem.weightDx, &problem.weightDy, &problem.weightDt,
+                                  &problem.weightDxt, &problem.weightDyt, &problem.weightDtPrevious};
+    for (Field* f : fields) f->clear();
+    appendWeights(problem.weightPrimal, v.primal, pixels, filtered, epsilon, radius, "primal");
+    appendWeights(problem.weightDx, v.dx, pixels, filtered, epsilon, radius, "dx");
+    appendWeights(problem.weightDy, v.dy, pixels, filtered, epsilon, radius, "dy");
+    appendWeights(problem.weightDt, v.dt, pixels, filtered, epsilon, radius, "dt");
+    if (mixed) {
+        appendWeights(problem.weightDxt, v.dxt, pixels, filtered, epsilon, radius, "dxt");
+        appendWeights(problem.weightDyt, v.dyt, pixels, filtered, epsilon, radius, "dyt");
+    }
+    if (previous) appendWeights(problem.weightDtPrevious, {v.dtPrevious}, pixels, filtered, epsilon, radius, "dt");
+    double sum = 0.0, rows = 0.0;
+    for (const Field* f : fields)
+        for (double w : *f)
+            if (w > 0.0) sum += w, rows += 1.0;
+    if (!(sum > 0.0)) return;
+    const double scale = rows / sum;
+    for (Field* f : fields)
+        for (double& w : *f) w *= scale;
+}
+
+}  // namespace gdpt
