@@ -151,9 +151,12 @@ std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t
     };
     pass(value, count, true);
     pass(value, count, false);
+    // A running sum that has taken a large value (a firefly's variance) in and out again keeps
+    // its rounding residue, which can be negative where every value left in the box is 0; a
+    // negative average would read as "no variance" (weight 0), so it is clamped.
     std::vector<float> out(n);
     for (std::size_t i = 0; i < n; ++i)
-        out[i] = count[i] > 0.5 ? static_cast<float>(value[i] / count[i]) : -1.0f;
+        out[i] = count[i] > 0.5 ? static_cast<float>(std::max(0.0, value[i]) / count[i]) : -1.0f;
     return out;
 }
 

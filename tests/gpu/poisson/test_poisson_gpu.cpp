@@ -664,6 +664,29 @@ TEST(BoxFilteredVariance, AveragesTheClippedBoxOfValidValues) {
     }
 }
 
+// A firefly's variance beside zeros: the running sums take it in and out again, and the boxes
+// after it, all zeros, must average to about 0 (a rounding residue far below WL1's ε = 1e-4),
+// never to a negative residue (which WL1 read as a missing variance and gave its rows weight 0).
+// Before the clamp: -2.6e-13 at every one of these pixels.
+TEST(BoxFilteredVariance, ZerosAfterAFireflyAverageToZero) {
+    const int w = 40, h = 3;
+    Image var(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int c = 0; c < 3; ++c) {
+            var.at(3, y, c) = 5703.4f;
+            var.at(4, y, c) = 0.1f + 0.01f * float(c);
+            var.at(5, y, c) = 13928.7f;
+        }
+    std::size_t nonFinite = 0, negative = 0;
+    const std::vector<float> f = boxFilteredVariance(var, 3, nonFinite, negative);
+    for (int y = 0; y < h; ++y)
+        for (int x = 9; x < w; ++x) {
+            EXPECT_GE(f[std::size_t(y * w + x)], 0.0f) << x << "," << y;
+            EXPECT_LT(f[std::size_t(y * w + x)], 1e-9f) << x << "," << y;
+        }
+    for (float v : f) EXPECT_GE(v, 0.0f);
+}
+
 // WL1 is L1 (IRLS) whose rows are weighted by the inverse of the box-filtered variances:
 // the same solve as L1 given those weights explicitly, and not the unweighted L1.
 TEST_F(PoissonGpu, WeightedL1IsL1WithFilteredInverseVarianceWeights) {
