@@ -34,8 +34,8 @@ bool SampleGroupRecorder::wants(std::uint32_t done) const {
 void SampleGroupRecorder::record(std::uint32_t done, std::vector<Image> means) {
     if (!wants(done)) return;
     if (!groups_.ends.empty() && done <= groups_.ends.back())
-        throw Error("sample groups: a group ends at " + std::to_string(done) + " samples, not after the last (" +
-                    std::to_string(groups_.ends.back()) + ")");
+        throw Error("sample groups: a group ends at " + std::to_string(done) +
+                    " samples, not after the last (" + std::to_string(groups_.ends.back()) + ")");
     groups_.ends.push_back(done);
     groups_.means.push_back(std::move(means));
     if (maxGroups_ == 0 || groups_.ends.size() <= maxGroups_) return;
@@ -77,7 +77,8 @@ Image pairedDifferenceVariance(const SampleGroups& later, const SampleGroups& ea
     const double n = double(earlier.ends.back());
     Image out(shape.width(), shape.height());
     std::vector<double> d(groups), m(groups);
-    for (std::size_t j = 0; j < groups; ++j) m[j] = double(earlier.ends[j]) - (j > 0 ? earlier.ends[j - 1] : 0.0);
+    for (std::size_t j = 0; j < groups; ++j)
+        m[j] = double(earlier.ends[j]) - (j > 0 ? earlier.ends[j - 1] : 0.0);
     // Group j's mean from the cumulative means at its ends: (e_j M_j − e_j−1 M_j−1) / m_j.
     const auto groupMean = [&](const SampleGroups& g, std::size_t j, int c, std::size_t i) {
         const double sum = double(g.ends[j]) * g.means[j][layer].plane(c)[i] -

@@ -25,8 +25,8 @@ void appendWeights(Field& to, const std::vector<Image>& images, std::size_t pixe
         }
         for (std::size_t i = 0; i < pixels; ++i) {
             const double r = var.plane(0)[i], g = var.plane(1)[i], b = var.plane(2)[i];
-            const bool usable = std::isfinite(r) && std::isfinite(g) && std::isfinite(b) && r >= 0.0 &&
-                                g >= 0.0 && b >= 0.0;
+            const bool usable =
+                std::isfinite(r) && std::isfinite(g) && std::isfinite(b) && r >= 0.0 && g >= 0.0 && b >= 0.0;
             to.push_back(usable ? 1.0 / ((r + g + b) / 3.0 + epsilon) : 0.0);
         }
     }
@@ -53,8 +53,9 @@ void setVarianceWeights(SpaceTimeProblem& problem, const RowVariances& v, bool f
     }
     if (previous && v.dtPrevious.pixelCount() != pixels)
         throw Error("space-time weights: the window joins a previous frame but has no variance for its dt");
-    std::vector<Field*> fields = {&problem.weightPrimal, &problem.weightDx, &problem.weightDy, &problem.weightDt,
-                                  &problem.weightDxt, &problem.weightDyt, &problem.weightDtPrevious};
+    std::vector<Field*> fields = {&problem.weightPrimal,    &problem.weightDx,  &problem.weightDy,
+                                  &problem.weightDt,        &problem.weightDxt, &problem.weightDyt,
+                                  &problem.weightDtPrevious};
     for (Field* f : fields) f->clear();
     appendWeights(problem.weightPrimal, v.primal, pixels, filtered, epsilon, radius, "primal");
     appendWeights(problem.weightDx, v.dx, pixels, filtered, epsilon, radius, "dx");
@@ -64,7 +65,8 @@ void setVarianceWeights(SpaceTimeProblem& problem, const RowVariances& v, bool f
         appendWeights(problem.weightDxt, v.dxt, pixels, filtered, epsilon, radius, "dxt");
         appendWeights(problem.weightDyt, v.dyt, pixels, filtered, epsilon, radius, "dyt");
     }
-    if (previous) appendWeights(problem.weightDtPrevious, {v.dtPrevious}, pixels, filtered, epsilon, radius, "dt");
+    if (previous)
+        appendWeights(problem.weightDtPrevious, {v.dtPrevious}, pixels, filtered, epsilon, radius, "dt");
     double sum = 0.0, rows = 0.0;
     for (const Field* f : fields)
         for (double w : *f)

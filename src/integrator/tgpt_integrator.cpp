@@ -138,7 +138,8 @@ std::uint64_t windowBytes(int width, int height, int frames, bool mixed, bool we
     const std::uint64_t image = std::uint64_t(width) * std::uint64_t(height) * 3u * 4u;
     const std::uint64_t perFrame = mixed ? (weighted ? 19u : 17u) : 13u;
     const std::uint64_t groups = 2u * kSampleGroups * (mixed && weighted ? 3u : 1u);
-    return spaceTimeSolveBytes(width, height, frames, mixed) + image * (std::uint64_t(frames) * perFrame + groups);
+    return spaceTimeSolveBytes(width, height, frames, mixed) +
+           image * (std::uint64_t(frames) * perFrame + groups);
 }
 
 // Refuses a window larger than the machine's memory, before it is sampled.
@@ -266,8 +267,8 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         if (paired) half.spp = pairedSpp;
         half.seed = window.seed(frame);
         // Paired: the same groups of samples as the second half it repeats (batches end there).
-        SampleGroupRecorder firstGroups = SampleGroupRecorder::atEnds(paired ? previousGroups.ends
-                                                                             : std::vector<std::uint32_t>{});
+        SampleGroupRecorder firstGroups =
+            SampleGroupRecorder::atEnds(paired ? previousGroups.ends : std::vector<std::uint32_t>{});
         if (paired) {
             firstSampling.groups = &firstGroups;
             firstSampling.groupGradients = groupGradients;
@@ -445,8 +446,8 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         out.layers.push_back({"dx", std::move(f.dx)});
         out.layers.push_back({"dy", std::move(f.dy)});
         out.layers.push_back({"dt", std::move(dtToPrevious[k])});
-        out.layers.push_back({"var_dt", f.varDt.empty() ? Image(width, height)
-                                                        : atLaterPixels(f.varDt, f.fromPrevious)});
+        out.layers.push_back(
+            {"var_dt", f.varDt.empty() ? Image(width, height) : atLaterPixels(f.varDt, f.fromPrevious)});
         out.layers.push_back({"motion", motionLayer(f.fromPrevious, hasPrevious, width, height)});
         out.layers.push_back({"direct", std::move(f.direct)});
         out.layers.push_back({"var_primal", std::move(f.varPrimal)});

@@ -11,8 +11,8 @@
 //   2. reconstruct: a space-time screened Poisson solve of the window from every frame's
 //      primal, dx, dy and the dt between its frames (poisson_spacetime.h; L1 by IRLS by
 //      default; wl1, wl2 weight every row by its inverse variance, spacetime_weights.h, dt's
-//      from the paired samples' groups, sample_groups.h), coupled to the previous window's last reconstructed frame through the dt
-//      between the windows, so that a sequence has no seam at window boundaries;
+//      from the paired samples' groups, sample_groups.h), coupled to the previous window's last reconstructed
+//      frame through the dt between the windows, so that a sequence has no seam at window boundaries;
 //   3. compose: final = reconstruction + very-direct light, per frame (as G-PT, §5 of
 //      Kettunen et al. 2015).
 // The temporal shift (TgptOptions::shift): random replay in primary sample space, Jacobian 1.

@@ -284,7 +284,8 @@ TEST_F(SequenceCli, TemporalGptRendersWindowsOfFrames) {
     EXPECT_EQ(wj["reconstructions"][0]["method"], "spacetime_wl1");
     EXPECT_EQ(wj["tgpt"]["dt_variance_groups"], 2);
     EXPECT_EQ(readJson(path("t.json"))["frame_summaries"][0]["tgpt"]["dt_variance_groups"], 0);
-    EXPECT_EQ(readExrLayer(path("w/f_1.exr"), "primal").plane(0), readExrLayer(path("t/f_1.exr"), "primal").plane(0));
+    EXPECT_EQ(readExrLayer(path("w/f_1.exr"), "primal").plane(0),
+              readExrLayer(path("t/f_1.exr"), "primal").plane(0));
     EXPECT_NE(readExrLayer(path("w/f_1.exr"), "recon_spacetime_wl1").plane(0),
               readExrLayer(path("t/f_1.exr"), "recon_spacetime_l1").plane(0));
     double varDt = 0.0;

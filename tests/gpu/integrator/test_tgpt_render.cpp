@@ -245,7 +245,8 @@ void TgptRender::expectUnbiasedTemporalDifferences(TemporalShift shift) {
     // 0.5 rejects that by far while allowing twice QMC's measured gain.
     EXPECT_LE(paired, 1.0 + 4.0 * pairedSe) << "var_dt understates the spread of dt";
     EXPECT_GE(paired, 0.5) << "var_dt overstates the spread of dt (se " << pairedSe << ")";
-    EXPECT_LT(unpaired + 4.0 * unpairedSe, 0.5) << "the test cannot tell var_dt from unpaired halves' variance";
+    EXPECT_LT(unpaired + 4.0 * unpairedSe, 0.5)
+        << "the test cannot tell var_dt from unpaired halves' variance";
 }
 
 TEST_F(TgptRender, TemporalDifferencesAreUnbiased) {

@@ -40,9 +40,12 @@ TEST(SampleGroups, EveryBatchMergesNeighboursPastTheLimit) {
         const SampleGroups& g = r.groups();
         ASSERT_LE(g.ends.size(), 16u);
         ASSERT_EQ(g.ends.back(), done);
-        if (done >= 16) ASSERT_GE(g.ends.size(), 8u);
+        if (done >= 16) {
+            ASSERT_GE(g.ends.size(), 8u);
+        }
         // Each kept end keeps its own cumulative mean.
-        for (std::size_t j = 0; j < g.ends.size(); ++j) ASSERT_EQ(g.means[j][0].at(0, 0, 0), float(g.ends[j]));
+        for (std::size_t j = 0; j < g.ends.size(); ++j)
+            ASSERT_EQ(g.means[j][0].at(0, 0, 0), float(g.ends[j]));
     }
     EXPECT_THROW(r.record(100, {Image(1, 1)}), Error);
     EXPECT_THROW((void)SampleGroupRecorder::everyBatch(1), Error);

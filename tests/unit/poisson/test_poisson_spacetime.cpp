@@ -422,7 +422,8 @@ TEST(SpaceTimePoisson, RowWeightsSolveTheWeightedLeastSquares) {
         for (int c = 0; c < 3; ++c) {
             p.previous[c].resize(np);
             p.dtPrevious[c].resize(np);
-            for (std::size_t j = 0; j < np; ++j) p.previous[c][j] = 1.0 + noise(rng), p.dtPrevious[c][j] = noise(rng);
+            for (std::size_t j = 0; j < np; ++j)
+                p.previous[c][j] = 1.0 + noise(rng), p.dtPrevious[c][j] = noise(rng);
         }
         for (std::size_t j = 0; j < np; ++j)
             p.previousPartner.push_back(rng() % 5 == 0 ? kNoTemporalPartner : std::uint32_t(rng() % np));
@@ -446,11 +447,13 @@ TEST(SpaceTimePoisson, RowWeightsSolveTheWeightedLeastSquares) {
             const Field dense = denseLeastSquares(p, c);
             EXPECT_LT(maxDiff(x[c], dense), 1e-8) << "seed " << seed << " channel " << c;
             EXPECT_LT(maxDiff(xj[c], dense), 1e-8) << "seed " << seed << " channel " << c;
-            EXPECT_LT(maxDiff(solveSpaceTimeExactL2(p, c), dense), 1e-8) << "seed " << seed << " channel " << c;
+            EXPECT_LT(maxDiff(solveSpaceTimeExactL2(p, c), dense), 1e-8)
+                << "seed " << seed << " channel " << c;
         }
         // Each kind of weight moves the answer.
-        for (Field SpaceTimeProblem::*weight : {&SpaceTimeProblem::weightDt, &SpaceTimeProblem::weightDxt,
-                                                &SpaceTimeProblem::weightDyt, &SpaceTimeProblem::weightDtPrevious}) {
+        for (Field SpaceTimeProblem::*weight :
+             {&SpaceTimeProblem::weightDt, &SpaceTimeProblem::weightDxt, &SpaceTimeProblem::weightDyt,
+              &SpaceTimeProblem::weightDtPrevious}) {
             SpaceTimeProblem unit = p;
             (unit.*weight).clear();
             EXPECT_GT(maxDiff(solveSpaceTime(unit, o)[0], x[0]), 1e-4) << "seed " << seed;
