@@ -53,9 +53,13 @@ void setVarianceWeights(SpaceTimeProblem& problem, const RowVariances& v, bool f
     }
     if (previous && v.dtPrevious.pixelCount() != pixels)
         throw Error("space-time weights: the window joins a previous frame but has no variance for its dt");
-    std::vector<Field*> fields = {&problem.weightPrimal,    &problem.weightDx,  &problem.weightDy,
-                                  &problem.weightDt,        &problem.weightDxt, &problem.weightDyt,
-                                  &problem.weightDtPrevious};
+    const bool mixedPrevious = !problem.dxtPrevious[0].empty();
+    if (mixedPrevious && (v.dxtPrevious.pixelCount() != pixels || v.dytPrevious.pixelCount() != pixels))
+        throw Error("space-time weights: the mixed rows to the previous frame have no variances");
+    std::vector<Field*> fields = {
+        &problem.weightPrimal,     &problem.weightDx,          &problem.weightDy,
+        &problem.weightDt,         &problem.weightDxt,         &problem.weightDyt,
+        &problem.weightDtPrevious, &problem.weightDxtPrevious, &problem.weightDytPrevious};
     for (Field* f : fields) f->clear();
     appendWeights(problem.weightPrimal, v.primal, pixels, filtered, epsilon, radius, "primal");
     appendWeights(problem.weightDx, v.dx, pixels, filtered, epsilon, radius, "dx");
@@ -67,6 +71,10 @@ void setVarianceWeights(SpaceTimeProblem& problem, const RowVariances& v, bool f
     }
     if (previous)
         appendWeights(problem.weightDtPrevious, {v.dtPrevious}, pixels, filtered, epsilon, radius, "dt");
+    if (mixedPrevious) {
+        appendWeights(problem.weightDxtPrevious, {v.dxtPrevious}, pixels, filtered, epsilon, radius, "dxt");
+        appendWeights(problem.weightDytPrevious, {v.dytPrevious}, pixels, filtered, epsilon, radius, "dyt");
+    }
     double sum = 0.0, rows = 0.0;
     for (const Field* f : fields)
         for (double w : *f)

@@ -20,11 +20,13 @@ struct RowVariances {
     // Per pair of consecutive frames (F − 1), at the earlier frame's pixels, as the solve's dt;
     // dxt, dyt only with mixed rows.
     std::vector<Image> dt, dxt, dyt;
-    Image dtPrevious;  // the rows to the previous window's last frame (at its pixels), or empty
+    Image dtPrevious;                // the rows to the previous window's last frame (at its pixels), or empty
+    Image dxtPrevious, dytPrevious;  // its mixed rows (with problem.dxtPrevious), or empty
 };
 
-// Sets problem.weight{Primal,Dx,Dy,Dt,Dxt,Dyt,DtPrevious} from `v` (dxt, dyt with γ > 0,
-// dtPrevious with problem.previous). Throws gdpt::Error if the counts or sizes disagree.
+// Sets problem.weight{Primal,Dx,Dy,Dt,Dxt,Dyt,DtPrevious,DxtPrevious,DytPrevious} from `v` (dxt,
+// dyt with γ > 0, dtPrevious with problem.previous, dxtPrevious and dytPrevious with
+// problem.dxtPrevious). Throws gdpt::Error if the counts or sizes disagree.
 void setVarianceWeights(SpaceTimeProblem& problem, const RowVariances& v, bool filtered, double epsilon,
                         int radius);
 

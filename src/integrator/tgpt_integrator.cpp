@@ -379,6 +379,13 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
             differenceAlong(frames[0].firstHalfPrimal, carry_->secondHalfPrimal, frames[0].fromPrevious);
         problem.previous = carry_->recon;
         append(problem.dtPrevious, dt);
+        if (mixed && !carry_->secondHalfDx.empty()) {
+            // Mixed rows across the windows' boundary, with targets as inside a window.
+            append(problem.dxtPrevious,
+                   differenceAlong(frames[0].firstHalfDx, carry_->secondHalfDx, frames[0].fromPrevious));
+            append(problem.dytPrevious,
+                   differenceAlong(frames[0].firstHalfDy, carry_->secondHalfDy, frames[0].fromPrevious));
+        }
         if (motion) problem.previousPartner = frames[0].fromPrevious;
         dtToPrevious[0] = atLaterPixels(dt, frames[0].fromPrevious);
     }
@@ -399,6 +406,10 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
             }
         }
         if (joined) v.dtPrevious = orZero(frames[0].varDt);
+        if (!problem.dxtPrevious[0].empty()) {
+            v.dxtPrevious = orZero(frames[0].varDxt);
+            v.dytPrevious = orZero(frames[0].varDyt);
+        }
         const SolveOptions defaults;
         setVarianceWeights(problem, v, options_.l1, defaults.varianceEpsilon, defaults.varianceFilterRadius);
     }
@@ -462,6 +473,8 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
                    std::move(frames.back().secondHalfPrimal),
                    pairedSpp,
                    std::move(previousGroups),
+                   mixed ? std::move(frames.back().secondHalfDx) : Image(),
+                   mixed ? std::move(frames.back().secondHalfDy) : Image(),
                    std::move(previousScene),
                    std::move(previousHits)};
     const std::size_t last = std::size_t(window.count - 1) * std::size_t(width) * std::size_t(height);

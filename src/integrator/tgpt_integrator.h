@@ -70,7 +70,8 @@ private:
         std::array<std::vector<double>, 3> recon;
         Image secondHalfPrimal;
         std::uint32_t secondHalfSpp = 0;
-        SampleGroups secondHalfGroups;  // its sample groups (the next first half repeats them)
+        SampleGroups secondHalfGroups;     // its sample groups (the next first half repeats them)
+        Image secondHalfDx, secondHalfDy;  // with mixed rows: the targets of the rows across
         // The motion shift: the last frame's scene and primary hits (motion_map.h).
         std::shared_ptr<const Scene> scene;
         std::vector<PrimaryHit> hits;

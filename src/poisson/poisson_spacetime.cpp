@@ -33,6 +33,10 @@ struct Operator {
     // row's coefficient at each of its four pixels (with mixed rows only; jacobiDiag()).
     Field cmx, cmy;
     Field mixedDiag;
+    // Mixed rows to the previous frame: γ² w of the row at its pixel j (W·H each; empty: none),
+    // an edge bnext(j)–bnext(j)+s of frame 0 added into cx, cy; cx0, cy0: frame 0's dx, dy rows'
+    // own coefficients (the right-hand side takes them apart).
+    Field bmx, bmy, cx0, cy0;
     std::vector<std::uint32_t>
         next;  // next(i): the temporal neighbour of i in the window, or kNoTemporalPartner
     std::vector<std::uint32_t> bnext;  // bnext(j): the pixel of frame 0 of the previous frame's pixel j
@@ -49,6 +53,7 @@ struct Operator {
 struct Weights {
     Field primal, dx, dy, dt, boundary;  // boundary: W·H rows to the previous frame, or empty
     Field mx, my;                        // mixed rows ((F − 1)·W·H), or empty without them
+    Field bmx, bmy;                      // mixed rows to the previous frame (W·H), or empty
 };
 
 // Pixels per range of the parallel loops. Sums are taken per range and added in range order,
@@ -152,6 +157,14 @@ void check(const SpaceTimeProblem& p) {
             sized(p.previous[c], p.pixels(), "previous");
             sized(p.dtPrevious[c], p.pixels(), "dtPrevious");
         }
+        if (!p.dxtPrevious[c].empty() || !p.dytPrevious[c].empty()) {
+            if (p.previous[c].empty() || !(p.gamma > 0.0))
+                throw Error(
+                    "space-time Poisson: mixed rows to the previous frame need the previous frame and gamma "
+                    "> 0");
+            sized(p.dxtPrevious[c], p.pixels(), "dxtPrevious");
+            sized(p.dytPrevious[c], p.pixels(), "dytPrevious");
+        }
     }
     if (p.previous[0].empty() != p.previous[1].empty() || p.previous[0].empty() != p.previous[2].empty())
         throw Error("space-time Poisson: previous is given for some channels only");
@@ -166,6 +179,7 @@ void check(const SpaceTimeProblem& p) {
                             " of a frame of " + std::to_string(p.pixels()));
     };
     const std::size_t nb = p.previous[0].empty() ? 0 : p.pixels();
+    const std::size_t nbm = p.dxtPrevious[0].empty() ? 0 : p.pixels();
     for (const auto& [field, what, want] :
          {std::tuple<const Field*, const char*, std::size_t>{&p.weightPrimal, "weightPrimal", n},
           {&p.weightDx, "weightDx", n},
@@ -173,7 +187,9 @@ void check(const SpaceTimeProblem& p) {
           {&p.weightDt, "weightDt", nt},
           {&p.weightDxt, "weightDxt", p.gamma > 0.0 ? nt : 0},
           {&p.weightDyt, "weightDyt", p.gamma > 0.0 ? nt : 0},
-          {&p.weightDtPrevious, "weightDtPrevious", nb}}) {
+          {&p.weightDtPrevious, "weightDtPrevious", nb},
+          {&p.weightDxtPrevious, "weightDxtPrevious", nbm},
+          {&p.weightDytPrevious, "weightDytPrevious", nbm}}) {
         if (field->empty()) continue;
         if (field->size() != want)
             throw Error(std::string("space-time Poisson: ") + what + " has " + std::to_string(field->size()) +
@@ -232,6 +248,21 @@ Weights unitWeights(const SpaceTimeProblem& p) {
         if (p.temporalPartner[i] == kNoTemporalPartner) wt.dt[i] = 0.0;
     for (std::size_t j = 0; j < p.previousPartner.size() && !wt.boundary.empty(); ++j)
         if (p.previousPartner[j] == kNoTemporalPartner) wt.boundary[j] = 0.0;
+    if (!p.dxtPrevious[0].empty()) {
+        // The same rule for the rows from the previous frame's pixel j into frame 0.
+        const std::vector<std::uint32_t> to = previousNext(p);
+        const std::size_t h = std::size_t(p.height);
+        wt.bmx.assign(np, 0.0);
+        wt.bmy.assign(np, 0.0);
+        for (std::size_t j = 0; j < np; ++j) {
+            const std::uint32_t q = to[j];
+            if (q == kNoTemporalPartner) continue;
+            if (j % w + 1 < w && std::size_t(q) % w + 1 < w && to[j + 1] == q + 1)
+                wt.bmx[j] = p.weightDxtPrevious.empty() ? 1.0 : p.weightDxtPrevious[j];
+            if (j / w + 1 < h && std::size_t(q) / w + 1 < h && to[j + w] == q + w)
+                wt.bmy[j] = p.weightDytPrevious.empty() ? 1.0 : p.weightDytPrevious[j];
+        }
+    }
     if (p.gamma > 0.0) {
         // A mixed row where i and i+s both have partners, carried rigidly: π(i+s) = π(i) + s,
         // with π(i) + s in π(i)'s row (x) or frame (y).
@@ -281,6 +312,22 @@ void setWeights(const SpaceTimeProblem& p, const Weights& wt, Operator& op, std:
     const double a2 = p.alpha * p.alpha, b2 = p.beta * p.beta;
     copied(op.cx, wt.dx);
     copied(op.cy, wt.dy);
+    if (wt.bmx.empty()) {
+        op.bmx.clear(), op.bmy.clear(), op.cx0.clear(), op.cy0.clear();
+    } else {
+        // Each mixed row to the previous frame is an edge of frame 0 (above).
+        const double g2 = p.gamma * p.gamma;
+        op.cx0.assign(op.cx.begin(), op.cx.begin() + std::ptrdiff_t(np));
+        op.cy0.assign(op.cy.begin(), op.cy.begin() + std::ptrdiff_t(np));
+        op.bmx.resize(np);
+        op.bmy.resize(np);
+        for (std::size_t j = 0; j < np; ++j) {
+            op.bmx[j] = g2 * wt.bmx[j];
+            op.bmy[j] = g2 * wt.bmy[j];
+            if (op.bmx[j] != 0.0) op.cx[op.bnext[j]] += op.bmx[j];
+            if (op.bmy[j] != 0.0) op.cy[op.bnext[j]] += op.bmy[j];
+        }
+    }
     sized(op.ct, n);
     sized(op.cp, n);
     sized(op.diag, n);
@@ -348,11 +395,15 @@ void rhs(const SpaceTimeProblem& p, const Operator& op, std::array<Field, 3>& b,
     parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
         for (int c = 0; c < 3; ++c) {
             const Field &dx = p.dx[c], &dy = p.dy[c], &dt = p.dt[c];
+            // The dx, dy rows' own coefficients (frame 0's cx, cy also hold the mixed rows to
+            // the previous frame, whose targets are added below).
+            const auto cxRow = [&](std::size_t i) { return i < op.cx0.size() ? op.cx0[i] : op.cx[i]; };
+            const auto cyRow = [&](std::size_t i) { return i < op.cy0.size() ? op.cy0[i] : op.cy[i]; };
             for (std::size_t i = begin; i < end; ++i) {
-                double v = op.cp[i] * p.primal[c][i] - op.cx[i] * dx[i] - op.cy[i] * dy[i];
+                double v = op.cp[i] * p.primal[c][i] - cxRow(i) * dx[i] - cyRow(i) * dy[i];
                 if (op.ct[i] != 0.0) v -= op.ct[i] * dt[i];
-                if (i >= 1) v += op.cx[i - 1] * dx[i - 1];
-                if (i >= w) v += op.cy[i - w] * dy[i - w];
+                if (i >= 1) v += cxRow(i - 1) * dx[i - 1];
+                if (i >= w) v += cyRow(i - w) * dy[i - w];
                 for (std::uint32_t k = op.backStart[i]; k < op.backStart[i + 1]; ++k)
                     v += op.ct[op.back[k]] * dt[op.back[k]];
                 if (mixed) v += gatherMixed(op, targets.x[c], i, 1) + gatherMixed(op, targets.y[c], i, w);
@@ -360,9 +411,24 @@ void rhs(const SpaceTimeProblem& p, const Operator& op, std::array<Field, 3>& b,
             }
         }
     });
-    for (int c = 0; c < 3; ++c)
+    for (int c = 0; c < 3; ++c) {
         for (std::size_t j = 0; j < op.cb.size(); ++j)
             if (op.cb[j] != 0.0) b[c][op.bnext[j]] += op.cb[j] * (p.previous[c][j] + p.dtPrevious[c][j]);
+        // Mixed rows to the previous frame: (x_q+s − x_q) with target previous_j+s − previous_j + dst_j.
+        for (std::size_t j = 0; j < op.bmx.size(); ++j) {
+            const std::size_t q = op.bnext[j];
+            if (op.bmx[j] != 0.0) {
+                const double t = op.bmx[j] * (p.previous[c][j + 1] - p.previous[c][j] + p.dxtPrevious[c][j]);
+                b[c][q + 1] += t;
+                b[c][q] -= t;
+            }
+            if (op.bmy[j] != 0.0) {
+                const double t = op.bmy[j] * (p.previous[c][j + w] - p.previous[c][j] + p.dytPrevious[c][j]);
+                b[c][q + w] += t;
+                b[c][q] -= t;
+            }
+        }
+    }
 }
 
 // (A x)_i for i in [begin, end); `rowsX`, `rowsY`: x's mixed row values C M x
@@ -672,6 +738,8 @@ void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array
     sized(wt.boundary, kept.boundary.size());
     sized(wt.mx, kept.mx.size());
     sized(wt.my, kept.my.size());
+    sized(wt.bmx, kept.bmx.size());
+    sized(wt.bmy, kept.bmy.size());
     const std::size_t n = p.size(), np = p.pixels(), w = std::size_t(p.width);
     std::vector<std::array<double, 2>> partial(rangesOf(n));  // per range: Σ weights, rows
     parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
@@ -736,8 +804,26 @@ void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array
         sum += v;
         rows += 1.0;
     }
+    for (std::size_t j = 0; j < wt.bmx.size(); ++j) {
+        const std::size_t q = op.bnext[j];
+        for (const auto& [kw, out, s, target] :
+             {std::tuple<const Field*, Field*, std::size_t, const std::array<Field, 3>*>{&kept.bmx, &wt.bmx,
+                                                                                         1, &p.dxtPrevious},
+              {&kept.bmy, &wt.bmy, w, &p.dytPrevious}}) {
+            (*out)[j] = 0.0;
+            if ((*kw)[j] == 0.0) continue;
+            double e[3];
+            for (int c = 0; c < 3; ++c)
+                e[c] = p.gamma * ((x[c][q + s] - x[c][q]) - (p.previous[c][j + s] - p.previous[c][j]) -
+                                  (*target)[c][j]);
+            const double v = 1.0 / (std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) + reg);
+            (*out)[j] = (*kw)[j] * v;
+            sum += v;
+            rows += 1.0;
+        }
+    }
     const double scale = sum > 0.0 ? rows / sum : 1.0;
-    for (Field* f : {&wt.primal, &wt.dx, &wt.dy, &wt.dt, &wt.boundary, &wt.mx, &wt.my}) {
+    for (Field* f : {&wt.primal, &wt.dx, &wt.dy, &wt.dt, &wt.boundary, &wt.mx, &wt.my, &wt.bmx, &wt.bmy}) {
         Field& v = *f;
         parallelRanges(threads, v.size(), kGrain, [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i) v[i] *= scale;

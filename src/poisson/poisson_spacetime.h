@@ -10,6 +10,8 @@
 //          [+ β² Σ_i wdb (I_0,π(i) − previous_i − dtPrevious_i)²    the frame before, fixed]
 //          [+ γ² Σ_{f<F−1} Σ_i Σ_{s∈{1,W}} wm ((I_f+1,π(i)+s − I_f+1,π(i))
 //                                              − (I_f,i+s − I_f,i) − dst_f,i)²]   mixed rows
+//          [+ γ² Σ_i Σ_s wbm ((I_0,π(i)+s − I_0,π(i)) − (previous_i+s − previous_i)
+//                              − dstPrevious_i)²]                  mixed rows to the frame before
 // which is poisson_problem.h's energy of each frame plus the temporal rows: a weighted graph
 // Laplacian over the pixels' x, y and temporal neighbours plus the screening diagonal. π(i) is
 // the pixel of the next frame that pixel i's temporal difference ends at: i itself (the
@@ -20,8 +22,8 @@
 // change of a spatial difference along the motion, dxt = ∂x∂t and dyt = ∂y∂t, where the motion
 // carries the pair of pixels i, i+s rigidly (π(i+s) = π(i) + s in the same row or column). Each
 // such row couples four unknowns, so it is not an edge of the graph Laplacian: the operator adds
-// it in gather form. Rows to the fixed previous frame carry only dt (no mixed rows across a
-// window boundary).
+// it in gather form. A mixed row to the fixed previous frame couples two unknowns of frame 0:
+// it is an edge of frame 0 (like a dx or dy row, with its own target).
 //
 // L2: the weights are 1. L1 (the default of G-PT): iteratively reweighted least squares as the
 // 2D device solver does it (poisson_irls.h, poisson_gpu.h's schedule): round 0 is the L2
@@ -76,12 +78,18 @@ struct SpaceTimeProblem {
     Field weightPrimal, weightDx, weightDy;
     // The same for the temporal rows ((F − 1)·W·H, at the earlier frame's pixel, as dt), the
     // mixed rows (as dxt, dyt; with γ > 0) and the rows to the previous frame (W·H, with
-    // `previous`): the variance-weighted reconstructions (tgpt --recon wl1|wl2).
-    Field weightDt, weightDxt, weightDyt, weightDtPrevious;
+    // `previous`, and its mixed rows with dxtPrevious): the variance-weighted reconstructions
+    // (tgpt --recon wl1|wl2).
+    Field weightDt, weightDxt, weightDyt, weightDtPrevious, weightDxtPrevious, weightDytPrevious;
     // Optional: the frame before the window, already reconstructed (W·H per channel), and the
     // target of I_0 − previous: temporal rows β (I_0 − previous − dtPrevious) that tie the
     // window to the one before it (a sequence reconstructed window by window has no seam).
     std::array<Field, 3> previous, dtPrevious;
+    // Optional, with `previous` and γ > 0: the mixed rows to the previous frame (W·H per
+    // channel, at its pixels j): γ ((I_0,π(j)+s − I_0,π(j)) − (previous_j+s − previous_j) −
+    // dxtPrevious_j) for s = 1 (dyt: W) where π carries j, j+s rigidly; with the previous frame
+    // fixed each is a spatial difference row of frame 0. Empty: none (dt rows only there).
+    std::array<Field, 3> dxtPrevious, dytPrevious;
     // π: where each temporal row ends, or empty for the same pixel everywhere. temporalPartner
     // has (F − 1)·W·H entries: for frame f's pixel i (at f·W·H + i), the pixel index (0 ..
     // W·H − 1) in frame f+1 that dt_f,i is the difference to, or kNoTemporalPartner (no row).

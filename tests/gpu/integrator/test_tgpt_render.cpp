@@ -10,6 +10,7 @@
 //     difference (motion);
 //   - var_dt (from the paired samples' groups) against the spread of dt over the seeds: a
 //     ratio near 1, where the variance of independent halves is 13-16 times too large;
+//   - mixed rows cross a window boundary (windows of one frame, --gamma 0 against 1);
 //   - a timed sequence pairs every sample of a first half with the frame before's second half;
 //   - the same seed gives the same bits.
 #include <gtest/gtest.h>
@@ -279,6 +280,32 @@ TEST_F(TgptRender, TimedHalvesArePairedSampleForSample) {
         EXPECT_EQ(frames[k].stats.partialPassRows, 0u) << "frame " << k;
         EXPECT_GE(t.secondHalfSpp, 1u);
     }
+}
+
+// Windows of one frame have no mixed rows inside them: --gamma acts only through the mixed rows
+// to the previous window's last frame, which must change the second frame's reconstruction
+// (from the same samples) and leave the first frame's, which has no frame before, alone.
+TEST_F(TgptRender, MixedRowsCrossTheWindowBoundary) {
+    const GltfAsset asset(std::string(GDPT_SOURCE_DIR) + "/scenes/moving_box.gltf");
+    const auto sceneAt = [&](int f) { return asset.instance(0, f * 0.25); };
+    const auto run = [&](double gamma) {
+        TgptOptions o;
+        o.window = 1;
+        o.gamma = gamma;
+        TgptIntegrator tgpt(o);
+        const RenderOptions options = renderOptions(24, 16, 4, 0);
+        std::vector<RenderOutput> frames = tgpt.renderWindow(keeping(), windowOf(sceneAt, 0, 1, 5), options);
+        const auto next = tgpt.renderWindow(keeping(), windowOf(sceneAt, 1, 1, 5, false), options);
+        frames.insert(frames.end(), next.begin(), next.end());
+        return frames;
+    };
+    const auto without = run(0.0), with = run(1.0);
+    ASSERT_EQ(with.size(), 2u);
+    ASSERT_TRUE(with[1].stats.tgpt.joinedPreviousWindow);
+    test::expectSameBits(without[0].layer("recon_spacetime_l1"), with[0].layer("recon_spacetime_l1"),
+                         "frame 0");
+    test::expectSameBits(without[1].layer("primal"), with[1].layer("primal"), "frame 1 primal");
+    EXPECT_NE(without[1].layer("recon_spacetime_l1").plane(0), with[1].layer("recon_spacetime_l1").plane(0));
 }
 
 TEST_F(TgptRender, SameSeedSameBits) {

@@ -273,6 +273,19 @@ Field denseLeastSquares(const SpaceTimeProblem& p, int c) {
         const std::uint32_t to = p.previousPartner.empty() ? std::uint32_t(j) : p.previousPartner[j];
         if (to != kNoTemporalPartner)
             row({{to, p.beta}}, p.beta * (p.previous[c][j] + p.dtPrevious[c][j]), p.weightDtPrevious, j);
+        // Mixed rows to the previous frame, where j and j+s are carried side by side.
+        if (p.dxtPrevious[c].empty() || to == kNoTemporalPartner) continue;
+        const auto partnerOf = [&](std::size_t at) {
+            return p.previousPartner.empty() ? std::uint32_t(at) : p.previousPartner[at];
+        };
+        const double g = p.gamma;
+        const std::size_t x = j % w, y = j / w, tx = to % w, ty = to / w, h = np / w;
+        if (x + 1 < w && tx + 1 < w && partnerOf(j + 1) == to + 1)
+            row({{to + 1, g}, {to, -g}}, g * (p.previous[c][j + 1] - p.previous[c][j] + p.dxtPrevious[c][j]),
+                p.weightDxtPrevious, j);
+        if (y + 1 < h && ty + 1 < h && partnerOf(j + w) == to + w)
+            row({{to + w, g}, {to, -g}}, g * (p.previous[c][j + w] - p.previous[c][j] + p.dytPrevious[c][j]),
+                p.weightDytPrevious, j);
     }
     Eigen::MatrixXd a = Eigen::MatrixXd::Zero(Eigen::Index(rows.size()), Eigen::Index(n));
     Eigen::VectorXd b(Eigen::Index(rows.size()));
@@ -425,8 +438,19 @@ TEST(SpaceTimePoisson, RowWeightsSolveTheWeightedLeastSquares) {
             for (std::size_t j = 0; j < np; ++j)
                 p.previous[c][j] = 1.0 + noise(rng), p.dtPrevious[c][j] = noise(rng);
         }
-        for (std::size_t j = 0; j < np; ++j)
-            p.previousPartner.push_back(rng() % 5 == 0 ? kNoTemporalPartner : std::uint32_t(rng() % np));
+        // Partners one pixel to the right, some missing, some elsewhere (as withMixedRows).
+        for (std::size_t j = 0; j < np; ++j) {
+            const unsigned r = rng() % 8;
+            p.previousPartner.push_back(r == 0 || j % 7 + 1 == 7 ? kNoTemporalPartner
+                                        : r == 1                 ? std::uint32_t(rng() % np)
+                                                                 : std::uint32_t(j + 1));
+        }
+        for (int c = 0; c < 3; ++c) {
+            p.dxtPrevious[c].resize(np);
+            p.dytPrevious[c].resize(np);
+            for (std::size_t j = 0; j < np; ++j)
+                p.dxtPrevious[c][j] = noise(rng), p.dytPrevious[c][j] = noise(rng);
+        }
         const auto weights = [&](std::size_t count) {
             Field f(count);
             for (double& v : f) v = rng() % 10 == 0 ? 0.0 : u(rng);
@@ -439,6 +463,8 @@ TEST(SpaceTimePoisson, RowWeightsSolveTheWeightedLeastSquares) {
         p.weightDxt = weights(nt);
         p.weightDyt = weights(nt);
         p.weightDtPrevious = weights(np);
+        p.weightDxtPrevious = weights(np);
+        p.weightDytPrevious = weights(np);
         const SpaceTimeOptions o = tightL2();
         SpaceTimeOptions diagonal = o;
         diagonal.multigrid = false;
@@ -453,7 +479,8 @@ TEST(SpaceTimePoisson, RowWeightsSolveTheWeightedLeastSquares) {
         // Each kind of weight moves the answer.
         for (Field SpaceTimeProblem::*weight :
              {&SpaceTimeProblem::weightDt, &SpaceTimeProblem::weightDxt, &SpaceTimeProblem::weightDyt,
-              &SpaceTimeProblem::weightDtPrevious}) {
+              &SpaceTimeProblem::weightDtPrevious, &SpaceTimeProblem::weightDxtPrevious,
+              &SpaceTimeProblem::weightDytPrevious}) {
             SpaceTimeProblem unit = p;
             (unit.*weight).clear();
             EXPECT_GT(maxDiff(solveSpaceTime(unit, o)[0], x[0]), 1e-4) << "seed " << seed;
@@ -465,6 +492,19 @@ TEST(SpaceTimePoisson, RowWeightsSolveTheWeightedLeastSquares) {
         bad = p;
         bad.weightDtPrevious[0] = -1.0;
         EXPECT_THROW((void)solveSpaceTime(bad, o), Error);
+        bad = p;
+        bad.dxtPrevious[1].pop_back();
+        EXPECT_THROW((void)solveSpaceTime(bad, o), Error);
+        bad = p;
+        bad.gamma = 0.0;
+        bad.dxt = bad.dyt = {};
+        EXPECT_THROW((void)solveSpaceTime(bad, o), Error) << "mixed rows to the previous frame without gamma";
+        // The mixed rows to the previous frame matter.
+        SpaceTimeProblem without = p;
+        without.dxtPrevious = without.dytPrevious = {};
+        without.weightDxtPrevious.clear();
+        without.weightDytPrevious.clear();
+        EXPECT_GT(maxDiff(solveSpaceTime(without, o)[0], x[0]), 1e-4) << "seed " << seed;
     }
 }
 
@@ -501,6 +541,18 @@ TEST(SpaceTimePoisson, MixedRowsKeepConsistentDataExact) {
         for (int c = 0; c < 3; ++c)
             EXPECT_LT(maxDiff(x[c], p.primal[c]), 1e-6) << "l1 " << l1 << " channel " << c;
     }
+    // The same window after its first frame, tied to it by dt and mixed rows: still exact.
+    SpaceTimeProblem after = afterFirstFrame(p);
+    after.gamma = p.gamma;
+    after.previousPartner.assign(p.temporalPartner.begin(), p.temporalPartner.begin() + std::ptrdiff_t(np));
+    after.temporalPartner.assign(p.temporalPartner.begin() + std::ptrdiff_t(np), p.temporalPartner.end());
+    for (int c = 0; c < 3; ++c) {
+        after.dxt[c].assign(p.dxt[c].begin() + std::ptrdiff_t(np), p.dxt[c].end());
+        after.dyt[c].assign(p.dyt[c].begin() + std::ptrdiff_t(np), p.dyt[c].end());
+        after.dxtPrevious[c].assign(p.dxt[c].begin(), p.dxt[c].begin() + std::ptrdiff_t(np));
+        after.dytPrevious[c].assign(p.dyt[c].begin(), p.dyt[c].begin() + std::ptrdiff_t(np));
+    }
+    expectRecoveredFromZero(after);
     // A wrong mixed target (the sign of ∂x∂t flipped) no longer fits: the data is not recovered.
     SpaceTimeProblem wrong = p;
     for (int c = 0; c < 3; ++c)
