@@ -126,8 +126,9 @@ Image frameOf(const std::array<Field, 3>& x, std::size_t frame, int width, int h
     return out;
 }
 
-// Groups of paired samples kept per half render (sample_groups.h): between 8 and 16, so that a
-// pixel's var_dt has 7 to 15 degrees of freedom.
+// Groups of paired samples kept per half render (sample_groups.h): at most 16, so that a pixel's
+// var_dt has up to 15 degrees of freedom (fewer below 16 samples per half, or in a timed half of
+// fewer batches).
 constexpr std::size_t kSampleGroups = 16;
 
 // What a window keeps: the solver's fields, and per frame thirteen float RGB images (the halves'
