@@ -483,11 +483,12 @@ void applyRange(const Operator& op, const Field& x, Field& y, std::size_t begin,
     applyRangeGeneral(op, x, y, hi, end, nullptr, nullptr);
 }
 
-// CG's multigrid preconditioner: block Jacobi over the frames with one V-cycle per frame
-// (host_vcycle.h). Each frame's diagonal block of A is a 5-point graph Laplacian (its dx, dy
-// rows, and the halves of the mixed rows inside one frame: a mixed row joins m with m+s and
-// π(m) with π(m)+s by edges of its weight) plus the diagonal; the rows between frames (dt, the
-// mixed rows' cross terms) are left to CG. One frame is HostVcycle on the operator itself.
+// CG's multigrid preconditioner: one V-cycle per frame (host_vcycle.h), as block Jacobi or block
+// Gauss-Seidel over the frames. Each frame's diagonal block of A is a 5-point graph Laplacian
+// (its dx, dy rows, and the halves of the mixed rows inside one frame: a mixed row joins m with
+// m+s and π(m) with π(m)+s by edges of its weight) plus the diagonal; the rows between frames
+// (dt, the mixed rows' cross terms) are left to CG (block Jacobi) or applied between the
+// frames' cycles (block Gauss-Seidel). One frame is HostVcycle on the operator itself.
 class FrameBlocks {
 public:
     void build(const Operator& op, std::uint32_t threads) {
@@ -519,9 +520,14 @@ public:
             cycles_[f].build(op.width, op.height, cx_[f], cy_[f], diag_[f], threads);
     }
 
-    // z = M⁻¹ r for the channels in `which`.
-    void apply(const std::array<Field, 3>& r, std::array<Field, 3>& z, const std::array<bool, 3>& which,
-               std::uint32_t threads) {
+    // z = M⁻¹ r for the channels in `which`: block Jacobi (a V-cycle per frame), or with
+    // `coupled` and several frames symmetric block Gauss-Seidel (applyCoupled).
+    void apply(const Operator& op, const std::array<Field, 3>& r, std::array<Field, 3>& z,
+               const std::array<bool, 3>& which, std::uint32_t threads, bool coupled) {
+        if (coupled && cycles_.size() > 1) {
+            applyCoupled(op, r, z, which, threads);
+            return;
+        }
         const std::size_t np = r[0].size() / cycles_.size();
         for (std::size_t f = 0; f < cycles_.size(); ++f) {
             std::array<const double*, 3> rf{};
@@ -533,8 +539,124 @@ public:
     }
 
 private:
+    // Symmetric block Gauss-Seidel over the frames, each block's inverse approximated by its
+    // V-cycle V_f: forward t_f = V_f (r_f − A_f,f−1 t_f−1), backward z_f = t_f − V_f A_f,f+1 z_f+1.
+    // With A_f+1,f = A_f,f+1ᵀ, M⁻¹ = (V⁻¹ + U)⁻¹ V⁻¹ (V⁻¹ + L)⁻¹ (L, U the blocks below and above
+    // the diagonal), symmetric positive definite for SPD V_f: a valid CG preconditioner that,
+    // unlike block Jacobi, sees the coupling between neighbouring frames (the temporal rows and
+    // the mixed rows' terms across frames), which IRLS makes stiff where the frames agree.
+    void applyCoupled(const Operator& op, const std::array<Field, 3>& r, std::array<Field, 3>& z,
+                      const std::array<bool, 3>& which, std::uint32_t threads) {
+        const std::size_t frames = cycles_.size(), np = op.pixels(), w = std::size_t(op.width);
+        const bool mixed = !op.cmx.empty();
+        for (int c = 0; c < 3; ++c) {
+            if (!which[c]) continue;
+            sized(s_[c], np);
+            sized(e_[c], np);
+            if (mixed) sized(rx_[c], np), sized(ry_[c], np);
+        }
+        const auto cycle = [&](std::size_t f, std::array<double*, 3> out) {
+            std::array<const double*, 3> in{};
+            for (int c = 0; c < 3; ++c)
+                if (which[c]) in[c] = s_[c].data();
+            cycles_[f].applyTo(in, out, which, threads);
+        };
+        // Forward: s = r_f + (the temporal rows' −A_f,f−1 t) − (the mixed rows' A_f,f−1 t), where
+        // t is z, filled for the frames before f. A mixed row at m of frame f−1 (b = next(m))
+        // has t's part c (t_m − t_m+s) (frame f's part is still 0) and enters A t at b with
+        // sign −1 and at b + s with +1.
+        for (std::size_t f = 0; f < frames; ++f) {
+            const std::size_t base = f * np, prev = base - np;
+            if (mixed && f > 0)
+                parallelRanges(threads, np, kGrain, [&](std::size_t begin, std::size_t end) {
+                    for (int c = 0; c < 3; ++c) {
+                        if (!which[c]) continue;
+                        const Field& t = z[c];
+                        for (std::size_t i = begin; i < end; ++i) {
+                            const std::size_t m = prev + i;
+                            rx_[c][i] = op.cmx[m] != 0.0 ? op.cmx[m] * (t[m] - t[m + 1]) : 0.0;
+                            ry_[c][i] = op.cmy[m] != 0.0 ? op.cmy[m] * (t[m] - t[m + w]) : 0.0;
+                        }
+                    }
+                });
+            parallelRanges(threads, np, kGrain, [&](std::size_t begin, std::size_t end) {
+                for (int c = 0; c < 3; ++c) {
+                    if (!which[c]) continue;
+                    const Field& t = z[c];
+                    for (std::size_t i = begin; i < end; ++i) {
+                        const std::size_t k = base + i;
+                        double v = r[c][k];
+                        if (f > 0) {
+                            for (std::uint32_t j = op.backStart[k]; j < op.backStart[k + 1]; ++j) {
+                                const std::uint32_t m = op.back[j];
+                                v += op.ct[m] * t[m];
+                                if (mixed) v += rx_[c][m - prev] + ry_[c][m - prev];
+                            }
+                            if (mixed && i >= 1)
+                                for (std::uint32_t j = op.backStart[k - 1]; j < op.backStart[k]; ++j)
+                                    v -= rx_[c][op.back[j] - prev];
+                            if (mixed && i >= w)
+                                for (std::uint32_t j = op.backStart[k - w]; j < op.backStart[k - w + 1]; ++j)
+                                    v -= ry_[c][op.back[j] - prev];
+                        }
+                        s_[c][i] = v;
+                    }
+                }
+            });
+            std::array<double*, 3> out{};
+            for (int c = 0; c < 3; ++c)
+                if (which[c]) out[c] = z[c].data() + base;
+            cycle(f, out);
+        }
+        // Backward: s = A_f,f+1 z_f+1: the temporal row at k (−ct z_next) and the mixed rows of
+        // frame f with their frame f+1 part c (z_b+s − z_b), entering at m with +1, m + s with −1.
+        for (std::size_t f = frames - 1; f-- > 0;) {
+            const std::size_t base = f * np;
+            if (mixed)
+                parallelRanges(threads, np, kGrain, [&](std::size_t begin, std::size_t end) {
+                    for (int c = 0; c < 3; ++c) {
+                        if (!which[c]) continue;
+                        const Field& zc = z[c];
+                        for (std::size_t i = begin; i < end; ++i) {
+                            const std::size_t k = base + i, b = op.next[k];
+                            rx_[c][i] = op.cmx[k] != 0.0 ? op.cmx[k] * (zc[b + 1] - zc[b]) : 0.0;
+                            ry_[c][i] = op.cmy[k] != 0.0 ? op.cmy[k] * (zc[b + w] - zc[b]) : 0.0;
+                        }
+                    }
+                });
+            parallelRanges(threads, np, kGrain, [&](std::size_t begin, std::size_t end) {
+                for (int c = 0; c < 3; ++c) {
+                    if (!which[c]) continue;
+                    const Field& zc = z[c];
+                    for (std::size_t i = begin; i < end; ++i) {
+                        const std::size_t k = base + i, b = op.next[k];
+                        double v = b != kNoTemporalPartner ? -op.ct[k] * zc[b] : 0.0;
+                        if (mixed) {
+                            v += rx_[c][i] + ry_[c][i];
+                            if (i >= 1) v -= rx_[c][i - 1];
+                            if (i >= w) v -= ry_[c][i - w];
+                        }
+                        s_[c][i] = v;
+                    }
+                }
+            });
+            std::array<double*, 3> out{};
+            for (int c = 0; c < 3; ++c)
+                if (which[c]) out[c] = e_[c].data();
+            cycle(f, out);
+            parallelRanges(threads, np, kGrain, [&](std::size_t begin, std::size_t end) {
+                for (int c = 0; c < 3; ++c) {
+                    if (!which[c]) continue;
+                    double* zf = z[c].data() + base;
+                    for (std::size_t i = begin; i < end; ++i) zf[i] -= e_[c][i];
+                }
+            });
+        }
+    }
+
     std::vector<HostVcycle> cycles_;
-    std::vector<Field> cx_, cy_, diag_;  // the frames' blocks (several frames only)
+    std::vector<Field> cx_, cy_, diag_;     // the frames' blocks (several frames only)
+    std::array<Field, 3> s_, e_, rx_, ry_;  // applyCoupled's, one frame each
 };
 
 struct ChannelSolve {
@@ -560,7 +682,7 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
                                 double tolerance, int maxIterations, std::uint32_t threads, CgVectors& v,
                                 const std::function<void(int)>& every16,
                                 std::optional<std::chrono::steady_clock::time_point> deadline,
-                                FrameBlocks* mg) {
+                                FrameBlocks* mg, bool coupleFrames) {
     const std::size_t n = op.size(), ranges = rangesOf(n);
     const Field& jd = op.jacobiDiag();
     std::array<Field, 3>&r = v.r, &p = v.p, &q = v.q;
@@ -579,7 +701,7 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
     }
     // z = M⁻¹ r and r·z for the channels in `which` (multigrid).
     const auto precondition = [&](const std::array<bool, 3>& which) {
-        mg->apply(r, v.z, which, threads);
+        mg->apply(op, r, v.z, which, threads, coupleFrames);
         parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
             std::array<double, 9> s{};
             for (int c = 0; c < 3; ++c) {
@@ -882,7 +1004,7 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
         }
         const std::array<ChannelSolve, 3> solved =
             pcg(op, b, x, tolerance, options.maxIterations, threads, vectors, every16,
-                round > 0 ? options.deadline : std::nullopt, mg);
+                round > 0 ? options.deadline : std::nullopt, mg, options.coupleFrames);
         s.residual = 0.0;
         s.converged = true;
         for (int c = 0; c < 3; ++c) {
@@ -901,6 +1023,7 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
     s.iterations = iterationsSoFar();
     s.irlsIterations = roundsDone;
     s.multigrid = multigrid;
+    s.coupledFrames = multigrid && options.coupleFrames && problem.frames > 1;
     s.ms = timer.ms();
     if (stats) *stats = s;
     return x;
