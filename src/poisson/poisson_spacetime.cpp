@@ -483,6 +483,15 @@ void applyRange(const Operator& op, const Field& x, Field& y, std::size_t begin,
     applyRangeGeneral(op, x, y, hi, end, nullptr, nullptr);
 }
 
+// fn(c, begin, end) for the channels in `which` over ranges of one frame's `np` pixels.
+template <class Fn>
+void overFrame(std::uint32_t threads, std::size_t np, const std::array<bool, 3>& which, const Fn& fn) {
+    parallelRanges(threads, np, kGrain, [&](std::size_t begin, std::size_t end) {
+        for (int c = 0; c < 3; ++c)
+            if (which[c]) fn(c, begin, end);
+    });
+}
+
 // CG's multigrid preconditioner: one V-cycle per frame (host_vcycle.h), as block Jacobi or block
 // Gauss-Seidel over the frames. Each frame's diagonal block of A is a 5-point graph Laplacian
 // (its dx, dy rows, and the halves of the mixed rows inside one frame: a mixed row joins m with
@@ -568,39 +577,33 @@ private:
         for (std::size_t f = 0; f < frames; ++f) {
             const std::size_t base = f * np, prev = base - np;
             if (mixed && f > 0)
-                parallelRanges(threads, np, kGrain, [&](std::size_t begin, std::size_t end) {
-                    for (int c = 0; c < 3; ++c) {
-                        if (!which[c]) continue;
-                        const Field& t = z[c];
-                        for (std::size_t i = begin; i < end; ++i) {
-                            const std::size_t m = prev + i;
-                            rx_[c][i] = op.cmx[m] != 0.0 ? op.cmx[m] * (t[m] - t[m + 1]) : 0.0;
-                            ry_[c][i] = op.cmy[m] != 0.0 ? op.cmy[m] * (t[m] - t[m + w]) : 0.0;
-                        }
-                    }
-                });
-            parallelRanges(threads, np, kGrain, [&](std::size_t begin, std::size_t end) {
-                for (int c = 0; c < 3; ++c) {
-                    if (!which[c]) continue;
+                overFrame(threads, np, which, [&](int c, std::size_t begin, std::size_t end) {
                     const Field& t = z[c];
                     for (std::size_t i = begin; i < end; ++i) {
-                        const std::size_t k = base + i;
-                        double v = r[c][k];
-                        if (f > 0) {
-                            for (std::uint32_t j = op.backStart[k]; j < op.backStart[k + 1]; ++j) {
-                                const std::uint32_t m = op.back[j];
-                                v += op.ct[m] * t[m];
-                                if (mixed) v += rx_[c][m - prev] + ry_[c][m - prev];
-                            }
-                            if (mixed && i >= 1)
-                                for (std::uint32_t j = op.backStart[k - 1]; j < op.backStart[k]; ++j)
-                                    v -= rx_[c][op.back[j] - prev];
-                            if (mixed && i >= w)
-                                for (std::uint32_t j = op.backStart[k - w]; j < op.backStart[k - w + 1]; ++j)
-                                    v -= ry_[c][op.back[j] - prev];
-                        }
-                        s_[c][i] = v;
+                        const std::size_t m = prev + i;
+                        rx_[c][i] = op.cmx[m] != 0.0 ? op.cmx[m] * (t[m] - t[m + 1]) : 0.0;
+                        ry_[c][i] = op.cmy[m] != 0.0 ? op.cmy[m] * (t[m] - t[m + w]) : 0.0;
                     }
+                });
+            overFrame(threads, np, which, [&](int c, std::size_t begin, std::size_t end) {
+                const Field& t = z[c];
+                for (std::size_t i = begin; i < end; ++i) {
+                    const std::size_t k = base + i;
+                    double v = r[c][k];
+                    if (f > 0) {
+                        for (std::uint32_t j = op.backStart[k]; j < op.backStart[k + 1]; ++j) {
+                            const std::uint32_t m = op.back[j];
+                            v += op.ct[m] * t[m];
+                            if (mixed) v += rx_[c][m - prev] + ry_[c][m - prev];
+                        }
+                        if (mixed && i >= 1)
+                            for (std::uint32_t j = op.backStart[k - 1]; j < op.backStart[k]; ++j)
+                                v -= rx_[c][op.back[j] - prev];
+                        if (mixed && i >= w)
+                            for (std::uint32_t j = op.backStart[k - w]; j < op.backStart[k - w + 1]; ++j)
+                                v -= ry_[c][op.back[j] - prev];
+                    }
+                    s_[c][i] = v;
                 }
             });
             std::array<double*, 3> out{};
@@ -613,43 +616,34 @@ private:
         for (std::size_t f = frames - 1; f-- > 0;) {
             const std::size_t base = f * np;
             if (mixed)
-                parallelRanges(threads, np, kGrain, [&](std::size_t begin, std::size_t end) {
-                    for (int c = 0; c < 3; ++c) {
-                        if (!which[c]) continue;
-                        const Field& zc = z[c];
-                        for (std::size_t i = begin; i < end; ++i) {
-                            const std::size_t k = base + i, b = op.next[k];
-                            rx_[c][i] = op.cmx[k] != 0.0 ? op.cmx[k] * (zc[b + 1] - zc[b]) : 0.0;
-                            ry_[c][i] = op.cmy[k] != 0.0 ? op.cmy[k] * (zc[b + w] - zc[b]) : 0.0;
-                        }
-                    }
-                });
-            parallelRanges(threads, np, kGrain, [&](std::size_t begin, std::size_t end) {
-                for (int c = 0; c < 3; ++c) {
-                    if (!which[c]) continue;
+                overFrame(threads, np, which, [&](int c, std::size_t begin, std::size_t end) {
                     const Field& zc = z[c];
                     for (std::size_t i = begin; i < end; ++i) {
                         const std::size_t k = base + i, b = op.next[k];
-                        double v = b != kNoTemporalPartner ? -op.ct[k] * zc[b] : 0.0;
-                        if (mixed) {
-                            v += rx_[c][i] + ry_[c][i];
-                            if (i >= 1) v -= rx_[c][i - 1];
-                            if (i >= w) v -= ry_[c][i - w];
-                        }
-                        s_[c][i] = v;
+                        rx_[c][i] = op.cmx[k] != 0.0 ? op.cmx[k] * (zc[b + 1] - zc[b]) : 0.0;
+                        ry_[c][i] = op.cmy[k] != 0.0 ? op.cmy[k] * (zc[b + w] - zc[b]) : 0.0;
                     }
+                });
+            overFrame(threads, np, which, [&](int c, std::size_t begin, std::size_t end) {
+                const Field& zc = z[c];
+                for (std::size_t i = begin; i < end; ++i) {
+                    const std::size_t k = base + i, b = op.next[k];
+                    double v = b != kNoTemporalPartner ? -op.ct[k] * zc[b] : 0.0;
+                    if (mixed) {
+                        v += rx_[c][i] + ry_[c][i];
+                        if (i >= 1) v -= rx_[c][i - 1];
+                        if (i >= w) v -= ry_[c][i - w];
+                    }
+                    s_[c][i] = v;
                 }
             });
             std::array<double*, 3> out{};
             for (int c = 0; c < 3; ++c)
                 if (which[c]) out[c] = e_[c].data();
             cycle(f, out);
-            parallelRanges(threads, np, kGrain, [&](std::size_t begin, std::size_t end) {
-                for (int c = 0; c < 3; ++c) {
-                    if (!which[c]) continue;
-                    double* zf = z[c].data() + base;
-                    for (std::size_t i = begin; i < end; ++i) zf[i] -= e_[c][i];
-                }
+            overFrame(threads, np, which, [&](int c, std::size_t begin, std::size_t end) {
+                double* zf = z[c].data() + base;
+                for (std::size_t i = begin; i < end; ++i) zf[i] -= e_[c][i];
             });
         }
     }
