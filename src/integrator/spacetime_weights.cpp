@@ -1,7 +1,6 @@
 // spacetime_weights.cpp — the variance-weighted space-time reconstructions' row weights.
 #include "integrator/spacetime_weights.h"
 
-#include <cmath>
 #include <string>
 
 #include "poisson/poisson_gpu.h"
@@ -17,18 +16,14 @@ void appendWeights(Field& to, const std::vector<Image>& images, std::size_t pixe
         if (var.pixelCount() != pixels)
             throw Error(std::string("space-time weights: a ") + what + " variance has " +
                         std::to_string(var.pixelCount()) + " pixels, expected " + std::to_string(pixels));
+        // (Non-finite or negative variances give weight 0; their counts are not reported.)
+        NonFiniteCounts unused;
         if (filtered) {
-            std::size_t nonFinite = 0, negative = 0;
-            for (float v : boxFilteredVariance(var, radius, nonFinite, negative))
-                to.push_back(v < 0.0f ? 0.0 : 1.0 / (double(v) + epsilon));
+            for (float v : boxFilteredVariance(var, radius, unused.variance, unused.negativeVariance))
+                to.push_back(inverseFilteredVariance(v, epsilon));
             continue;
         }
-        for (std::size_t i = 0; i < pixels; ++i) {
-            const double r = var.plane(0)[i], g = var.plane(1)[i], b = var.plane(2)[i];
-            const bool usable =
-                std::isfinite(r) && std::isfinite(g) && std::isfinite(b) && r >= 0.0 && g >= 0.0 && b >= 0.0;
-            to.push_back(usable ? 1.0 / ((r + g + b) / 3.0 + epsilon) : 0.0);
-        }
+        for (std::size_t i = 0; i < pixels; ++i) to.push_back(inverseVariance(var, i, epsilon, unused));
     }
 }
 

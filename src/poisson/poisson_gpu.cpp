@@ -45,21 +45,6 @@ std::vector<float> sanitise(const Image& im, std::size_t& count, std::vector<std
     return out;
 }
 
-// Row weight from an RGB variance image: 1/(mean variance + ε); 0 where a channel is
-// non-finite or negative (no variance is), counted in `counts`.
-float inverseVariance(const Image& var, std::size_t i, double eps, NonFiniteCounts& counts) {
-    if (!finite3(var, i)) {
-        ++counts.variance;
-        return 0.0f;
-    }
-    if (var.plane(0)[i] < 0.0f || var.plane(1)[i] < 0.0f || var.plane(2)[i] < 0.0f) {
-        ++counts.negativeVariance;
-        return 0.0f;
-    }
-    const double v = (double(var.plane(0)[i]) + var.plane(1)[i] + var.plane(2)[i]) / 3.0;
-    return static_cast<float>(1.0 / (v + eps));
-}
-
 // The largest magnitude of the (finite) values.
 float maxMagnitude(const std::vector<float>& values) {
     float m = 0.0f;
@@ -99,6 +84,23 @@ bool needsVariance(Reconstruction r) {
 
 bool debiases(Reconstruction r, int debiasCells) {
     return debiasCells > 0 && r != Reconstruction::L2;
+}
+
+double inverseVariance(const Image& var, std::size_t i, double eps, NonFiniteCounts& counts) {
+    if (!finite3(var, i)) {
+        ++counts.variance;
+        return 0.0;
+    }
+    if (var.plane(0)[i] < 0.0f || var.plane(1)[i] < 0.0f || var.plane(2)[i] < 0.0f) {
+        ++counts.negativeVariance;
+        return 0.0;
+    }
+    const double v = (double(var.plane(0)[i]) + var.plane(1)[i] + var.plane(2)[i]) / 3.0;
+    return 1.0 / (v + eps);
+}
+
+double inverseFilteredVariance(float filtered, double eps) {
+    return filtered < 0.0f ? 0.0 : 1.0 / (double(filtered) + eps);
 }
 
 std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& nonFinite,
@@ -565,7 +567,10 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
         varY = boxFilteredVariance(*in.varDy, o.varianceFilterRadius, nf.variance, nf.negativeVariance);
     }
     const auto inverseFiltered = [&](const std::vector<float>& v, std::size_t i) {
-        return v[i] < 0.0f ? 0.0f : static_cast<float>(1.0 / (double(v[i]) + o.varianceEpsilon));
+        return static_cast<float>(inverseFilteredVariance(v[i], o.varianceEpsilon));
+    };
+    const auto inverse = [&](const Image& var, std::size_t i) {
+        return static_cast<float>(inverseVariance(var, i, o.varianceEpsilon, report.nonFinite));
     };
     for (std::size_t i = 0; i < n; ++i) {
         float* wp = &weights[i];
@@ -582,9 +587,9 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
         *wx = userWeight(in.weightDx);
         *wy = userWeight(in.weightDy);
         if (wl2) {
-            *wp *= inverseVariance(*in.varPrimal, i, o.varianceEpsilon, report.nonFinite);
-            *wx *= inverseVariance(*in.varDx, i, o.varianceEpsilon, report.nonFinite);
-            *wy *= inverseVariance(*in.varDy, i, o.varianceEpsilon, report.nonFinite);
+            *wp *= inverse(*in.varPrimal, i);
+            *wx *= inverse(*in.varDx, i);
+            *wy *= inverse(*in.varDy, i);
         }
         if (wl1) {
             *wp *= inverseFiltered(varP, i);

@@ -177,6 +177,12 @@ bool needsVariance(Reconstruction r);
 // unbiased as it is (a linear function of unbiased estimates).
 bool debiases(Reconstruction r, int debiasCells);
 
+// A row's weight from an RGB variance image (WL2): 1/(mean variance at i + ε); 0 where a
+// channel is non-finite or negative (no variance is), counted in `counts`.
+double inverseVariance(const Image& var, std::size_t i, double eps, NonFiniteCounts& counts);
+// The same from a box-filtered variance (WL1, boxFilteredVariance): 0 for -1 (none valid).
+double inverseFilteredVariance(float filtered, double eps);
+
 // Mean over RGB of `var`, averaged over the (2·radius+1)² box around each pixel (clipped at
 // the borders; separable, linear in the pixels). A pixel with a non-finite or a negative
 // channel counts as missing: it is left out of the averages and counted in `nonFinite` or
