@@ -229,6 +229,24 @@ std::vector<std::uint32_t> previousNext(const SpaceTimeProblem& p) {
     return next;
 }
 
+// The mixed rows' weights (1, or weightX, weightY where given) of rows i in [0, count) whose pixel
+// pair k, k+s (k = i mod W·H) both have partners, carried rigidly: π(i+s) = π(i) + s, with
+// π(i) + s in π(i)'s row (x: s = 1) or frame (y: s = W). wx, wy keep their values elsewhere.
+template <class PartnerOf>
+void rigidMixedRows(std::size_t count, std::size_t np, std::size_t w, std::size_t h,
+                    const PartnerOf& partnerOf, const Field& weightX, const Field& weightY, Field& wx,
+                    Field& wy) {
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::uint32_t to = partnerOf(i);
+        if (to == kNoTemporalPartner) continue;
+        const std::size_t k = i % np;
+        if (k % w + 1 < w && std::size_t(to) % w + 1 < w && partnerOf(i + 1) == to + 1)
+            wx[i] = weightX.empty() ? 1.0 : weightX[i];
+        if (k / w + 1 < h && std::size_t(to) / w + 1 < h && partnerOf(i + w) == to + w)
+            wy[i] = weightY.empty() ? 1.0 : weightY[i];
+    }
+}
+
 Weights unitWeights(const SpaceTimeProblem& p) {
     const std::size_t n = p.size(), np = p.pixels(), w = std::size_t(p.width);
     Weights wt{hugeVector(n, 1.0), hugeVector(n, 1.0), hugeVector(n, 1.0),
@@ -248,39 +266,24 @@ Weights unitWeights(const SpaceTimeProblem& p) {
         if (p.temporalPartner[i] == kNoTemporalPartner) wt.dt[i] = 0.0;
     for (std::size_t j = 0; j < p.previousPartner.size() && !wt.boundary.empty(); ++j)
         if (p.previousPartner[j] == kNoTemporalPartner) wt.boundary[j] = 0.0;
+    const std::size_t h = std::size_t(p.height);
     if (!p.dxtPrevious[0].empty()) {
         // The same rule for the rows from the previous frame's pixel j into frame 0.
         const std::vector<std::uint32_t> to = previousNext(p);
-        const std::size_t h = std::size_t(p.height);
         wt.bmx.assign(np, 0.0);
         wt.bmy.assign(np, 0.0);
-        for (std::size_t j = 0; j < np; ++j) {
-            const std::uint32_t q = to[j];
-            if (q == kNoTemporalPartner) continue;
-            if (j % w + 1 < w && std::size_t(q) % w + 1 < w && to[j + 1] == q + 1)
-                wt.bmx[j] = p.weightDxtPrevious.empty() ? 1.0 : p.weightDxtPrevious[j];
-            if (j / w + 1 < h && std::size_t(q) / w + 1 < h && to[j + w] == q + w)
-                wt.bmy[j] = p.weightDytPrevious.empty() ? 1.0 : p.weightDytPrevious[j];
-        }
+        rigidMixedRows(
+            np, np, w, h, [&](std::size_t j) { return to[j]; }, p.weightDxtPrevious, p.weightDytPrevious,
+            wt.bmx, wt.bmy);
     }
     if (p.gamma > 0.0) {
-        // A mixed row where i and i+s both have partners, carried rigidly: π(i+s) = π(i) + s,
-        // with π(i) + s in π(i)'s row (x) or frame (y).
-        const std::size_t nt = np * std::size_t(p.frames - 1), h = std::size_t(p.height);
+        const std::size_t nt = np * std::size_t(p.frames - 1);
         const auto partner = [&](std::size_t i) {
             return p.temporalPartner.empty() ? std::uint32_t(i % np) : p.temporalPartner[i];
         };
         wt.mx = hugeVector(nt, 0.0);
         wt.my = hugeVector(nt, 0.0);
-        for (std::size_t i = 0; i < nt; ++i) {
-            const std::uint32_t to = partner(i);
-            if (to == kNoTemporalPartner) continue;
-            const std::size_t k = i % np;
-            if (k % w + 1 < w && std::size_t(to) % w + 1 < w && partner(i + 1) == to + 1)
-                wt.mx[i] = p.weightDxt.empty() ? 1.0 : p.weightDxt[i];
-            if (k / w + 1 < h && std::size_t(to) / w + 1 < h && partner(i + w) == to + w)
-                wt.my[i] = p.weightDyt.empty() ? 1.0 : p.weightDyt[i];
-        }
+        rigidMixedRows(nt, np, w, h, partner, p.weightDxt, p.weightDyt, wt.mx, wt.my);
     }
     return wt;
 }
@@ -842,6 +845,11 @@ std::array<ChannelSolve, 3> pcg(const Operator& op, const std::array<Field, 3>& 
     return out;
 }
 
+// IRLS's factor of a row with RGB residual e: 1 / (‖e‖ + reg).
+inline double irlsFactor(const double e[3], double reg) {
+    return 1.0 / (std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) + reg);
+}
+
 // IRLS weights of the estimate x: the row's weight times 1 / (‖e‖_RGB + reg) for every kept
 // row, the IRLS factors renormalised to mean 1 over the kept rows (as poisson_irls_weights.comp).
 // `kept`: the unit weights (0 for dropped rows); `wt` gets the same sizes.
@@ -861,7 +869,7 @@ void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array
     parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
         double sum = 0.0, rows = 0.0;
         const auto weightOf = [&](const double e[3]) {
-            const double v = 1.0 / (std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) + reg);
+            const double v = irlsFactor(e, reg);
             sum += v;
             rows += 1.0;
             return v;
@@ -915,7 +923,7 @@ void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array
         const std::size_t j = op.bnext[i];
         double e[3];
         for (int c = 0; c < 3; ++c) e[c] = p.beta * (x[c][j] - p.previous[c][i] - p.dtPrevious[c][i]);
-        const double v = 1.0 / (std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) + reg);
+        const double v = irlsFactor(e, reg);
         wt.boundary[i] = kept.boundary[i] * v;
         sum += v;
         rows += 1.0;
@@ -932,7 +940,7 @@ void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array
             for (int c = 0; c < 3; ++c)
                 e[c] = p.gamma * ((x[c][q + s] - x[c][q]) - (p.previous[c][j + s] - p.previous[c][j]) -
                                   (*target)[c][j]);
-            const double v = 1.0 / (std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) + reg);
+            const double v = irlsFactor(e, reg);
             (*out)[j] = (*kw)[j] * v;
             sum += v;
             rows += 1.0;
