@@ -35,7 +35,6 @@ struct FrameSamples {
     // solve's rows), from the sample groups of its second half and this first half; empty
     // without a frame before (or with fewer than two groups); dxt, dyt for weighted mixed rows.
     Image varDt, varDxt, varDyt;
-    int dtGroups = 0;
     RenderStats stats;
 };
 
@@ -282,9 +281,10 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         }
         half.batchStops.clear();
         FrameSamples f;
+        int dtGroups = 0;  // (stats are set below, from both halves)
         if (paired) {
             const SampleGroups groups = firstGroups.take();
-            f.dtGroups = int(groups.ends.size());
+            dtGroups = int(groups.ends.size());
             f.varDt = pairedDifferenceVariance(groups, previousGroups, 0, fromPrevious);
             if (groupGradients) {
                 f.varDxt = pairedDifferenceVariance(groups, previousGroups, 1, fromPrevious);
@@ -335,7 +335,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         f.stats.tgpt.secondHalfSpp = second.stats.spp;
         f.stats.tgpt.motionPartnered = partnered;
         f.stats.tgpt.motionMs = motionMs;
-        f.stats.tgpt.dtVarianceGroups = f.dtGroups;
+        f.stats.tgpt.dtVarianceGroups = dtGroups;
         f.fromPrevious = std::move(fromPrevious);
         pairedSpp = second.stats.spp;
         frames.push_back(std::move(f));
