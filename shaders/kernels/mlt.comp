@@ -7,8 +7,8 @@
 //   start      chain c takes bootstrap sample starts[c]'s state (drawn again from the same
 //              numbers) as its current state;
 //   mutate     chain c proposes a small or a large step (mlt.glsl), evaluates it, writes two
-//              records (the current state with weight (1 − a)/T, the proposal with a/T) and
-//              accepts with probability a; one step per dispatch (llvmpipe's loop limit, see
+//              records (the current state with Metropolis share 1 − a, the proposal with a;
+//              mlt.glsl's splat weights) and accepts with probability a; one step per dispatch (llvmpipe's loop limit, see
 //              samplesPerDispatch in pt_pass.h), the records of a batch in step order;
 //   direct     one invocation per pixel: the emission the camera sees directly, by
 //              stratified camera samples (G-PT's "very direct" light, which is neither in the
@@ -174,7 +174,9 @@ void writeRecord(uint at, uint pixel, float weight, float largeTarget, vec3 valu
     records[at].pixel = pixel;
     records[at].weight = weight;
     records[at].largeTarget = largeTarget;
-    for (uint k = 0u; k < kMltValues; ++k) records[at].value[k] = weight > 0.0 ? value[k] : vec3(0.0);
+    // A large step's proposal is splatted by the host even with no Metropolis share.
+    bool splatted = weight > 0.0 || largeTarget > 0.0;
+    for (uint k = 0u; k < kMltValues; ++k) records[at].value[k] = splatted ? value[k] : vec3(0.0);
 }
 
 // Draws chain c's proposal into gPss: a large step (fresh decisions) or a small step of
@@ -195,8 +197,9 @@ void finishMutation(uint c, Evaluated e, bool large, inout Rng m) {
     MltChain cur = chains[c];
     float a = mltAcceptance(cur.target, e.target);
     uint at = frame.recordOffset + 2u * c;
-    writeRecord(at, cur.pixel, mltSplatWeight(1.0 - a, cur.target), -1.0, cur.value);
-    writeRecord(at + 1u, e.pixel, mltSplatWeight(a, e.target), large ? e.target : -1.0, e.value);
+    float bLarge = frame.misNormalisation * frame.largeStep;
+    writeRecord(at, cur.pixel, mltSplatWeight(1.0 - a, cur.target, bLarge), -1.0, cur.value);
+    writeRecord(at + 1u, e.pixel, mltSplatWeight(a, e.target, bLarge), large ? e.target : -1.0, e.value);
     bool accept = rngNext(m) < a;
     if (large) {
         chains[c].proposedLarge++;

@@ -9,9 +9,25 @@
 //   small step  every coordinate moved by ±s2·exp(−ln(s2/s1)·ξ), wrapped into [0, 1) (§3.1,
 //               s1 = 1/1024, s2 = 1/64);
 // both proposals are symmetric (q(x→y) = q(y→x)), so the acceptance probability is
-// a = min(1, T(y)/T(x)) for the target T. The contribution is splatted with the expected
-// values of Kelemen et al. §4: the current state with weight (1 − a)/T(x), the proposal with
-// a/T(y); their image estimate is b/N Σ weight·f, with b = ∫ T over the hypercube.
+// a = min(1, T(y)/T(x)) for the target T.
+//
+// Splatting (Kelemen et al. 2002, §4): every mutation contributes its current state x with
+// acceptance share 1 − a and its proposal y with share a (expected values), and a large step's
+// proposal, a uniform sample of the hypercube, is also an independent sample of the image.
+// The two sampling techniques, N Metropolis samples of density T/b and (in expectation) N·p
+// uniform ones (p the large-step probability), are combined by the balance heuristic, so a
+// state of target T contributes its value g times
+//     Metropolis share:  share / (N · (T/b + p))
+//     large step:        1 / (N · (T/b + p))
+// where the image is dark (T/b ≪ p) the large steps carry the estimate, as a path tracer's
+// samples would, and where it is bright the chains do. The weights may use any b' > 0 in
+// place of b (the balance heuristic's weights sum to one for any), but the Metropolis
+// samples' density is T/b with the true b: with b' in the weights the shares become
+//     Metropolis:  b · share / (N · (T + b'·p))      (b: the final estimate b̂, applied by the host)
+//     large step:  b' / (N · (T + b'·p))
+// (mltSplatWeight and mltLargeStepWeight without the common 1/N). b' is the bootstrap's b̂,
+// known before the chains start; b̂ pools the large steps' targets too. p = 0 is plain
+// Metropolis splatting, share / T.
 #ifndef GDPT_LIB_MLT
 #define GDPT_LIB_MLT
 
@@ -39,10 +55,18 @@ GDPT_INLINE float mltAcceptance(float tCurrent, float tProposed) {
     return min(1.0f, tProposed / tCurrent);
 }
 
-// Splat weight of a state with target t and acceptance share w (a for the proposal, 1 − a
-// for the current state): w / t, 0 for a state the target does not see.
-GDPT_INLINE float mltSplatWeight(float w, float t) {
-    return t > 0.0f ? w / t : 0.0f;
+// Metropolis splat weight of a state with target t and acceptance share w (a for the
+// proposal, 1 − a for the current state): w / (t + bLarge), bLarge = b'·p; 0 for a state no
+// technique sees.
+GDPT_INLINE float mltSplatWeight(float w, float t, float bLarge) {
+    float d = t + bLarge;
+    return d > 0.0f ? w / d : 0.0f;
+}
+
+// Large-step weight of a large step's proposal of target t: b' / (t + b'·p).
+GDPT_INLINE float mltLargeStepWeight(float t, float bWeights, float largeStep) {
+    float d = t + bWeights * largeStep;
+    return d > 0.0f ? bWeights / d : 0.0f;
 }
 
 // The target of gradient-domain MLT (Lehtinen et al. 2013, §4: the sum of the absolute

@@ -35,20 +35,21 @@ GDPT_CONST uint kMltPhaseStart = 1u;      // chain c: the state of bootstrap sam
 GDPT_CONST uint kMltPhaseMutate = 2u;     // chain c: one proposal, two records, accept or not
 GDPT_CONST uint kMltPhaseDirect = 3u;     // pixel: the emission the camera sees directly
 
-// Push constants of mlt.comp (<= 128 bytes). 48 bytes.
+// Push constants of mlt.comp (<= 128 bytes). 52 bytes.
 struct MltParams {
-    uint phase;            // kMltPhase*
-    uint count;            // invocations that work (samples, chains or image rows x width)
-    uint seed;             // user seed
-    uint index;            // bootstrap: first sample index; mutate: the mutation step's index
-    uint recordOffset;     // mutate: first record this dispatch writes (2 per chain)
-    uint width;            // image width in pixels
-    uint height;           // image height in pixels
-    float shiftThreshold;  // as GptFrameParams::shiftThreshold (gpt_path.glsl reads frame.shiftThreshold)
-    float largeStep;       // probability of a large step (a fresh state) per mutation
-    float targetAlpha;     // G-MLT: weight of the primal term of the target (mlt.glsl)
-    uint directSamples;    // direct: camera samples per pixel
-    uint rowOffset;        // direct: first image row of this dispatch
+    uint phase;              // kMltPhase*
+    uint count;              // invocations that work (samples, chains or image rows x width)
+    uint seed;               // user seed
+    uint index;              // bootstrap: first sample index; mutate: the mutation step's index
+    uint recordOffset;       // mutate: first record this dispatch writes (2 per chain)
+    uint width;              // image width in pixels
+    uint height;             // image height in pixels
+    float shiftThreshold;    // as GptFrameParams::shiftThreshold (gpt_path.glsl reads frame.shiftThreshold)
+    float largeStep;         // probability of a large step (a fresh state) per mutation
+    float targetAlpha;       // G-MLT: weight of the primal term of the target (mlt.glsl)
+    uint directSamples;      // direct: camera samples per pixel
+    uint rowOffset;          // direct: first image row of this dispatch
+    float misNormalisation;  // mutate: b' of the splat weights' multiple importance sampling (mlt.glsl)
 };
 
 // A chain's current state besides its decisions (kBindMltPss). 144 bytes.
@@ -64,11 +65,13 @@ struct MltChain {
     uint pad;
 };
 
-// One splat: `weight` times `value` goes to pixel `pixel` (Kelemen et al. 2002, §4: the
-// current sample with weight (1 − a)/T, the proposal with a/T, a the acceptance
-// probability). The host sums them in record order. A large step's proposal is a fresh
-// uniform state, so its target is one more sample of b = ∫ T (Kelemen et al. §4 estimate b
-// from the large steps): the host pools them with the bootstrap's. 120 bytes.
+// One splat: `weight` times `value` goes to pixel `pixel`: the Metropolis share of the
+// state's contribution (mlt.glsl mltSplatWeight: the current state with acceptance share
+// 1 − a, the proposal with a). The host sums them in record order. A large step's proposal
+// is a fresh uniform state, so it is also an independent sample of the image (the host adds
+// its share of the multiple importance sampling, mltLargeStepWeight) and its target is one
+// more sample of b = ∫ T (Kelemen et al. 2002, §4): the host pools them with the
+// bootstrap's. 120 bytes.
 struct MltRecord {
     uint pixel;
     float weight;       // 0: nothing to splat
@@ -91,7 +94,7 @@ kSpecMltBaseOnly = 20u  // 1: trace the base path alone (PSSMLT), 0: base + offs
     GDPT_ENUM_END();
 
 #ifdef __cplusplus
-static_assert(sizeof(MltParams) == 48, "MltParams layout");
+static_assert(sizeof(MltParams) == 52, "MltParams layout");
 static_assert(sizeof(MltChain) == 144, "MltChain layout (scalar)");
 static_assert(sizeof(MltRecord) == 120, "MltRecord layout (scalar)");
 static_assert(std::uint32_t{kBindMltChains} > std::uint32_t{kBindGptEdgeProbe},

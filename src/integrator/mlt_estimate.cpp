@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "lib/mlt.glsl"
 #include "lib/rng.glsl"
 
 namespace gdpt {
@@ -65,35 +66,48 @@ std::vector<std::uint32_t> mltChainStarts(const std::vector<float>& targets, std
     return starts;
 }
 
-MltAccumulator::MltAccumulator(int width, int height)
+MltAccumulator::MltAccumulator(int width, int height, float misNormalisation, float largeStep)
     : width_(width),
       height_(height),
-      sums_(std::size_t(width) * std::size_t(height) * gpu::kMltValues * 3, 0.0) {}
+      misNormalisation_(misNormalisation),
+      largeStep_(largeStep),
+      sums_(std::size_t(width) * std::size_t(height) * gpu::kMltValues * 3, 0.0),
+      largeSums_(sums_.size(), 0.0) {}
 
 void MltAccumulator::add(const gpu::MltRecord* records, std::size_t count) {
     const std::size_t pixels = std::size_t(width_) * std::size_t(height_);
     for (std::size_t r = 0; r < count; ++r) {
         const gpu::MltRecord& rec = records[r];
-        if (rec.largeTarget >= 0.0f) largeSteps_.add(rec.largeTarget);
-        if (!(rec.weight > 0.0f) || rec.pixel >= pixels) continue;
-        double* s = &sums_[std::size_t(rec.pixel) * gpu::kMltValues * 3];
-        const double w = rec.weight;
-        for (std::uint32_t k = 0; k < gpu::kMltValues; ++k)
-            for (int c = 0; c < 3; ++c) s[k * 3 + std::uint32_t(c)] += w * double(rec.value[k][c]);
+        const bool large = rec.largeTarget >= 0.0f;
+        if (large) largeSteps_.add(rec.largeTarget);
+        if (rec.pixel >= pixels) continue;
+        const std::size_t at = std::size_t(rec.pixel) * gpu::kMltValues * 3;
+        if (rec.weight > 0.0f) {
+            const double w = rec.weight;
+            for (std::uint32_t k = 0; k < gpu::kMltValues; ++k)
+                for (std::uint32_t c = 0; c < 3; ++c) sums_[at + k * 3 + c] += w * double(rec.value[k][c]);
+        }
+        if (large && rec.largeTarget > 0.0f) {
+            const double w = gpu::mltLargeStepWeight(rec.largeTarget, misNormalisation_, largeStep_);
+            for (std::uint32_t k = 0; k < gpu::kMltValues; ++k)
+                for (std::uint32_t c = 0; c < 3; ++c)
+                    largeSums_[at + k * 3 + c] += w * double(rec.value[k][c]);
+        }
     }
 }
 
-Image MltAccumulator::quantity(std::uint32_t k, double scale) const {
+Image MltAccumulator::quantity(std::uint32_t k, MltScale scale) const {
     Image out(width_, height_);
     const std::size_t pixels = std::size_t(width_) * std::size_t(height_);
     for (std::size_t p = 0; p < pixels; ++p)
-        for (int c = 0; c < 3; ++c)
-            out.plane(c)[p] =
-                static_cast<float>(scale * sums_[(p * gpu::kMltValues + k) * 3 + std::size_t(c)]);
+        for (int c = 0; c < 3; ++c) {
+            const std::size_t at = (p * gpu::kMltValues + k) * 3 + std::size_t(c);
+            out.plane(c)[p] = static_cast<float>(scale.metropolis * sums_[at] + scale.large * largeSums_[at]);
+        }
     return out;
 }
 
-MltImages resolveGradientSamples(const MltAccumulator& acc, double scale) {
+MltImages resolveGradientSamples(const MltAccumulator& acc, MltScale scale) {
     const Image central = acc.quantity(gpu::kMltCentral, scale);
     Image neighbor[4], gradient[4];
     for (std::uint32_t i = 0; i < 4; ++i) {

@@ -2,12 +2,15 @@
 // bootstrap's normalisation, the chains' starting states, and the splat of the kernel's
 // records into images. Plain CPU code, tested on its own (tests/unit/sampling/test_mlt_chain.cpp).
 //
-// Estimator (Veach 1997 §11.3; Kelemen et al. 2002 §4): with T the target over the unit
-// hypercube of decisions, b = ∫ T (the bootstrap's mean), and N mutations, a quantity X of
-// pixel p is estimated by
-//     X(p) ≈ (W·H) · b / N · Σ_records weight · X(record) · [record in p]
-// (W·H because the film position is uniform over the whole image: a pixel's mean is W·H times
-// the integral over its share of the hypercube).
+// Estimator (Veach 1997 §11.3; Kelemen et al. 2002 §4, whose multiple importance sampling of
+// the Metropolis samples and the large steps' uniform ones mlt.glsl derives): with T the
+// target over the unit hypercube of decisions, b = ∫ T, N mutations and b' the b̂ the splat
+// weights were computed with, a quantity X of pixel p is estimated by
+//     X(p) ≈ (W·H) / N · Σ_records [b̂ · weight + largeWeight] · X(record) · [record in p]
+// (weight: the record's Metropolis share, mltSplatWeight; largeWeight: mltLargeStepWeight for
+// a large step's proposal, else 0; W·H because the film position is uniform over the whole
+// image: a pixel's mean is W·H times the integral over its share of the hypercube). The two
+// sums are kept apart, since b̂ is final only after the last large step.
 #pragma once
 
 #include <cstdint>
@@ -43,20 +46,27 @@ MltNormalisation mltNormalisation(const std::vector<float>& targets);
 std::vector<std::uint32_t> mltChainStarts(const std::vector<float>& targets, std::uint32_t chains,
                                           std::uint32_t seed);
 
-// Per-pixel sums Σ weight · value of the records, in double, in the order they are added.
+// The factors of the two sums: metropolis = W·H·b̂/N, large = W·H/N.
+struct MltScale {
+    double metropolis = 0.0, large = 0.0;
+};
+
+// Per-pixel sums Σ weight · value and Σ largeWeight · value of the records, in double, in the
+// order they are added. `misNormalisation` and `largeStep`: b' and p of the weights.
 class MltAccumulator {
 public:
-    MltAccumulator(int width, int height);
+    MltAccumulator(int width, int height, float misNormalisation, float largeStep);
     // Adds the records' splats, and the targets of the large steps' proposals to largeSteps().
     void add(const gpu::MltRecord* records, std::size_t count);
     [[nodiscard]] const TargetSums& largeSteps() const { return largeSteps_; }
-    // The mean of quantity k (kMltCentral, kMltNeighbor + i, kMltGradient + i) per pixel,
-    // scaled by `scale` (= W·H·b/N).
-    [[nodiscard]] Image quantity(std::uint32_t k, double scale) const;
+    // The mean of quantity k (kMltCentral, kMltNeighbor + i, kMltGradient + i) per pixel.
+    [[nodiscard]] Image quantity(std::uint32_t k, MltScale scale) const;
 
 private:
     int width_, height_;
-    std::vector<double> sums_;  // [pixel][k][channel]
+    float misNormalisation_, largeStep_;
+    std::vector<double> sums_;       // [pixel][k][channel], Metropolis shares
+    std::vector<double> largeSums_;  // the same, large steps' shares
     TargetSums largeSteps_;
 };
 
@@ -65,6 +75,6 @@ private:
 struct MltImages {
     Image primal, dx, dy;
 };
-MltImages resolveGradientSamples(const MltAccumulator& acc, double scale);
+MltImages resolveGradientSamples(const MltAccumulator& acc, MltScale scale);
 
 }  // namespace gdpt

@@ -131,6 +131,9 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     }
     TargetSums fresh;  // the targets of fresh states: the bootstrap's, then the large steps'
     for (float t : targets) fresh.add(t);
+    // b' of the splat weights (mlt.glsl): the bootstrap's b̂.
+    const auto misNormalisation = static_cast<float>(fresh.normalisation().b);
+    pass.setMisNormalisation(misNormalisation);
     stats.mlt.chains = po.chains;
     stats.mlt.bootstrapSamples = targets.size();
     const std::vector<std::uint32_t> starts = mltChainStarts(targets, po.chains, options.seed);
@@ -138,7 +141,7 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
 
     // Stage 2: the chains. Mutation steps in batches; the host splats each batch's records
     // in record order while nothing else runs (the same order on every run).
-    MltAccumulator acc(width, height);
+    MltAccumulator acc(width, height, misNormalisation, po.largeStep);
     const bool timed = options.timeBudget > 0.0;
     const double budget = options.timeBudget - options.elapsedBefore;
     const std::uint64_t wantedMutations = std::uint64_t{options.spp} * pixels;
@@ -202,15 +205,19 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
         std::fprintf(stderr, "gdpt: warning: %s: %llu samples were NaN/Inf and were counted as zero\n",
                      name_.c_str(), static_cast<unsigned long long>(stats.nanSamples));
 
-    // Stage 3: the estimate, X(p) = W·H·b/N Σ weight·X (mlt_estimate.h), with b̂ from every
-    // fresh state (Kelemen et al. 2002, §4); gmlt reconstructs.
+    // Stage 3: the estimate, X(p) = W·H/N Σ (b̂·weight + largeWeight)·X (mlt_estimate.h), with
+    // b̂ from every fresh state (Kelemen et al. 2002, §4); gmlt reconstructs.
     fresh.add(acc.largeSteps());
     const MltNormalisation norm = fresh.normalisation();
     stats.mlt.normalisation = norm.b;
     stats.mlt.normalisationStdErr = norm.standardError;
     stats.mlt.normalisationSamples = norm.samples;
     Timer readback;
-    const double scale = stats.mlt.mutations ? double(pixels) * norm.b / double(stats.mlt.mutations) : 0.0;
+    MltScale scale;
+    if (stats.mlt.mutations) {
+        scale.large = double(pixels) / double(stats.mlt.mutations);
+        scale.metropolis = scale.large * norm.b;
+    }
     Image direct = pass.directImage();
     stats.readbackMs = readback.ms();
     if (!gradients()) {

@@ -76,6 +76,7 @@ gpu::MltParams MltPass::params(std::uint32_t phase, std::uint32_t count, std::ui
     p.shiftThreshold = shiftThreshold_;
     p.largeStep = options_.largeStep;
     p.targetAlpha = options_.targetAlpha;
+    p.misNormalisation = misNormalisation_;
     return p;
 }
 

@@ -51,6 +51,8 @@ public:
     // Starts chain c at bootstrap sample starts[c] (starts.size() == chains).
     void recordStart(VkCommandBuffer cmd, const std::vector<std::uint32_t>& starts, std::uint32_t seed,
                      vk::GpuTimer* timer);
+    // b' of the splat weights (mlt.glsl; the bootstrap's b̂), for the mutations recorded after.
+    void setMisNormalisation(float b) { misNormalisation_ = b; }
     // Records `steps` (≤ stepsPerBatch) mutation steps of every chain, step indices from `first`.
     void recordMutations(VkCommandBuffer cmd, std::uint32_t first, std::uint32_t steps, std::uint32_t seed,
                          vk::GpuTimer* timer);
@@ -71,6 +73,7 @@ private:
     const vk::Context& ctx_;
     std::uint32_t width_, height_;
     float shiftThreshold_;
+    float misNormalisation_ = 0.0f;
     MltPassOptions options_;
     vk::Buffer counters_, chains_, pss_, records_, starts_, direct_;
     vk::Buffer bootstrap_;

@@ -7,8 +7,15 @@
 // tested against the target's cell integrals. The same test with a wrong acceptance ratio
 // (min(1, sqrt(T'/T)): its chain targets sqrt(T)) must fail, and does by a wide margin: the
 // test has the power to catch a broken Metropolis-Hastings ratio.
+//
+// The splat: chains on the same target splat a carried quantity with mlt.glsl's weights (the
+// Metropolis shares and the large steps' multiple importance sampling) into four quadrants;
+// over independent runs the estimates' means must match the quadrants' integrals, with the
+// weights' b' 50 % off the true b (any b' is unbiased), and must not without the large
+// steps' share, or with the Metropolis sum scaled by b' instead of b.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -17,6 +24,7 @@
 #include "integrator/mlt_estimate.h"
 #include "lib/mlt.glsl"
 #include "stats.h"
+#include "stats_normal.h"
 
 namespace gdpt {
 namespace {
@@ -100,8 +108,12 @@ TEST(MltChain, AcceptanceIsTheMetropolisRatio) {
     EXPECT_FLOAT_EQ(gpu::mltAcceptance(1.0f, 3.0f), 1.0f);
     EXPECT_FLOAT_EQ(gpu::mltAcceptance(1.0f, 0.0f), 0.0f);
     EXPECT_FLOAT_EQ(gpu::mltAcceptance(0.0f, 0.0f), 1.0f);
-    EXPECT_FLOAT_EQ(gpu::mltSplatWeight(0.25f, 2.0f), 0.125f);
-    EXPECT_FLOAT_EQ(gpu::mltSplatWeight(1.0f, 0.0f), 0.0f);
+    EXPECT_FLOAT_EQ(gpu::mltSplatWeight(0.25f, 2.0f, 0.0f), 0.125f);
+    EXPECT_FLOAT_EQ(gpu::mltSplatWeight(1.0f, 0.0f, 0.0f), 0.0f);
+    EXPECT_FLOAT_EQ(gpu::mltSplatWeight(0.25f, 2.0f, 0.5f), 0.1f);
+    // b' = 2, p = 0.25: the large step's share b'/(T + b'p).
+    EXPECT_FLOAT_EQ(gpu::mltLargeStepWeight(1.5f, 2.0f, 0.25f), 1.0f);
+    EXPECT_FLOAT_EQ(gpu::mltLargeStepWeight(0.0f, 0.0f, 0.25f), 0.0f);
 }
 
 TEST(MltChain, DetailedBalanceKeepsTheTargetDistribution) {
@@ -121,6 +133,106 @@ TEST(MltChain, DetailedBalanceKeepsTheTargetDistribution) {
     };
     const stats::Chi2Result bad = stats::chi2Test(finalStateHistogram(wrong, 11), expected);
     EXPECT_LT(bad.pValue, 1e-9) << "chi2 " << bad.statistic << " dof " << bad.dof;
+}
+
+// What a state carries: non-zero only where the target is, and not proportional to it.
+double carried(double u, double v) {
+    return target(u, v) * (0.5 + u) + (target(u, v) > 0.0 && v > 0.9 ? 2.0 : 0.0);
+}
+
+int quadrant(double u, double v) {
+    return (v < 0.5 ? 0 : 2) + (u < 0.5 ? 0 : 1);
+}
+
+// ∫ target and the quadrants' ∫ carried, by a 400 x 400 midpoint rule (the hole's and the
+// band's edges lie on its cell boundaries).
+void exactIntegrals(double& b, std::array<double, 4>& q) {
+    constexpr int kN = 400;
+    b = 0.0;
+    q = {};
+    for (int j = 0; j < kN; ++j)
+        for (int i = 0; i < kN; ++i) {
+            const double u = (i + 0.5) / kN, v = (j + 0.5) / kN;
+            b += target(u, v) / (kN * kN);
+            q[std::size_t(quadrant(u, v))] += carried(u, v) / (kN * kN);
+        }
+}
+
+// One render of the quadrants: chains started from exact samples of the target, each
+// mutating as mlt.comp does and splatting both records with mlt.glsl's weights (b' = bWeights),
+// the Metropolis sum scaled by the true b (mlt_estimate.h), the large steps' share kept or not.
+std::array<double, 4> misRender(std::uint32_t seed, double b, float bWeights, bool largeShare) {
+    constexpr int kMisChains = 400, kMisSteps = 100;
+    std::mt19937 gen(seed);
+    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+    std::array<double, 4> metropolis{}, large{};
+    const float bLarge = bWeights * kLargeStep;
+    for (int c = 0; c < kMisChains; ++c) {
+        float u, v;
+        do {
+            u = uni(gen);
+            v = uni(gen);
+        } while (uni(gen) * 1.1f >= target(u, v));
+        float t = static_cast<float>(target(u, v));
+        for (int s = 0; s < kMisSteps; ++s) {
+            const bool isLarge = uni(gen) < kLargeStep;
+            float pu, pv;
+            if (isLarge) {
+                pu = uni(gen);
+                pv = uni(gen);
+            } else {
+                pu = gpu::mltSmallStep(u, uni(gen), uni(gen));
+                pv = gpu::mltSmallStep(v, uni(gen), uni(gen));
+            }
+            const float tp = static_cast<float>(target(pu, pv));
+            const float a = gpu::mltAcceptance(t, tp);
+            metropolis[std::size_t(quadrant(u, v))] +=
+                gpu::mltSplatWeight(1.0f - a, t, bLarge) * carried(u, v);
+            metropolis[std::size_t(quadrant(pu, pv))] += gpu::mltSplatWeight(a, tp, bLarge) * carried(pu, pv);
+            if (isLarge)
+                large[std::size_t(quadrant(pu, pv))] +=
+                    gpu::mltLargeStepWeight(tp, bWeights, kLargeStep) * carried(pu, pv);
+            if (uni(gen) < a) u = pu, v = pv, t = tp;
+        }
+    }
+    std::array<double, 4> q{};
+    for (std::size_t k = 0; k < 4; ++k)
+        q[k] = (b * metropolis[k] + (largeShare ? large[k] : 0.0)) / double(kMisChains * kMisSteps);
+    return q;
+}
+
+// The largest |t| over the quadrants of kRuns renders' means against the exact integrals;
+// b scales the Metropolis sum.
+double worstQuadrantT(double b, float bWeights, bool largeShare, const std::array<double, 4>& exact) {
+    constexpr int kRuns = 30;
+    std::array<double, 4> sum{}, sumSquares{};
+    for (int r = 0; r < kRuns; ++r) {
+        const std::array<double, 4> q = misRender(1000u + std::uint32_t(r), b, bWeights, largeShare);
+        for (std::size_t k = 0; k < 4; ++k) sum[k] += q[k], sumSquares[k] += q[k] * q[k];
+    }
+    double worst = 0.0;
+    for (std::size_t k = 0; k < 4; ++k) {
+        const double mean = sum[k] / kRuns;
+        const double var = (sumSquares[k] - kRuns * mean * mean) / (kRuns - 1);
+        worst = std::max(worst, std::abs(mean - exact[k]) / std::sqrt(var / kRuns));
+    }
+    return worst;
+}
+
+TEST(MltEstimate, LargeStepMultipleImportanceSamplingIsUnbiased) {
+    double b = 0.0;
+    std::array<double, 4> exact{};
+    exactIntegrals(b, exact);
+    // 30 independent renders: Student t with 29 degrees of freedom, Šidák over 4 quadrants
+    // and the 2 settings at a family level of 1e-3.
+    const double threshold = test::twoSidedT(test::sidakAlpha(1e-3, 8), 29);
+    EXPECT_LT(worstQuadrantT(b, static_cast<float>(b), true, exact), threshold) << "b' = b";
+    EXPECT_LT(worstQuadrantT(b, static_cast<float>(1.5 * b), true, exact), threshold) << "b' = 1.5 b";
+    // Power: without the large steps' share the estimate misses about p/(T/b + p) of it.
+    EXPECT_GT(worstQuadrantT(b, static_cast<float>(b), false, exact), threshold) << "the test has no power";
+    // Nor with the Metropolis sum scaled by the weights' b' = 1.5 b instead of b.
+    EXPECT_GT(worstQuadrantT(1.5 * b, static_cast<float>(1.5 * b), true, exact), threshold)
+        << "the test has no power";
 }
 
 TEST(MltEstimate, NormalisationIsTheMeanTargetWithItsStandardError) {
@@ -165,7 +277,7 @@ TEST(MltEstimate, ChainsStartInProportionToTheTarget) {
 TEST(MltEstimate, RecordsResolveLikeGptResolve) {
     // A 3 x 2 image; one record at pixel (1, 0) with central c and an offset to the right n
     // and a gradient to the right g, one at (2, 0) with a gradient to the left g2.
-    MltAccumulator acc(3, 2);
+    MltAccumulator acc(3, 2, 1.0f, 0.0f);
     gpu::MltRecord r[2]{};
     r[0].pixel = 1;
     r[0].weight = 0.5f;
@@ -180,7 +292,8 @@ TEST(MltEstimate, RecordsResolveLikeGptResolve) {
     acc.add(r, 2);
     EXPECT_EQ(acc.largeSteps().count, 1u);
     EXPECT_DOUBLE_EQ(acc.largeSteps().sum, 4.0);
-    const double scale = 3.0;
+    // p = 0: the large step's share b'/(T + 0) = 1/4 goes to the second sum.
+    const MltScale scale{3.0, 0.0};
     const MltImages m = resolveGradientSamples(acc, scale);
     // (1, 0) has neighbours left, right, down: k = 3. (2, 0) has left and down: k = 2.
     EXPECT_FLOAT_EQ(m.primal.at(1, 0, 0), float(3.0 * 0.5 * 2.0 / 3.0));
@@ -192,6 +305,10 @@ TEST(MltEstimate, RecordsResolveLikeGptResolve) {
     EXPECT_FLOAT_EQ(m.dx.at(1, 0, 1), float(3.0 * 0.5 * 0.5));
     EXPECT_FLOAT_EQ(m.dx.at(2, 0, 0), 0.0f);  // last column
     EXPECT_FLOAT_EQ(m.dy.at(1, 0, 0), 0.0f);
+    // The large step's share (b' = 1, p = 0: 1/4 of its values) scaled by `large`.
+    const MltImages l = resolveGradientSamples(acc, MltScale{0.0, 8.0});
+    EXPECT_FLOAT_EQ(l.dx.at(1, 0, 0), float(-8.0 * 0.25 * 0.25));
+    EXPECT_FLOAT_EQ(l.primal.at(1, 0, 0), 0.0f);
 }
 
 }  // namespace
