@@ -65,6 +65,7 @@ struct DiffArgs {
     std::string test;
     std::string reference;
     std::string json;
+    std::string errorMap;  // EXR of each pixel's relMSE term, with a PNG preview beside it
 };
 
 struct DiffSequenceArgs {

@@ -9,11 +9,13 @@
 #include <utility>
 
 #include "app/bench_util.h"
+#include "app/render_setup.h"
 #include "app/subcommand.h"
 #include "image/atomic_write.h"
 #include "image/exr_io.h"
 #include "image/finite_check.h"
 #include "image/metrics.h"
+#include "image/png_preview.h"
 #include "integrator/gpt_sampler.h"
 #include "render/device_scene/features.h"
 #include "scene/gltf_loader.h"
@@ -58,6 +60,10 @@ glm::vec3 parseColor(const std::string& text, const std::string& flag) {
 int runDiff(const DiffArgs& args) {
     OutputSet outputs({{"test image", args.test}, {"reference", args.reference}});
     const TextOutput jsonOutput(outputs, args.json, "--json");
+    const StagedFile* mapFile = args.errorMap.empty() ? nullptr : &outputs.add(args.errorMap, "--error-map");
+    const StagedFile* mapPreview =
+        args.errorMap.empty() ? nullptr
+                              : &outputs.add(previewPath(args.errorMap), "PNG preview of --error-map");
     const Image test = readExrLayer(args.test);
     const Image reference = readExrLayer(args.reference);
     const auto size = [](const Image& im) {
@@ -89,12 +95,26 @@ int runDiff(const DiffArgs& args) {
               {"mean_test", e.meanTest},
               {"mean_reference", e.meanReference},
               {"finite_pixels", e.finitePixels},
-              {"nonfinite_pixels", e.nonFinitePixels}};
+              {"nonfinite_pixels", e.nonFinitePixels},
+              {"relmse_by_brightness", e.relMseByQuarter}};
     jsonOutput.write(j.dump(2) + "\n");
+    if (mapFile) {
+        const Image map = relMseMap(test, reference);
+        writeExr(*mapFile, {{"", map}});
+        // Reinhard with the mean term at 1/2: the map's structure, whatever its scale.
+        PreviewOptions preview;
+        preview.toneMap = ToneMap::Reinhard;
+        preview.exposure = e.relMse > 0.0 ? static_cast<float>(1.0 / e.relMse) : 1.0f;
+        writePngPreview(*mapPreview, map, preview);
+    }
     outputs.commit();
-    if (args.json != "-")
+    if (args.json != "-") {
         std::printf("relMSE %.6g  MSE %.6g  MAE %.6g  max %.6g  bias %.3g  (%zu pixels, %zu non-finite)\n",
                     e.relMse, e.mse, e.mae, e.maxAbsError, e.meanBias, e.finitePixels, e.nonFinitePixels);
+        const auto& q = e.relMseByQuarter;
+        std::printf("relMSE by the reference's brightness, darkest quarter first: %.4g  %.4g  %.4g  %.4g\n",
+                    q[0], q[1], q[2], q[3]);
+    }
     return 0;
 }
 
@@ -256,7 +276,13 @@ Subcommand addDiffCommand(CLI::App& app) {
         "diff", "Compare two EXR images: relMSE (Kettunen et al. 2015), MSE, MAE, max error");
     d->add_option("test", diff.test, "Image to evaluate")->required()->check(InputFile);
     d->add_option("reference", diff.reference, "Reference image")->required()->check(InputFile);
-    d->add_option("--json", diff.json, "Write the metrics as JSON to this file ('-' = stdout)");
+    d->add_option("--json", diff.json,
+                  "Write the metrics as JSON to this file ('-' = stdout); relmse_by_brightness splits relMSE "
+                  "by quarters of the pixels ordered by the reference's brightness, darkest first");
+    d->add_option(
+        "--error-map", diff.errorMap,
+        "Write each pixel's relMSE term to this EXR (their mean is relMSE; NaN where a value is not "
+        "finite) and a PNG preview beside it (the mean term at mid-grey)");
 
     return {d, [args] { return runDiff(*args); }};
 }

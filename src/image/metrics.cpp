@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "util/error.h"
 
@@ -14,11 +16,59 @@ namespace {
 constexpr double kRelMseEpsilon = 1e-3;
 }  // namespace
 
-ImageErrorStats compareImages(const Image& test, const Image& reference) {
+namespace {
+void checkSameSize(const Image& test, const Image& reference) {
     if (!test.sameSize(reference))
         throw Error("cannot compare a " + std::to_string(test.width()) + "x" + std::to_string(test.height()) +
                     " image with a " + std::to_string(reference.width()) + "x" +
                     std::to_string(reference.height()) + " reference");
+}
+
+// The pixel's relMSE term, NaN if a value of either image is not finite.
+double relMseTerm(const Image& test, const Image& reference, std::size_t i) {
+    double t[3], r[3];
+    for (int c = 0; c < 3; ++c) {
+        t[c] = test.plane(c)[i];
+        r[c] = reference.plane(c)[i];
+        if (!std::isfinite(t[c]) || !std::isfinite(r[c])) return std::numeric_limits<double>::quiet_NaN();
+    }
+    const double gray = (r[0] + r[1] + r[2]) / 3.0;
+    double sum = 0.0;
+    for (int c = 0; c < 3; ++c) sum += (t[c] - r[c]) * (t[c] - r[c]);
+    return sum / (kRelMseEpsilon + gray * gray);
+}
+
+// relMSE's sum by quarters of the finite pixels ordered by the reference's gray.
+std::array<double, 4> relMseQuarters(const Image& test, const Image& reference, std::size_t finitePixels) {
+    std::vector<std::pair<double, double>> byGray;  // (gray, term)
+    byGray.reserve(finitePixels);
+    for (std::size_t i = 0; i < test.pixelCount(); ++i) {
+        const double term = relMseTerm(test, reference, i);
+        if (std::isfinite(term))
+            byGray.emplace_back(
+                (double(reference.plane(0)[i]) + reference.plane(1)[i] + reference.plane(2)[i]) / 3.0, term);
+    }
+    std::stable_sort(byGray.begin(), byGray.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::array<double, 4> q{};
+    for (std::size_t k = 0; k < byGray.size(); ++k) q[k * 4 / byGray.size()] += byGray[k].second;
+    for (double& v : q) v /= double(std::max<std::size_t>(byGray.size(), 1));
+    return q;
+}
+}  // namespace
+
+Image relMseMap(const Image& test, const Image& reference) {
+    checkSameSize(test, reference);
+    Image out(test.width(), test.height());
+    for (std::size_t i = 0; i < test.pixelCount(); ++i) {
+        const auto term = static_cast<float>(relMseTerm(test, reference, i));
+        for (int c = 0; c < 3; ++c) out.plane(c)[i] = term;
+    }
+    return out;
+}
+
+ImageErrorStats compareImages(const Image& test, const Image& reference) {
+    checkSameSize(test, reference);
     ImageErrorStats s;
     double relSum = 0.0, sqSum = 0.0, absSum = 0.0, biasSum = 0.0;
     for (std::size_t i = 0; i < test.pixelCount(); ++i) {
@@ -63,6 +113,7 @@ ImageErrorStats compareImages(const Image& test, const Image& reference) {
         s.meanTest[c] /= pixels;
         s.meanReference[c] /= pixels;
     }
+    s.relMseByQuarter = relMseQuarters(test, reference, s.finitePixels);
     return s;
 }
 

@@ -30,10 +30,19 @@ struct ImageErrorStats {
     std::array<double, 3> meanReference{};  // per-channel mean of R (finite pixels)
     std::size_t finitePixels = 0;           // pixels used
     std::size_t nonFinitePixels = 0;        // pixels excluded (NaN/inf in I or R)
+    // relMSE's sum split by the reference's brightness: the finite pixels ordered by gray(R)
+    // (ties by index) and cut into quarters, darkest first; each the quarter's share of
+    // relMse (their sum), so where the error lies shows at a glance.
+    std::array<double, 4> relMseByQuarter{};
 };
 
 // All metrics of `test` against `reference`. Throws gdpt::Error if the sizes differ.
 ImageErrorStats compareImages(const Image& test, const Image& reference);
+
+// Each pixel's term of relMSE, Σ_c (I_pc − R_pc)² / (1e-3 + gray(R_p)²), in all three
+// channels (their mean over the finite pixels is relMse); NaN where compareImages leaves the
+// pixel out. Throws gdpt::Error if the sizes differ.
+Image relMseMap(const Image& test, const Image& reference);
 
 // The temporal error of a sequence between two consecutive frames: the relMSE of the test's
 // frame-to-frame change against the reference's change,

@@ -331,6 +331,29 @@ TEST_F(Cli, DiffOfAnImageWithItselfIsZero) {
     EXPECT_EQ(j["max_abs_error"].get<double>(), 0.0);
 }
 
+TEST_F(Cli, DiffErrorMapAveragesToRelMse) {
+    const std::string a = path("a.exr"), b = path("b.exr"), map = path("map.exr");
+    ASSERT_EQ(run("render " + kScene + " -o " + a + " --width 8 --height 8 --spp 2 --seed 1 --quiet").code,
+              0);
+    ASSERT_EQ(run("render " + kScene + " -o " + b + " --width 8 --height 8 --spp 2 --seed 2 --quiet").code,
+              0);
+    const RunResult r = run("diff " + a + " " + b + " --json - --error-map " + map);
+    ASSERT_EQ(r.code, 0) << r.output;
+    const auto j = nlohmann::json::parse(r.output);
+    const double relmse = j["relmse"].get<double>();
+    ASSERT_GT(relmse, 0.0);
+    double quarters = 0.0;
+    for (const auto& q : j["relmse_by_brightness"]) quarters += q.get<double>();
+    EXPECT_NEAR(quarters, relmse, 1e-9 * relmse);
+    const Image m = readExrLayer(map);
+    double sum = 0.0;
+    for (float v : m.plane(1)) sum += v;
+    EXPECT_NEAR(sum / double(m.pixelCount()), relmse, 1e-5 * relmse);
+    EXPECT_TRUE(std::filesystem::exists(path("map.png")));
+    // The map may not overwrite an input.
+    EXPECT_NE(run("diff " + a + " " + b + " --error-map " + a).code, 0);
+}
+
 TEST_F(Cli, DevicesListsAtLeastOneUsableDevice) {
     const RunResult r = run("devices --json");
     ASSERT_EQ(r.code, 0) << r.output;

@@ -69,6 +69,29 @@ TEST(Metrics, NonFinitePixelsAreCountedAndExcluded) {
     EXPECT_EQ(compareImages(allNan, allNan).nonFinitePixels, 1u);
 }
 
+TEST(Metrics, ErrorMapAndBrightnessQuartersSplitRelMse) {
+    // Four pixels, references of gray 0.2, 0 (the darkest), 1, and a NaN test value; the
+    // hand-computed terms of the two-pixel test above, and 0.25 / 1.001 for the gray-1 pixel.
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const Image reference =
+        makeImage(4, 1, {0.1f, 0.2f, 0.3f, 0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 1.0f, 0.5f, 0.5f, 0.5f});
+    const Image test =
+        makeImage(4, 1, {0.2f, 0.2f, 0.1f, 0.01f, 0.0f, 0.02f, 1.5f, 1.0f, 1.0f, nan, 0.5f, 0.5f});
+    const Image map = relMseMap(test, reference);
+    EXPECT_NEAR(map.at(0, 0, 0), 0.05 / 0.041, 1e-6);
+    EXPECT_NEAR(map.at(1, 0, 2), 0.5, 1e-6);
+    EXPECT_NEAR(map.at(2, 0, 1), 0.25 / 1.001, 1e-6);
+    EXPECT_TRUE(std::isnan(map.at(3, 0, 0)));
+    const ImageErrorStats s = compareImages(test, reference);
+    // Three finite pixels by gray: 0 (quarter 0), 0.2 (quarter 1), 1 (quarter 2); none in 3.
+    EXPECT_NEAR(s.relMseByQuarter[0], 0.5 / 3.0, 1e-6);
+    EXPECT_NEAR(s.relMseByQuarter[1], 0.05 / 0.041 / 3.0, 1e-6);
+    EXPECT_NEAR(s.relMseByQuarter[2], 0.25 / 1.001 / 3.0, 1e-6);
+    EXPECT_EQ(s.relMseByQuarter[3], 0.0);
+    EXPECT_NEAR(s.relMseByQuarter[0] + s.relMseByQuarter[1] + s.relMseByQuarter[2], s.relMse, 1e-12);
+    EXPECT_THROW(relMseMap(Image(2, 2), Image(2, 3)), Error);
+}
+
 TEST(Metrics, SizeMismatchThrows) {
     EXPECT_THROW(compareImages(Image(2, 2), Image(2, 3)), Error);
     EXPECT_THROW(relMse(Image(3, 1), Image(1, 3)), Error);
