@@ -36,18 +36,28 @@ float gPss[kMltPssDims];
 bool gPssActive = false;
 
 // Slot of component `component` of decision `dim` (sampler.glsl's ids: 0 the film position,
-// then per bounce +1 light choice, +2 light point, +3 BSDF lobe, +4 BSDF direction).
+// then per bounce +1 light choice, +2 light point, +3 BSDF lobe, +4 BSDF direction; the
+// state's layout: mlt_shared.h kMltPssDims).
 bool pssLookup(uint dim, uint component, out float value) {
     value = 0.0;
     if (!gPssActive) return false;
     uint slot = component;
     if (dim > 0u) {
-        uint bounce = (dim - 1u) / 4u;
+        uint bounce = (dim - 1u) / 4u;  // sampler.glsl kLdBounceStride
         uint which = (dim - 1u) % 4u;
         uint start = which == 0u ? 0u : (which == 1u ? 1u : (which == 2u ? 3u : 4u));
-        slot = 2u + 6u * bounce + start + component;
+        slot = 2u + kMltPssPerBounce * bounce + start + component;
     }
     if (slot >= kMltPssDims) return false;
+    value = gPss[slot];
+    return true;
+}
+
+// The Russian roulette number of bounce `depth` (sampler.glsl ldRoulette).
+bool pssRouletteLookup(uint depth, out float value) {
+    value = 0.0;
+    uint slot = 2u + kMltPssPerBounce * depth + 6u;
+    if (!gPssActive || slot >= kMltPssDims) return false;
     value = gPss[slot];
     return true;
 }

@@ -215,7 +215,7 @@ bool gptContinueBase(BsdfParams bsdf, vec3 woLocal, vec3 t, vec3 b, SurfaceHit s
         beta *= bs.weight;
         if (depth + 1u >= scene.rrDepth) {
             float q = min(maxComponent(beta), 0.95);
-            alive = !(rngNext(rng) >= q);
+            alive = !(ldRoulette(depth, rng) >= q);
             rrInv = 1.0 / q;
             beta *= rrInv;
         }

@@ -121,7 +121,7 @@ void ptProcessHit(inout PathState s, Hit hit) {
         bool survive = true;
         if (s.depth >= scene.rrDepth) {
             float q = min(maxComponent(s.beta), 0.95);
-            survive = rngNext(rng) < q;
+            survive = ldRoulette(s.depth - 1u, rng) < q;  // the decision of the bounce just sampled
             s.beta /= q;
         }
         if (survive) s.flags |= kPathFlagAlive;

@@ -1,7 +1,7 @@
 // sampler.glsl — the sample values of the path tracers' decisions (pixel position, light
 // sample, BSDF sample of every bounce): Owen-scrambled Sobol' points, one independently
 // shuffled and scrambled 2-D (or 1-D) pattern per decision ("padding"), shared by the
-// kernels and the CPU tests. Russian roulette keeps drawing from the path's Rng.
+// kernels and the CPU tests. Russian roulette draws from the path's Rng (ldRoulette).
 //
 // Why: with independent random numbers the error of an N-sample pixel estimate falls as
 // N^-1/2 whatever the integrand; scrambled (0,m,2)-nets keep every estimate unbiased and
@@ -91,6 +91,21 @@ GDPT_INLINE vec2 ldGet2(LdSample s, uint dim) {
     return vec2(ldToFloat(owenScramble(sobolReverseBits(i), pcgHash(h + 1u))),
                 ldToFloat(owenScramble(sobolDim1(i), pcgHash(h + 2u))));
 }
+
+// The number Russian roulette compares with its survival probability after the BSDF sample
+// of bounce `depth`: the path's Rng, except in primary-sample-space Metropolis, whose chain
+// state holds it (mlt.comp's `pssRouletteLookup(uint depth, out float value)`), so that a
+// state's value is a function of the state (a chain whose target were redrawn at every
+// evaluation would stick to the states a lucky survival made bright).
+#ifdef GDPT_PSS_SAMPLER
+GDPT_INLINE float ldRoulette(uint depth, GDPT_INOUT(Rng) rng) {
+    float held;
+    if (pssRouletteLookup(depth, held)) return held;
+    return rngNext(rng);
+}
+#else
+#define ldRoulette(depth, rng) rngNext(rng)
+#endif
 
 // The three numbers of a light sample (choice, then the point) at bounce `depth`.
 GDPT_INLINE vec3 ldLight(LdSample s, uint depth) {

@@ -12,13 +12,15 @@
 namespace gdpt::gpu {
 #endif
 
-// Decisions a chain's state holds: the film position (2 numbers), then 6 per bounce (light
-// choice, light point (2), BSDF lobe choice, BSDF direction (2); sampler.glsl's decisions in
-// that order) for the first kMltPssBounces bounces. Deeper decisions and Russian roulette are
-// drawn afresh at every proposal: an independence proposal in those coordinates, symmetric,
-// so the chain stays a valid Metropolis-Hastings chain on the extended space.
+// Decisions a chain's state holds: the film position (2 numbers), then 7 per bounce (light
+// choice, light point (2), BSDF lobe choice, BSDF direction (2), Russian roulette;
+// sampler.glsl's decisions in that order) for the first kMltPssBounces bounces. Deeper
+// decisions are drawn afresh at every proposal: an independence proposal in those
+// coordinates, symmetric, so the chain stays a valid Metropolis-Hastings chain on the
+// extended space.
 GDPT_CONST uint kMltPssBounces = 8u;
-GDPT_CONST uint kMltPssDims = 2u + 6u * kMltPssBounces;
+GDPT_CONST uint kMltPssPerBounce = 7u;
+GDPT_CONST uint kMltPssDims = 2u + kMltPssPerBounce * kMltPssBounces;
 
 // Quantities a sample carries (G-PT's per-camera-sample estimator, gpt.comp): central, the
 // four offsets' MIS-weighted radiance (neighbor_i) and the four gradients (gradient_i), in
