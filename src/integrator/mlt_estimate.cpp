@@ -31,6 +31,10 @@ MltNormalisation TargetSums::normalisation() const {
     return n;
 }
 
+double TargetSums::effectiveSampleSize() const {
+    return sumSquares > 0.0 ? sum * sum / sumSquares : 0.0;
+}
+
 MltNormalisation mltNormalisation(const std::vector<float>& targets) {
     TargetSums s;
     for (float t : targets) s.add(t);

@@ -37,6 +37,9 @@ struct TargetSums {
     void add(float target);
     void add(const TargetSums& other);
     [[nodiscard]] MltNormalisation normalisation() const;
+    // (Σ T)² / Σ T² (Kish's effective sample size of weights T): how many equally weighted
+    // samples a resampling in proportion to T draws from; 0 without a positive target.
+    [[nodiscard]] double effectiveSampleSize() const;
 };
 MltNormalisation mltNormalisation(const std::vector<float>& targets);
 

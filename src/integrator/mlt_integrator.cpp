@@ -131,6 +131,7 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     }
     TargetSums fresh;  // the targets of fresh states: the bootstrap's, then the large steps'
     for (float t : targets) fresh.add(t);
+    stats.mlt.bootstrapEss = fresh.effectiveSampleSize();
     // b' of the splat weights (mlt.glsl): the bootstrap's b̂.
     const auto misNormalisation = static_cast<float>(fresh.normalisation().b);
     pass.setMisNormalisation(misNormalisation);
@@ -257,6 +258,7 @@ void MltIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
                 {"proposed_small", m.proposedSmall},
                 {"proposed_large", m.proposedLarge},
                 {"bootstrap_samples", m.bootstrapSamples},
+                {"bootstrap_ess", m.bootstrapEss},
                 {"normalisation", m.normalisation},
                 {"normalisation_stderr", m.normalisationStdErr},
                 {"normalisation_samples", m.normalisationSamples},

@@ -132,6 +132,7 @@ struct MltStats {
     std::uint64_t mutations = 0;  // proposals, all chains
     std::uint64_t proposedSmall = 0, acceptedSmall = 0, proposedLarge = 0, acceptedLarge = 0;
     std::uint64_t bootstrapSamples = 0;
+    double bootstrapEss = 0.0;               // their targets' effective sample size, (Σ T)² / Σ T²
     double normalisation = 0.0;              // b̂ = ∫ T: the mean target of fresh states
     double normalisationStdErr = 0.0;        // its standard error
     std::uint64_t normalisationSamples = 0;  // fresh states it averages (bootstrap + large steps)

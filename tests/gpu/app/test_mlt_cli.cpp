@@ -44,6 +44,8 @@ TEST_F(MltCli, JsonReportsChainsAcceptanceAndNormalisation) {
             EXPECT_LT(m[rate].get<double>(), 1.0) << rate;
         }
         EXPECT_GE(m["bootstrap_samples"], 512 * 16);
+        EXPECT_GT(m["bootstrap_ess"].get<double>(), 1.0);
+        EXPECT_LE(m["bootstrap_ess"].get<double>(), m["bootstrap_samples"].get<double>());
         EXPECT_GT(m["normalisation"].get<double>(), 0.0);
         EXPECT_GT(m["normalisation_stderr"].get<double>(), 0.0);
         EXPECT_LT(m["normalisation_stderr"].get<double>(), 0.1 * m["normalisation"].get<double>());

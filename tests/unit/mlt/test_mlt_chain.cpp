@@ -245,6 +245,11 @@ TEST(MltEstimate, NormalisationIsTheMeanTargetWithItsStandardError) {
     for (double v : {1.0, 2.0, 3.0, 6.0, 0.0, 0.0, 0.0}) ss += (v - 12.0 / 7.0) * (v - 12.0 / 7.0);
     EXPECT_NEAR(n.standardError, std::sqrt(ss / 6.0 / 7.0), 1e-12);
     EXPECT_EQ(mltNormalisation({}).b, 0.0);
+    // Kish's effective sample size: (1 + 2 + 3 + 6)² / (1 + 4 + 9 + 36) = 144 / 50.
+    TargetSums sums;
+    for (float v : t) sums.add(v);
+    EXPECT_DOUBLE_EQ(sums.effectiveSampleSize(), 144.0 / 50.0);
+    EXPECT_EQ(TargetSums{}.effectiveSampleSize(), 0.0);
 }
 
 TEST(MltEstimate, PooledTargetsAreTheMeanOfAllSamples) {
