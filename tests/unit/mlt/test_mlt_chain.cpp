@@ -42,28 +42,48 @@ constexpr float kLargeStep = 0.3f;
 
 using Acceptance = std::function<float(float, float)>;
 
+// Chains on the analytic target, as mlt.comp walks: uniform numbers, a start drawn from the
+// target exactly (rejection sampling), and the proposal (a large step with probability
+// kLargeStep, else a small step of both coordinates).
+class AnalyticChains {
+public:
+    explicit AnalyticChains(std::uint32_t seed) : gen_(seed) {}
+    float uniform() { return uni_(gen_); }
+    void start(float& u, float& v) {
+        do {
+            u = uniform();
+            v = uniform();
+        } while (uniform() * 1.1f >= target(u, v));
+    }
+    // The proposal from (u, v) into (pu, pv); true for a large step.
+    bool propose(float u, float v, float& pu, float& pv) {
+        if (uniform() < kLargeStep) {
+            pu = uniform();
+            pv = uniform();
+            return true;
+        }
+        pu = gpu::mltSmallStep(u, uniform(), uniform());
+        pv = gpu::mltSmallStep(v, uniform(), uniform());
+        return false;
+    }
+
+private:
+    std::mt19937 gen_;
+    std::uniform_real_distribution<float> uni_{0.0f, 1.0f};
+};
+
 std::vector<double> finalStateHistogram(const Acceptance& accept, std::uint32_t seed) {
-    std::mt19937 gen(seed);
-    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+    AnalyticChains chains(seed);
     std::vector<double> counts(kCells * kCells, 0.0);
     for (int c = 0; c < kChains; ++c) {
         float u, v;
-        do {  // rejection sampling: the start is distributed by the target exactly
-            u = uni(gen);
-            v = uni(gen);
-        } while (uni(gen) * 1.1f >= target(u, v));
+        chains.start(u, v);
         float t = static_cast<float>(target(u, v));
         for (int s = 0; s < kSteps; ++s) {
             float pu, pv;
-            if (uni(gen) < kLargeStep) {
-                pu = uni(gen);
-                pv = uni(gen);
-            } else {
-                pu = gpu::mltSmallStep(u, uni(gen), uni(gen));
-                pv = gpu::mltSmallStep(v, uni(gen), uni(gen));
-            }
+            chains.propose(u, v, pu, pv);
             const float tp = static_cast<float>(target(pu, pv));
-            if (uni(gen) < accept(t, tp)) u = pu, v = pv, t = tp;
+            if (chains.uniform() < accept(t, tp)) u = pu, v = pv, t = tp;
         }
         counts[std::size_t(std::min(int(v * kCells), kCells - 1) * kCells +
                            std::min(int(u * kCells), kCells - 1))] += 1.0;
@@ -163,27 +183,16 @@ void exactIntegrals(double& b, std::array<double, 4>& q) {
 // the Metropolis sum scaled by the true b (mlt_estimate.h), the large steps' share kept or not.
 std::array<double, 4> misRender(std::uint32_t seed, double b, float bWeights, bool largeShare) {
     constexpr int kMisChains = 400, kMisSteps = 100;
-    std::mt19937 gen(seed);
-    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+    AnalyticChains chains(seed);
     std::array<double, 4> metropolis{}, large{};
     const float bLarge = bWeights * kLargeStep;
     for (int c = 0; c < kMisChains; ++c) {
         float u, v;
-        do {
-            u = uni(gen);
-            v = uni(gen);
-        } while (uni(gen) * 1.1f >= target(u, v));
+        chains.start(u, v);
         float t = static_cast<float>(target(u, v));
         for (int s = 0; s < kMisSteps; ++s) {
-            const bool isLarge = uni(gen) < kLargeStep;
             float pu, pv;
-            if (isLarge) {
-                pu = uni(gen);
-                pv = uni(gen);
-            } else {
-                pu = gpu::mltSmallStep(u, uni(gen), uni(gen));
-                pv = gpu::mltSmallStep(v, uni(gen), uni(gen));
-            }
+            const bool isLarge = chains.propose(u, v, pu, pv);
             const float tp = static_cast<float>(target(pu, pv));
             const float a = gpu::mltAcceptance(t, tp);
             metropolis[std::size_t(quadrant(u, v))] +=
@@ -192,7 +201,7 @@ std::array<double, 4> misRender(std::uint32_t seed, double b, float bWeights, bo
             if (isLarge)
                 large[std::size_t(quadrant(pu, pv))] +=
                     gpu::mltLargeStepWeight(tp, bWeights, kLargeStep) * carried(pu, pv);
-            if (uni(gen) < a) u = pu, v = pv, t = tp;
+            if (chains.uniform() < a) u = pu, v = pv, t = tp;
         }
     }
     std::array<double, 4> q{};
