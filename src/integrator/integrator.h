@@ -119,7 +119,7 @@ struct GptOptions {
 // The settings of Metropolis light transport (pssmlt, gmlt; mlt_integrator.h).
 struct MltOptions {
     std::uint32_t chains = 0;             // Markov chains at once; 0 = per image size (defaultMltChains)
-    float largeStep = 0.3f;               // probability of a large step (a fresh state) per mutation
+    float largeStep = 0.5f;               // probability of a large step (a fresh state) per mutation
     float targetAlpha = 0.25f;            // gmlt: weight of the radiance in the target (mlt.glsl gmltTarget)
     std::uint32_t bootstrapPerPixel = 1;  // bootstrap samples per pixel (at least 16 per chain)
     std::uint32_t directSamples = 16;     // camera samples per pixel of the very-direct image

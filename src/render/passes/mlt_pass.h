@@ -24,7 +24,7 @@ struct MltPassOptions {
     bool baseOnly = false;            // PSSMLT: the base path alone; else G-MLT (base + offsets)
     std::uint32_t chains = 4096;      // Markov chains run at once
     std::uint32_t stepsPerBatch = 8;  // mutation steps a batch records (records buffer size)
-    float largeStep = 0.3f;           // probability of a large step
+    float largeStep = 0.5f;           // probability of a large step
     float targetAlpha = 0.25f;        // G-MLT: weight of the primal term of the target
 };
 
