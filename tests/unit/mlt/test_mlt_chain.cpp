@@ -72,22 +72,39 @@ private:
     std::uniform_real_distribution<float> uni_{0.0f, 1.0f};
 };
 
-std::vector<double> finalStateHistogram(const Acceptance& accept, std::uint32_t seed) {
+// What a mutation of the chains below sees: the current state (u, v) of target t, the
+// proposal (pu, pv) of target tp, and whether it is a large step.
+struct Mutation {
+    float u, v, t, pu, pv, tp;
+    bool large;
+};
+
+// Walks `count` chains of `steps` mutations from exact starts: `step(m)` returns the
+// acceptance probability of mutation m (and may splat it); `end(u, v)` sees each final state.
+template <class Step, class End>
+void walkChains(std::uint32_t seed, int count, int steps, Step step, End end) {
     AnalyticChains chains(seed);
-    std::vector<double> counts(kCells * kCells, 0.0);
-    for (int c = 0; c < kChains; ++c) {
-        float u, v;
-        chains.start(u, v);
-        float t = static_cast<float>(target(u, v));
-        for (int s = 0; s < kSteps; ++s) {
-            float pu, pv;
-            chains.propose(u, v, pu, pv);
-            const float tp = static_cast<float>(target(pu, pv));
-            if (chains.uniform() < accept(t, tp)) u = pu, v = pv, t = tp;
+    for (int c = 0; c < count; ++c) {
+        Mutation m{};
+        chains.start(m.u, m.v);
+        m.t = static_cast<float>(target(m.u, m.v));
+        for (int s = 0; s < steps; ++s) {
+            m.large = chains.propose(m.u, m.v, m.pu, m.pv);
+            m.tp = static_cast<float>(target(m.pu, m.pv));
+            if (chains.uniform() < step(m)) m.u = m.pu, m.v = m.pv, m.t = m.tp;
         }
-        counts[std::size_t(std::min(int(v * kCells), kCells - 1) * kCells +
-                           std::min(int(u * kCells), kCells - 1))] += 1.0;
+        end(m.u, m.v);
     }
+}
+
+std::vector<double> finalStateHistogram(const Acceptance& accept, std::uint32_t seed) {
+    std::vector<double> counts(kCells * kCells, 0.0);
+    walkChains(
+        seed, kChains, kSteps, [&](const Mutation& m) { return accept(m.t, m.tp); },
+        [&](float u, float v) {
+            counts[std::size_t(std::min(int(v * kCells), kCells - 1) * kCells +
+                               std::min(int(u * kCells), kCells - 1))] += 1.0;
+        });
     return counts;
 }
 
@@ -183,27 +200,22 @@ void exactIntegrals(double& b, std::array<double, 4>& q) {
 // the Metropolis sum scaled by the true b (mlt_estimate.h), the large steps' share kept or not.
 std::array<double, 4> misRender(std::uint32_t seed, double b, float bWeights, bool largeShare) {
     constexpr int kMisChains = 400, kMisSteps = 100;
-    AnalyticChains chains(seed);
     std::array<double, 4> metropolis{}, large{};
     const float bLarge = bWeights * kLargeStep;
-    for (int c = 0; c < kMisChains; ++c) {
-        float u, v;
-        chains.start(u, v);
-        float t = static_cast<float>(target(u, v));
-        for (int s = 0; s < kMisSteps; ++s) {
-            float pu, pv;
-            const bool isLarge = chains.propose(u, v, pu, pv);
-            const float tp = static_cast<float>(target(pu, pv));
-            const float a = gpu::mltAcceptance(t, tp);
-            metropolis[std::size_t(quadrant(u, v))] +=
-                gpu::mltSplatWeight(1.0f - a, t, bLarge) * carried(u, v);
-            metropolis[std::size_t(quadrant(pu, pv))] += gpu::mltSplatWeight(a, tp, bLarge) * carried(pu, pv);
-            if (isLarge)
-                large[std::size_t(quadrant(pu, pv))] +=
-                    gpu::mltLargeStepWeight(tp, bWeights, kLargeStep) * carried(pu, pv);
-            if (chains.uniform() < a) u = pu, v = pv, t = tp;
-        }
-    }
+    walkChains(
+        seed, kMisChains, kMisSteps,
+        [&](const Mutation& m) {
+            const float a = gpu::mltAcceptance(m.t, m.tp);
+            metropolis[std::size_t(quadrant(m.u, m.v))] +=
+                gpu::mltSplatWeight(1.0f - a, m.t, bLarge) * carried(m.u, m.v);
+            metropolis[std::size_t(quadrant(m.pu, m.pv))] +=
+                gpu::mltSplatWeight(a, m.tp, bLarge) * carried(m.pu, m.pv);
+            if (m.large)
+                large[std::size_t(quadrant(m.pu, m.pv))] +=
+                    gpu::mltLargeStepWeight(m.tp, bWeights, kLargeStep) * carried(m.pu, m.pv);
+            return a;
+        },
+        [](float, float) {});
     std::array<double, 4> q{};
     for (std::size_t k = 0; k < 4; ++k)
         q[k] = (b * metropolis[k] + (largeShare ? large[k] : 0.0)) / double(kMisChains * kMisSteps);
