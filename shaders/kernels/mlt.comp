@@ -8,8 +8,9 @@
 //              numbers) as its current state;
 //   mutate     chain c proposes a small or a large step (mlt.glsl), evaluates it, writes two
 //              records (the current state with Metropolis share 1 − a, the proposal with a;
-//              mlt.glsl's splat weights) and accepts with probability a; one step per dispatch (llvmpipe's loop limit, see
-//              samplesPerDispatch in pt_pass.h), the records of a batch in step order;
+//              mlt.glsl's splat weights) and accepts with probability a; one step per
+//              dispatch (llvmpipe's loop limit, see samplesPerDispatch in pt_pass.h), the
+//              records of a batch in step order;
 //   direct     one invocation per pixel: the emission the camera sees directly, by
 //              stratified camera samples (G-PT's "very direct" light, which is neither in the
 //              chains' target nor reconstructed).
