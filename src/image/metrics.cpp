@@ -14,9 +14,7 @@ namespace gdpt {
 namespace {
 // Kettunen et al.'s regulariser in the relMSE denominator (calculateRelMSE.m).
 constexpr double kRelMseEpsilon = 1e-3;
-}  // namespace
 
-namespace {
 void checkSameSize(const Image& test, const Image& reference) {
     if (!test.sameSize(reference))
         throw Error("cannot compare a " + std::to_string(test.width()) + "x" + std::to_string(test.height()) +
@@ -24,30 +22,31 @@ void checkSameSize(const Image& test, const Image& reference) {
                     std::to_string(reference.height()) + " reference");
 }
 
-// The pixel's relMSE term, NaN if a value of either image is not finite.
-double relMseTerm(const Image& test, const Image& reference, std::size_t i) {
-    double t[3], r[3];
+// Pixel i's values of both images; false if one is not finite.
+bool finitePixel(const Image& test, const Image& reference, std::size_t i, double t[3], double r[3]) {
+    bool finite = true;
     for (int c = 0; c < 3; ++c) {
         t[c] = test.plane(c)[i];
         r[c] = reference.plane(c)[i];
-        if (!std::isfinite(t[c]) || !std::isfinite(r[c])) return std::numeric_limits<double>::quiet_NaN();
+        finite = finite && std::isfinite(t[c]) && std::isfinite(r[c]);
     }
-    const double gray = (r[0] + r[1] + r[2]) / 3.0;
-    double sum = 0.0;
-    for (int c = 0; c < 3; ++c) sum += (t[c] - r[c]) * (t[c] - r[c]);
-    return sum / (kRelMseEpsilon + gray * gray);
+    return finite;
 }
 
-// relMSE's sum by quarters of the finite pixels ordered by the reference's gray.
-std::array<double, 4> relMseQuarters(const Image& test, const Image& reference, std::size_t finitePixels) {
-    std::vector<std::pair<double, double>> byGray;  // (gray, term)
-    byGray.reserve(finitePixels);
-    for (std::size_t i = 0; i < test.pixelCount(); ++i) {
-        const double term = relMseTerm(test, reference, i);
-        if (std::isfinite(term))
-            byGray.emplace_back(
-                (double(reference.plane(0)[i]) + reference.plane(1)[i] + reference.plane(2)[i]) / 3.0, term);
-    }
+double grayOf(const double r[3]) {
+    return (r[0] + r[1] + r[2]) / 3.0;
+}
+
+// A finite pixel's relMSE term, Σ_c (t_c − r_c)² / (ε + gray(r)²).
+double relMseTerm(const double t[3], const double r[3]) {
+    const double denominator = kRelMseEpsilon + grayOf(r) * grayOf(r);
+    double sum = 0.0;
+    for (int c = 0; c < 3; ++c) sum += (t[c] - r[c]) * (t[c] - r[c]) / denominator;
+    return sum;
+}
+
+// relMSE's sum by quarters of the (gray, term) pairs of the finite pixels ordered by gray.
+std::array<double, 4> relMseQuarters(std::vector<std::pair<double, double>> byGray) {
     std::stable_sort(byGray.begin(), byGray.end(),
                      [](const auto& a, const auto& b) { return a.first < b.first; });
     std::array<double, 4> q{};
@@ -61,7 +60,10 @@ Image relMseMap(const Image& test, const Image& reference) {
     checkSameSize(test, reference);
     Image out(test.width(), test.height());
     for (std::size_t i = 0; i < test.pixelCount(); ++i) {
-        const auto term = static_cast<float>(relMseTerm(test, reference, i));
+        double t[3], r[3];
+        const auto term = static_cast<float>(finitePixel(test, reference, i, t, r)
+                                                 ? relMseTerm(t, r)
+                                                 : std::numeric_limits<double>::quiet_NaN());
         for (int c = 0; c < 3; ++c) out.plane(c)[i] = term;
     }
     return out;
@@ -71,24 +73,20 @@ ImageErrorStats compareImages(const Image& test, const Image& reference) {
     checkSameSize(test, reference);
     ImageErrorStats s;
     double relSum = 0.0, sqSum = 0.0, absSum = 0.0, biasSum = 0.0;
+    std::vector<std::pair<double, double>> byGray;  // (gray, relMSE term) of the finite pixels
+    byGray.reserve(test.pixelCount());
     for (std::size_t i = 0; i < test.pixelCount(); ++i) {
         double t[3], r[3];
-        bool finite = true;
-        for (int c = 0; c < 3; ++c) {
-            t[c] = test.plane(c)[i];
-            r[c] = reference.plane(c)[i];
-            finite = finite && std::isfinite(t[c]) && std::isfinite(r[c]);
-        }
-        if (!finite) {
+        if (!finitePixel(test, reference, i, t, r)) {
             ++s.nonFinitePixels;
             continue;
         }
         ++s.finitePixels;
-        const double gray = (r[0] + r[1] + r[2]) / 3.0;
-        const double denominator = kRelMseEpsilon + gray * gray;
+        const double term = relMseTerm(t, r);
+        relSum += term;
+        byGray.emplace_back(grayOf(r), term);
         for (int c = 0; c < 3; ++c) {
             const double d = t[c] - r[c];
-            relSum += d * d / denominator;
             sqSum += d * d;
             absSum += std::abs(d);
             biasSum += d;
@@ -113,7 +111,7 @@ ImageErrorStats compareImages(const Image& test, const Image& reference) {
         s.meanTest[c] /= pixels;
         s.meanReference[c] /= pixels;
     }
-    s.relMseByQuarter = relMseQuarters(test, reference, s.finitePixels);
+    s.relMseByQuarter = relMseQuarters(std::move(byGray));
     return s;
 }
 
