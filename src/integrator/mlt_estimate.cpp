@@ -86,17 +86,13 @@ void MltAccumulator::add(const gpu::MltRecord* records, std::size_t count) {
         if (large) largeSteps_.add(rec.largeTarget);
         if (rec.pixel >= pixels) continue;
         const std::size_t at = std::size_t(rec.pixel) * gpu::kMltValues * 3;
-        if (rec.weight > 0.0f) {
-            const double w = rec.weight;
+        const auto splat = [&](std::vector<double>& sums, double w) {
             for (std::uint32_t k = 0; k < gpu::kMltValues; ++k)
-                for (std::uint32_t c = 0; c < 3; ++c) sums_[at + k * 3 + c] += w * double(rec.value[k][c]);
-        }
-        if (large && rec.largeTarget > 0.0f) {
-            const double w = gpu::mltLargeStepWeight(rec.largeTarget, misNormalisation_, largeStep_);
-            for (std::uint32_t k = 0; k < gpu::kMltValues; ++k)
-                for (std::uint32_t c = 0; c < 3; ++c)
-                    largeSums_[at + k * 3 + c] += w * double(rec.value[k][c]);
-        }
+                for (std::uint32_t c = 0; c < 3; ++c) sums[at + k * 3 + c] += w * double(rec.value[k][c]);
+        };
+        if (rec.weight > 0.0f) splat(sums_, rec.weight);
+        if (large && rec.largeTarget > 0.0f)
+            splat(largeSums_, gpu::mltLargeStepWeight(rec.largeTarget, misNormalisation_, largeStep_));
     }
 }
 
