@@ -177,7 +177,7 @@ void HostVcycle::cycle(std::size_t level, const std::array<const double*, 3>& b,
                         continue;
                     }
                     const bool top = y == 0, bottom = y + 1 == h;
-                    for (std::size_t px = (y + std::size_t(colour)) & 1u; px < w; px += 2) {
+                    const auto update = [&](std::size_t px) {
                         const std::size_t i = row + px;
                         double s = bc[i];
                         if (px + 1 < w) s += cx[i] * xc[i + 1];
@@ -185,7 +185,25 @@ void HostVcycle::cycle(std::size_t level, const std::array<const double*, 3>& b,
                         if (!bottom) s += cy[i] * xc[i + w];
                         if (!top) s += cy[i - w] * xc[i - w];
                         xc[i] = s * inv[i];
+                    };
+                    std::size_t px = (y + std::size_t(colour)) & 1u;
+                    if (top || bottom || w < 3) {
+                        for (; px < w; px += 2) update(px);
+                        continue;
                     }
+                    // Inside the level: every neighbour is there (the same terms in the same
+                    // order as update's).
+                    if (px == 0) update(0), px = 2;
+                    for (; px + 1 < w; px += 2) {
+                        const std::size_t i = row + px;
+                        double s = bc[i];
+                        s += cx[i] * xc[i + 1];
+                        s += cx[i - 1] * xc[i - 1];
+                        s += cy[i] * xc[i + w];
+                        s += cy[i - w] * xc[i - w];
+                        xc[i] = s * inv[i];
+                    }
+                    if (px < w) update(px);
                 }
             }
         });
@@ -204,12 +222,31 @@ void HostVcycle::cycle(std::size_t level, const std::array<const double*, 3>& b,
             double* cb = C.b[c].data();
             for (std::size_t Y = Y0; Y < Y1; ++Y) {
                 std::fill(cb + Y * cw, cb + (Y + 1) * cw, 0.0);
-                for (std::size_t y = 2 * Y; y < std::min(2 * Y + 2, h); ++y)
-                    for (std::size_t px = 0; px < w; ++px) {
-                        const std::size_t i = y * w + px;
-                        const double res = b[c][i] - applyAt(diag, cx, cy, x[c], i, px, y, w, h);
-                        cb[Y * cw + px / 2] += 0.25 * res;
+                const double* bc = b[c];
+                const double* xc = x[c];
+                for (std::size_t y = 2 * Y; y < std::min(2 * Y + 2, h); ++y) {
+                    const std::size_t row = y * w;
+                    const auto add = [&](std::size_t px) {
+                        const std::size_t i = row + px;
+                        cb[Y * cw + px / 2] += 0.25 * (bc[i] - applyAt(diag, cx, cy, xc, i, px, y, w, h));
+                    };
+                    if (y == 0 || y + 1 == h || w < 3) {
+                        for (std::size_t px = 0; px < w; ++px) add(px);
+                        continue;
                     }
+                    // Inside the level: applyAt's terms in its order, without its tests.
+                    add(0);
+                    for (std::size_t px = 1; px + 1 < w; ++px) {
+                        const std::size_t i = row + px;
+                        double v = diag[i] * xc[i];
+                        v -= cx[i] * xc[i + 1];
+                        v -= cx[i - 1] * xc[i - 1];
+                        v -= cy[i] * xc[i + w];
+                        v -= cy[i - w] * xc[i - w];
+                        cb[Y * cw + px / 2] += 0.25 * (bc[i] - v);
+                    }
+                    add(w - 1);
+                }
             }
         }
     });

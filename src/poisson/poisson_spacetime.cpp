@@ -42,6 +42,16 @@ struct Operator {
     std::vector<std::uint32_t> bnext;  // bnext(j): the pixel of frame 0 of the previous frame's pixel j
     // The pixels whose next() is i: back[backStart[i] .. backStart[i+1]).
     std::vector<std::uint32_t> backStart, back;
+    // The links again in a form without tests (linkedOnce(), where every pixel is next() of at
+    // most one pixel, as the motion map and the replay make it; empty otherwise), for the
+    // loops that run every CG iteration: fwd[i] = next(i), or i where none (its ct is 0); src[i]
+    // = the pixel whose next() is i, or i where none (srcCt 0); srcRow[i] = the same, or n
+    // where none (the mixed row values are n + 1 long, 0 past the rows); mxTo[m] (myTo[m]) =
+    // next(m) where next(m) + 1 (+ W) is in the window, else m (a row that cannot exist there,
+    // whose residual with the target m is 0, as its coefficient is).
+    std::vector<std::uint32_t> fwd, src, srcRow, mxTo, myTo;
+    Field srcCt;  // ct(src(i)), 0 where none (setWeights)
+    [[nodiscard]] bool linkedOnce() const { return !fwd.empty(); }
     [[nodiscard]] std::size_t pixels() const { return std::size_t(width) * std::size_t(height); }
     [[nodiscard]] std::size_t size() const { return pixels() * std::size_t(frames); }
     // The diagonal of A (Jacobi's, and the V-cycles'): the operator's own applies diag and
@@ -98,14 +108,32 @@ struct MixedRowValues {
 void mixedRowValues(const Operator& op, const std::array<Field, 3>& v, const std::array<bool, 3>& which,
                     MixedRowValues& out, std::uint32_t threads) {
     const std::size_t nt = op.cmx.size(), w = std::size_t(op.width);
+    // linkedOnce(): n + 1 values, the ones past the rows 0 (resize's), for the operator's
+    // gather without tests.
+    const std::size_t size = op.linkedOnce() ? op.size() + 1 : nt;
     for (int c = 0; c < 3; ++c) {
         if (!which[c]) continue;
-        sized(out.x[c], nt);
-        sized(out.y[c], nt);
+        sized(out.x[c], size);
+        sized(out.y[c], size);
     }
     parallelRanges(threads, nt, kGrain, [&](std::size_t begin, std::size_t end) {
         for (int c = 0; c < 3; ++c) {
             if (!which[c]) continue;
+            if (op.linkedOnce()) {
+                const double* __restrict x = v[c].data();
+                const double* __restrict cmx = op.cmx.data();
+                const double* __restrict cmy = op.cmy.data();
+                const std::uint32_t* __restrict tx = op.mxTo.data();
+                const std::uint32_t* __restrict ty = op.myTo.data();
+                double* __restrict rx = out.x[c].data();
+                double* __restrict ry = out.y[c].data();
+                for (std::size_t m = begin; m < end; ++m) {
+                    const double xm = x[m];
+                    rx[m] = cmx[m] * ((x[tx[m] + 1] - x[tx[m]]) - (x[m + 1] - xm));
+                    ry[m] = cmy[m] * ((x[ty[m] + w] - x[ty[m]]) - (x[m + w] - xm));
+                }
+                continue;
+            }
             for (std::size_t m = begin; m < end; ++m) {
                 out.x[c][m] = op.cmx[m] != 0.0 ? op.cmx[m] * mixedResidual(op, v[c], m, 1) : 0.0;
                 out.y[c][m] = op.cmy[m] != 0.0 ? op.cmy[m] * mixedResidual(op, v[c], m, w) : 0.0;
@@ -306,6 +334,27 @@ Operator makeStructure(const SpaceTimeProblem& p) {
     std::vector<std::uint32_t> fill(op.backStart.begin(), op.backStart.end() - 1);
     for (std::size_t i = 0; i < n; ++i)
         if (op.next[i] != kNoTemporalPartner) op.back[fill[op.next[i]]++] = std::uint32_t(i);
+    for (std::size_t i = 0; i < n; ++i)
+        if (op.backStart[i + 1] - op.backStart[i] > 1) return op;  // no linkedOnce() form
+    op.fwd.resize(n);
+    op.src.resize(n);
+    op.srcRow.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        op.fwd[i] = op.next[i] == kNoTemporalPartner ? std::uint32_t(i) : op.next[i];
+        const bool has = op.backStart[i + 1] > op.backStart[i];
+        op.src[i] = has ? op.back[op.backStart[i]] : std::uint32_t(i);
+        op.srcRow[i] = has ? op.back[op.backStart[i]] : std::uint32_t(n);
+    }
+    if (p.gamma > 0.0) {
+        const std::size_t nt = n - p.pixels(), w = std::size_t(p.width);
+        op.mxTo.resize(nt);
+        op.myTo.resize(nt);
+        for (std::size_t m = 0; m < nt; ++m) {
+            const std::size_t b = op.next[m];
+            op.mxTo[m] = std::uint32_t(b != kNoTemporalPartner && b + 1 < n ? b : m);
+            op.myTo[m] = std::uint32_t(b != kNoTemporalPartner && b + w < n ? b : m);
+        }
+    }
     return op;
 }
 
@@ -349,6 +398,12 @@ void setWeights(const SpaceTimeProblem& p, const Weights& wt, Operator& op, std:
             op.diag[i] = d;
         }
     });
+    if (op.linkedOnce()) {
+        sized(op.srcCt, n);
+        parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i) op.srcCt[i] = op.src[i] != i ? op.ct[op.src[i]] : 0.0;
+        });
+    }
     op.cb = wt.boundary;
     for (std::size_t j = 0; j < op.cb.size(); ++j) {
         op.cb[j] *= b2;
@@ -456,6 +511,55 @@ void applyRangeGeneral(const Operator& op, const Field& x, Field& y, std::size_t
     }
 }
 
+// applyRange of a window of several frames in its linkedOnce() form: the pixels [lo, hi) away
+// from the window's first and last rows without a test (the neighbours across a row's end have
+// coefficient 0, a missing temporal neighbour is the pixel itself with coefficient 0, a missing
+// mixed row has the value 0), the others by applyRangeGeneral. The same terms as
+// applyRangeGeneral, in another order.
+void applyRangeLinked(const Operator& op, const Field& x, Field& y, std::size_t begin, std::size_t lo,
+                      std::size_t hi, std::size_t end, const Field* rowsX, const Field* rowsY) {
+    const std::size_t w = std::size_t(op.width);
+    applyRangeGeneral(op, x, y, begin, lo, rowsX, rowsY);
+    const double* __restrict xs = x.data();
+    const double* __restrict d = op.diag.data();
+    const double* __restrict cx = op.cx.data();
+    const double* __restrict cy = op.cy.data();
+    const double* __restrict ct = op.ct.data();
+    const double* __restrict sct = op.srcCt.data();
+    const std::uint32_t* __restrict fwd = op.fwd.data();
+    const std::uint32_t* __restrict src = op.src.data();
+    double* __restrict ys = y.data();
+    if (rowsX) {
+        const double* __restrict rx = rowsX->data();
+        const double* __restrict ry = rowsY->data();
+        const std::uint32_t* __restrict sr = op.srcRow.data();
+        for (std::size_t i = lo; i < hi; ++i) {
+            double v = d[i] * xs[i];
+            v -= cx[i] * xs[i + 1];
+            v -= cx[i - 1] * xs[i - 1];
+            v -= cy[i] * xs[i + w];
+            v -= cy[i - w] * xs[i - w];
+            v -= ct[i] * xs[fwd[i]];
+            v -= sct[i] * xs[src[i]];
+            v += (rx[i] - rx[i - 1]) - (rx[sr[i]] - rx[sr[i - 1]]);
+            v += (ry[i] - ry[i - w]) - (ry[sr[i]] - ry[sr[i - w]]);
+            ys[i] = v;
+        }
+    } else {
+        for (std::size_t i = lo; i < hi; ++i) {
+            double v = d[i] * xs[i];
+            v -= cx[i] * xs[i + 1];
+            v -= cx[i - 1] * xs[i - 1];
+            v -= cy[i] * xs[i + w];
+            v -= cy[i - w] * xs[i - w];
+            v -= ct[i] * xs[fwd[i]];
+            v -= sct[i] * xs[src[i]];
+            ys[i] = v;
+        }
+    }
+    applyRangeGeneral(op, x, y, hi, end, rowsX, rowsY);
+}
+
 // (A x)_i for i in [begin, end): one frame (no temporal or mixed rows) takes the 5-point stencil
 // without a test per neighbour at the pixels that have all four in the field (rows 1 .. H−2,
 // and the neighbours across a row's end, whose coefficient is 0); the same operations in the
@@ -464,11 +568,15 @@ void applyRangeGeneral(const Operator& op, const Field& x, Field& y, std::size_t
 void applyRange(const Operator& op, const Field& x, Field& y, std::size_t begin, std::size_t end,
                 const Field* rowsX, const Field* rowsY) {
     const std::size_t n = op.size(), w = std::size_t(op.width);
-    if (op.frames != 1 || n <= 2 * w) {
+    if (n <= 2 * w || (op.frames != 1 && !op.linkedOnce())) {
         applyRangeGeneral(op, x, y, begin, end, rowsX, rowsY);
         return;
     }
     const std::size_t lo = std::clamp(w, begin, end), hi = std::clamp(n - w, lo, end);
+    if (op.frames != 1) {
+        applyRangeLinked(op, x, y, begin, lo, hi, end, rowsX, rowsY);
+        return;
+    }
     applyRangeGeneral(op, x, y, begin, lo, nullptr, nullptr);
     const double* __restrict xs = x.data();
     const double* __restrict d = op.diag.data();
@@ -565,7 +673,8 @@ private:
             if (!which[c]) continue;
             sized(s_[c], np);
             sized(e_[c], np);
-            if (mixed) sized(rx_[c], np), sized(ry_[c], np);
+            // One more, always 0: the value of a missing row (linkedOnce()).
+            if (mixed) sized(rx_[c], np + 1), sized(ry_[c], np + 1);
         }
         const auto cycle = [&](std::size_t f, std::array<double*, 3> out) {
             std::array<const double*, 3> in{};
@@ -581,15 +690,25 @@ private:
             const std::size_t base = f * np, prev = base - np;
             if (mixed && f > 0)
                 overFrame(threads, np, which, [&](int c, std::size_t begin, std::size_t end) {
-                    const Field& t = z[c];
+                    // (m + W is in the window: m is in a frame before the last; a missing row's
+                    // coefficient is 0.)
+                    const double* __restrict t = z[c].data() + prev;
+                    const double* __restrict cmx = op.cmx.data() + prev;
+                    const double* __restrict cmy = op.cmy.data() + prev;
+                    double* __restrict rx = rx_[c].data();
+                    double* __restrict ry = ry_[c].data();
                     for (std::size_t i = begin; i < end; ++i) {
-                        const std::size_t m = prev + i;
-                        rx_[c][i] = op.cmx[m] != 0.0 ? op.cmx[m] * (t[m] - t[m + 1]) : 0.0;
-                        ry_[c][i] = op.cmy[m] != 0.0 ? op.cmy[m] * (t[m] - t[m + w]) : 0.0;
+                        rx[i] = cmx[i] * (t[i] - t[i + 1]);
+                        ry[i] = cmy[i] * (t[i] - t[i + w]);
                     }
                 });
             overFrame(threads, np, which, [&](int c, std::size_t begin, std::size_t end) {
                 const Field& t = z[c];
+                if (f > 0 && op.linkedOnce()) {
+                    const std::size_t lo = std::clamp(w, begin, end);
+                    forwardLinked(op, r[c], t, base, lo, end, mixed, c);
+                    end = lo;
+                }
                 for (std::size_t i = begin; i < end; ++i) {
                     const std::size_t k = base + i;
                     double v = r[c][k];
@@ -621,6 +740,20 @@ private:
             if (mixed)
                 overFrame(threads, np, which, [&](int c, std::size_t begin, std::size_t end) {
                     const Field& zc = z[c];
+                    if (op.linkedOnce()) {
+                        const double* __restrict cmx = op.cmx.data() + base;
+                        const double* __restrict cmy = op.cmy.data() + base;
+                        const std::uint32_t* __restrict tx = op.mxTo.data() + base;
+                        const std::uint32_t* __restrict ty = op.myTo.data() + base;
+                        const double* __restrict zs = zc.data();
+                        double* __restrict rx = rx_[c].data();
+                        double* __restrict ry = ry_[c].data();
+                        for (std::size_t i = begin; i < end; ++i) {
+                            rx[i] = cmx[i] * (zs[tx[i] + 1] - zs[tx[i]]);
+                            ry[i] = cmy[i] * (zs[ty[i] + w] - zs[ty[i]]);
+                        }
+                        return;
+                    }
                     for (std::size_t i = begin; i < end; ++i) {
                         const std::size_t k = base + i, b = op.next[k];
                         rx_[c][i] = op.cmx[k] != 0.0 ? op.cmx[k] * (zc[b + 1] - zc[b]) : 0.0;
@@ -629,6 +762,11 @@ private:
                 });
             overFrame(threads, np, which, [&](int c, std::size_t begin, std::size_t end) {
                 const Field& zc = z[c];
+                if (op.linkedOnce()) {
+                    const std::size_t lo = std::clamp(w, begin, end);
+                    backwardLinked(op, zc, base, lo, end, mixed, c);
+                    end = lo;
+                }
                 for (std::size_t i = begin; i < end; ++i) {
                     const std::size_t k = base + i, b = op.next[k];
                     double v = b != kNoTemporalPartner ? -op.ct[k] * zc[b] : 0.0;
@@ -649,6 +787,56 @@ private:
                 for (std::size_t i = begin; i < end; ++i) zf[i] -= e_[c][i];
             });
         }
+    }
+
+    // The forward sweep's right-hand side s_ at frame pixels [lo, end) (lo ≥ W) of the frame at
+    // `base` (not the first), in the operator's linkedOnce() form: r plus the temporal row from
+    // the pixel's source in the frame before (a missing one has coefficient 0) and, with
+    // `mixed`, the mixed rows' terms (rx_, ry_ at the frame before's pixels; np: a 0).
+    void forwardLinked(const Operator& op, const Field& r, const Field& t, std::size_t base, std::size_t lo,
+                       std::size_t end, bool mixed, int c) {
+        const std::size_t np = op.pixels(), w = std::size_t(op.width), n = op.size(), prev = base - np;
+        const double* __restrict rs = r.data() + base;
+        const double* __restrict ts = t.data();
+        const double* __restrict sct = op.srcCt.data() + base;
+        const std::uint32_t* __restrict src = op.src.data() + base;
+        double* __restrict out = s_[c].data();
+        if (!mixed) {
+            for (std::size_t i = lo; i < end; ++i) out[i] = rs[i] + sct[i] * ts[src[i]];
+            return;
+        }
+        const std::uint32_t* __restrict sr = op.srcRow.data() + base;
+        const double* __restrict rx = rx_[c].data();
+        const double* __restrict ry = ry_[c].data();
+        const auto local = [&](std::uint32_t m) { return m == n ? np : std::size_t(m) - prev; };
+        for (std::size_t i = lo; i < end; ++i) {
+            const std::size_t a = local(sr[i]);
+            double v = rs[i] + sct[i] * ts[src[i]];
+            v += rx[a] + ry[a];
+            v -= rx[local(sr[i - 1])];
+            v -= ry[local(sr[i - w])];
+            out[i] = v;
+        }
+    }
+
+    // The backward sweep's s_ = A_f,f+1 z_f+1 at frame pixels [lo, end) (lo ≥ W) of the frame at
+    // `base`, in the linkedOnce() form (a missing temporal neighbour is the pixel itself with
+    // coefficient 0); with `mixed`, rx_, ry_ hold the frame's mixed rows' parts in frame f+1.
+    void backwardLinked(const Operator& op, const Field& z, std::size_t base, std::size_t lo, std::size_t end,
+                        bool mixed, int c) {
+        const std::size_t w = std::size_t(op.width);
+        const double* __restrict zs = z.data();
+        const double* __restrict ct = op.ct.data() + base;
+        const std::uint32_t* __restrict fwd = op.fwd.data() + base;
+        double* __restrict out = s_[c].data();
+        if (!mixed) {
+            for (std::size_t i = lo; i < end; ++i) out[i] = -ct[i] * zs[fwd[i]];
+            return;
+        }
+        const double* __restrict rx = rx_[c].data();
+        const double* __restrict ry = ry_[c].data();
+        for (std::size_t i = lo; i < end; ++i)
+            out[i] = -ct[i] * zs[fwd[i]] + (rx[i] + ry[i]) - rx[i - 1] - ry[i - w];
     }
 
     std::vector<HostVcycle> cycles_;
