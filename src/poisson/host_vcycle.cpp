@@ -161,49 +161,80 @@ void HostVcycle::cycle(std::size_t level, const std::array<const double*, 3>& b,
     // One colour's Gauss-Seidel update, rows [y0, y1): x_i = (b_i + Σ_j c_ij x_j) / d_i at the
     // pixels with (px + y) % 2 == colour. fromZero: x was 0 (the first sweep of a cycle), so the
     // red pixels are b_i / d_i and the black ones are set to 0.
+    const bool all = active[0] && active[1] && active[2];
     const auto sweep = [&](int colour, bool fromZero) {
         overRows(n, w, h, threads, [&](std::size_t y0, std::size_t y1) {
-            for (int c = 0; c < 3; ++c) {
-                if (!active[c]) continue;
-                const double* bc = b[c];
-                double* xc = x[c];
-                for (std::size_t y = y0; y < y1; ++y) {
-                    const std::size_t row = y * w;
-                    if (fromZero) {
-                        for (std::size_t px = (y + std::size_t(colour)) & 1u; px < w; px += 2)
-                            xc[row + px] = bc[row + px] * inv[row + px];
-                        for (std::size_t px = (y + std::size_t(colour) + 1) & 1u; px < w; px += 2)
-                            xc[row + px] = 0.0;
-                        continue;
+            for (std::size_t y = y0; y < y1; ++y) {
+                const std::size_t row = y * w, first = (y + std::size_t(colour)) & 1u;
+                if (fromZero) {
+                    for (int c = 0; c < 3; ++c) {
+                        if (!active[c]) continue;
+                        for (std::size_t px = first; px < w; px += 2)
+                            x[c][row + px] = b[c][row + px] * inv[row + px];
+                        for (std::size_t px = first ^ 1u; px < w; px += 2) x[c][row + px] = 0.0;
                     }
-                    const bool top = y == 0, bottom = y + 1 == h;
-                    const auto update = [&](std::size_t px) {
+                    continue;
+                }
+                const bool top = y == 0, bottom = y + 1 == h;
+                const auto update = [&](int c, std::size_t px) {
+                    const double* bc = b[c];
+                    double* xc = x[c];
+                    const std::size_t i = row + px;
+                    double s = bc[i];
+                    if (px + 1 < w) s += cx[i] * xc[i + 1];
+                    if (px > 0) s += cx[i - 1] * xc[i - 1];
+                    if (!bottom) s += cy[i] * xc[i + w];
+                    if (!top) s += cy[i - w] * xc[i - w];
+                    xc[i] = s * inv[i];
+                };
+                if (top || bottom || w < 3) {
+                    for (int c = 0; c < 3; ++c)
+                        if (active[c])
+                            for (std::size_t px = first; px < w; px += 2) update(c, px);
+                    continue;
+                }
+                // Inside the level every neighbour is there: update's terms in its order,
+                // without its tests, and with every channel active each pixel's coefficients
+                // read once for the three.
+                const std::size_t lo = first == 0 ? 2 : 1;
+                const std::size_t last = (w - 1 - first) % 2 == 0 ? w - 1 : w;  // one past the inside
+                for (int c = 0; c < 3; ++c) {
+                    if (!active[c]) continue;
+                    if (first == 0) update(c, 0);
+                    if (last < w) update(c, last);
+                }
+                if (all) {
+                    const double* __restrict b0 = b[0];
+                    const double* __restrict b1 = b[1];
+                    const double* __restrict b2 = b[2];
+                    double* __restrict x0 = x[0];
+                    double* __restrict x1 = x[1];
+                    double* __restrict x2 = x[2];
+                    for (std::size_t px = lo; px + 1 < w; px += 2) {
                         const std::size_t i = row + px;
-                        double s = bc[i];
-                        if (px + 1 < w) s += cx[i] * xc[i + 1];
-                        if (px > 0) s += cx[i - 1] * xc[i - 1];
-                        if (!bottom) s += cy[i] * xc[i + w];
-                        if (!top) s += cy[i - w] * xc[i - w];
-                        xc[i] = s * inv[i];
-                    };
-                    std::size_t px = (y + std::size_t(colour)) & 1u;
-                    if (top || bottom || w < 3) {
-                        for (; px < w; px += 2) update(px);
-                        continue;
+                        const double e = cx[i], west = cx[i - 1], s = cy[i], north = cy[i - w], d = inv[i];
+                        x0[i] =
+                            (b0[i] + e * x0[i + 1] + west * x0[i - 1] + s * x0[i + w] + north * x0[i - w]) *
+                            d;
+                        x1[i] =
+                            (b1[i] + e * x1[i + 1] + west * x1[i - 1] + s * x1[i + w] + north * x1[i - w]) *
+                            d;
+                        x2[i] =
+                            (b2[i] + e * x2[i + 1] + west * x2[i - 1] + s * x2[i + w] + north * x2[i - w]) *
+                            d;
                     }
-                    // Inside the level: every neighbour is there (the same terms in the same
-                    // order as update's).
-                    if (px == 0) update(0), px = 2;
-                    for (; px + 1 < w; px += 2) {
+                    continue;
+                }
+                for (int c = 0; c < 3; ++c) {
+                    if (!active[c]) continue;
+                    const double* __restrict bc = b[c];
+                    double* __restrict xc = x[c];
+                    for (std::size_t px = lo; px + 1 < w; px += 2) {
                         const std::size_t i = row + px;
-                        double s = bc[i];
-                        s += cx[i] * xc[i + 1];
-                        s += cx[i - 1] * xc[i - 1];
-                        s += cy[i] * xc[i + w];
-                        s += cy[i - w] * xc[i - w];
-                        xc[i] = s * inv[i];
+                        xc[i] = (bc[i] + cx[i] * xc[i + 1] + cx[i - 1] * xc[i - 1] + cy[i] * xc[i + w] +
+                                 cy[i - w] * xc[i - w]) *
+                                inv[i];
                     }
-                    if (px < w) update(px);
                 }
             }
         });
@@ -217,36 +248,61 @@ void HostVcycle::cycle(std::size_t level, const std::array<const double*, 3>& b,
     const std::size_t cw = C.width, ch = C.height;
     const double* diag = L.diag;
     overRows(n, w, ch, threads, [&](std::size_t Y0, std::size_t Y1) {
-        for (int c = 0; c < 3; ++c) {
-            if (!active[c]) continue;
-            double* cb = C.b[c].data();
-            for (std::size_t Y = Y0; Y < Y1; ++Y) {
-                std::fill(cb + Y * cw, cb + (Y + 1) * cw, 0.0);
-                const double* bc = b[c];
-                const double* xc = x[c];
-                for (std::size_t y = 2 * Y; y < std::min(2 * Y + 2, h); ++y) {
-                    const std::size_t row = y * w;
-                    const auto add = [&](std::size_t px) {
-                        const std::size_t i = row + px;
-                        cb[Y * cw + px / 2] += 0.25 * (bc[i] - applyAt(diag, cx, cy, xc, i, px, y, w, h));
-                    };
-                    if (y == 0 || y + 1 == h || w < 3) {
-                        for (std::size_t px = 0; px < w; ++px) add(px);
+        for (std::size_t Y = Y0; Y < Y1; ++Y) {
+            for (int c = 0; c < 3; ++c)
+                if (active[c]) std::fill(C.b[c].data() + Y * cw, C.b[c].data() + (Y + 1) * cw, 0.0);
+            for (std::size_t y = 2 * Y; y < std::min(2 * Y + 2, h); ++y) {
+                const std::size_t row = y * w;
+                const auto add = [&](int c, std::size_t px) {
+                    const std::size_t i = row + px;
+                    C.b[c][Y * cw + px / 2] += 0.25 * (b[c][i] - applyAt(diag, cx, cy, x[c], i, px, y, w, h));
+                };
+                const bool inside = y > 0 && y + 1 < h && w >= 3;
+                for (int c = 0; c < 3; ++c) {
+                    if (!active[c]) continue;
+                    if (!inside) {
+                        for (std::size_t px = 0; px < w; ++px) add(c, px);
                         continue;
                     }
-                    // Inside the level: applyAt's terms in its order, without its tests.
-                    add(0);
+                    add(c, 0);
+                }
+                if (!inside) continue;
+                // Inside the level: applyAt's terms in its order, without its tests, and with
+                // every channel active each pixel's coefficients read once for the three.
+                const auto residual = [&](const double* __restrict bc, const double* __restrict xc,
+                                          std::size_t i, double d, double e, double west, double s,
+                                          double north) {
+                    double v = d * xc[i];
+                    v -= e * xc[i + 1];
+                    v -= west * xc[i - 1];
+                    v -= s * xc[i + w];
+                    v -= north * xc[i - w];
+                    return 0.25 * (bc[i] - v);
+                };
+                if (all) {
+                    double* __restrict c0 = C.b[0].data() + Y * cw;
+                    double* __restrict c1 = C.b[1].data() + Y * cw;
+                    double* __restrict c2 = C.b[2].data() + Y * cw;
                     for (std::size_t px = 1; px + 1 < w; ++px) {
                         const std::size_t i = row + px;
-                        double v = diag[i] * xc[i];
-                        v -= cx[i] * xc[i + 1];
-                        v -= cx[i - 1] * xc[i - 1];
-                        v -= cy[i] * xc[i + w];
-                        v -= cy[i - w] * xc[i - w];
-                        cb[Y * cw + px / 2] += 0.25 * (bc[i] - v);
+                        const double d = diag[i], e = cx[i], west = cx[i - 1], s = cy[i], north = cy[i - w];
+                        c0[px / 2] += residual(b[0], x[0], i, d, e, west, s, north);
+                        c1[px / 2] += residual(b[1], x[1], i, d, e, west, s, north);
+                        c2[px / 2] += residual(b[2], x[2], i, d, e, west, s, north);
                     }
-                    add(w - 1);
+                } else {
+                    for (int c = 0; c < 3; ++c) {
+                        if (!active[c]) continue;
+                        double* __restrict cb = C.b[c].data() + Y * cw;
+                        for (std::size_t px = 1; px + 1 < w; ++px) {
+                            const std::size_t i = row + px;
+                            cb[px / 2] +=
+                                residual(b[c], x[c], i, diag[i], cx[i], cx[i - 1], cy[i], cy[i - w]);
+                        }
+                    }
                 }
+                for (int c = 0; c < 3; ++c)
+                    if (active[c]) add(c, w - 1);
             }
         }
     });
