@@ -358,35 +358,44 @@ Operator makeStructure(const SpaceTimeProblem& p) {
     return op;
 }
 
-// The coefficients of the weights `wt` into `op` (made by makeStructure), on `threads`.
-void setWeights(const SpaceTimeProblem& p, const Weights& wt, Operator& op, std::uint32_t threads) {
+// The coefficients of the row weights `wt` into `op` (made by makeStructure), on `threads`: op
+// takes wt's arrays over and scales them in place (takeWeightStorage hands them back for the
+// next round's weights), so that a window holds its weights once.
+void setWeights(const SpaceTimeProblem& p, Weights&& wt, Operator& op, std::uint32_t threads) {
     const std::size_t n = p.size(), np = p.pixels(), w = std::size_t(p.width);
-    const double a2 = p.alpha * p.alpha, b2 = p.beta * p.beta;
-    copied(op.cx, wt.dx);
-    copied(op.cy, wt.dy);
-    if (wt.bmx.empty()) {
-        op.bmx.clear(), op.bmy.clear(), op.cx0.clear(), op.cy0.clear();
+    const double a2 = p.alpha * p.alpha, b2 = p.beta * p.beta, g2 = p.gamma * p.gamma;
+    const auto scaled = [&](Field& f, double by) {
+        parallelRanges(threads, f.size(), kGrain, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i) f[i] *= by;
+        });
+    };
+    op.cx = std::move(wt.dx);
+    op.cy = std::move(wt.dy);
+    op.bmx = std::move(wt.bmx);
+    op.bmy = std::move(wt.bmy);
+    if (op.bmx.empty()) {
+        op.bmy.clear(), op.cx0.clear(), op.cy0.clear();
     } else {
         // Each mixed row to the previous frame is an edge of frame 0 (above).
-        const double g2 = p.gamma * p.gamma;
         op.cx0.assign(op.cx.begin(), op.cx.begin() + std::ptrdiff_t(np));
         op.cy0.assign(op.cy.begin(), op.cy.begin() + std::ptrdiff_t(np));
-        op.bmx.resize(np);
-        op.bmy.resize(np);
         for (std::size_t j = 0; j < np; ++j) {
-            op.bmx[j] = g2 * wt.bmx[j];
-            op.bmy[j] = g2 * wt.bmy[j];
+            op.bmx[j] *= g2;
+            op.bmy[j] *= g2;
             if (op.bmx[j] != 0.0) op.cx[op.bnext[j]] += op.bmx[j];
             if (op.bmy[j] != 0.0) op.cy[op.bnext[j]] += op.bmy[j];
         }
     }
-    sized(op.ct, n);
-    sized(op.cp, n);
+    // The temporal rows' weights are (F − 1)·W·H (or already n from takeWeightStorage); the
+    // last frame's coefficients are 0.
+    op.ct = std::move(wt.dt);
+    op.ct.resize(n, 0.0);
+    op.cp = std::move(wt.primal);
     sized(op.diag, n);
     parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) {
-            op.ct[i] = i + np < n && op.next[i] != kNoTemporalPartner ? b2 * wt.dt[i] : 0.0;
-            op.cp[i] = a2 * wt.primal[i];
+            op.ct[i] = i + np < n && op.next[i] != kNoTemporalPartner ? b2 * op.ct[i] : 0.0;
+            op.cp[i] *= a2;
         }
     });
     parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
@@ -404,29 +413,38 @@ void setWeights(const SpaceTimeProblem& p, const Weights& wt, Operator& op, std:
             for (std::size_t i = begin; i < end; ++i) op.srcCt[i] = op.src[i] != i ? op.ct[op.src[i]] : 0.0;
         });
     }
-    op.cb = wt.boundary;
+    op.cb = std::move(wt.boundary);
     for (std::size_t j = 0; j < op.cb.size(); ++j) {
         op.cb[j] *= b2;
         if (op.cb[j] != 0.0) op.diag[op.bnext[j]] += op.cb[j];
     }
-    if (wt.mx.empty()) {
-        op.cmx.clear();
-        op.cmy.clear();
-        return;
-    }
-    const double g2 = p.gamma * p.gamma;
-    sized(op.cmx, wt.mx.size());
-    sized(op.cmy, wt.my.size());
-    for (std::size_t i = 0; i < wt.mx.size(); ++i) {
-        op.cmx[i] = g2 * wt.mx[i];
-        op.cmy[i] = g2 * wt.my[i];
-    }
+    op.cmx = std::move(wt.mx);
+    op.cmy = std::move(wt.my);
+    if (op.cmx.empty()) return;
+    scaled(op.cmx, g2);
+    scaled(op.cmy, g2);
     // Each row adds its coefficient to the diagonal at its four pixels (σ² = 1).
     copied(op.mixedDiag, op.diag);
     parallelRanges(threads, n, kGrain, [&](std::size_t begin, std::size_t end) {
         for (std::size_t k = begin; k < end; ++k)
             op.mixedDiag[k] += gatherMixed(op, op.cmx, k, 1, true) + gatherMixed(op, op.cmy, k, w, true);
     });
+}
+
+// The arrays of op's row weights (setWeights's), for the next round's weights to be written
+// into; op's coefficients are gone until setWeights.
+Weights takeWeightStorage(Operator& op) {
+    Weights wt;
+    wt.primal = std::move(op.cp);
+    wt.dx = std::move(op.cx);
+    wt.dy = std::move(op.cy);
+    wt.dt = std::move(op.ct);
+    wt.boundary = std::move(op.cb);
+    wt.mx = std::move(op.cmx);
+    wt.my = std::move(op.cmy);
+    wt.bmx = std::move(op.bmx);
+    wt.bmy = std::move(op.bmy);
+    return wt;
 }
 
 // b = Pᵀ W target for the three channels: α² wp t minus the weighted divergence of the
@@ -1046,7 +1064,7 @@ void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array
     sized(wt.primal, kept.primal.size());
     sized(wt.dx, kept.dx.size());
     sized(wt.dy, kept.dy.size());
-    sized(wt.dt, kept.dt.size());
+    sized(wt.dt, p.size());  // as op.ct (setWeights), the last frame's 0
     sized(wt.boundary, kept.boundary.size());
     sized(wt.mx, kept.mx.size());
     sized(wt.my, kept.my.size());
@@ -1079,8 +1097,8 @@ void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array
                 for (int c = 0; c < 3; ++c) e[c] = x[c][i + w] - x[c][i] - p.dy[c][i];
                 wt.dy[i] = kept.dy[i] * weightOf(e);
             }
+            wt.dt[i] = 0.0;
             if (i + np < n) {
-                wt.dt[i] = 0.0;
                 if (kept.dt[i] != 0.0) {
                     const std::size_t j = op.next[i];
                     for (int c = 0; c < 3; ++c) e[c] = p.beta * (x[c][j] - x[c][i] - p.dt[c][i]);
@@ -1156,7 +1174,6 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
     const std::uint32_t threads = defaultThreads(static_cast<std::uint32_t>(std::max(0, options.threads)));
     Operator op = makeStructure(problem);
     const Weights kept = unitWeights(problem);
-    Weights wt;
     std::array<Field, 3> b;
     CgVectors vectors;
     SpaceTimeStats s;
@@ -1175,10 +1192,15 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
             s.stoppedAtDeadline = true;
             break;
         }
-        if (round > 0)
+        Weights wt;
+        if (round == 0) {
+            wt = kept;
+        } else {
+            wt = takeWeightStorage(op);
             irlsWeights(problem, op, x, options.regInit * std::pow(options.regIter, round - 1), kept, wt,
                         threads);
-        setWeights(problem, round == 0 ? kept : wt, op, threads);
+        }
+        setWeights(problem, std::move(wt), op, threads);
         const bool last = round + 1 == rounds;
         const double tolerance = last ? options.tolerance : options.innerTolerance;
         rhs(problem, op, b, vectors.rows, threads);  // (the rows' scratch is free until pcg)
