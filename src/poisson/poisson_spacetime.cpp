@@ -105,12 +105,16 @@ struct MixedRowValues {
     std::array<Field, 3> x, y;  // per channel, (F − 1)·W·H
 };
 
+// The size of the row values: in the linkedOnce() form n + 1, the ones past the rows 0
+// (resize's), for the operator's gather without tests.
+std::size_t rowValuesSize(const Operator& op) {
+    return op.linkedOnce() ? op.size() + 1 : op.cmx.size();
+}
+
 void mixedRowValues(const Operator& op, const std::array<Field, 3>& v, const std::array<bool, 3>& which,
                     MixedRowValues& out, std::uint32_t threads) {
     const std::size_t nt = op.cmx.size(), w = std::size_t(op.width);
-    // linkedOnce(): n + 1 values, the ones past the rows 0 (resize's), for the operator's
-    // gather without tests.
-    const std::size_t size = op.linkedOnce() ? op.size() + 1 : nt;
+    const std::size_t size = rowValuesSize(op);
     for (int c = 0; c < 3; ++c) {
         if (!which[c]) continue;
         sized(out.x[c], size);
@@ -456,9 +460,10 @@ void rhs(const SpaceTimeProblem& p, const Operator& op, std::array<Field, 3>& b,
     for (Field& f : b) sized(f, n);
     const bool mixed = !op.cmx.empty();
     if (mixed) {
+        // (The operator's size, so that the scratch is allocated once: gatherMixed takes either.)
         for (int c = 0; c < 3; ++c) {
-            sized(targets.x[c], op.cmx.size());
-            sized(targets.y[c], op.cmy.size());
+            sized(targets.x[c], rowValuesSize(op));
+            sized(targets.y[c], rowValuesSize(op));
         }
         parallelRanges(threads, op.cmx.size(), kGrain, [&](std::size_t begin, std::size_t end) {
             for (int c = 0; c < 3; ++c)
@@ -475,7 +480,7 @@ void rhs(const SpaceTimeProblem& p, const Operator& op, std::array<Field, 3>& b,
             // the previous frame, whose targets are added below).
             const auto cxRow = [&](std::size_t i) { return i < op.cx0.size() ? op.cx0[i] : op.cx[i]; };
             const auto cyRow = [&](std::size_t i) { return i < op.cy0.size() ? op.cy0[i] : op.cy[i]; };
-            for (std::size_t i = begin; i < end; ++i) {
+            const auto at = [&](std::size_t i) {
                 double v = op.cp[i] * p.primal[c][i] - cxRow(i) * dx[i] - cyRow(i) * dy[i];
                 if (op.ct[i] != 0.0) v -= op.ct[i] * dt[i];
                 if (i >= 1) v += cxRow(i - 1) * dx[i - 1];
@@ -484,7 +489,42 @@ void rhs(const SpaceTimeProblem& p, const Operator& op, std::array<Field, 3>& b,
                     v += op.ct[op.back[k]] * dt[op.back[k]];
                 if (mixed) v += gatherMixed(op, targets.x[c], i, 1) + gatherMixed(op, targets.y[c], i, w);
                 b[c][i] = v;
+            };
+            // The linkedOnce() form: away from the window's first and last rows and from frame
+            // 0's rows to the frame before (cx0, cy0), at's terms without the lists and the tests
+            // (a missing source has coefficient 0; a missing mixed row the value 0).
+            std::size_t lo = end, hi = end;
+            if (op.linkedOnce() && n > 2 * w) {
+                lo = std::clamp(std::max(w, op.cx0.size()), begin, end);
+                hi = std::clamp(n - w, lo, end);
             }
+            for (std::size_t i = begin; i < lo; ++i) at(i);
+            const double* __restrict cp = op.cp.data();
+            const double* __restrict cx = op.cx.data();
+            const double* __restrict cy = op.cy.data();
+            const double* __restrict ct = op.ct.data();
+            const double* __restrict sct = op.srcCt.data();
+            const std::uint32_t* __restrict src = op.src.data();
+            const std::uint32_t* __restrict sr = op.srcRow.data();
+            const double* __restrict t = p.primal[c].data();
+            const double* __restrict tx = dx.data();
+            const double* __restrict ty = dy.data();
+            const double* __restrict tt = dt.data();
+            const double* __restrict rx = mixed ? targets.x[c].data() : nullptr;
+            const double* __restrict ry = mixed ? targets.y[c].data() : nullptr;
+            for (std::size_t i = lo; i < hi; ++i) {
+                double v = cp[i] * t[i] - cx[i] * tx[i] - cy[i] * ty[i];
+                if (ct[i] != 0.0) v -= ct[i] * tt[i];
+                v += cx[i - 1] * tx[i - 1];
+                v += cy[i - w] * ty[i - w];
+                if (sct[i] != 0.0) v += sct[i] * tt[src[i]];
+                if (mixed) {
+                    v += (rx[i] - rx[i - 1]) - (rx[sr[i]] - rx[sr[i - 1]]);
+                    v += (ry[i] - ry[i - w]) - (ry[sr[i]] - ry[sr[i - w]]);
+                }
+                b[c][i] = v;
+            }
+            for (std::size_t i = hi; i < end; ++i) at(i);
         }
     });
     for (int c = 0; c < 3; ++c) {

@@ -460,6 +460,22 @@ TEST(SpaceTimePoisson, PartnersOfOnePixelEachSolveTheLeastSquaresOfTheirRows) {
             EXPECT_LT(maxDiff(y[c], denseLeastSquares(without, c)), 1e-8)
                 << "seed " << seed << " channel " << c;
         EXPECT_GT(maxDiff(y[0], x[0]), 1e-3);
+        // Tied to a frame before the window by rows of one partner each (its mixed rows too),
+        // which frame 0 takes in the general form.
+        SpaceTimeProblem tied = p;
+        const std::size_t np = p.pixels();
+        tied.previousPartner.assign(p.temporalPartner.begin(),
+                                    p.temporalPartner.begin() + std::ptrdiff_t(np));
+        std::mt19937 rng(seed);
+        std::normal_distribution<double> noise(0.0, 0.3);
+        for (int c = 0; c < 3; ++c)
+            for (Field* f :
+                 {&tied.previous[c], &tied.dtPrevious[c], &tied.dxtPrevious[c], &tied.dytPrevious[c]}) {
+                f->resize(np);
+                for (double& v : *f) v = noise(rng);
+            }
+        const auto z = expectDenseLeastSquares(tied, seed);
+        EXPECT_GT(maxDiff(z[0], x[0]), 1e-3);
     }
 }
 
