@@ -680,22 +680,23 @@ public:
         cy_.resize(frames);
         diag_.resize(frames);
         const std::size_t nt = op.cmx.size();
-        for (std::size_t f = 0; f < frames; ++f) {
+        // The frames' blocks and hierarchies side by side (each on one thread: a frame's coarse
+        // levels are too small to share).
+        parallelFor(threads, frames, [&](std::size_t f) {
             const std::size_t at = f * np;
             cx_[f].assign(op.cx.begin() + std::ptrdiff_t(at), op.cx.begin() + std::ptrdiff_t(at + np));
             cy_[f].assign(op.cy.begin() + std::ptrdiff_t(at), op.cy.begin() + std::ptrdiff_t(at + np));
             diag_[f].assign(op.jacobiDiag().begin() + std::ptrdiff_t(at),
                             op.jacobiDiag().begin() + std::ptrdiff_t(at + np));
-            if (nt == 0) continue;
-            for (std::size_t i = 0; i < np; ++i) {
-                const std::size_t k = at + i;
-                if (k < nt) cx_[f][i] += op.cmx[k], cy_[f][i] += op.cmy[k];
-                for (std::uint32_t j = op.backStart[k]; j < op.backStart[k + 1]; ++j)
-                    cx_[f][i] += op.cmx[op.back[j]], cy_[f][i] += op.cmy[op.back[j]];
-            }
-        }
-        for (std::size_t f = 0; f < frames; ++f)
-            cycles_[f].build(op.width, op.height, cx_[f], cy_[f], diag_[f], threads);
+            if (nt > 0)
+                for (std::size_t i = 0; i < np; ++i) {
+                    const std::size_t k = at + i;
+                    if (k < nt) cx_[f][i] += op.cmx[k], cy_[f][i] += op.cmy[k];
+                    for (std::uint32_t j = op.backStart[k]; j < op.backStart[k + 1]; ++j)
+                        cx_[f][i] += op.cmx[op.back[j]], cy_[f][i] += op.cmy[op.back[j]];
+                }
+            cycles_[f].build(op.width, op.height, cx_[f], cy_[f], diag_[f], 1);
+        });
     }
 
     // z = M⁻¹ r for the channels in `which`: block Jacobi (a V-cycle per frame), or with
