@@ -130,10 +130,11 @@ Image frameOf(const std::array<Field, 3>& x, std::size_t frame, int width, int h
 // fewer batches).
 constexpr std::size_t kSampleGroups = 16;
 
-// What a window keeps: the solver's fields, and per frame thirteen float RGB images (the halves'
-// primals, the combined estimates and variances, var_dt; seventeen with the halves' dx, dy for
-// mixed rows, nineteen with their weights' variances) until it is written, plus the sample
-// groups of two half renders (one image per group, three for weighted mixed rows).
+// What a window keeps: the solver's fields (its workspace, also held from window to window),
+// and per frame thirteen float RGB images (the halves' primals, the combined estimates and
+// variances, var_dt; seventeen with the halves' dx, dy for mixed rows, nineteen with their
+// weights' variances) until it is written, plus the sample groups of two half renders (one
+// image per group, three for weighted mixed rows).
 std::uint64_t windowBytes(int width, int height, int frames, bool mixed, bool weighted) {
     const std::uint64_t image = std::uint64_t(width) * std::uint64_t(height) * 3u * 4u;
     const std::uint64_t perFrame = mixed ? (weighted ? 19u : 17u) : 13u;
@@ -418,7 +419,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
     solve.l1 = options_.l1;
     solve.tolerance = options_.tolerance;
     SpaceTimeStats solved;
-    const std::array<Field, 3> x = solveSpaceTime(problem, solve, &solved);
+    const std::array<Field, 3> x = solveSpaceTime(problem, solve, &solved, &workspace_);
     lastSolveSeconds_ = solved.ms * 1e-3;
     lastSolveFrames_ = window.count;
     if (!options.quiet)

@@ -40,6 +40,7 @@
 #include "integrator/integrator.h"
 #include "integrator/motion_map.h"
 #include "integrator/sample_groups.h"
+#include "poisson/poisson_spacetime.h"
 
 namespace gdpt {
 
@@ -77,6 +78,8 @@ private:
         std::vector<PrimaryHit> hits;
     };
     std::optional<Carry> carry_;
+    // The space-time solver's buffers, kept from window to window (poisson_spacetime.h).
+    SpaceTimeWorkspace workspace_;
     // The last window's solve, reserved (per frame) from the next window's budget.
     double lastSolveSeconds_ = 0.0;
     int lastSolveFrames_ = 1;

@@ -234,11 +234,11 @@ void check(const SpaceTimeProblem& p) {
     partners(p.previousPartner, p.previous[0].empty() ? 0 : p.pixels(), "previousPartner");
 }
 
-// The temporal neighbour of every row's pixel in the window (frame f's i → frame f+1's π(i)),
-// a window index, or kNoTemporalPartner where π names none.
-std::vector<std::uint32_t> nextPixels(const SpaceTimeProblem& p) {
+// The temporal neighbour of every pixel in the window (frame f's i → frame f+1's π(i)), a
+// window index, or kNoTemporalPartner where π names none (and in the last frame), into `next`.
+void nextPixels(const SpaceTimeProblem& p, std::vector<std::uint32_t>& next) {
     const std::size_t np = p.pixels(), nt = np * std::size_t(p.frames - 1);
-    std::vector<std::uint32_t> next(nt);
+    next.assign(p.size(), kNoTemporalPartner);
     for (std::size_t i = 0; i < nt; ++i) {
         const std::size_t frameStart = (i / np + 1) * np;
         if (p.temporalPartner.empty())
@@ -248,7 +248,6 @@ std::vector<std::uint32_t> nextPixels(const SpaceTimeProblem& p) {
                           ? kNoTemporalPartner
                           : std::uint32_t(frameStart + p.temporalPartner[i]);
     }
-    return next;
 }
 
 // The pixel of frame 0 that each pixel of the previous frame joins (the same pixel without
@@ -279,11 +278,21 @@ void rigidMixedRows(std::size_t count, std::size_t np, std::size_t w, std::size_
     }
 }
 
-Weights unitWeights(const SpaceTimeProblem& p) {
+// f = n copies of v, in f's buffer where it is large enough (else one advised for huge pages).
+void filled(Field& f, std::size_t n, double v) {
+    sized(f, n);
+    std::fill(f.begin(), f.end(), v);
+}
+
+// The rows' own weights (1, or the problem's; 0 for the rows that do not exist), into wt (its
+// buffers reused).
+void unitWeights(const SpaceTimeProblem& p, Weights& wt) {
     const std::size_t n = p.size(), np = p.pixels(), w = std::size_t(p.width);
-    Weights wt{hugeVector(n, 1.0), hugeVector(n, 1.0), hugeVector(n, 1.0),
-               hugeVector(np * std::size_t(p.frames - 1), 1.0),
-               p.previous[0].empty() ? Field() : Field(np, 1.0)};
+    filled(wt.primal, n, 1.0);
+    filled(wt.dx, n, 1.0);
+    filled(wt.dy, n, 1.0);
+    filled(wt.dt, np * std::size_t(p.frames - 1), 1.0);
+    filled(wt.boundary, p.previous[0].empty() ? 0 : np, 1.0);
     for (std::size_t i = 0; i < n; ++i) {
         if (!p.weightPrimal.empty()) wt.primal[i] = p.weightPrimal[i];
         if (!p.weightDx.empty()) wt.dx[i] = p.weightDx[i];
@@ -299,11 +308,12 @@ Weights unitWeights(const SpaceTimeProblem& p) {
     for (std::size_t j = 0; j < p.previousPartner.size() && !wt.boundary.empty(); ++j)
         if (p.previousPartner[j] == kNoTemporalPartner) wt.boundary[j] = 0.0;
     const std::size_t h = std::size_t(p.height);
+    wt.bmx.clear(), wt.bmy.clear();
     if (!p.dxtPrevious[0].empty()) {
         // The same rule for the rows from the previous frame's pixel j into frame 0.
         const std::vector<std::uint32_t> to = previousNext(p);
-        wt.bmx.assign(np, 0.0);
-        wt.bmy.assign(np, 0.0);
+        filled(wt.bmx, np, 0.0);
+        filled(wt.bmy, np, 0.0);
         rigidMixedRows(
             np, np, w, h, [&](std::size_t j) { return to[j]; }, p.weightDxtPrevious, p.weightDytPrevious,
             wt.bmx, wt.bmy);
@@ -313,23 +323,24 @@ Weights unitWeights(const SpaceTimeProblem& p) {
         const auto partner = [&](std::size_t i) {
             return p.temporalPartner.empty() ? std::uint32_t(i % np) : p.temporalPartner[i];
         };
-        wt.mx = hugeVector(nt, 0.0);
-        wt.my = hugeVector(nt, 0.0);
+        filled(wt.mx, nt, 0.0);
+        filled(wt.my, nt, 0.0);
         rigidMixedRows(nt, np, w, h, partner, p.weightDxt, p.weightDyt, wt.mx, wt.my);
+    } else {
+        wt.mx.clear(), wt.my.clear();
     }
-    return wt;
 }
 
-// The structure of the operator (neighbours), which the weights do not change.
-Operator makeStructure(const SpaceTimeProblem& p) {
-    Operator op;
+// The structure of the operator (neighbours), which the weights do not change, into op (its
+// buffers reused).
+void makeStructure(const SpaceTimeProblem& p, Operator& op) {
     op.width = p.width;
     op.height = p.height;
     op.frames = p.frames;
     const std::size_t n = p.size();
-    op.next = nextPixels(p);
-    op.next.resize(n, kNoTemporalPartner);
+    nextPixels(p, op.next);
     op.bnext = previousNext(p);
+    op.fwd.clear(), op.src.clear(), op.srcRow.clear(), op.mxTo.clear(), op.myTo.clear();
     op.backStart.assign(n + 1, 0);
     for (std::size_t i = 0; i < n; ++i)
         if (op.next[i] != kNoTemporalPartner) ++op.backStart[op.next[i] + 1];
@@ -339,7 +350,7 @@ Operator makeStructure(const SpaceTimeProblem& p) {
     for (std::size_t i = 0; i < n; ++i)
         if (op.next[i] != kNoTemporalPartner) op.back[fill[op.next[i]]++] = std::uint32_t(i);
     for (std::size_t i = 0; i < n; ++i)
-        if (op.backStart[i + 1] - op.backStart[i] > 1) return op;  // no linkedOnce() form
+        if (op.backStart[i + 1] - op.backStart[i] > 1) return;  // no linkedOnce() form
     op.fwd.resize(n);
     op.src.resize(n);
     op.srcRow.resize(n);
@@ -359,7 +370,6 @@ Operator makeStructure(const SpaceTimeProblem& p) {
             op.myTo[m] = std::uint32_t(b != kNoTemporalPartner && b + w < n ? b : m);
         }
     }
-    return op;
 }
 
 // The coefficients of the row weights `wt` into `op` (made by makeStructure), on `threads`: op
@@ -449,6 +459,19 @@ Weights takeWeightStorage(Operator& op) {
     wt.bmx = std::move(op.bmx);
     wt.bmy = std::move(op.bmy);
     return wt;
+}
+
+// to = from, each array in to's buffer where it is large enough.
+void copyWeights(const Weights& from, Weights& to) {
+    copied(to.primal, from.primal);
+    copied(to.dx, from.dx);
+    copied(to.dy, from.dy);
+    copied(to.dt, from.dt);
+    copied(to.boundary, from.boundary);
+    copied(to.mx, from.mx);
+    copied(to.my, from.my);
+    copied(to.bmx, from.bmx);
+    copied(to.bmy, from.bmy);
 }
 
 // b = Pᵀ W target for the three channels: α² wp t minus the weighted divergence of the
@@ -1204,19 +1227,37 @@ void irlsWeights(const SpaceTimeProblem& p, const Operator& op, const std::array
 
 }  // namespace
 
+struct SpaceTimeWorkspace::State {
+    Operator op;
+    Weights kept;
+    std::array<Field, 3> b;
+    CgVectors vectors;
+    FrameBlocks vcycle;
+};
+
+SpaceTimeWorkspace::SpaceTimeWorkspace() : state_(std::make_unique<State>()) {}
+SpaceTimeWorkspace::~SpaceTimeWorkspace() = default;
+SpaceTimeWorkspace::SpaceTimeWorkspace(SpaceTimeWorkspace&&) noexcept = default;
+SpaceTimeWorkspace& SpaceTimeWorkspace::operator=(SpaceTimeWorkspace&&) noexcept = default;
+
 std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const SpaceTimeOptions& options,
-                                    SpaceTimeStats* stats) {
+                                    SpaceTimeStats* stats, SpaceTimeWorkspace* workspace) {
     check(problem);
     Timer timer;
+    std::optional<SpaceTimeWorkspace> own;
+    if (!workspace) workspace = &own.emplace();
+    SpaceTimeWorkspace::State& ws = *workspace->state_;
     std::array<Field, 3> x;
     for (int c = 0; c < 3; ++c)
         copied(x[c], problem.initial[c].empty() ? problem.primal[c] : problem.initial[c]);
     const int rounds = options.l1 ? std::max(1, options.irlsIterations) : 1;
     const std::uint32_t threads = defaultThreads(static_cast<std::uint32_t>(std::max(0, options.threads)));
-    Operator op = makeStructure(problem);
-    const Weights kept = unitWeights(problem);
-    std::array<Field, 3> b;
-    CgVectors vectors;
+    Operator& op = ws.op;
+    makeStructure(problem, op);
+    Weights& kept = ws.kept;
+    unitWeights(problem, kept);
+    std::array<Field, 3>& b = ws.b;
+    CgVectors& vectors = ws.vectors;
     SpaceTimeStats s;
     std::array<int, 3> iterations{};
     const auto iterationsSoFar = [&] { return *std::max_element(iterations.begin(), iterations.end()); };
@@ -1227,17 +1268,16 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
     // (133 -> 46 iterations at γ = 1). Without mixed rows the diagonal takes 52 iterations where
     // the V-cycles take 31, each iteration costing more than twice as much.
     const bool multigrid = options.multigrid && (problem.frames == 1 || problem.gamma > 0.0);
-    FrameBlocks vcycle;
+    FrameBlocks& vcycle = ws.vcycle;
     for (int round = 0; round < rounds; ++round) {
         if (round > 0 && options.deadline && std::chrono::steady_clock::now() >= *options.deadline) {
             s.stoppedAtDeadline = true;
             break;
         }
-        Weights wt;
+        Weights wt = takeWeightStorage(op);
         if (round == 0) {
-            wt = kept;
+            copyWeights(kept, wt);
         } else {
-            wt = takeWeightStorage(op);
             irlsWeights(problem, op, x, options.regInit * std::pow(options.regIter, round - 1), kept, wt,
                         threads);
         }
@@ -1284,8 +1324,11 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
 
 Field solveSpaceTimeExactL2(const SpaceTimeProblem& problem, int channel) {
     check(problem);
-    Operator op = makeStructure(problem);
-    setWeights(problem, unitWeights(problem), op, 1);
+    Operator op;
+    makeStructure(problem, op);
+    Weights unit;
+    unitWeights(problem, unit);
+    setWeights(problem, std::move(unit), op, 1);
     std::array<Field, 3> rhsAll;
     MixedRowValues scratch;
     rhs(problem, op, rhsAll, scratch, 1);

@@ -47,6 +47,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -139,10 +140,35 @@ struct SpaceTimeStats {
     double ms = 0.0;
 };
 
-// The reconstruction of the window, three channels of F·W·H values. Throws gdpt::Error if the
-// sizes disagree, a value is not finite, α ≤ 0 (the primal rows anchor the solve) or β < 0.
+class SpaceTimeWorkspace;
+
+// The reconstruction of the window, three channels of F·W·H values, in `workspace`'s buffers
+// where given (the same bits as without). Throws gdpt::Error if the sizes disagree, a value is
+// not finite, α ≤ 0 (the primal rows anchor the solve) or β < 0.
 std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const SpaceTimeOptions& options = {},
-                                    SpaceTimeStats* stats = nullptr);
+                                    SpaceTimeStats* stats = nullptr, SpaceTimeWorkspace* workspace = nullptr);
+
+// The buffers of a solve (the operator, the weights, CG's vectors, the V-cycles' hierarchies),
+// kept for the next: a sequence reconstructed window by window reuses them instead of touching
+// fresh memory for each window, which on a virtual machine cost a third of a 10 × 256² window's
+// solve (bench/RESULTS.md, "The space-time solve, 2026-12-05"). Holds about
+// spaceTimeSolveBytes between solves.
+class SpaceTimeWorkspace {
+public:
+    SpaceTimeWorkspace();
+    ~SpaceTimeWorkspace();
+    SpaceTimeWorkspace(SpaceTimeWorkspace&&) noexcept;
+    SpaceTimeWorkspace& operator=(SpaceTimeWorkspace&&) noexcept;
+    SpaceTimeWorkspace(const SpaceTimeWorkspace&) = delete;
+    SpaceTimeWorkspace& operator=(const SpaceTimeWorkspace&) = delete;
+
+    struct State;  // poisson_spacetime.cpp's
+
+private:
+    friend std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem&, const SpaceTimeOptions&,
+                                               SpaceTimeStats*, SpaceTimeWorkspace*);
+    std::unique_ptr<State> state_;
+};
 
 // Bytes solveSpaceTime holds for a window: about 17 doubles per pixel, channel and frame (the
 // targets, the iterate, CG's vectors, the operator's weights), 20 with mixed rows.

@@ -479,6 +479,31 @@ TEST(SpaceTimePoisson, PartnersOfOnePixelEachSolveTheLeastSquaresOfTheirRows) {
     }
 }
 
+// A workspace carried from solve to solve (a sequence's windows) changes no bit, whatever the
+// solves before it: other sizes, general or one-partner maps, with or without mixed rows and a
+// frame before.
+TEST(SpaceTimePoisson, AWorkspaceGivesTheSameBitsAsFreshBuffers) {
+    SpaceTimeProblem tied = onePartnerEach(withMixedRows(7));
+    SpaceTimeProblem plain = noisy(consistentProblem(9, 5, 3), 0.2, 8);
+    tied.previousPartner.assign(tied.temporalPartner.begin(), tied.temporalPartner.begin() + 42);
+    for (int c = 0; c < 3; ++c)
+        for (Field* f : {&tied.previous[c], &tied.dtPrevious[c], &tied.dxtPrevious[c], &tied.dytPrevious[c]})
+            f->assign(42, 0.1 * (c + 1));
+    const std::vector<SpaceTimeProblem> problems = {withMixedRows(1), onePartnerEach(withMixedRows(5)), plain,
+                                                    tied, withRandomPartners(2)};
+    std::vector<std::array<Field, 3>> fresh;
+    for (const SpaceTimeProblem& p : problems) fresh.push_back(solveSpaceTime(p));
+    for (const bool reversed : {false, true}) {
+        SpaceTimeWorkspace workspace;
+        for (std::size_t k = 0; k < problems.size(); ++k) {
+            const std::size_t at = reversed ? problems.size() - 1 - k : k;
+            const auto x = solveSpaceTime(problems[at], {}, nullptr, &workspace);
+            for (int c = 0; c < 3; ++c)
+                EXPECT_TRUE(x[c] == fresh[at][c]) << "problem " << at << (reversed ? " (reversed)" : "");
+        }
+    }
+}
+
 TEST(SpaceTimePoisson, MixedRowsSolveTheLeastSquaresOfTheirRows) {
     for (const unsigned seed : {1u, 2u}) {
         const SpaceTimeProblem p = withMixedRows(seed);
