@@ -667,17 +667,20 @@ TEST(SpaceTimePoisson, SameBitsForAnyThreadCount) {
         p.dxt[c].assign(np * (p.frames - 1), 0.01 * c);
         p.dyt[c].assign(np * (p.frames - 1), -0.02);
     }
-    SpaceTimeOptions o;
-    o.threads = 1;
-    SpaceTimeStats one;
-    const auto x1 = solveSpaceTime(p, o, &one);
-    ASSERT_GT(one.iterations, 10);
-    for (const int threads : {2, 3}) {
-        o.threads = threads;
-        SpaceTimeStats s;
-        const auto x = solveSpaceTime(p, o, &s);
-        EXPECT_EQ(s.iterations, one.iterations) << threads << " threads";
-        for (int c = 0; c < 3; ++c) EXPECT_TRUE(x[c] == x1[c]) << threads << " threads, channel " << c;
+    // The shared partners above take the general form, one partner each the linked one.
+    for (const SpaceTimeProblem& q : {p, onePartnerEach(p)}) {
+        SpaceTimeOptions o;
+        o.threads = 1;
+        SpaceTimeStats one;
+        const auto x1 = solveSpaceTime(q, o, &one);
+        ASSERT_GT(one.iterations, 10);
+        for (const int threads : {2, 3}) {
+            o.threads = threads;
+            SpaceTimeStats s;
+            const auto x = solveSpaceTime(q, o, &s);
+            EXPECT_EQ(s.iterations, one.iterations) << threads << " threads";
+            for (int c = 0; c < 3; ++c) EXPECT_TRUE(x[c] == x1[c]) << threads << " threads, channel " << c;
+        }
     }
 }
 
