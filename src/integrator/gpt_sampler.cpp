@@ -62,14 +62,7 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     const auto recordGroup = [&](std::uint32_t done) {
         if (!gpt.groups->wants(done)) return;
         resolveNow();
-        GptImages images = pass->readback();
-        std::vector<Image> means;
-        means.push_back(std::move(images.primal));
-        if (gpt.groupGradients) {
-            means.push_back(std::move(images.dx));
-            means.push_back(std::move(images.dy));
-        }
-        gpt.groups->record(done, std::move(means));
+        gpt.groups->record(done, pass->readbackMeans(gpt.groupGradients));
     };
     sampling.run(
         [&] {

@@ -328,4 +328,21 @@ GptImages GptPass::readback() const {
     return out;
 }
 
+std::vector<Image> GptPass::readbackMeans(bool withGradients) const {
+    const std::size_t pixels = std::size_t{width_} * height_;
+    const auto px = resolved_.read<gpu::GptResolved>(pixels);
+    const int w = static_cast<int>(width_), h = static_cast<int>(height_);
+    std::vector<Image> out(withGradients ? 3 : 1, Image(w, h));
+    parallelRanges(0, pixels, std::size_t{1} << 14, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+            for (int c = 0; c < 3; ++c) {
+                out[0].plane(c)[i] = px[i].primal[c];
+                if (!withGradients) continue;
+                out[1].plane(c)[i] = px[i].dx[c];
+                out[2].plane(c)[i] = px[i].dy[c];
+            }
+    });
+    return out;
+}
+
 }  // namespace gdpt

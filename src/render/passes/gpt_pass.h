@@ -118,6 +118,9 @@ public:
     gpu::Counters takeCounters() override;
     // Reads the resolved images (after the fence of a resolve()).
     [[nodiscard]] GptImages readback() const;
+    // Only the resolved primal, and dx and dy `withGradients` (in that order; not demodulated):
+    // what a sample group records (integrator/sample_groups.h), without the other five images.
+    [[nodiscard]] std::vector<Image> readbackMeans(bool withGradients) const;
     // The raw per-pixel statistics of the 10 buffers, in binding order, then the supersampled
     // visible emission's, then (with demodulation) the modulation's (after the fence), and
     // their replacement (before the next record()) to continue a checkpointed render.
