@@ -610,33 +610,29 @@ void applyRangeLinked(const Operator& op, const Field& x, Field& y, std::size_t 
     const std::uint32_t* __restrict fwd = op.fwd.data();
     const std::uint32_t* __restrict src = op.src.data();
     double* __restrict ys = y.data();
+    // The graph Laplacian's terms: the frame's neighbours, the temporal neighbour and source.
+    const auto laplacian = [&](std::size_t i) {
+        double v = d[i] * xs[i];
+        v -= cx[i] * xs[i + 1];
+        v -= cx[i - 1] * xs[i - 1];
+        v -= cy[i] * xs[i + w];
+        v -= cy[i - w] * xs[i - w];
+        v -= ct[i] * xs[fwd[i]];
+        v -= sct[i] * xs[src[i]];
+        return v;
+    };
     if (rowsX) {
         const double* __restrict rx = rowsX->data();
         const double* __restrict ry = rowsY->data();
         const std::uint32_t* __restrict sr = op.srcRow.data();
         for (std::size_t i = lo; i < hi; ++i) {
-            double v = d[i] * xs[i];
-            v -= cx[i] * xs[i + 1];
-            v -= cx[i - 1] * xs[i - 1];
-            v -= cy[i] * xs[i + w];
-            v -= cy[i - w] * xs[i - w];
-            v -= ct[i] * xs[fwd[i]];
-            v -= sct[i] * xs[src[i]];
+            double v = laplacian(i);
             v += (rx[i] - rx[i - 1]) - (rx[sr[i]] - rx[sr[i - 1]]);
             v += (ry[i] - ry[i - w]) - (ry[sr[i]] - ry[sr[i - w]]);
             ys[i] = v;
         }
     } else {
-        for (std::size_t i = lo; i < hi; ++i) {
-            double v = d[i] * xs[i];
-            v -= cx[i] * xs[i + 1];
-            v -= cx[i - 1] * xs[i - 1];
-            v -= cy[i] * xs[i + w];
-            v -= cy[i - w] * xs[i - w];
-            v -= ct[i] * xs[fwd[i]];
-            v -= sct[i] * xs[src[i]];
-            ys[i] = v;
-        }
+        for (std::size_t i = lo; i < hi; ++i) ys[i] = laplacian(i);
     }
     applyRangeGeneral(op, x, y, hi, end, rowsX, rowsY);
 }
