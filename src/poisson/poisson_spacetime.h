@@ -150,8 +150,8 @@ std::array<Field, 3> solveSpaceTime(const SpaceTimeProblem& problem, const Space
 
 // The buffers of a solve (the operator, the weights, CG's vectors, the V-cycles' hierarchies),
 // kept for the next: a sequence reconstructed window by window reuses them instead of touching
-// fresh memory for each window, which on a virtual machine cost a third of a 10 × 256² window's
-// solve (bench/RESULTS.md, "The space-time solve, 2026-12-05"). Holds about
+// fresh memory for each window, which on a virtual machine cost a fifth of a later 10 × 256²
+// window's solve (bench/RESULTS.md, "The space-time solve, 2026-12-05"). Holds about
 // spaceTimeSolveBytes between solves.
 class SpaceTimeWorkspace {
 public:
