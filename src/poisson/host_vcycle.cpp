@@ -203,37 +203,24 @@ void HostVcycle::cycle(std::size_t level, const std::array<const double*, 3>& b,
                     if (first == 0) update(c, 0);
                     if (last < w) update(c, last);
                 }
+                const auto relax = [&](const double* __restrict bc, double* __restrict xc, std::size_t i,
+                                       double e, double west, double s, double north, double d) {
+                    xc[i] =
+                        (bc[i] + e * xc[i + 1] + west * xc[i - 1] + s * xc[i + w] + north * xc[i - w]) * d;
+                };
                 if (all) {
-                    const double* __restrict b0 = b[0];
-                    const double* __restrict b1 = b[1];
-                    const double* __restrict b2 = b[2];
-                    double* __restrict x0 = x[0];
-                    double* __restrict x1 = x[1];
-                    double* __restrict x2 = x[2];
                     for (std::size_t px = lo; px + 1 < w; px += 2) {
                         const std::size_t i = row + px;
                         const double e = cx[i], west = cx[i - 1], s = cy[i], north = cy[i - w], d = inv[i];
-                        x0[i] =
-                            (b0[i] + e * x0[i + 1] + west * x0[i - 1] + s * x0[i + w] + north * x0[i - w]) *
-                            d;
-                        x1[i] =
-                            (b1[i] + e * x1[i + 1] + west * x1[i - 1] + s * x1[i + w] + north * x1[i - w]) *
-                            d;
-                        x2[i] =
-                            (b2[i] + e * x2[i + 1] + west * x2[i - 1] + s * x2[i + w] + north * x2[i - w]) *
-                            d;
+                        for (int c = 0; c < 3; ++c) relax(b[c], x[c], i, e, west, s, north, d);
                     }
                     continue;
                 }
                 for (int c = 0; c < 3; ++c) {
                     if (!active[c]) continue;
-                    const double* __restrict bc = b[c];
-                    double* __restrict xc = x[c];
                     for (std::size_t px = lo; px + 1 < w; px += 2) {
                         const std::size_t i = row + px;
-                        xc[i] = (bc[i] + cx[i] * xc[i + 1] + cx[i - 1] * xc[i - 1] + cy[i] * xc[i + w] +
-                                 cy[i - w] * xc[i - w]) *
-                                inv[i];
+                        relax(b[c], x[c], i, cx[i], cx[i - 1], cy[i], cy[i - w], inv[i]);
                     }
                 }
             }
@@ -280,15 +267,11 @@ void HostVcycle::cycle(std::size_t level, const std::array<const double*, 3>& b,
                     return 0.25 * (bc[i] - v);
                 };
                 if (all) {
-                    double* __restrict c0 = C.b[0].data() + Y * cw;
-                    double* __restrict c1 = C.b[1].data() + Y * cw;
-                    double* __restrict c2 = C.b[2].data() + Y * cw;
                     for (std::size_t px = 1; px + 1 < w; ++px) {
                         const std::size_t i = row + px;
                         const double d = diag[i], e = cx[i], west = cx[i - 1], s = cy[i], north = cy[i - w];
-                        c0[px / 2] += residual(b[0], x[0], i, d, e, west, s, north);
-                        c1[px / 2] += residual(b[1], x[1], i, d, e, west, s, north);
-                        c2[px / 2] += residual(b[2], x[2], i, d, e, west, s, north);
+                        for (int c = 0; c < 3; ++c)
+                            C.b[c][Y * cw + px / 2] += residual(b[c], x[c], i, d, e, west, s, north);
                     }
                 } else {
                     for (int c = 0; c < 3; ++c) {

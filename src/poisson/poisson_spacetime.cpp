@@ -161,6 +161,13 @@ inline double gatherMixed(const Operator& op, const Field& r, std::size_t k, std
     return v;
 }
 
+// gatherMixed in the linkedOnce() form, at k ≥ s: r holds n + 1 values (0 past the rows) and
+// sr[k] is k's source (n where none), so every term is there without a test.
+inline double gatherMixedLinked(const double* __restrict r, const std::uint32_t* __restrict sr, std::size_t k,
+                                std::size_t s) {
+    return (r[k] - r[k - s]) - (r[sr[k]] - r[sr[k - s]]);
+}
+
 void check(const SpaceTimeProblem& p) {
     if (p.width < 1 || p.height < 1 || p.frames < 1) throw Error("space-time Poisson: empty window");
     if (!(p.alpha > 0.0) || !std::isfinite(p.alpha)) throw Error("space-time Poisson: alpha must be > 0");
@@ -542,8 +549,8 @@ void rhs(const SpaceTimeProblem& p, const Operator& op, std::array<Field, 3>& b,
                 v += cy[i - w] * ty[i - w];
                 if (sct[i] != 0.0) v += sct[i] * tt[src[i]];
                 if (mixed) {
-                    v += (rx[i] - rx[i - 1]) - (rx[sr[i]] - rx[sr[i - 1]]);
-                    v += (ry[i] - ry[i - w]) - (ry[sr[i]] - ry[sr[i - w]]);
+                    v += gatherMixedLinked(rx, sr, i, 1);
+                    v += gatherMixedLinked(ry, sr, i, w);
                 }
                 b[c][i] = v;
             }
@@ -627,8 +634,8 @@ void applyRangeLinked(const Operator& op, const Field& x, Field& y, std::size_t 
         const std::uint32_t* __restrict sr = op.srcRow.data();
         for (std::size_t i = lo; i < hi; ++i) {
             double v = laplacian(i);
-            v += (rx[i] - rx[i - 1]) - (rx[sr[i]] - rx[sr[i - 1]]);
-            v += (ry[i] - ry[i - w]) - (ry[sr[i]] - ry[sr[i - w]]);
+            v += gatherMixedLinked(rx, sr, i, 1);
+            v += gatherMixedLinked(ry, sr, i, w);
             ys[i] = v;
         }
     } else {
