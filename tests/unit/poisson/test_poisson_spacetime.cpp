@@ -446,6 +446,21 @@ SpaceTimeProblem onePartnerEach(SpaceTimeProblem p) {
     return p;
 }
 
+// p tied to a frame before the window (noisy previous frame, dt and mixed targets), whose
+// pixels take the partners of p's first frame.
+SpaceTimeProblem tiedToFrameBefore(SpaceTimeProblem p, unsigned seed) {
+    const std::size_t np = p.pixels();
+    p.previousPartner.assign(p.temporalPartner.begin(), p.temporalPartner.begin() + std::ptrdiff_t(np));
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> noise(0.0, 0.3);
+    for (int c = 0; c < 3; ++c)
+        for (Field* f : {&p.previous[c], &p.dtPrevious[c], &p.dxtPrevious[c], &p.dytPrevious[c]}) {
+            f->resize(np);
+            for (double& v : *f) v = noise(rng);
+        }
+    return p;
+}
+
 TEST(SpaceTimePoisson, PartnersOfOnePixelEachSolveTheLeastSquaresOfTheirRows) {
     for (const unsigned seed : {5u, 6u}) {
         const SpaceTimeProblem shared = withMixedRows(seed);
@@ -462,19 +477,7 @@ TEST(SpaceTimePoisson, PartnersOfOnePixelEachSolveTheLeastSquaresOfTheirRows) {
         EXPECT_GT(maxDiff(y[0], x[0]), 1e-3);
         // Tied to a frame before the window by rows of one partner each (its mixed rows too),
         // which frame 0 takes in the general form.
-        SpaceTimeProblem tied = p;
-        const std::size_t np = p.pixels();
-        tied.previousPartner.assign(p.temporalPartner.begin(),
-                                    p.temporalPartner.begin() + std::ptrdiff_t(np));
-        std::mt19937 rng(seed);
-        std::normal_distribution<double> noise(0.0, 0.3);
-        for (int c = 0; c < 3; ++c)
-            for (Field* f :
-                 {&tied.previous[c], &tied.dtPrevious[c], &tied.dxtPrevious[c], &tied.dytPrevious[c]}) {
-                f->resize(np);
-                for (double& v : *f) v = noise(rng);
-            }
-        const auto z = expectDenseLeastSquares(tied, seed);
+        const auto z = expectDenseLeastSquares(tiedToFrameBefore(p, seed), seed);
         EXPECT_GT(maxDiff(z[0], x[0]), 1e-3);
     }
 }
@@ -483,14 +486,9 @@ TEST(SpaceTimePoisson, PartnersOfOnePixelEachSolveTheLeastSquaresOfTheirRows) {
 // solves before it: other sizes, general or one-partner maps, with or without mixed rows and a
 // frame before.
 TEST(SpaceTimePoisson, AWorkspaceGivesTheSameBitsAsFreshBuffers) {
-    SpaceTimeProblem tied = onePartnerEach(withMixedRows(7));
-    SpaceTimeProblem plain = noisy(consistentProblem(9, 5, 3), 0.2, 8);
-    tied.previousPartner.assign(tied.temporalPartner.begin(), tied.temporalPartner.begin() + 42);
-    for (int c = 0; c < 3; ++c)
-        for (Field* f : {&tied.previous[c], &tied.dtPrevious[c], &tied.dxtPrevious[c], &tied.dytPrevious[c]})
-            f->assign(42, 0.1 * (c + 1));
-    const std::vector<SpaceTimeProblem> problems = {withMixedRows(1), onePartnerEach(withMixedRows(5)), plain,
-                                                    tied, withRandomPartners(2)};
+    const std::vector<SpaceTimeProblem> problems = {
+        withMixedRows(1), onePartnerEach(withMixedRows(5)), noisy(consistentProblem(9, 5, 3), 0.2, 8),
+        tiedToFrameBefore(onePartnerEach(withMixedRows(7)), 7), withRandomPartners(2)};
     std::vector<std::array<Field, 3>> fresh;
     for (const SpaceTimeProblem& p : problems) fresh.push_back(solveSpaceTime(p));
     for (const bool reversed : {false, true}) {
