@@ -424,7 +424,8 @@ Subcommand addRenderCommand(CLI::App& app) {
          "--light-selection", a.lightSelection,
          "How next-event estimation picks an emitter (the triangles of one emissive material; within it, "
          "by power): power (in proportion to emitted power), uniform (each emitter alike), mixed (half "
-         "of each: robust where most power is far away, e.g. a sky beside a lamp)")
+         "of each: robust where most power is far away, e.g. a sky beside a lamp), probe (half mixed, half "
+         "by what each emitter gives the surfaces the camera sees, from a fixed probe of rays)")
         ->capture_default_str()
         ->check(CLI::IsMember(
             std::vector<std::string>(std::begin(kLightSelectionChoices), std::end(kLightSelectionChoices))))

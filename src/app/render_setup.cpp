@@ -135,7 +135,7 @@ RenderOptions renderOptionsFor(const RenderArgs& args) {
     o.scene.shiftThreshold = args.shiftThreshold;
     const std::optional<LightSelection> selection = parseLightSelection(args.lightSelection);
     if (!selection)
-        throw Error("--light-selection: '" + args.lightSelection + "' is not power, uniform or mixed");
+        throw Error("--light-selection: '" + args.lightSelection + "' is not power, uniform, mixed or probe");
     o.scene.lightSelection = *selection;
     o.spp = args.spp;
     o.timeBudget = args.time;
@@ -196,6 +196,11 @@ json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrato
                             {"merge_s", s.distributed.mergeMs * 1e-3},
                             {"wait_s", s.distributed.waitMs * 1e-3}};
     integrator.describe(j, s);
+    j["light_probe"] = s.lightProbed;
+    json shares = json::array();
+    for (const auto& [material, probability] : s.lightShares)
+        shares.push_back({{"material", material}, {"probability", probability}});
+    j["light_shares"] = shares;
     j["emitter_supersampling"] = {{"factor", s.emitterSupersampling},
                                   {"rays_per_sample", s.emitterRaysPerSample},
                                   {"pixels", s.emitterSupersampledPixels}};

@@ -85,6 +85,8 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     stats.bvhBuildMs = sceneGpu.bvhInfo().buildMs;
     stats.sceneDeviceBytes = sceneGpu.deviceBytes();
     stats.bvhRegisterStack = sceneGpu.spec().bvhRegisterStack();
+    stats.lightShares = sceneGpu.lightShares();
+    stats.lightProbed = sceneGpu.lightProbed();
     stats.features = sceneGpu.features();
     if (options.whileCompiling) options.whileCompiling();
     if (!stage_.empty()) stage_.solver(ctx, width, height).preparePipelines(stage_.solves());

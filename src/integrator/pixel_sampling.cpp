@@ -37,6 +37,8 @@ PixelSampling::PixelSampling(const vk::Context& ctx, const Scene& scene, const R
     stats_.bvhBuildMs = scene_->bvhInfo().buildMs;
     stats_.sceneDeviceBytes = scene_->deviceBytes();
     stats_.bvhRegisterStack = scene_->spec().bvhRegisterStack();
+    stats_.lightShares = scene_->lightShares();
+    stats_.lightProbed = scene_->lightProbed();
     stats_.features = scene_->features();
     stats_.uploadMs = phase.ms() - stats_.bvhBuildMs;
 }

@@ -163,14 +163,18 @@ struct RenderStats {
     double bvhBuildMs = 0.0;
     std::uint64_t sceneDeviceBytes = 0;  // the scene's tables on the device (BVH, triangles, textures...)
     std::uint32_t bvhRegisterStack = 0;  // entries of the kernels' register traversal stack (0: in memory)
-    double uploadMs = 0.0;               // scene upload + pipeline creation (the part not overlapped)
-    double pipelineWaitMs = 0.0;         // of which: waiting for the pipelines after the scene upload
-    double compileMs = 0.0;              // the main kernels' first, empty, dispatch (lavapipe compiles there)
-    double setupSeconds = 0.0;           // the render's time when sampling began (its fixed costs before it)
-    double firstBatchSeconds = 0.0;      // this run's first batch (PT, G-PT: 1 spp; MLT: one step)
-    double samplingLoad = 0.0;  // load factor over the batch loop (util/cpu_share.h); 0: not measured
-    double reserveScale = 1.0;  // timed: the reservations at the last batch's load ÷ as measured
-    double samplingMs = 0.0;    // wall time of the batch loop
+    // Emissive material -> NEE's probability of picking it, and whether the light probe set
+    // them (SceneGpu::lightShares).
+    std::map<std::uint32_t, double> lightShares;
+    bool lightProbed = false;
+    double uploadMs = 0.0;           // scene upload + pipeline creation (the part not overlapped)
+    double pipelineWaitMs = 0.0;     // of which: waiting for the pipelines after the scene upload
+    double compileMs = 0.0;          // the main kernels' first, empty, dispatch (lavapipe compiles there)
+    double setupSeconds = 0.0;       // the render's time when sampling began (its fixed costs before it)
+    double firstBatchSeconds = 0.0;  // this run's first batch (PT, G-PT: 1 spp; MLT: one step)
+    double samplingLoad = 0.0;       // load factor over the batch loop (util/cpu_share.h); 0: not measured
+    double reserveScale = 1.0;       // timed: the reservations at the last batch's load ÷ as measured
+    double samplingMs = 0.0;         // wall time of the batch loop
     double readbackMs = 0.0;
     double reconstructionMs = 0.0;                     // G-PT: screened Poisson solve(s)
     std::vector<ReconstructionStats> reconstructions;  // G-PT: one per reconstruction, in order

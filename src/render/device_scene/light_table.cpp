@@ -1,5 +1,6 @@
 #include "render/device_scene/light_table.h"
 
+#include <cmath>
 #include <map>
 
 #include "render/device_scene/features.h"
@@ -17,6 +18,7 @@ double uniformShare(LightSelection s) {
         case LightSelection::Uniform:
             return 1.0;
         case LightSelection::Mixed:
+        case LightSelection::Probe:
             return 0.5;
     }
     return 0.5;
@@ -33,6 +35,7 @@ std::optional<LightSelection> parseLightSelection(const std::string& text) {
     if (text == "power") return LightSelection::Power;
     if (text == "uniform") return LightSelection::Uniform;
     if (text == "mixed") return LightSelection::Mixed;
+    if (text == "probe") return LightSelection::Probe;
     return std::nullopt;
 }
 
@@ -44,12 +47,14 @@ const char* toString(LightSelection s) {
             return "uniform";
         case LightSelection::Mixed:
             return "mixed";
+        case LightSelection::Probe:
+            return "probe";
     }
     return "?";
 }
 
 LightTable makeLightTable(const Scene& scene, const std::vector<std::uint32_t>& order,
-                          LightSelection selection) {
+                          LightSelection selection, const std::map<std::uint32_t, double>& probeWeights) {
     // Each range's emitters, found in parallel and joined in leaf order.
     std::vector<std::vector<Emissive>> found((order.size() + kGrain - 1) / kGrain);
     parallelRanges(0, order.size(), kGrain, [&](std::size_t begin, std::size_t end) {
@@ -69,12 +74,29 @@ LightTable makeLightTable(const Scene& scene, const std::vector<std::uint32_t>& 
             emitterPowers[e.material] += e.power;
         }
     t.emitters = static_cast<std::uint32_t>(emitterPowers.size());
+    // The probe's half: emitter e's share w_e / Σ w over the emitters of this table.
+    double weightSum = 0.0;
+    if (selection == LightSelection::Probe && t.emitters > 1)
+        for (const auto& [material, power] : emitterPowers) {
+            const auto w = probeWeights.find(material);
+            if (w != probeWeights.end() && w->second > 0.0 && std::isfinite(w->second))
+                weightSum += w->second;
+        }
+    t.probed = weightSum > 0.0 && std::isfinite(weightSum);
     const double u = uniformShare(selection);
     double running = 0.0;
     for (const auto& range : found)
         for (const Emissive& e : range) {
-            const double pmf = (1.0 - u) * e.power / t.totalPower +
-                               u * e.power / (emitterPowers[e.material] * double(t.emitters));
+            double pmf = (1.0 - u) * e.power / t.totalPower +
+                         u * e.power / (emitterPowers[e.material] * double(t.emitters));
+            if (t.probed) {
+                const auto w = probeWeights.find(e.material);
+                const double share = w != probeWeights.end() && w->second > 0.0 && std::isfinite(w->second)
+                                         ? w->second / weightSum
+                                         : 0.0;
+                pmf = 0.5 * pmf + 0.5 * share * e.power / emitterPowers[e.material];
+            }
+            t.shares[e.material] += pmf;
             running += pmf;
             t.lights.push_back({e.leaf, static_cast<float>(running), static_cast<float>(pmf), 0.0f});
         }

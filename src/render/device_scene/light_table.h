@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -22,10 +23,14 @@ namespace gdpt {
 //  - Mixed (the default): half of each, a defensive mixture (Hesterberg 1995): no triangle
 //    gets less than half the probability either rule gives it, so it costs at most 2x the
 //    variance of the better rule and avoids the worse one's failures.
-enum class LightSelection { Power, Uniform, Mixed };
+//  - Probe: half `mixed`, half each emitter in proportion to the square root of its second
+//    moment at the surfaces the camera sees (light_probe.h), the share that minimises the
+//    variance of next-event estimation there. `mixed` where the probe has nothing to say
+//    (one emitter, none seen, more than kLightProbeMaxEmitters).
+enum class LightSelection { Power, Uniform, Mixed, Probe };
 
 // The names of the rules (toString), for --light-selection.
-inline constexpr const char* kLightSelectionChoices[] = {"power", "uniform", "mixed"};
+inline constexpr const char* kLightSelectionChoices[] = {"power", "uniform", "mixed", "probe"};
 std::optional<LightSelection> parseLightSelection(const std::string& text);
 const char* toString(LightSelection s);
 
@@ -33,11 +38,17 @@ struct LightTable {
     std::vector<gpu::LightTriangle> lights;  // triangle = leaf position; pmf, cdf
     double totalPower = 0.0;                 // of every emissive triangle
     std::uint32_t emitters = 0;              // emissive materials with a light triangle
+    // Emissive material -> the probability that NEE picks one of its triangles.
+    std::map<std::uint32_t, double> shares;
+    // Probe: whether the probe's weights were used (false: the table is `mixed`'s).
+    bool probed = false;
 };
 
 // `order`: the BVH's leaf order (leaf position -> scene triangle). Triangles without area or
-// power are no lights.
+// power are no lights. `probeWeights` (Probe only): emissive material -> a weight ∝ the
+// probability the probe's half gives it (√M_e, light_probe.h); without a positive weight
+// for some emitter the table is `mixed`'s, bit for bit.
 LightTable makeLightTable(const Scene& scene, const std::vector<std::uint32_t>& order,
-                          LightSelection selection);
+                          LightSelection selection, const std::map<std::uint32_t, double>& probeWeights = {});
 
 }  // namespace gdpt

@@ -7,6 +7,7 @@
 
 #include "bvh/builder.h"
 #include "bvh/wide_bvh.h"
+#include "render/device_scene/light_probe.h"
 #include "render/device_scene/light_table.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
@@ -214,7 +215,18 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     bvhInfo_.buildMs = built->buildMs;
     bvhInfo_.nodes = static_cast<std::uint32_t>(bvh.nodes.size());
     bvhInfo_.maxDepth = bvh.stats.maxDepth;
-    const LightTable lightTable = makeLightTable(scene, bvh.triangleOrder, options.lightSelection);
+    const Bounds b = scene.bounds();
+    const float sceneRadius = 0.5f * glm::length(b.max - b.min);
+    setCamera(constants_, renderCamera(scene, options.camera), options.width, options.height);
+    std::map<std::uint32_t, double> probeWeights;
+    if (options.lightSelection == LightSelection::Probe) {
+        const EmitterProbe probe = probeEmitters(scene, *built, constants_, sceneRadius);
+        for (const auto& [material, m2] : probe.secondMoment) probeWeights[material] = std::sqrt(m2);
+    }
+    const LightTable lightTable =
+        makeLightTable(scene, bvh.triangleOrder, options.lightSelection, probeWeights);
+    lightShares_ = lightTable.shares;
+    lightProbed_ = lightTable.probed;
     const std::vector<gpu::LightTriangle>& lights = lightTable.lights;
     const double total = lightTable.totalPower;
     // The spec counted the same lights (emitterPower) to specialise the kernels.
@@ -238,7 +250,6 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
         texInfo.push_back(info);
     }
 
-    setCamera(constants_, renderCamera(scene, options.camera), options.width, options.height);
     constants_.envRadiance = options.envRadiance;
     constants_.numLightTriangles = static_cast<std::uint32_t>(lights.size());
     constants_.numPunctualLights = static_cast<std::uint32_t>(scene.punctualLights.size());
@@ -247,8 +258,7 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     constants_.maxDepth = options.maxDepth;
     constants_.rrDepth = options.rrDepth;
     constants_.numTriangles = static_cast<std::uint32_t>(bvh.triangleOrder.size());
-    const Bounds b = scene.bounds();
-    constants_.sceneRadius = 0.5f * glm::length(b.max - b.min);
+    constants_.sceneRadius = sceneRadius;
 
     if (progress) progress->update(2.0, "upload");
     const std::vector<std::uint32_t>& order = bvh.triangleOrder;

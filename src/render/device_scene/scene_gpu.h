@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -84,11 +85,17 @@ public:
     [[nodiscard]] const BvhBuildInfo& bvhInfo() const { return bvhInfo_; }
     // Bytes of the scene's buffers on the device (BVH nodes, triangle tables, textures, ...).
     [[nodiscard]] std::uint64_t deviceBytes() const;
+    // Emissive material -> the probability that next-event estimation picks it (light_table.h),
+    // and whether the light probe set them (`--light-selection probe` with two emitters or more).
+    [[nodiscard]] const std::map<std::uint32_t, double>& lightShares() const { return lightShares_; }
+    [[nodiscard]] bool lightProbed() const { return lightProbed_; }
 
 private:
     SceneSpec spec_;
     gpu::SceneConstants constants_{};
     BvhBuildInfo bvhInfo_;
+    std::map<std::uint32_t, double> lightShares_;
+    bool lightProbed_ = false;
     vk::Buffer triGeom_, triShading_, bvh_, materials_, texInfo_, texels_, lightTris_, punctual_, sceneConst_;
 };
 

@@ -151,7 +151,7 @@ TEST_F(Cli, SmallValidatedRenderWritesExrPngAndJson) {
 // --light-selection: each rule renders and is reported; any other value is refused before
 // anything is written.
 TEST_F(Cli, LightSelectionIsChosenAndReported) {
-    for (const char* rule : {"power", "uniform"}) {
+    for (const char* rule : {"power", "uniform", "probe"}) {
         const std::string json = path(std::string(rule) + ".json");
         const RunResult r =
             run("render " + kScene + " --method pt --width 8 --height 8 --spp 1 --quiet -o " +

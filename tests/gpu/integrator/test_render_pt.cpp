@@ -75,7 +75,8 @@ TEST_F(RenderPt, WhiteFurnaceAlbedoPointEight) {
 // biases it (a test build whose MIS weights used pmf x 1.25 failed every rule).
 TEST_F(RenderPt, WhiteFurnaceWithTwoEmittersUnderEveryLightSelection) {
     const Scene scene = makeTwoEmitterFurnace(0.5f, glm::vec3(1.0f), 3);
-    for (LightSelection sel : {LightSelection::Power, LightSelection::Uniform, LightSelection::Mixed}) {
+    for (LightSelection sel :
+         {LightSelection::Power, LightSelection::Uniform, LightSelection::Mixed, LightSelection::Probe}) {
         SCOPED_TRACE(toString(sel));
         RenderOptions o = renderOptions(16, 16, 256, 11);
         o.scene.lightSelection = sel;

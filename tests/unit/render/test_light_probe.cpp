@@ -1,0 +1,153 @@
+// The light probe (light_probe.h) and the table it sets (light_table.h, LightSelection::Probe),
+// on the Cornell box with a second emitter that no visible surface can see (behind the back
+// wall), and with a second light facing away from the room or into it.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numeric>
+
+#include "render/device_scene/light_probe.h"
+#include "render/device_scene/light_table.h"
+#include "render/device_scene/scene_gpu.h"
+#include "scene/procedural.h"
+
+namespace gdpt {
+namespace {
+
+constexpr std::uint32_t kCeilingLight = 3;  // makeCornellBox's light material
+
+// Appends quad a, b, c, d (emitting along (b − a) × (c − a)) with a new emissive material.
+std::uint32_t addEmitter(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::vec3 radiance) {
+    gpu::Material m = s.materials[kCeilingLight];
+    m.emissive = radiance;
+    s.materials.push_back(m);
+    const auto material = static_cast<std::uint32_t>(s.materials.size() - 1);
+    const glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+    const auto base = static_cast<std::uint32_t>(s.positions.size());
+    for (const glm::vec3& p : {a, b, c, a, c, d}) {
+        s.positions.push_back(p);
+        s.normals.push_back(n);
+    }
+    s.triangles.emplace_back(base, base + 1, base + 2);
+    s.triangles.emplace_back(base + 3, base + 4, base + 5);
+    s.triangleMaterial.insert(s.triangleMaterial.end(), 2, material);
+    return material;
+}
+
+// The box with a bright quad behind its back wall (z = −1), emitting towards it: the wall
+// hides it from everything inside.
+Scene boxWithHiddenEmitter(std::uint32_t& hidden) {
+    Scene s = makeCornellBox();
+    hidden = addEmitter(s, {-0.5f, 0.5f, -1.5f}, {0.5f, 0.5f, -1.5f}, {0.5f, 1.5f, -1.5f}, {-0.5f, 1.5f, -1.5f},
+                        glm::vec3(50.0f));
+    return s;
+}
+
+gpu::SceneConstants cameraOf(const Scene& s, int width, int height) {
+    gpu::SceneConstants c{};
+    setCamera(c, renderCamera(s, -1), width, height);
+    return c;
+}
+
+float radiusOf(const Scene& s) {
+    const Bounds b = s.bounds();
+    return 0.5f * glm::length(b.max - b.min);
+}
+
+std::vector<std::uint32_t> identityOrder(const Scene& s) {
+    std::vector<std::uint32_t> order(s.triangles.size());
+    std::iota(order.begin(), order.end(), 0u);
+    return order;
+}
+
+TEST(LightProbe, AnEmitterNoVisibleSurfaceSeesScoresZeroAndKeepsHalfItsMixedShare) {
+    std::uint32_t hidden = 0;
+    const Scene s = boxWithHiddenEmitter(hidden);
+    const SceneBvh bvh = buildSceneBvh(s);
+    const EmitterProbe probe = probeEmitters(s, bvh, cameraOf(s, 64, 64), radiusOf(s));
+    EXPECT_EQ(probe.points, 32u * 32u);  // every probe ray hits the closed room
+    ASSERT_EQ(probe.secondMoment.size(), 2u);
+    EXPECT_EQ(probe.secondMoment.at(hidden), 0.0);
+    EXPECT_GT(probe.secondMoment.at(kCeilingLight), 0.0);
+
+    std::map<std::uint32_t, double> weights;
+    for (const auto& [m, m2] : probe.secondMoment) weights[m] = std::sqrt(m2);
+    const std::vector<std::uint32_t> order = identityOrder(s);
+    const LightTable mixed = makeLightTable(s, order, LightSelection::Mixed);
+    const LightTable probed = makeLightTable(s, order, LightSelection::Probe, weights);
+    EXPECT_TRUE(probed.probed);
+    EXPECT_NEAR(probed.shares.at(hidden), 0.5 * mixed.shares.at(hidden), 1e-12);
+    EXPECT_NEAR(probed.shares.at(kCeilingLight), 1.0 - 0.5 * mixed.shares.at(hidden), 1e-12);
+    EXPECT_EQ(probed.lights.back().cdf, 1.0f);
+}
+
+// A second light of the ceiling light's size and radiance across the open front of the box
+// (z = 0.999), facing out (towards the camera: nothing in the room receives its light) or in.
+TEST(LightProbe, AnEmitterFacingAwayFromTheVisibleSurfacesScoresZero) {
+    for (const bool in : {false, true}) {
+        SCOPED_TRACE(in ? "facing in" : "facing out");
+        Scene s = makeCornellBox();
+        const glm::vec3 a{0.3f, 0.3f, 0.999f}, b{0.77f, 0.3f, 0.999f}, c{0.77f, 0.68f, 0.999f}, d{0.3f, 0.68f, 0.999f};
+        const glm::vec3 le = s.materials[kCeilingLight].emissive;
+        const std::uint32_t twin = in ? addEmitter(s, d, c, b, a, le) : addEmitter(s, a, b, c, d, le);
+        const SceneBvh bvh = buildSceneBvh(s);
+        const EmitterProbe probe = probeEmitters(s, bvh, cameraOf(s, 64, 64), radiusOf(s));
+        ASSERT_EQ(probe.secondMoment.size(), 2u);
+        EXPECT_GT(probe.secondMoment.at(kCeilingLight), 0.0);
+        if (in)
+            EXPECT_GT(probe.secondMoment.at(twin), 0.0);
+        else
+            EXPECT_EQ(probe.secondMoment.at(twin), 0.0);
+    }
+}
+
+TEST(LightProbe, SameProbeOnEveryRun) {
+    std::uint32_t hidden = 0;
+    const Scene s = boxWithHiddenEmitter(hidden);
+    const SceneBvh bvh = buildSceneBvh(s);
+    const EmitterProbe a = probeEmitters(s, bvh, cameraOf(s, 48, 40), radiusOf(s));
+    const EmitterProbe b = probeEmitters(s, bvh, cameraOf(s, 48, 40), radiusOf(s));
+    EXPECT_EQ(a.points, b.points);
+    EXPECT_EQ(a.secondMoment, b.secondMoment);
+}
+
+TEST(LightProbe, OneEmitterIsNotProbed) {
+    const Scene s = makeCornellBox();
+    const EmitterProbe probe = probeEmitters(s, buildSceneBvh(s), cameraOf(s, 16, 16), radiusOf(s));
+    EXPECT_TRUE(probe.secondMoment.empty());
+    EXPECT_EQ(probe.points, 0u);
+}
+
+// The probe's half follows the weights exactly; without usable weights, or with one emitter,
+// the table is `mixed`'s bit for bit.
+TEST(LightTable, ProbeRuleMixesTheWeightsHalfAndHalfWithMixed) {
+    std::uint32_t hidden = 0;
+    const Scene s = boxWithHiddenEmitter(hidden);
+    const std::vector<std::uint32_t> order = identityOrder(s);
+    const LightTable mixed = makeLightTable(s, order, LightSelection::Mixed);
+    const LightTable probed =
+        makeLightTable(s, order, LightSelection::Probe, {{kCeilingLight, 3.0}, {hidden, 1.0}});
+    EXPECT_TRUE(probed.probed);
+    EXPECT_NEAR(probed.shares.at(kCeilingLight), 0.5 * mixed.shares.at(kCeilingLight) + 0.375, 1e-12);
+    EXPECT_NEAR(probed.shares.at(hidden), 0.5 * mixed.shares.at(hidden) + 0.125, 1e-12);
+
+    for (const std::map<std::uint32_t, double>& w :
+         {std::map<std::uint32_t, double>{}, std::map<std::uint32_t, double>{{hidden, 0.0}},
+          std::map<std::uint32_t, double>{{kCeilingLight, std::nan("")}}}) {
+        const LightTable t = makeLightTable(s, order, LightSelection::Probe, w);
+        EXPECT_FALSE(t.probed);
+        ASSERT_EQ(t.lights.size(), mixed.lights.size());
+        for (std::size_t i = 0; i < t.lights.size(); ++i) {
+            EXPECT_EQ(t.lights[i].pmf, mixed.lights[i].pmf);
+            EXPECT_EQ(t.lights[i].cdf, mixed.lights[i].cdf);
+        }
+    }
+    const Scene one = makeCornellBox();
+    const LightTable single = makeLightTable(one, identityOrder(one), LightSelection::Probe, {{kCeilingLight, 1.0}});
+    const LightTable singleMixed = makeLightTable(one, identityOrder(one), LightSelection::Mixed);
+    EXPECT_FALSE(single.probed);
+    for (std::size_t i = 0; i < single.lights.size(); ++i) EXPECT_EQ(single.lights[i].pmf, singleMixed.lights[i].pmf);
+}
+
+}  // namespace
+}  // namespace gdpt
