@@ -32,7 +32,7 @@ struct RenderArgs {
     std::string method = "gpt";
     std::string workgroup = "8x8";
     float shiftThreshold = 0.001f;
-    std::string lightSelection = "mixed";  // power, uniform, mixed, probe (LightSelection)
+    std::string lightSelection = "probe";  // power, uniform, mixed, probe (LightSelection)
     std::string splitBounce = "auto";      // G-PT: auto, on, off (GptPassOptions::SplitBounce)
     std::uint32_t emitterSupersampling =
         kDefaultEmitterSupersampling;                 // render/passes/emitter_supersampling_pass.h

@@ -29,20 +29,6 @@ gpu::Material lambertian(glm::vec3 albedo, glm::vec3 emission = glm::vec3(0.0f))
     return m;
 }
 
-// Appends quad a,b,c,d as triangles (a,b,c), (a,c,d) with six own vertices and the face
-// normal, the layout cbox.gltf uses.
-void addQuad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, std::uint32_t mat) {
-    const glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
-    const auto base = static_cast<std::uint32_t>(s.positions.size());
-    for (const glm::vec3& p : {a, b, c, a, c, d}) {
-        s.positions.push_back(p);
-        s.normals.push_back(n);
-    }
-    s.triangles.emplace_back(base, base + 1, base + 2);
-    s.triangles.emplace_back(base + 3, base + 4, base + 5);
-    s.triangleMaterial.insert(s.triangleMaterial.end(), 2, mat);
-}
-
 // A box given by its 8 corners in cbox.gltf's corner order; faces as in that file.
 void addBox(Scene& s, const glm::vec3 (&c)[8], std::uint32_t mat) {
     static constexpr int kFaces[6][4] = {{0, 1, 2, 3}, {4, 5, 6, 7}, {7, 6, 2, 1},
@@ -140,6 +126,18 @@ struct SplitMix {
 };
 
 }  // namespace
+
+void addQuad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, std::uint32_t mat) {
+    const glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+    const auto base = static_cast<std::uint32_t>(s.positions.size());
+    for (const glm::vec3& p : {a, b, c, a, c, d}) {
+        s.positions.push_back(p);
+        s.normals.push_back(n);
+    }
+    s.triangles.emplace_back(base, base + 1, base + 2);
+    s.triangles.emplace_back(base + 3, base + 4, base + 5);
+    s.triangleMaterial.insert(s.triangleMaterial.end(), 2, mat);
+}
 
 Scene makeCornellBox() {
     Scene s;

@@ -11,6 +11,11 @@
 
 namespace gdpt {
 
+// Appends quad a, b, c, d as triangles (a, b, c), (a, c, d) of material `mat`, with six vertices
+// of its own and the face normal (b − a) × (c − a), the layout cbox.gltf uses; counter-clockwise
+// seen from the side the normal points to.
+void addQuad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, std::uint32_t mat);
+
 // The Cornell box in Bitterli's layout: Lambertian red, green and white walls, two white
 // boxes and a ceiling light of radiance (17, 12, 4) emitting downwards; 36 triangles,
 // materials white, red, green, light = 0..3; camera at (0, 1, 6.8) looking at (0, 1, 0)

@@ -74,8 +74,8 @@ struct LightTerm {
 };
 
 LightTerm lightTerm(const Scene& scene, const SceneBvh& bvh, const std::vector<gpu::TriangleGeom>& geoms,
-                        const Emitter& e, std::size_t pick, glm::vec2 u, glm::vec3 x, glm::vec3 n,
-                        float sceneRadius) {
+                    const Emitter& e, std::size_t pick, glm::vec2 u, glm::vec3 x, glm::vec3 n,
+                    float sceneRadius) {
     const std::uint32_t tri = e.triangles[pick];
     const glm::vec3 v0 = scene.positions[scene.triangles[tri].x];
     const glm::vec3 e1 = scene.positions[scene.triangles[tri].y] - v0;
@@ -98,7 +98,8 @@ LightTerm lightTerm(const Scene& scene, const SceneBvh& bvh, const std::vector<g
     const glm::vec3 origin = gpu::offsetRayOriginScaled(x, n, sceneRadius);
     const glm::vec3 towards = y - origin;
     const float len = glm::length(towards);
-    if (len > 0.0f && traceAnyWideCpu(bvh.wide.nodes, geoms, origin, towards / len, 0.0f, len * (1.0f - 1e-4f)))
+    if (len > 0.0f &&
+        traceAnyWideCpu(bvh.wide.nodes, geoms, origin, towards / len, 0.0f, len * (1.0f - 1e-4f)))
         return {};
     constexpr double kPi = 3.14159265358979;
     const double share = e.cdf[pick] - (pick > 0 ? e.cdf[pick - 1] : 0.0);
@@ -152,8 +153,8 @@ EmitterProbe probeEmitters(const Scene& scene, const SceneBvh& bvh, const gpu::S
                     const auto pick = static_cast<std::size_t>(
                         std::lower_bound(e.cdf.begin(), e.cdf.end(), pickU) - e.cdf.begin());
                     const glm::vec2 u(float(radicalInverse(index, 3)), float(radicalInverse(index, 5)));
-                    const LightTerm t = lightTerm(scene, bvh, geoms, e, std::min(pick, e.cdf.size() - 1), u, x, n,
-                                                  sceneRadius);
+                    const LightTerm t = lightTerm(scene, bvh, geoms, e, std::min(pick, e.cdf.size() - 1), u,
+                                                  x, n, sceneRadius);
                     mean[k] += t.g / kLightProbeSamples;
                     moment[k] += t.weighted * t.weighted / kLightProbeSamples;
                 }

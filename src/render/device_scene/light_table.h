@@ -20,10 +20,10 @@ namespace gdpt {
 //    scene. Optimal for one emitter, poor when most of the power leaves the scene: a sky dome
 //    holding 99 % of it takes 99 % of the samples from a lamp that outshines it locally.
 //  - Uniform: each emitter with the same probability, as Mitsuba 0.5 picks its emitters.
-//  - Mixed (the default): half of each, a defensive mixture (Hesterberg 1995): no triangle
+//  - Mixed: half of each, a defensive mixture (Hesterberg 1995): no triangle
 //    gets less than half the probability either rule gives it, so it costs at most 2x the
 //    variance of the better rule and avoids the worse one's failures.
-//  - Probe: half `mixed`, half each emitter in proportion to the square root of its second
+//  - Probe (the default): half `mixed`, half each emitter in proportion to the square root of its second
 //    moment at the surfaces the camera sees (light_probe.h), the share that minimises the
 //    variance of next-event estimation there. `mixed` where the probe has nothing to say
 //    (one emitter, none seen, more than kLightProbeMaxEmitters).

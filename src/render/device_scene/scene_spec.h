@@ -40,7 +40,7 @@ struct SceneGpuOptions {
     // instead of reconnectable; the one place this setting is held.
     float shiftThreshold = 0.001f;
     // How next-event estimation picks among the emitters (light_table.h).
-    LightSelection lightSelection = LightSelection::Mixed;
+    LightSelection lightSelection = LightSelection::Probe;
     // Bits (1u << kSpec*) of scene features to compile in whatever the scene needs (the
     // generic kernel; kSpecMaxDepth: the 1024-bounce cap; kSpecBvhRegisterStack: the stack
     // in memory, which every tree fits). For `gdpt bench-features`, which

@@ -22,15 +22,7 @@ std::uint32_t addEmitter(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::v
     m.emissive = radiance;
     s.materials.push_back(m);
     const auto material = static_cast<std::uint32_t>(s.materials.size() - 1);
-    const glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
-    const auto base = static_cast<std::uint32_t>(s.positions.size());
-    for (const glm::vec3& p : {a, b, c, a, c, d}) {
-        s.positions.push_back(p);
-        s.normals.push_back(n);
-    }
-    s.triangles.emplace_back(base, base + 1, base + 2);
-    s.triangles.emplace_back(base + 3, base + 4, base + 5);
-    s.triangleMaterial.insert(s.triangleMaterial.end(), 2, material);
+    addQuad(s, a, b, c, d, material);
     return material;
 }
 
@@ -38,8 +30,8 @@ std::uint32_t addEmitter(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::v
 // hides it from everything inside.
 Scene boxWithHiddenEmitter(std::uint32_t& hidden) {
     Scene s = makeCornellBox();
-    hidden = addEmitter(s, {-0.5f, 0.5f, -1.5f}, {0.5f, 0.5f, -1.5f}, {0.5f, 1.5f, -1.5f}, {-0.5f, 1.5f, -1.5f},
-                        glm::vec3(50.0f));
+    hidden = addEmitter(s, {-0.5f, 0.5f, -1.5f}, {0.5f, 0.5f, -1.5f}, {0.5f, 1.5f, -1.5f},
+                        {-0.5f, 1.5f, -1.5f}, glm::vec3(50.0f));
     return s;
 }
 
@@ -87,7 +79,8 @@ TEST(LightProbe, AnEmitterFacingAwayFromTheVisibleSurfacesScoresZero) {
     for (const bool in : {false, true}) {
         SCOPED_TRACE(in ? "facing in" : "facing out");
         Scene s = makeCornellBox();
-        const glm::vec3 a{0.3f, 0.3f, 0.999f}, b{0.77f, 0.3f, 0.999f}, c{0.77f, 0.68f, 0.999f}, d{0.3f, 0.68f, 0.999f};
+        const glm::vec3 a{0.3f, 0.3f, 0.999f}, b{0.77f, 0.3f, 0.999f}, c{0.77f, 0.68f, 0.999f},
+            d{0.3f, 0.68f, 0.999f};
         const glm::vec3 le = s.materials[kCeilingLight].emissive;
         const std::uint32_t twin = in ? addEmitter(s, d, c, b, a, le) : addEmitter(s, a, b, c, d, le);
         const SceneBvh bvh = buildSceneBvh(s);
@@ -143,10 +136,12 @@ TEST(LightTable, ProbeRuleMixesTheWeightsHalfAndHalfWithMixed) {
         }
     }
     const Scene one = makeCornellBox();
-    const LightTable single = makeLightTable(one, identityOrder(one), LightSelection::Probe, {{kCeilingLight, 1.0}});
+    const LightTable single =
+        makeLightTable(one, identityOrder(one), LightSelection::Probe, {{kCeilingLight, 1.0}});
     const LightTable singleMixed = makeLightTable(one, identityOrder(one), LightSelection::Mixed);
     EXPECT_FALSE(single.probed);
-    for (std::size_t i = 0; i < single.lights.size(); ++i) EXPECT_EQ(single.lights[i].pmf, singleMixed.lights[i].pmf);
+    for (std::size_t i = 0; i < single.lights.size(); ++i)
+        EXPECT_EQ(single.lights[i].pmf, singleMixed.lights[i].pmf);
 }
 
 }  // namespace
