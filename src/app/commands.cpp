@@ -18,6 +18,7 @@
 #include "image/png_preview.h"
 #include "integrator/gpt_sampler.h"
 #include "render/device_scene/features.h"
+#include "render/device_scene/scene_gpu.h"
 #include "scene/gltf_loader.h"
 #include "scene/light_sources.h"
 #include "util/error.h"
@@ -203,6 +204,23 @@ int runInfo(const InfoArgs& args) {
     else
         std::printf("  %-26s built with the scene upload (more than %zu triangles)\n", "bvh traversal stack",
                     kSpecBvhTriangles);
+    // Next-event estimation's share of each emitter (light_table.h), by the default rule at the
+    // default camera and image size.
+    if (spec && f.emissiveTriangles > 0) {
+        const std::shared_ptr<const SceneBvh> bvh =
+            spec->bvh() ? spec->bvh() : std::make_shared<const SceneBvh>(buildSceneBvh(scene));
+        const LightTable table = sceneLightTable(scene, *bvh, so);
+        std::string shares;
+        for (const auto& [material, p] : table.shares) {
+            char item[64];
+            std::snprintf(item, sizeof item, "%smaterial %u %.3f", shares.empty() ? "" : ", ", material, p);
+            shares += item;
+        }
+        std::printf("  %-26s %s (%s%s)\n", "light shares", shares.c_str(), toString(so.lightSelection),
+                    table.probed         ? ""
+                    : table.emitters > 1 ? ", nothing probed: mixed"
+                                         : "");
+    }
     // visibleEmission: emitter supersampling (render/passes/emitter_supersampling_pass.h) at the default
     // factor, which needs something the camera can see emit.
     std::printf(

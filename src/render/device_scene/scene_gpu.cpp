@@ -191,6 +191,22 @@ Camera renderCamera(const Scene& scene, int index) {
     return scene.cameras.empty() ? defaultCamera(scene) : scene.cameras.front();
 }
 
+float sceneRadius(const Scene& scene) {
+    const Bounds b = scene.bounds();
+    return 0.5f * glm::length(b.max - b.min);
+}
+
+LightTable sceneLightTable(const Scene& scene, const SceneBvh& bvh, const SceneGpuOptions& options) {
+    std::map<std::uint32_t, double> probeWeights;
+    if (options.lightSelection == LightSelection::Probe) {
+        gpu::SceneConstants camera{};
+        setCamera(camera, renderCamera(scene, options.camera), options.width, options.height);
+        const EmitterProbe probe = probeEmitters(scene, bvh, camera, sceneRadius(scene));
+        for (const auto& [material, m2] : probe.secondMoment) probeWeights[material] = std::sqrt(m2);
+    }
+    return makeLightTable(scene, bvh.binary.triangleOrder, options.lightSelection, probeWeights);
+}
+
 SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOptions& options)
     : SceneGpu(ctx, scene, options, SceneSpec(scene, options)) {}
 
@@ -215,16 +231,8 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     bvhInfo_.buildMs = built->buildMs;
     bvhInfo_.nodes = static_cast<std::uint32_t>(bvh.nodes.size());
     bvhInfo_.maxDepth = bvh.stats.maxDepth;
-    const Bounds b = scene.bounds();
-    const float sceneRadius = 0.5f * glm::length(b.max - b.min);
     setCamera(constants_, renderCamera(scene, options.camera), options.width, options.height);
-    std::map<std::uint32_t, double> probeWeights;
-    if (options.lightSelection == LightSelection::Probe) {
-        const EmitterProbe probe = probeEmitters(scene, *built, constants_, sceneRadius);
-        for (const auto& [material, m2] : probe.secondMoment) probeWeights[material] = std::sqrt(m2);
-    }
-    const LightTable lightTable =
-        makeLightTable(scene, bvh.triangleOrder, options.lightSelection, probeWeights);
+    const LightTable lightTable = sceneLightTable(scene, *built, options);
     lightShares_ = lightTable.shares;
     lightProbed_ = lightTable.probed;
     const std::vector<gpu::LightTriangle>& lights = lightTable.lights;
@@ -258,7 +266,7 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     constants_.maxDepth = options.maxDepth;
     constants_.rrDepth = options.rrDepth;
     constants_.numTriangles = static_cast<std::uint32_t>(bvh.triangleOrder.size());
-    constants_.sceneRadius = sceneRadius;
+    constants_.sceneRadius = sceneRadius(scene);
 
     if (progress) progress->update(2.0, "upload");
     const std::vector<std::uint32_t>& order = bvh.triangleOrder;

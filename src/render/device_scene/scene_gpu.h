@@ -11,6 +11,7 @@
 
 #include "gdpt_shared.h"
 #include "render/device_scene/features.h"
+#include "render/device_scene/light_table.h"
 #include "render/device_scene/scene_spec.h"
 #include "scene/gltf_loader.h"
 #include "scene/scene.h"
@@ -98,6 +99,14 @@ private:
     bool lightProbed_ = false;
     vk::Buffer triGeom_, triShading_, bvh_, materials_, texInfo_, texels_, lightTris_, punctual_, sceneConst_;
 };
+
+// Half the diagonal of the scene's bounds (SceneConstants::sceneRadius, the scale of the
+// rays' origin offsets).
+float sceneRadius(const Scene& scene);
+
+// The table next-event estimation picks lights from for this scene, BVH (its leaf order) and
+// options (light selection; the camera and image size, which the probe rule looks through).
+LightTable sceneLightTable(const Scene& scene, const SceneBvh& bvh, const SceneGpuOptions& options);
 
 // Builds the camera constants for an image of width × height (shared with tests).
 void setCamera(gpu::SceneConstants& c, const Camera& camera, int width, int height);

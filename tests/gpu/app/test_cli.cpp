@@ -340,6 +340,13 @@ TEST_F(Cli, InfoPrintsTheFeaturesAndTheKernelVariant) {
     const RunResult textured = run("info " + std::string(GDPT_SOURCE_DIR) + "/scenes/textured.gltf");
     ASSERT_EQ(textured.code, 0) << textured.output;
     EXPECT_NE(textured.output.find("gpt variant: demodulate=1"), std::string::npos) << textured.output;
+    // The emitters' shares under the default rule: one light has them all; the open scene's
+    // two are probed.
+    EXPECT_NE(box.output.find("material 3 1.000 (probe)"), std::string::npos) << box.output;
+    const RunResult open = run("info " + std::string(GDPT_SOURCE_DIR) + "/scenes/open_scene.gltf");
+    ASSERT_EQ(open.code, 0) << open.output;
+    EXPECT_NE(open.output.find("light shares"), std::string::npos) << open.output;
+    EXPECT_NE(open.output.find("(probe)"), std::string::npos) << open.output;
 }
 
 TEST_F(Cli, DiffOfAnImageWithItselfIsZero) {

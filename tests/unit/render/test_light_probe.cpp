@@ -41,11 +41,6 @@ gpu::SceneConstants cameraOf(const Scene& s, int width, int height) {
     return c;
 }
 
-float radiusOf(const Scene& s) {
-    const Bounds b = s.bounds();
-    return 0.5f * glm::length(b.max - b.min);
-}
-
 std::vector<std::uint32_t> identityOrder(const Scene& s) {
     std::vector<std::uint32_t> order(s.triangles.size());
     std::iota(order.begin(), order.end(), 0u);
@@ -56,7 +51,7 @@ TEST(LightProbe, AnEmitterNoVisibleSurfaceSeesScoresZeroAndKeepsHalfItsMixedShar
     std::uint32_t hidden = 0;
     const Scene s = boxWithHiddenEmitter(hidden);
     const SceneBvh bvh = buildSceneBvh(s);
-    const EmitterProbe probe = probeEmitters(s, bvh, cameraOf(s, 64, 64), radiusOf(s));
+    const EmitterProbe probe = probeEmitters(s, bvh, cameraOf(s, 64, 64), sceneRadius(s));
     EXPECT_EQ(probe.points, 32u * 32u);  // every probe ray hits the closed room
     ASSERT_EQ(probe.secondMoment.size(), 2u);
     EXPECT_EQ(probe.secondMoment.at(hidden), 0.0);
@@ -84,7 +79,7 @@ TEST(LightProbe, AnEmitterFacingAwayFromTheVisibleSurfacesScoresZero) {
         const glm::vec3 le = s.materials[kCeilingLight].emissive;
         const std::uint32_t twin = in ? addEmitter(s, d, c, b, a, le) : addEmitter(s, a, b, c, d, le);
         const SceneBvh bvh = buildSceneBvh(s);
-        const EmitterProbe probe = probeEmitters(s, bvh, cameraOf(s, 64, 64), radiusOf(s));
+        const EmitterProbe probe = probeEmitters(s, bvh, cameraOf(s, 64, 64), sceneRadius(s));
         ASSERT_EQ(probe.secondMoment.size(), 2u);
         EXPECT_GT(probe.secondMoment.at(kCeilingLight), 0.0);
         if (in)
@@ -98,15 +93,15 @@ TEST(LightProbe, SameProbeOnEveryRun) {
     std::uint32_t hidden = 0;
     const Scene s = boxWithHiddenEmitter(hidden);
     const SceneBvh bvh = buildSceneBvh(s);
-    const EmitterProbe a = probeEmitters(s, bvh, cameraOf(s, 48, 40), radiusOf(s));
-    const EmitterProbe b = probeEmitters(s, bvh, cameraOf(s, 48, 40), radiusOf(s));
+    const EmitterProbe a = probeEmitters(s, bvh, cameraOf(s, 48, 40), sceneRadius(s));
+    const EmitterProbe b = probeEmitters(s, bvh, cameraOf(s, 48, 40), sceneRadius(s));
     EXPECT_EQ(a.points, b.points);
     EXPECT_EQ(a.secondMoment, b.secondMoment);
 }
 
 TEST(LightProbe, OneEmitterIsNotProbed) {
     const Scene s = makeCornellBox();
-    const EmitterProbe probe = probeEmitters(s, buildSceneBvh(s), cameraOf(s, 16, 16), radiusOf(s));
+    const EmitterProbe probe = probeEmitters(s, buildSceneBvh(s), cameraOf(s, 16, 16), sceneRadius(s));
     EXPECT_TRUE(probe.secondMoment.empty());
     EXPECT_EQ(probe.points, 0u);
 }
