@@ -6,6 +6,7 @@
 #include <glm/glm.hpp>
 
 #include "gdpt_shared.h"
+#include "scene/procedural.h"
 #include "scene/scene.h"
 
 namespace gdpt::test {
@@ -45,6 +46,27 @@ inline Camera lookDown(float height, float yfovDeg) {
     c.up = glm::vec3(0.0f, 1.0f, 0.0f);
     c.yfov = glm::radians(yfovDeg);
     return c;
+}
+
+// Appends quad a, b, c, d (emitting along (b − a) × (c − a)) with a new emissive material of
+// radiance `radiance`; returns the material.
+inline std::uint32_t addEmitterQuad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d,
+                                    glm::vec3 radiance) {
+    s.materials.push_back(lambert(glm::vec3(0.0f), radiance));
+    const auto material = static_cast<std::uint32_t>(s.materials.size() - 1);
+    addQuad(s, a, b, c, d, material);
+    return material;
+}
+
+// The Cornell box (makeCornellBox, its light material 3) with a 1 m² quad of radiance 50
+// behind its back wall (z = −1.5), emitting towards the wall, which hides it from everything
+// inside: 96 % of the scene's emitted power lights nothing the camera sees. Its material is
+// `hidden`.
+inline Scene cornellBoxWithHiddenEmitter(std::uint32_t& hidden) {
+    Scene s = makeCornellBox();
+    hidden = addEmitterQuad(s, {-0.5f, 0.5f, -1.5f}, {0.5f, 0.5f, -1.5f}, {0.5f, 1.5f, -1.5f},
+                            {-0.5f, 1.5f, -1.5f}, glm::vec3(50.0f));
+    return s;
 }
 
 }  // namespace gdpt::test

@@ -10,30 +10,12 @@
 #include "render/device_scene/light_table.h"
 #include "render/device_scene/scene_gpu.h"
 #include "scene/procedural.h"
+#include "scene_builders.h"
 
 namespace gdpt {
 namespace {
 
 constexpr std::uint32_t kCeilingLight = 3;  // makeCornellBox's light material
-
-// Appends quad a, b, c, d (emitting along (b − a) × (c − a)) with a new emissive material.
-std::uint32_t addEmitter(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::vec3 radiance) {
-    gpu::Material m = s.materials[kCeilingLight];
-    m.emissive = radiance;
-    s.materials.push_back(m);
-    const auto material = static_cast<std::uint32_t>(s.materials.size() - 1);
-    addQuad(s, a, b, c, d, material);
-    return material;
-}
-
-// The box with a bright quad behind its back wall (z = −1), emitting towards it: the wall
-// hides it from everything inside.
-Scene boxWithHiddenEmitter(std::uint32_t& hidden) {
-    Scene s = makeCornellBox();
-    hidden = addEmitter(s, {-0.5f, 0.5f, -1.5f}, {0.5f, 0.5f, -1.5f}, {0.5f, 1.5f, -1.5f},
-                        {-0.5f, 1.5f, -1.5f}, glm::vec3(50.0f));
-    return s;
-}
 
 gpu::SceneConstants cameraOf(const Scene& s, int width, int height) {
     gpu::SceneConstants c{};
@@ -49,7 +31,7 @@ std::vector<std::uint32_t> identityOrder(const Scene& s) {
 
 TEST(LightProbe, AnEmitterNoVisibleSurfaceSeesScoresZeroAndKeepsHalfItsMixedShare) {
     std::uint32_t hidden = 0;
-    const Scene s = boxWithHiddenEmitter(hidden);
+    const Scene s = test::cornellBoxWithHiddenEmitter(hidden);
     const SceneBvh bvh = buildSceneBvh(s);
     const EmitterProbe probe = probeEmitters(s, bvh, cameraOf(s, 64, 64), sceneRadius(s));
     EXPECT_EQ(probe.points, 32u * 32u);  // every probe ray hits the closed room
@@ -77,7 +59,8 @@ TEST(LightProbe, AnEmitterFacingAwayFromTheVisibleSurfacesScoresZero) {
         const glm::vec3 a{0.3f, 0.3f, 0.999f}, b{0.77f, 0.3f, 0.999f}, c{0.77f, 0.68f, 0.999f},
             d{0.3f, 0.68f, 0.999f};
         const glm::vec3 le = s.materials[kCeilingLight].emissive;
-        const std::uint32_t twin = in ? addEmitter(s, d, c, b, a, le) : addEmitter(s, a, b, c, d, le);
+        const std::uint32_t twin =
+            in ? test::addEmitterQuad(s, d, c, b, a, le) : test::addEmitterQuad(s, a, b, c, d, le);
         const SceneBvh bvh = buildSceneBvh(s);
         const EmitterProbe probe = probeEmitters(s, bvh, cameraOf(s, 64, 64), sceneRadius(s));
         ASSERT_EQ(probe.secondMoment.size(), 2u);
@@ -91,7 +74,7 @@ TEST(LightProbe, AnEmitterFacingAwayFromTheVisibleSurfacesScoresZero) {
 
 TEST(LightProbe, SameProbeOnEveryRun) {
     std::uint32_t hidden = 0;
-    const Scene s = boxWithHiddenEmitter(hidden);
+    const Scene s = test::cornellBoxWithHiddenEmitter(hidden);
     const SceneBvh bvh = buildSceneBvh(s);
     const EmitterProbe a = probeEmitters(s, bvh, cameraOf(s, 48, 40), sceneRadius(s));
     const EmitterProbe b = probeEmitters(s, bvh, cameraOf(s, 48, 40), sceneRadius(s));
@@ -110,7 +93,7 @@ TEST(LightProbe, OneEmitterIsNotProbed) {
 // the table is `mixed`'s bit for bit.
 TEST(LightTable, ProbeRuleMixesTheWeightsHalfAndHalfWithMixed) {
     std::uint32_t hidden = 0;
-    const Scene s = boxWithHiddenEmitter(hidden);
+    const Scene s = test::cornellBoxWithHiddenEmitter(hidden);
     const std::vector<std::uint32_t> order = identityOrder(s);
     const LightTable mixed = makeLightTable(s, order, LightSelection::Mixed);
     const LightTable probed =
