@@ -24,6 +24,30 @@ double uniformShare(LightSelection s) {
     return 0.5;
 }
 
+// Emitter shares as multiples of 1/kShareSteps where every share is at least half a step: the
+// light choice is a stratified dimension (sampler.glsl: every aligned block of 16 samples of a
+// pixel puts one point in each sixteenth of [0, 1)), so an emitter whose CDF interval starts
+// and ends on sixteenths gets exactly its share of every such block instead of one sample
+// more or less, which costs variance (bench/RESULTS.md, "The probe rule"). Rounding moves a
+// share by at most half a step; the sum's rounding error goes to the largest share. Shares
+// that would round to zero leave the table as it was.
+constexpr double kShareSteps = 16.0;
+std::map<std::uint32_t, double> alignedShares(const std::map<std::uint32_t, double>& shares) {
+    std::map<std::uint32_t, double> out;
+    double sum = 0.0;
+    std::uint32_t largest = shares.begin()->first;
+    for (const auto& [material, share] : shares) {
+        const double q = std::round(share * kShareSteps) / kShareSteps;
+        if (!(q > 0.0)) return shares;
+        out[material] = q;
+        sum += q;
+        if (share > shares.at(largest)) largest = material;
+    }
+    out[largest] += 1.0 - sum;
+    if (!(out[largest] > 0.0)) return shares;
+    return out;
+}
+
 struct Emissive {
     std::uint32_t leaf;
     std::uint32_t material;
@@ -84,22 +108,39 @@ LightTable makeLightTable(const Scene& scene, const std::vector<std::uint32_t>& 
         }
     t.probed = weightSum > 0.0 && std::isfinite(weightSum);
     const double u = uniformShare(selection);
-    double running = 0.0;
-    for (const auto& range : found)
-        for (const Emissive& e : range) {
-            double pmf = (1.0 - u) * e.power / t.totalPower +
-                         u * e.power / (emitterPowers[e.material] * double(t.emitters));
-            if (t.probed) {
-                const auto w = probeWeights.find(e.material);
-                const double share = w != probeWeights.end() && w->second > 0.0 && std::isfinite(w->second)
-                                         ? w->second / weightSum
-                                         : 0.0;
-                pmf = 0.5 * pmf + 0.5 * share * e.power / emitterPowers[e.material];
+    const auto baseShare = [&](std::uint32_t material) {  // the fixed rules' share of an emitter
+        return (1.0 - u) * emitterPowers[material] / t.totalPower + u / double(t.emitters);
+    };
+    if (!t.probed) {
+        double running = 0.0;
+        for (const auto& range : found)
+            for (const Emissive& e : range) {
+                const double pmf = (1.0 - u) * e.power / t.totalPower +
+                                   u * e.power / (emitterPowers[e.material] * double(t.emitters));
+                t.shares[e.material] += pmf;
+                running += pmf;
+                t.lights.push_back({e.leaf, static_cast<float>(running), static_cast<float>(pmf), 0.0f});
             }
-            t.shares[e.material] += pmf;
-            running += pmf;
-            t.lights.push_back({e.leaf, static_cast<float>(running), static_cast<float>(pmf), 0.0f});
+    } else {
+        // Half `mixed`, half the probe's weights, then in multiples of 1/kShareSteps
+        // (alignedShares), each emitter's triangles contiguous from an aligned start.
+        for (const auto& [material, power] : emitterPowers) {
+            const auto w = probeWeights.find(material);
+            const double weight =
+                w != probeWeights.end() && w->second > 0.0 && std::isfinite(w->second) ? w->second : 0.0;
+            t.shares[material] = 0.5 * baseShare(material) + 0.5 * weight / weightSum;
         }
+        t.shares = alignedShares(t.shares);
+        double running = 0.0;
+        for (const auto& [material, share] : t.shares)
+            for (const auto& range : found)
+                for (const Emissive& e : range) {
+                    if (e.material != material) continue;
+                    const double pmf = share * e.power / emitterPowers[material];
+                    running += pmf;
+                    t.lights.push_back({e.leaf, static_cast<float>(running), static_cast<float>(pmf), 0.0f});
+                }
+    }
     if (!t.lights.empty()) t.lights.back().cdf = 1.0f;
     return t;
 }

@@ -1,5 +1,6 @@
 // light_table.h — the emissive triangles as next-event estimation chooses among them: one
-// record per emissive triangle (in the BVH's leaf order) with its selection probability and
+// record per emissive triangle (in the BVH's leaf order; under the probe rule grouped by
+// emitter, each group starting on a sixteenth of the CDF) with its selection probability and
 // the running CDF that shaders/lib/scene_access.glsl searches.
 #pragma once
 
@@ -26,7 +27,9 @@ namespace gdpt {
 //  - Probe (the default): half `mixed`, half each emitter in proportion to the square root of its second
 //    moment at the surfaces the camera sees (light_probe.h), the share that minimises the
 //    variance of next-event estimation there. `mixed` where the probe has nothing to say
-//    (one emitter, none seen, more than kLightProbeMaxEmitters).
+//    (one emitter, none seen, more than kLightProbeMaxEmitters). The shares are rounded to
+//    sixteenths where none rounds to zero, so that the stratified light choice gives each
+//    emitter exactly its share of every 16 samples of a pixel (light_table.cpp).
 enum class LightSelection { Power, Uniform, Mixed, Probe };
 
 // The names of the rules (toString), for --light-selection.

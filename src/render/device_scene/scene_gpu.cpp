@@ -70,11 +70,22 @@ vk::Buffer makeFilledBuffer(const vk::Context& ctx, std::size_t count, const std
     return b;
 }
 
-// Triangle shading records for leaf positions [begin, end); `lights` gives each emitter's
-// index in the light table.
+// Each light triangle's leaf position and its entry in the light table, by leaf position (the
+// table itself is in leaf order, or grouped by emitter: light_table.h).
+std::vector<std::pair<std::uint32_t, std::uint32_t>> lightEntries(
+    const std::vector<gpu::LightTriangle>& lights) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> byLeaf(lights.size());
+    for (std::size_t k = 0; k < lights.size(); ++k)
+        byLeaf[k] = {lights[k].triangle, static_cast<std::uint32_t>(k)};
+    std::sort(byLeaf.begin(), byLeaf.end());
+    return byLeaf;
+}
+
+// Triangle shading records for leaf positions [begin, end); `lights` (lightEntries) gives each
+// emitter's index in the light table.
 void writeShading(const Scene& scene, const std::vector<std::uint32_t>& order,
-                  const std::vector<gpu::LightTriangle>& lights, std::size_t begin, std::size_t end,
-                  gpu::TriangleShading* out) {
+                  const std::vector<std::pair<std::uint32_t, std::uint32_t>>& lights, std::size_t begin,
+                  std::size_t end, gpu::TriangleShading* out) {
     const bool normals = !scene.normals.empty();
     const bool uvs = !scene.uvs.empty();
     for (std::size_t i = begin; i < end; ++i) {
@@ -96,10 +107,9 @@ void writeShading(const Scene& scene, const std::vector<std::uint32_t>& order,
         s.lightIndex = gpu::kInvalidIndex;
         if (materialIsEmissive(scene, order[i])) {
             const auto it =
-                std::lower_bound(lights.begin(), lights.end(), i,
-                                 [](const gpu::LightTriangle& l, std::size_t x) { return l.triangle < x; });
-            if (it != lights.end() && it->triangle == i)
-                s.lightIndex = static_cast<std::uint32_t>(it - lights.begin());
+                std::lower_bound(lights.begin(), lights.end(),
+                                 std::pair<std::uint32_t, std::uint32_t>(static_cast<std::uint32_t>(i), 0u));
+            if (it != lights.end() && it->first == i) s.lightIndex = it->second;
         }
         out[i - begin] = s;
     }
@@ -275,10 +285,11 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
         [&](gpu::TriangleGeom* out, std::size_t begin, std::size_t end) {
             writeTriangleGeoms(scene.positions, scene.triangles, order, begin, end, out);
         });
+    const auto entries = lightEntries(lights);
     triShading_ = makeFilledBuffer<gpu::TriangleShading>(
         ctx, order.size(), "triangle shading", gpu::kBindTriShading,
         [&](gpu::TriangleShading* out, std::size_t begin, std::size_t end) {
-            writeShading(scene, order, lights, begin, end, out);
+            writeShading(scene, order, entries, begin, end, out);
         });
     bvh_ = makeBuffer(ctx, built->wide.nodes, "BVH nodes (4-wide)", gpu::kBindBvh);
     materials_ = makeBuffer(ctx, scene.materials, "materials", gpu::kBindMaterials);

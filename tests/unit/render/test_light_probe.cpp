@@ -29,6 +29,11 @@ std::vector<std::uint32_t> identityOrder(const Scene& s) {
     return order;
 }
 
+// The probe rule's shares are rounded to sixteenths (light_table.cpp, alignedShares).
+double sixteenths(double share) {
+    return std::round(16.0 * share) / 16.0;
+}
+
 TEST(LightProbe, AnEmitterNoVisibleSurfaceSeesScoresZeroAndKeepsHalfItsMixedShare) {
     std::uint32_t hidden = 0;
     const Scene s = test::cornellBoxWithHiddenEmitter(hidden);
@@ -45,8 +50,9 @@ TEST(LightProbe, AnEmitterNoVisibleSurfaceSeesScoresZeroAndKeepsHalfItsMixedShar
     const LightTable mixed = makeLightTable(s, order, LightSelection::Mixed);
     const LightTable probed = makeLightTable(s, order, LightSelection::Probe, weights);
     EXPECT_TRUE(probed.probed);
-    EXPECT_NEAR(probed.shares.at(hidden), 0.5 * mixed.shares.at(hidden), 1e-12);
-    EXPECT_NEAR(probed.shares.at(kCeilingLight), 1.0 - 0.5 * mixed.shares.at(hidden), 1e-12);
+    // Half its `mixed` share (0.364), in sixteenths.
+    EXPECT_EQ(probed.shares.at(hidden), sixteenths(0.5 * mixed.shares.at(hidden)));
+    EXPECT_EQ(probed.shares.at(kCeilingLight), 1.0 - probed.shares.at(hidden));
     EXPECT_EQ(probed.lights.back().cdf, 1.0f);
 }
 
@@ -99,8 +105,25 @@ TEST(LightTable, ProbeRuleMixesTheWeightsHalfAndHalfWithMixed) {
     const LightTable probed =
         makeLightTable(s, order, LightSelection::Probe, {{kCeilingLight, 3.0}, {hidden, 1.0}});
     EXPECT_TRUE(probed.probed);
-    EXPECT_NEAR(probed.shares.at(kCeilingLight), 0.5 * mixed.shares.at(kCeilingLight) + 0.375, 1e-12);
-    EXPECT_NEAR(probed.shares.at(hidden), 0.5 * mixed.shares.at(hidden) + 0.125, 1e-12);
+    EXPECT_EQ(probed.shares.at(kCeilingLight), sixteenths(0.5 * mixed.shares.at(kCeilingLight) + 0.375));
+    EXPECT_EQ(probed.shares.at(hidden), sixteenths(0.5 * mixed.shares.at(hidden) + 0.125));
+    EXPECT_EQ(probed.shares.at(kCeilingLight) + probed.shares.at(hidden), 1.0);
+    // Each emitter's triangles are one run of the table, starting and ending on a sixteenth of
+    // the CDF, their probabilities in proportion to their power.
+    std::map<std::uint32_t, int> runs;
+    std::uint32_t previous = UINT32_MAX;
+    float start = 0.0f;
+    for (const gpu::LightTriangle& l : probed.lights) {
+        const std::uint32_t m = s.triangleMaterial[order[l.triangle]];
+        if (m != previous) {
+            ++runs[m];
+            EXPECT_EQ(start * 16.0f, std::round(start * 16.0f)) << "emitter " << m << " starts at " << start;
+            previous = m;
+        }
+        start = l.cdf;
+    }
+    EXPECT_EQ(runs.at(kCeilingLight), 1);
+    EXPECT_EQ(runs.at(hidden), 1);
 
     for (const std::map<std::uint32_t, double>& w :
          {std::map<std::uint32_t, double>{}, std::map<std::uint32_t, double>{{hidden, 0.0}},
@@ -120,6 +143,31 @@ TEST(LightTable, ProbeRuleMixesTheWeightsHalfAndHalfWithMixed) {
     EXPECT_FALSE(single.probed);
     for (std::size_t i = 0; i < single.lights.size(); ++i)
         EXPECT_EQ(single.lights[i].pmf, singleMixed.lights[i].pmf);
+}
+
+// With 40 emitters `mixed` gives each small one less than a sixteenth: shares that would round
+// to zero leave every share as the half-and-half formula gives it.
+TEST(LightTable, ProbeSharesBelowHalfASixteenthAreNotRounded) {
+    Scene s = makeCornellBox();
+    std::map<std::uint32_t, double> weights{{kCeilingLight, 1.0}};
+    for (int k = 0; k < 39; ++k) {
+        const float x = -0.9f + 0.04f * float(k);
+        weights[test::addEmitterQuad(s, {x, 0.01f, 0.5f}, {x + 0.02f, 0.01f, 0.5f}, {x + 0.02f, 0.01f, 0.48f},
+                                     {x, 0.01f, 0.48f}, glm::vec3(1.0f))] = 0.0;
+    }
+    const std::vector<std::uint32_t> order = identityOrder(s);
+    const LightTable mixed = makeLightTable(s, order, LightSelection::Mixed);
+    const LightTable probed = makeLightTable(s, order, LightSelection::Probe, weights);
+    ASSERT_TRUE(probed.probed);
+    ASSERT_EQ(probed.emitters, 40u);
+    double sum = 0.0;
+    for (const auto& [m, share] : probed.shares) {
+        EXPECT_NEAR(share, 0.5 * mixed.shares.at(m) + (m == kCeilingLight ? 0.5 : 0.0), 1e-12)
+            << "material " << m;
+        sum += share;
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-12);
+    EXPECT_EQ(probed.lights.back().cdf, 1.0f);
 }
 
 }  // namespace
