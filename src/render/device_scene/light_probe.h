@@ -14,7 +14,8 @@
 // (an emitter that lights the camera's room only through a gap scores nothing), the BSDFs
 // (every point is a white Lambertian) and the MIS with BSDF sampling. The light table
 // therefore mixes the probe's rule half and half with `mixed` (Hesterberg 1995's defensive
-// mixture): no triangle gets less than half of what `mixed` gives it.
+// mixture): no emitter gets less than half of what `mixed` gives it, less at most the
+// rounding of the shares to sixteenths (light_table.cpp).
 #pragma once
 
 #include <cstdint>
