@@ -8,8 +8,10 @@
 #include "bvh/builder.h"
 #include "bvh/traverse_cpu.h"
 #include "lib/ray.glsl"
+#include "lib/sampling.glsl"
 #include "render/device_scene/camera_ray.h"
 #include "render/device_scene/features.h"
+#include "render/device_scene/light_table.h"
 #include "util/parallel.h"
 
 namespace gdpt {
@@ -41,8 +43,7 @@ std::vector<Emitter> collectEmitters(const Scene& scene) {
     for (auto& [material, e] : byMaterial) {
         const gpu::Material& m = scene.materials[material];
         e.material = material;
-        e.luminance = std::max(0.2126f * m.emissive.x + 0.7152f * m.emissive.y + 0.0722f * m.emissive.z,
-                               std::max({m.emissive.x, m.emissive.y, m.emissive.z}) * 1e-3f);
+        e.luminance = std::max(gpu::luminance(m.emissive), gpu::maxComponent(m.emissive) * 1e-3f);
         e.doubleSided = (m.flags & gpu::kMatFlagDoubleSided) != 0;
         e.power = e.cdf.back();
         for (double& c : e.cdf) c /= e.power;
@@ -51,7 +52,9 @@ std::vector<Emitter> collectEmitters(const Scene& scene) {
     }
     double total = 0.0;
     for (const Emitter& e : out) total += e.power;
-    for (Emitter& e : out) e.selection = 0.5 * e.power / total + 0.5 / double(out.size());
+    for (Emitter& e : out)
+        e.selection =
+            emitterShare(LightSelection::Mixed, e.power, total, static_cast<std::uint32_t>(out.size()));
     return out;
 }
 
@@ -80,8 +83,8 @@ LightTerm lightTerm(const Scene& scene, const SceneBvh& bvh, const std::vector<g
     const glm::vec3 v0 = scene.positions[scene.triangles[tri].x];
     const glm::vec3 e1 = scene.positions[scene.triangles[tri].y] - v0;
     const glm::vec3 e2 = scene.positions[scene.triangles[tri].z] - v0;
-    const float su = std::sqrt(u.x);
-    const glm::vec3 y = v0 + (1.0f - u.y) * su * e1 + u.y * su * e2;  // uniform on the triangle
+    const glm::vec3 bary = gpu::sampleUniformTriangle(u);  // as the kernels' sampleLight
+    const glm::vec3 y = v0 + bary.y * e1 + bary.z * e2;
     const glm::vec3 c = glm::cross(e1, e2);
     const float area = 0.5f * glm::length(c);
     if (!(area > 0.0f)) return {};

@@ -77,6 +77,12 @@ const char* toString(LightSelection s) {
     return "?";
 }
 
+double emitterShare(LightSelection selection, double emitterPower, double totalPower,
+                    std::uint32_t emitters) {
+    const double u = uniformShare(selection);
+    return (1.0 - u) * emitterPower / totalPower + u / double(emitters);
+}
+
 LightTable makeLightTable(const Scene& scene, const std::vector<std::uint32_t>& order,
                           LightSelection selection, const std::map<std::uint32_t, double>& probeWeights) {
     // Each range's emitters, found in parallel and joined in leaf order.
@@ -98,19 +104,17 @@ LightTable makeLightTable(const Scene& scene, const std::vector<std::uint32_t>& 
             emitterPowers[e.material] += e.power;
         }
     t.emitters = static_cast<std::uint32_t>(emitterPowers.size());
-    // The probe's half: emitter e's share w_e / Σ w over the emitters of this table.
+    // The probe's half: emitter e's share w_e / Σ w over the emitters of this table, counting
+    // only positive, finite weights.
+    const auto weight = [&](std::uint32_t material) {
+        const auto w = probeWeights.find(material);
+        return w != probeWeights.end() && w->second > 0.0 && std::isfinite(w->second) ? w->second : 0.0;
+    };
     double weightSum = 0.0;
     if (selection == LightSelection::Probe && t.emitters > 1)
-        for (const auto& [material, power] : emitterPowers) {
-            const auto w = probeWeights.find(material);
-            if (w != probeWeights.end() && w->second > 0.0 && std::isfinite(w->second))
-                weightSum += w->second;
-        }
+        for (const auto& [material, power] : emitterPowers) weightSum += weight(material);
     t.probed = weightSum > 0.0 && std::isfinite(weightSum);
     const double u = uniformShare(selection);
-    const auto baseShare = [&](std::uint32_t material) {  // the fixed rules' share of an emitter
-        return (1.0 - u) * emitterPowers[material] / t.totalPower + u / double(t.emitters);
-    };
     if (!t.probed) {
         double running = 0.0;
         for (const auto& range : found)
@@ -124,12 +128,9 @@ LightTable makeLightTable(const Scene& scene, const std::vector<std::uint32_t>& 
     } else {
         // Half `mixed`, half the probe's weights, then in multiples of 1/kShareSteps
         // (alignedShares), each emitter's triangles contiguous from an aligned start.
-        for (const auto& [material, power] : emitterPowers) {
-            const auto w = probeWeights.find(material);
-            const double weight =
-                w != probeWeights.end() && w->second > 0.0 && std::isfinite(w->second) ? w->second : 0.0;
-            t.shares[material] = 0.5 * baseShare(material) + 0.5 * weight / weightSum;
-        }
+        for (const auto& [material, power] : emitterPowers)
+            t.shares[material] = 0.5 * emitterShare(selection, power, t.totalPower, t.emitters) +
+                                 0.5 * weight(material) / weightSum;
         t.shares = alignedShares(t.shares);
         double running = 0.0;
         for (const auto& [material, share] : t.shares)

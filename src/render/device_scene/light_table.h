@@ -47,6 +47,10 @@ struct LightTable {
     bool probed = false;
 };
 
+// The probability that a fixed rule (Power, Uniform, Mixed) gives an emitter of power
+// `emitterPower` among `emitters` emitters of total power `totalPower`.
+double emitterShare(LightSelection selection, double emitterPower, double totalPower, std::uint32_t emitters);
+
 // `order`: the BVH's leaf order (leaf position -> scene triangle). Triangles without area or
 // power are no lights. `probeWeights` (Probe only): emissive material -> a weight ∝ the
 // probability the probe's half gives it (√M_e, light_probe.h); without a positive weight

@@ -7,6 +7,7 @@
 
 #include "bvh/builder.h"
 #include "bvh/wide_bvh.h"
+#include "lib/common.glsl"
 #include "render/device_scene/light_probe.h"
 #include "render/device_scene/light_table.h"
 #include "scene/gltf_loader.h"
@@ -21,10 +22,6 @@ namespace gdpt {
 namespace {
 
 constexpr float kPi = 3.14159265358979f;
-
-float luminance(glm::vec3 c) {
-    return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
-}
 
 // A scene binding's size checked against the limit of how the kernels read it: a texel buffer
 // of its SceneSpec::sceneTexelBindings format, else a storage buffer.
@@ -241,7 +238,6 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     bvhInfo_.buildMs = built->buildMs;
     bvhInfo_.nodes = static_cast<std::uint32_t>(bvh.nodes.size());
     bvhInfo_.maxDepth = bvh.stats.maxDepth;
-    setCamera(constants_, renderCamera(scene, options.camera), options.width, options.height);
     const LightTable lightTable = sceneLightTable(scene, *built, options);
     lightShares_ = lightTable.shares;
     lightProbed_ = lightTable.probed;
@@ -252,7 +248,7 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
 
     double punctualPower = 0.0;
     for (const auto& l : scene.punctualLights)
-        punctualPower += 4.0 * kPi * std::max(1e-12, double(luminance(l.intensity)));
+        punctualPower += 4.0 * kPi * std::max(1e-12, double(gpu::luminance(l.intensity)));
 
     // Textures: linear RGBA as packed halves.
     std::vector<gpu::TextureInfo> texInfo;
@@ -268,6 +264,7 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
         texInfo.push_back(info);
     }
 
+    setCamera(constants_, renderCamera(scene, options.camera), options.width, options.height);
     constants_.envRadiance = options.envRadiance;
     constants_.numLightTriangles = static_cast<std::uint32_t>(lights.size());
     constants_.numPunctualLights = static_cast<std::uint32_t>(scene.punctualLights.size());
