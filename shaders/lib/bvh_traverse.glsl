@@ -265,7 +265,11 @@ GDPT_NAMESPACE_END
 // newest entry in .x of the first, shifted on push and pop, which stay in registers
 // (bench/RESULTS.md). The same entries in the same order either way, so the same hits.
 // kBvhRegisterStack = 0 (the host's default): the array.
+#ifdef GDPT_BVH_UNIT_STEPS
+const uint kBvhRegisterStack = 0u;  // the unit-step build: the stack in memory, always
+#else
 layout(constant_id = kSpecBvhRegisterStack) const uint kBvhRegisterStack = 0u;
+#endif
 
 #define GDPT_BVH_STACK_DECLARE()                                  \
     uint stackNode[kBvhWideStackSize];                            \
@@ -325,6 +329,132 @@ bool intersectTriangle(vec3 orig, vec3 dir, uint tri, float tMin, inout float tM
 // nearest is visited next, the others pushed farthest first (so they pop near to far) with
 // their entry distance; popped entries beyond the closest hit so far are skipped. The stack
 // never holds more than collapseToWide's maxStack <= kBvhWideStackSize.
+//
+// Two builds of the loop (SceneSpec::kernelDesc picks one per scene). Both test the same
+// triangles in the same order and find the same hit; they differ in what one iteration does.
+//  * Node steps (the default build; small trees, whose stack is in registers): a node's boxes
+//    and then every triangle of its hit leaves, before its inner children are sorted.
+//  * Unit steps (GDPT_BVH_UNIT_STEPS; the stack in memory): at most one triangle and then,
+//    once the node's leaves are done, the next node. Lavapipe runs an iteration's code for
+//    every branch that any lane of a SIMD vector takes, so with node steps a lane that met
+//    sixteen leaf triangles made the vector's eight lanes wait through sixteen tests; with
+//    unit steps one lane's triangles share iterations with another's nodes. On trees of 10k
+//    to 1M triangles that traces 20-30 % more rays per second; on the Cornell box the extra
+//    iterations and loop state cost 5-8 % (bench/RESULTS.md, "Unit steps for large trees").
+//    Inner children are sorted before the node's triangles shrink the hit distance, so an
+//    entry beyond it is skipped when popped rather than not pushed: the same nodes visited.
+#ifdef GDPT_BVH_UNIT_STEPS
+Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
+    Hit hit = missHit(tMax);
+    vec3 invDir = bvhSafeInverse(dir);
+    GDPT_BVH_STACK_DECLARE();
+    uint node = 0u;
+    float nodeNear = tMin;  // entry distance of `node`
+    uvec4 leafFirst = uvec4(0u);
+    uvec4 leafCount = uvec4(0u);
+    uint k = 0u;     // the next of the last node's leaf triangles (wideLeafTriangle) ...
+    uint kEnd = 0u;  // ... and their end
+    while (true) {
+        if (k < kEnd) {
+            uint i = wideLeafTriangle(leafFirst, k, leafCount);
+            float tCand = hit.t;
+            float u;
+            float v;
+            if (intersectTriangle(orig, dir, i, tMin, tCand, u, v) && GDPT_ANYHIT_FILTER(i, u, v)) {
+                hit.t = tCand;
+                hit.u = u;
+                hit.v = v;
+                hit.triangle = i;
+            }
+            ++k;
+            if (k < kEnd) continue;
+        }
+        if (node == kInvalidIndex || nodeNear > hit.t) {
+            node = kInvalidIndex;
+            while (node == kInvalidIndex && stackSize > 0u) {
+                uint popped;
+                float poppedNear;
+                GDPT_BVH_STACK_POP(popped, poppedNear);
+                if (poppedNear <= hit.t) {
+                    node = popped;
+                    nodeNear = poppedNear;
+                }
+            }
+            if (node == kInvalidIndex) break;
+        }
+        BvhWideNode n = bvhNode(node);
+        vec4 tNear;
+        bvec4 h;
+        wideNodeBoxes(n, orig, invDir, tMin, hit.t, tNear, h);
+        uvec4 count = wideCounts(n);
+        leafFirst = n.child;
+        leafCount = wideLeafCounts(count, h);
+        k = 0u;
+        kEnd = leafCount.x + leafCount.y + leafCount.z + leafCount.w;
+        WideOrder o = wideSortInner(n, count, h, tNear, hit.t);
+        node = o.child.x;
+        nodeNear = o.t.x;
+        if (o.child.w != kInvalidIndex) {
+            GDPT_BVH_STACK_PUSH(o.child.w, o.t.w);
+        }
+        if (o.child.z != kInvalidIndex) {
+            GDPT_BVH_STACK_PUSH(o.child.z, o.t.z);
+        }
+        if (o.child.y != kInvalidIndex) {
+            GDPT_BVH_STACK_PUSH(o.child.y, o.t.y);
+        }
+    }
+    return hit;
+}
+
+// Occlusion: true as soon as any accepted hit with tMin < t < tMax is found. Same traversal
+// without the shrinking tMax and the ordering (order does not change the answer).
+bool traceAny(vec3 orig, vec3 dir, float tMin, float tMax) {
+    vec3 invDir = bvhSafeInverse(dir);
+    GDPT_BVH_STACK_DECLARE();
+    uint node = 0u;
+    uvec4 leafFirst = uvec4(0u);
+    uvec4 leafCount = uvec4(0u);
+    uint k = 0u;
+    uint kEnd = 0u;
+    while (true) {
+        if (k < kEnd) {
+            uint i = wideLeafTriangle(leafFirst, k, leafCount);
+            float tCand = tMax;
+            float u;
+            float v;
+            if (intersectTriangle(orig, dir, i, tMin, tCand, u, v) && GDPT_ANYHIT_FILTER(i, u, v)) return true;
+            ++k;
+            if (k < kEnd) continue;
+        }
+        if (node == kInvalidIndex) {
+            if (stackSize == 0u) break;
+            float unusedNear;
+            GDPT_BVH_STACK_POP(node, unusedNear);
+        }
+        BvhWideNode n = bvhNode(node);
+        vec4 tNear;
+        bvec4 h;
+        wideNodeBoxes(n, orig, invDir, tMin, tMax, tNear, h);
+        uvec4 count = wideCounts(n);
+        leafFirst = n.child;
+        leafCount = wideLeafCounts(count, h);
+        k = 0u;
+        kEnd = leafCount.x + leafCount.y + leafCount.z + leafCount.w;
+        uint next = kInvalidIndex;
+        for (uint j = 0u; j < 4u; ++j) {
+            if (!(h[j] && count[j] == 0u)) continue;
+            if (next == kInvalidIndex) {
+                next = n.child[j];
+            } else {
+                GDPT_BVH_STACK_PUSH(n.child[j], 0.0f);
+            }
+        }
+        node = next;
+    }
+    return false;
+}
+#else
 Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
     Hit hit = missHit(tMax);
     vec3 invDir = bvhSafeInverse(dir);
@@ -412,6 +542,8 @@ bool traceAny(vec3 orig, vec3 dir, float tMin, float tMax) {
     }
     return false;
 }
+
+#endif  // GDPT_BVH_UNIT_STEPS
 
 // Whether anything lies between `origin` and a target point (a light point, a reconnection
 // vertex), the target's own surface excluded. The ray is aimed from the offset origin at the

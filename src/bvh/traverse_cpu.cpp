@@ -1,8 +1,9 @@
 // traverse_cpu.cpp — host mirror of shaders/lib/bvh_traverse.glsl (traceClosest, traceAny:
 // traceClosestWideCpu, traceAnyWideCpu) and the traversal of the binary tree they are
 // collapsed from (traceClosestCpu, traceAnyCpu: the builder's tests and benchmark). Keep the
-// wide control flow identical to the GLSL so both visit the same nodes and test the same
-// triangles in the same order; the arithmetic is shared through the included GLSL.
+// wide control flow identical to the GLSL's node-step build so both visit the same nodes and
+// test the same triangles in the same order (the unit-step build tests the same triangles in
+// the same order too; bvh_traverse.glsl); the arithmetic is shared through the included GLSL.
 #include "bvh/traverse_cpu.h"
 
 namespace gdpt {

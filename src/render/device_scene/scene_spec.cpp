@@ -94,9 +94,10 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> SceneSpec::specConstants() 
     return spec;
 }
 
-vk::KernelDesc SceneSpec::kernelDesc(vk::KernelDesc base, WorkgroupSize wg,
+vk::KernelDesc SceneSpec::kernelDesc(const TracingKernel& kernel, WorkgroupSize wg,
                                      const std::vector<std::uint32_t>& extraBindings,
                                      std::uint32_t pushBytes) const {
+    vk::KernelDesc base = bvhUnitSteps() ? kernel.unitSteps : kernel.nodeSteps;
     base.bindings = sceneBindings();
     base.texelBindings = sceneTexelBindings();
     base.bindings.insert(base.bindings.end(), extraBindings.begin(), extraBindings.end());

@@ -64,6 +64,20 @@ SceneBvh buildSceneBvh(const Scene& scene);
 // kBvhRegisterStackMax stack entries anyway (a 5k-triangle soup of spheres needs 20).
 inline constexpr std::size_t kSpecBvhTriangles = 4096;
 
+// The two builds of a kernel that traces rays (shaders/lib/bvh_traverse.glsl): its traversal
+// loop in node steps (the stack in registers or memory) and in unit steps (GDPT_BVH_UNIT_STEPS,
+// the stack in memory). GDPT_TRACING_KERNEL(label, name) names the embedded SPIR-V of both
+// (kSpv_<name>* and kSpv_<name>_units*).
+struct TracingKernel {
+    vk::KernelDesc nodeSteps;
+    vk::KernelDesc unitSteps;
+};
+#define GDPT_TRACING_KERNEL(label, name)                                   \
+    ::gdpt::TracingKernel {                                                \
+        ::gdpt::vk::kernelDesc(label, GDPT_KERNEL_SPIRV(name)),            \
+            ::gdpt::vk::kernelDesc(label, GDPT_KERNEL_SPIRV(name##_units)) \
+    }
+
 // Throws gdpt::Error naming the scene's file if it has no triangles to render.
 void checkHasTriangles(const Scene& scene);
 
@@ -92,10 +106,14 @@ public:
     // the geometry's (triangles and BVH, scene_geometry.glsl) alone for ray-query kernels.
     [[nodiscard]] static std::vector<std::pair<std::uint32_t, VkFormat>> geometryTexelBindings();
     [[nodiscard]] static std::vector<std::pair<std::uint32_t, VkFormat>> sceneTexelBindings();
-    // Completes `base` (name + SPIR-V) into the descriptor of a kernel that reads the scene:
-    // the scene bindings plus `extraBindings`, `pushBytes` of push constants, the scene's
-    // feature specialisation constants and the workgroup size.
-    [[nodiscard]] vk::KernelDesc kernelDesc(vk::KernelDesc base, WorkgroupSize wg,
+    // Whether the kernels traverse the BVH in unit steps (the stack in memory: a tree that the
+    // register stack does not hold, or not known before the pipelines) or in node steps.
+    [[nodiscard]] bool bvhUnitSteps() const { return bvhRegisterStack() == 0; }
+    // Completes the build of `kernel` that the scene's tree takes (bvhUnitSteps) into the
+    // descriptor of a kernel that reads the scene: the scene bindings plus `extraBindings`,
+    // `pushBytes` of push constants, the scene's feature specialisation constants and the
+    // workgroup size.
+    [[nodiscard]] vk::KernelDesc kernelDesc(const TracingKernel& kernel, WorkgroupSize wg,
                                             const std::vector<std::uint32_t>& extraBindings,
                                             std::uint32_t pushBytes = sizeof(gpu::FrameParams)) const;
 

@@ -1,6 +1,7 @@
 #include "render/passes/bench_pass.h"
 
 #include "bench_rays.spv.h"
+#include "bench_rays_units.spv.h"
 #include "render/device_scene/scene_gpu.h"
 #include "util/timer.h"
 #include "vk/commands.h"
@@ -13,8 +14,7 @@ BenchRaysPass::BenchRaysPass(const vk::Context& ctx, const SceneGpu& scene, Work
     : ctx_(ctx),
       width_(scene.constants().width),
       height_(scene.constants().height),
-      kernel_(ctx, scene.kernelDesc(vk::kernelDesc("bench_rays", GDPT_KERNEL_SPIRV(bench_rays)), wg,
-                                    {gpu::kBindCounters})),
+      kernel_(ctx, scene.kernelDesc(GDPT_TRACING_KERNEL("bench_rays", bench_rays), wg, {gpu::kBindCounters})),
       counters_(ctx, sizeof(gpu::Counters), "bench counters") {
     scene.bindTo(kernel_);
     kernel_.bind(gpu::kBindCounters, counters_);

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "edge.spv.h"
+#include "edge_units.spv.h"
 #include "gpt_shared.h"
 #include "util/error.h"
 #include "vk/commands.h"
@@ -43,7 +44,7 @@ EdgePass::EdgePass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize
                    "edge probe"),
       list_(ctx, 0, "edge list") {
     if (!enabled()) return;
-    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("edge", GDPT_KERNEL_SPIRV(edge)), wg,
+    vk::KernelDesc d = scene.kernelDesc(GDPT_TRACING_KERNEL("edge", edge), wg,
                                         {gpu::kBindGptEdgeMask, gpu::kBindGptEdgeProbe}, 0);
     kernel_.emplace(ctx, d, creation);
     kernel_->bindAddress(gpu::kBindGptEdgeMask, maskBuffer_);

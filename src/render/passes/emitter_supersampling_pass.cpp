@@ -4,6 +4,7 @@
 #include <string>
 
 #include "emitter_supersampling.spv.h"
+#include "emitter_supersampling_units.spv.h"
 #include "util/error.h"
 #include "vk/commands.h"
 #include "vk/context.h"
@@ -49,7 +50,7 @@ EmitterSupersamplingPass::EmitterSupersamplingPass(const vk::Context& ctx, const
       counter_(ctx, sizeof(gpu::VisibleCounter), "emitter-supersampling counter") {
     if (!enabled()) return;
     vk::KernelDesc d = scene.kernelDesc(
-        vk::kernelDesc("emitter_supersampling", GDPT_KERNEL_SPIRV(emitter_supersampling)), wg,
+        GDPT_TRACING_KERNEL("emitter_supersampling", emitter_supersampling), wg,
         {gpu::kBindCounters, gpu::kBindVisibleStats, gpu::kBindVisibleProbe, gpu::kBindVisibleCounter},
         sizeof(gpu::VisibleParams));
     kernel_.emplace(ctx, d, creation);

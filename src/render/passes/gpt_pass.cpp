@@ -6,6 +6,8 @@
 #include "gpt.spv.h"
 #include "gpt_resolve.spv.h"
 #include "gpt_split.spv.h"
+#include "gpt_split_units.spv.h"
+#include "gpt_units.spv.h"
 #include "lib/surface_rules.glsl"
 #include "render/device_scene/scene_gpu.h"
 #include "util/error.h"
@@ -35,9 +37,9 @@ vk::KernelDesc gptDesc(const SceneSpec& scene, WorkgroupSize wg, bool halfVector
     std::vector<std::uint32_t> extra = {gpu::kBindCounters, gpu::kBindGptDemodMask, gpu::kBindGptModulation,
                                         gpu::kBindGptStreamKey};
     for (std::uint32_t i = 0; i < kNumStats; ++i) extra.push_back(gpu::kBindGptCentral + i);
-    vk::KernelDesc d = scene.kernelDesc(splitBounce ? vk::kernelDesc("gpt", GDPT_KERNEL_SPIRV(gpt_split))
-                                                    : vk::kernelDesc("gpt", GDPT_KERNEL_SPIRV(gpt)),
-                                        wg, extra, sizeof(gpu::GptFrameParams));
+    vk::KernelDesc d = scene.kernelDesc(
+        splitBounce ? GDPT_TRACING_KERNEL("gpt", gpt_split) : GDPT_TRACING_KERNEL("gpt", gpt), wg, extra,
+        sizeof(gpu::GptFrameParams));
     for (auto& [id, value] : d.specConstants)
         if (id == gpu::kSpecHasGlossy) value = halfVector ? 1u : 0u;
     d.specConstants.push_back({gpu::kSpecGptDemodulate, demodulate ? 1u : 0u});

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "mlt.spv.h"
+#include "mlt_units.spv.h"
 #include "render/passes/gpt_pass.h"
 #include "util/error.h"
 #include "vk/commands.h"
@@ -18,8 +19,7 @@ vk::KernelDesc mltDesc(const SceneSpec& scene, WorkgroupSize wg, bool baseOnly) 
     const std::vector<std::uint32_t> extra = {
         gpu::kBindCounters,     gpu::kBindMltChains, gpu::kBindMltPss,   gpu::kBindMltRecords,
         gpu::kBindMltBootstrap, gpu::kBindMltStarts, gpu::kBindMltDirect};
-    vk::KernelDesc d =
-        scene.kernelDesc(vk::kernelDesc("mlt", GDPT_KERNEL_SPIRV(mlt)), wg, extra, sizeof(gpu::MltParams));
+    vk::KernelDesc d = scene.kernelDesc(GDPT_TRACING_KERNEL("mlt", mlt), wg, extra, sizeof(gpu::MltParams));
     for (auto& [id, value] : d.specConstants)
         if (id == gpu::kSpecHasGlossy) value = gptNeedsHalfVector(scene) ? 1u : 0u;
     d.specConstants.push_back({gpu::kSpecMltBaseOnly, baseOnly ? 1u : 0u});

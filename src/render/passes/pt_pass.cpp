@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "pt.spv.h"
+#include "pt_units.spv.h"
 #include "render/device_scene/scene_gpu.h"
 #include "util/error.h"
 #include "util/parallel.h"
@@ -19,8 +20,8 @@ constexpr std::uint64_t kMaxPixelSamplesPerDispatch = 1u << 20;
 
 namespace {
 vk::KernelDesc ptDesc(const SceneSpec& scene, WorkgroupSize wg, const EmitterSupersamplingPass& visible) {
-    vk::KernelDesc d = scene.kernelDesc(vk::kernelDesc("pt", GDPT_KERNEL_SPIRV(pt)), wg,
-                                        {gpu::kBindAccum, gpu::kBindCounters});
+    vk::KernelDesc d =
+        scene.kernelDesc(GDPT_TRACING_KERNEL("pt", pt), wg, {gpu::kBindAccum, gpu::kBindCounters});
     visible.configure(d);
     return d;
 }

@@ -16,6 +16,7 @@
 #include "gpu_fixture.h"
 #include "render/device_scene/scene_spec.h"
 #include "trace_rays.spv.h"
+#include "trace_rays_units.spv.h"
 #include "vk/buffer.h"
 #include "vk/commands.h"
 #include "vk/kernel.h"
@@ -126,17 +127,24 @@ double tTolerance(const gpu::TriangleGeom& g, const glm::vec3& orig, const glm::
     return 2 * relative * std::abs(t);
 }
 
+// The traversal loop's two builds (shaders/lib/bvh_traverse.glsl).
+enum class Steps { Nodes, Units };
+
 class BvhGpu : public test::GpuTest {
 protected:
     // registerStack: kSpecBvhRegisterStack (0 = the stack in memory); the tree must fit it.
+    // Steps::Units: the unit-step build, whose stack is always in memory.
     void check(const Soup& soup, std::uint32_t seed,
                vk::PipelineCreation creation = vk::PipelineCreation::Now, std::uint32_t registerStack = 0,
-               std::uint32_t rayCount = 100000) {
+               std::uint32_t rayCount = 100000, Steps steps = Steps::Nodes) {
         const Bvh bvh = buildBvh(soup.positions, soup.triangles);
         const auto geoms = makeTriangleGeoms(soup.positions, soup.triangles, bvh.triangleOrder);
         const auto rays = randomRays(rayCount, seed);
 
-        vk::KernelDesc desc = vk::kernelDesc("trace_rays", GDPT_KERNEL_SPIRV(trace_rays));
+        ASSERT_TRUE(steps == Steps::Nodes || registerStack == 0) << "unit steps keep the stack in memory";
+        vk::KernelDesc desc = steps == Steps::Units
+                                  ? vk::kernelDesc("trace_rays", GDPT_KERNEL_SPIRV(trace_rays_units))
+                                  : vk::kernelDesc("trace_rays", GDPT_KERNEL_SPIRV(trace_rays));
         desc.bindings = {gpu::kBindTriGeom, gpu::kBindBvh, gpu::kBindTestInput, gpu::kBindTestOutput,
                          gpu::kBindTestOutput2};
         desc.texelBindings = SceneSpec::geometryTexelBindings();
@@ -223,6 +231,19 @@ TEST_F(BvhGpu, UnusedBackgroundPipelineIsDestroyed) {
 }
 TEST_F(BvhGpu, DegenerateTrianglesMatchBruteForce) {
     check(degenerate(9), 13);
+}
+
+// The unit-step build on the same soups, and on one whose tree is deep (a stack of more than
+// 16 entries, as the scenes that take this build have).
+TEST_F(BvhGpu, UnitStepsMatchBruteForce) {
+    check(randomSoup(1000, 7), 11, vk::PipelineCreation::Now, 0, 30000, Steps::Units);
+    check(coplanarGrid(), 12, vk::PipelineCreation::Now, 0, 30000, Steps::Units);
+    check(degenerate(9), 13, vk::PipelineCreation::Now, 0, 30000, Steps::Units);
+}
+TEST_F(BvhGpu, UnitStepsOnADeepTreeMatchBruteForce) {
+    const Soup soup = randomSoup(6000, 5, 0.05f);
+    ASSERT_GT(collapseToWide(buildBvh(soup.positions, soup.triangles).nodes).maxStack, 16u);
+    check(soup, 14, vk::PipelineCreation::Now, 0, 10000, Steps::Units);
 }
 
 // The register stacks at their capacity: a soup whose tree needs exactly 8 (16) entries,

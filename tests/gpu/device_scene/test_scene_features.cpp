@@ -104,18 +104,22 @@ TEST(BvhRegisterStack, SpecPicksTheSmallestStackThatHoldsTheTree) {
         const std::uint32_t need = spec.bvh()->wide.maxStack;
         const std::uint32_t expected = need <= 8 ? 8u : need <= 16 ? 16u : 0u;
         EXPECT_EQ(registerStack(spec), expected) << name << " needs " << need;
+        EXPECT_EQ(spec.bvhUnitSteps(), expected == 0u) << name << ": unit steps with the stack in memory";
     }
     const SceneSpec large(makeTriangleScene(10000, 1), o);
     EXPECT_FALSE(large.bvh()) << "built with the upload, after the pipelines";
     EXPECT_EQ(registerStack(large), 0u);
+    EXPECT_TRUE(large.bvhUnitSteps());
     o.genericFeatures = 1u << gpu::kSpecBvhRegisterStack;
     EXPECT_EQ(registerStack(SceneSpec(makeCornellBox(), o)), 0u) << "the generic kernel keeps it in memory";
+    EXPECT_TRUE(SceneSpec(makeCornellBox(), o).bvhUnitSteps());
 }
 
 class BvhRegisterStackSpecialisation : public test::GpuTest {};
 
-// The same bits, PT and G-PT, with the stack in registers and in memory: cornell_box's tree
-// takes the 8-entry stack, glossy_cornell's the 16-entry one.
+// The same bits, PT and G-PT, with the stack in registers (node steps) and in memory (unit
+// steps, bvh_traverse.glsl): cornell_box's tree takes the 8-entry stack, glossy_cornell's the
+// 16-entry one.
 TEST_F(BvhRegisterStackSpecialisation, SameImageEitherWay) {
     for (const char* name : {"cornell_box", "glossy_cornell"}) {
         const Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR "/scenes/") + name + ".gltf");
