@@ -335,8 +335,9 @@ bool intersectTriangle(vec3 orig, vec3 dir, uint tri, float tMin, inout float tM
 //    every branch that any lane of a SIMD vector takes, so with node steps a lane that met
 //    sixteen leaf triangles made the vector's eight lanes wait through sixteen tests; with
 //    unit steps one lane's triangles share iterations with another's nodes. On trees of 10k
-//    to 1M triangles that traces 20-30 % more rays per second; on the Cornell box the extra
-//    iterations and loop state cost 5-8 % (bench/RESULTS.md, "Unit steps for large trees").
+//    to 1M triangles that traces 25-37 % more rays per second; on the Cornell box's few,
+//    full nodes the extra iterations cost 20 % (bench/RESULTS.md, "Unit steps for large
+//    trees"), so small trees keep node steps.
 //    Inner children are sorted before the node's triangles shrink the hit distance, so an
 //    entry beyond it is skipped when popped rather than not pushed: the same nodes visited.
 //    The host gives this build kBvhRegisterStack = 0 (SceneSpec::bvhUnitSteps); the triangle
