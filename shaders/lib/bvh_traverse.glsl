@@ -320,6 +320,27 @@ bool intersectTriangle(vec3 orig, vec3 dir, uint tri, float tMin, inout float tM
     return intersectTriangleGeom(orig, dir, g.v0, g.e1, g.e2, tMin, tMax, u, v);
 }
 
+// Triangle `tri` against the ray: shrinks `hit` to it if it is accepted and closer.
+void closerHit(vec3 orig, vec3 dir, uint tri, float tMin, inout Hit hit) {
+    float tCand = hit.t;
+    float u;
+    float v;
+    if (intersectTriangle(orig, dir, tri, tMin, tCand, u, v) && GDPT_ANYHIT_FILTER(tri, u, v)) {
+        hit.t = tCand;
+        hit.u = u;
+        hit.v = v;
+        hit.triangle = tri;
+    }
+}
+
+// Triangle `tri` is hit and accepted with tMin < t < tMax.
+bool anyHitAt(vec3 orig, vec3 dir, uint tri, float tMin, float tMax) {
+    float tCand = tMax;
+    float u;
+    float v;
+    return intersectTriangle(orig, dir, tri, tMin, tCand, u, v) && GDPT_ANYHIT_FILTER(tri, u, v);
+}
+
 // Closest hit with tMin < t < tMax. Per node: the four boxes, then the triangles of every hit
 // leaf child (slot order), then the inner children in reach sorted by entry distance: the
 // nearest is visited next, the others pushed farthest first (so they pop near to far) with
@@ -358,15 +379,7 @@ Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
     while (true) {
         while (k < kEnd) {
             uint i = wideLeafTriangle(leafFirst, k, leafCount);
-            float tCand = hit.t;
-            float u;
-            float v;
-            if (intersectTriangle(orig, dir, i, tMin, tCand, u, v) && GDPT_ANYHIT_FILTER(i, u, v)) {
-                hit.t = tCand;
-                hit.u = u;
-                hit.v = v;
-                hit.triangle = i;
-            }
+            closerHit(orig, dir, i, tMin, hit);
             ++k;
             if (kBvhRegisterStack == 0u) break;
         }
@@ -422,10 +435,7 @@ bool traceAny(vec3 orig, vec3 dir, float tMin, float tMax) {
     while (true) {
         while (k < kEnd) {
             uint i = wideLeafTriangle(leafFirst, k, leafCount);
-            float tCand = tMax;
-            float u;
-            float v;
-            if (intersectTriangle(orig, dir, i, tMin, tCand, u, v) && GDPT_ANYHIT_FILTER(i, u, v)) return true;
+            if (anyHitAt(orig, dir, i, tMin, tMax)) return true;
             ++k;
             if (kBvhRegisterStack == 0u) break;
         }
@@ -472,15 +482,7 @@ Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
         uvec4 c = wideLeafCounts(count, h);
         for (uint k = 0u; k < c.x + c.y + c.z + c.w; ++k) {
             uint i = wideLeafTriangle(n.child, k, c);
-            float tCand = hit.t;
-            float u;
-            float v;
-            if (intersectTriangle(orig, dir, i, tMin, tCand, u, v) && GDPT_ANYHIT_FILTER(i, u, v)) {
-                hit.t = tCand;
-                hit.u = u;
-                hit.v = v;
-                hit.triangle = i;
-            }
+            closerHit(orig, dir, i, tMin, hit);
         }
         // Inner children still in reach, nearest first (wideSortInner); visit the nearest,
         // push the others farthest first so that they pop in near-to-far order.
@@ -522,10 +524,7 @@ bool traceAny(vec3 orig, vec3 dir, float tMin, float tMax) {
         uvec4 c = wideLeafCounts(count, h);
         for (uint k = 0u; k < c.x + c.y + c.z + c.w; ++k) {
             uint i = wideLeafTriangle(n.child, k, c);
-            float tCand = tMax;
-            float u;
-            float v;
-            if (intersectTriangle(orig, dir, i, tMin, tCand, u, v) && GDPT_ANYHIT_FILTER(i, u, v)) return true;
+            if (anyHitAt(orig, dir, i, tMin, tMax)) return true;
         }
         uint next = kInvalidIndex;
         for (uint j = 0u; j < 4u; ++j) {
