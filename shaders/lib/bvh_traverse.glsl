@@ -313,6 +313,31 @@ layout(constant_id = kSpecBvhRegisterStack) const uint kBvhRegisterStack = 0u;
         (t) = stackNear[stackSize];                               \
     }
 
+// The inner children of a WideOrder but the nearest, farthest first (so that they pop in
+// near-to-far order), with their entry distances.
+#define GDPT_BVH_PUSH_FARTHER(o)                                  \
+    if ((o).child.w != kInvalidIndex) {                           \
+        GDPT_BVH_STACK_PUSH((o).child.w, (o).t.w);                \
+    }                                                             \
+    if ((o).child.z != kInvalidIndex) {                           \
+        GDPT_BVH_STACK_PUSH((o).child.z, (o).t.z);                \
+    }                                                             \
+    if ((o).child.y != kInvalidIndex) {                           \
+        GDPT_BVH_STACK_PUSH((o).child.y, (o).t.y);                \
+    }
+
+// traceAny's order: the first inner child hit (slot order) becomes `next`, the others are
+// pushed (order does not change an occlusion answer).
+#define GDPT_BVH_ANY_ORDER(n, h, count, next)                     \
+    for (uint j = 0u; j < 4u; ++j) {                              \
+        if (!((h)[j] && (count)[j] == 0u)) continue;              \
+        if ((next) == kInvalidIndex) {                            \
+            (next) = (n).child[j];                                \
+        } else {                                                  \
+            GDPT_BVH_STACK_PUSH((n).child[j], 0.0f);              \
+        }                                                         \
+    }
+
 // Triangle `tri` (TriangleGeom order) against the ray; see intersectTriangleGeom.
 bool intersectTriangle(vec3 orig, vec3 dir, uint tri, float tMin, inout float tMax, out float u,
                        out float v) {
@@ -409,15 +434,7 @@ Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
         WideOrder o = wideSortInner(n, count, h, tNear, hit.t);
         node = o.child.x;
         nodeNear = o.t.x;
-        if (o.child.w != kInvalidIndex) {
-            GDPT_BVH_STACK_PUSH(o.child.w, o.t.w);
-        }
-        if (o.child.z != kInvalidIndex) {
-            GDPT_BVH_STACK_PUSH(o.child.z, o.t.z);
-        }
-        if (o.child.y != kInvalidIndex) {
-            GDPT_BVH_STACK_PUSH(o.child.y, o.t.y);
-        }
+        GDPT_BVH_PUSH_FARTHER(o);
     }
     return hit;
 }
@@ -455,14 +472,7 @@ bool traceAny(vec3 orig, vec3 dir, float tMin, float tMax) {
         k = 0u;
         kEnd = leafCount.x + leafCount.y + leafCount.z + leafCount.w;
         uint next = kInvalidIndex;
-        for (uint j = 0u; j < 4u; ++j) {
-            if (!(h[j] && count[j] == 0u)) continue;
-            if (next == kInvalidIndex) {
-                next = n.child[j];
-            } else {
-                GDPT_BVH_STACK_PUSH(n.child[j], 0.0f);
-            }
-        }
+        GDPT_BVH_ANY_ORDER(n, h, count, next);
         node = next;
     }
     return false;
@@ -488,15 +498,7 @@ Hit traceClosest(vec3 orig, vec3 dir, float tMin, float tMax) {
         // push the others farthest first so that they pop in near-to-far order.
         WideOrder o = wideSortInner(n, count, h, tNear, hit.t);
         uint next = o.child.x;
-        if (o.child.w != kInvalidIndex) {
-            GDPT_BVH_STACK_PUSH(o.child.w, o.t.w);
-        }
-        if (o.child.z != kInvalidIndex) {
-            GDPT_BVH_STACK_PUSH(o.child.z, o.t.z);
-        }
-        if (o.child.y != kInvalidIndex) {
-            GDPT_BVH_STACK_PUSH(o.child.y, o.t.y);
-        }
+        GDPT_BVH_PUSH_FARTHER(o);
         while (next == kInvalidIndex && stackSize > 0u) {
             uint popped;
             float poppedNear;
@@ -527,14 +529,7 @@ bool traceAny(vec3 orig, vec3 dir, float tMin, float tMax) {
             if (anyHitAt(orig, dir, i, tMin, tMax)) return true;
         }
         uint next = kInvalidIndex;
-        for (uint j = 0u; j < 4u; ++j) {
-            if (!(h[j] && count[j] == 0u)) continue;
-            if (next == kInvalidIndex) {
-                next = n.child[j];
-            } else {
-                GDPT_BVH_STACK_PUSH(n.child[j], 0.0f);
-            }
-        }
+        GDPT_BVH_ANY_ORDER(n, h, count, next);
         if (next == kInvalidIndex) {
             if (stackSize == 0u) break;
             float unusedNear;
