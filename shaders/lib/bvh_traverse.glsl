@@ -372,18 +372,20 @@ bool anyHitAt(vec3 orig, vec3 dir, uint tri, float tMin, float tMax) {
 // their entry distance; popped entries beyond the closest hit so far are skipped. The stack
 // never holds more than collapseToWide's maxStack <= kBvhWideStackSize.
 //
-// Two builds of the loop (SceneSpec::kernelDesc picks one per scene). Both test the same
-// triangles in the same order and find the same hit; they differ in what one iteration does.
-//  * Node steps (the default build; small trees, whose stack is in registers): a node's boxes
-//    and then every triangle of its hit leaves, before its inner children are sorted.
-//  * Unit steps (GDPT_BVH_UNIT_STEPS; the stack in memory): at most one triangle and then,
-//    once the node's leaves are done, the next node. Lavapipe runs an iteration's code for
-//    every branch that any lane of a SIMD vector takes, so with node steps a lane that met
-//    sixteen leaf triangles made the vector's eight lanes wait through sixteen tests; with
-//    unit steps one lane's triangles share iterations with another's nodes. On trees of 10k
-//    to 1M triangles that traces 25-37 % more rays per second; on the Cornell box's few,
-//    full nodes the extra iterations cost 20 % (bench/RESULTS.md, "Unit steps for large
-//    trees"), so small trees keep node steps.
+// Two builds of the loop (SceneSpec::bvhUnitSteps picks one per scene and device). Both
+// test the same triangles in the same order and find the same hit; they differ in what one
+// iteration does.
+//  * Node steps (the default build): a node's boxes and then every triangle of its hit
+//    leaves, before its inner children are sorted.
+//  * Unit steps (GDPT_BVH_UNIT_STEPS; trees whose stack is in memory, on lavapipe before
+//    Mesa 23): at most one triangle and then, once the node's leaves are done, the next node.
+//    Lavapipe 22.3 runs an iteration's code for every branch that any lane of a SIMD vector
+//    takes, so with node steps a lane that met sixteen leaf triangles made the vector's eight
+//    lanes wait through sixteen tests; with unit steps one lane's triangles share iterations
+//    with another's nodes. On trees of 10k to 1M triangles that traces 25-37 % more rays per
+//    second; on the Cornell box's few, full nodes the extra iterations cost 20 %, and Mesa 25,
+//    which skips the branches no lane takes, traced 3-9 % fewer rays with them
+//    (bench/RESULTS.md, "Unit steps for large trees").
 //    Inner children are sorted before the node's triangles shrink the hit distance, so an
 //    entry beyond it is skipped when popped rather than not pushed: the same nodes visited.
 //    The host gives this build kBvhRegisterStack = 0 (SceneSpec::bvhUnitSteps); the triangle

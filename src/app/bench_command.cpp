@@ -119,9 +119,11 @@ int runBench(const BenchArgs& a) {
         std::vector<double> primary, incoherent, primaryCpu, incoherentCpu;
         std::vector<double> embreePrimary, embreeIncoherent, embreePrimaryCpu, embreeIncoherentCpu;
         std::uint32_t registerStack = 0;
+        bool unitSteps = false;
         {
             SceneGpu sceneGpu(ctx, scene, so);
             registerStack = sceneGpu.spec().bvhRegisterStack();
+            unitSteps = sceneGpu.spec().bvhUnitSteps(ctx.info());
             BenchRaysPass pass(ctx, sceneGpu, wg);
             pass.run(1, false, 99);  // warm-up: pipeline compilation happens lazily on some drivers
 #if defined(GDPT_HAVE_EMBREE)
@@ -182,6 +184,7 @@ int runBench(const BenchArgs& a) {
                       {"bvh_sah_cost", bvhStats.sahCost},
                       {"bvh_nodes", bvhStats.nodeCount},
                       {"bvh_register_stack", registerStack},
+                      {"bvh_steps", unitSteps ? "units" : "nodes"},
                       {"primary_rays_per_s", median(primary)},
                       {"incoherent_rays_per_s", median(incoherent)},
                       {"primary_rays_per_cpu_s", median(primaryCpu)},

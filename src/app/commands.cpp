@@ -197,7 +197,7 @@ int runInfo(const InfoArgs& args) {
     for (const auto& [k, v] : describeFeatures(f)) std::printf("  %-26s %s\n", k.c_str(), v.c_str());
     // bvhRegisterStack: entries of the register traversal stack when the tree was built before
     // the pipelines (small scenes) and its traversals hold at most kBvhRegisterStackMax
-    // (bvh_traverse.glsl); 0 = the stack in memory, traversed in unit steps (bvhSteps below).
+    // (bvh_traverse.glsl); 0 = the stack in memory.
     if (spec && spec->bvh())
         std::printf("  %-26s %u (register stack up to %u)\n", "bvh traversal stack",
                     spec->bvh()->wide.maxStack, gpu::kBvhRegisterStackMax);
@@ -225,10 +225,10 @@ int runInfo(const InfoArgs& args) {
     // factor, which needs something the camera can see emit.
     std::printf(
         "kernel variant: pt[textures=%d punctual=%d lightTris=%d env=%d glossy=%d alphaMask=%d "
-        "shadingNormals=%d specularLobe=%d emitterSupersampling=%d bvhRegisterStack=%u bvhSteps=%s]\n",
+        "shadingNormals=%d specularLobe=%d emitterSupersampling=%d bvhRegisterStack=%u]\n",
         f.hasTextures, f.hasPunctual, f.hasLightTris, f.hasEnv, f.hasGlossy, f.hasAlphaMask,
         f.hasShadingNormals, f.hasSpecularLayer, emitterSupersamplingPossible(f),
-        spec ? spec->bvhRegisterStack() : 0u, !spec || spec->bvhUnitSteps() ? "units" : "nodes");
+        spec ? spec->bvhRegisterStack() : 0u);
     // G-PT's first-hit texture demodulation as --demodulate auto chooses it (gpt_pass.h).
     std::printf("gpt variant: demodulate=%d\n", demodulationApplies(scene) ? 1 : 0);
     for (const auto& u : scene.unsupported) std::printf("  unsupported: %s\n", u.c_str());

@@ -164,6 +164,7 @@ json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrato
               {"seed", args.seed},
               {"batches", s.batches},
               {"bvh_register_stack", s.bvhRegisterStack},
+              {"bvh_steps", s.bvhUnitSteps ? "units" : "nodes"},
               {"light_selection", args.lightSelection},
               {"time_s",
                {{"total", seconds},

@@ -85,6 +85,7 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     stats.bvhBuildMs = sceneGpu.bvhInfo().buildMs;
     stats.sceneDeviceBytes = sceneGpu.deviceBytes();
     stats.bvhRegisterStack = sceneGpu.spec().bvhRegisterStack();
+    stats.bvhUnitSteps = sceneGpu.spec().bvhUnitSteps(ctx.info());
     stats.lightShares = sceneGpu.lightShares();
     stats.lightProbed = sceneGpu.lightProbed();
     stats.features = sceneGpu.features();

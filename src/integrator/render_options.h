@@ -163,6 +163,7 @@ struct RenderStats {
     double bvhBuildMs = 0.0;
     std::uint64_t sceneDeviceBytes = 0;  // the scene's tables on the device (BVH, triangles, textures...)
     std::uint32_t bvhRegisterStack = 0;  // entries of the kernels' register traversal stack (0: in memory)
+    bool bvhUnitSteps = false;           // the kernels traverse in unit steps (SceneSpec::bvhUnitSteps)
     // Emissive material -> NEE's probability of picking it, and whether the light probe set
     // them (SceneGpu::lightShares).
     std::map<std::uint32_t, double> lightShares;

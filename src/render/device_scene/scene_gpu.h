@@ -75,10 +75,10 @@ public:
         return spec_.specConstants();
     }
     [[nodiscard]] static std::vector<std::uint32_t> sceneBindings() { return SceneSpec::sceneBindings(); }
-    [[nodiscard]] vk::KernelDesc kernelDesc(const TracingKernel& kernel, WorkgroupSize wg,
-                                            const std::vector<std::uint32_t>& extraBindings,
+    [[nodiscard]] vk::KernelDesc kernelDesc(const TracingKernel& kernel, const vk::DeviceInfo& device,
+                                            WorkgroupSize wg, const std::vector<std::uint32_t>& extraBindings,
                                             std::uint32_t pushBytes = sizeof(gpu::FrameParams)) const {
-        return spec_.kernelDesc(kernel, wg, extraBindings, pushBytes);
+        return spec_.kernelDesc(kernel, device, wg, extraBindings, pushBytes);
     }
 
     [[nodiscard]] const SceneFeatures& features() const { return spec_.features(); }

@@ -1,6 +1,8 @@
 #include "render/device_scene/scene_spec.h"
 
 #include <algorithm>
+#include <cstdlib>
+#include <string>
 
 #include "util/error.h"
 #include "util/timer.h"
@@ -94,10 +96,24 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> SceneSpec::specConstants() 
     return spec;
 }
 
-vk::KernelDesc SceneSpec::kernelDesc(const TracingKernel& kernel, WorkgroupSize wg,
-                                     const std::vector<std::uint32_t>& extraBindings,
+bool SceneSpec::bvhUnitSteps(const vk::DeviceInfo& device) const {
+    const char* env = std::getenv("GDPT_BVH_STEPS");
+    const std::string v = env != nullptr ? env : "";
+    bool units = device.lavapipeBeforeMesa23;
+    if (v == "units") {
+        units = true;
+    } else if (v == "nodes") {
+        units = false;
+    } else if (!v.empty() && v != "auto") {
+        throw Error("GDPT_BVH_STEPS='" + v + "': expected auto, nodes or units");
+    }
+    return units && bvhRegisterStack() == 0;
+}
+
+vk::KernelDesc SceneSpec::kernelDesc(const TracingKernel& kernel, const vk::DeviceInfo& device,
+                                     WorkgroupSize wg, const std::vector<std::uint32_t>& extraBindings,
                                      std::uint32_t pushBytes) const {
-    vk::KernelDesc base = bvhUnitSteps() ? kernel.unitSteps : kernel.nodeSteps;
+    vk::KernelDesc base = bvhUnitSteps(device) ? kernel.unitSteps : kernel.nodeSteps;
     base.bindings = sceneBindings();
     base.texelBindings = sceneTexelBindings();
     base.bindings.insert(base.bindings.end(), extraBindings.begin(), extraBindings.end());

@@ -19,6 +19,7 @@
 #include "render/device_scene/features.h"
 #include "render/device_scene/light_table.h"
 #include "scene/scene.h"
+#include "vk/context.h"
 #include "vk/kernel.h"
 
 namespace gdpt {
@@ -106,15 +107,19 @@ public:
     // the geometry's (triangles and BVH, scene_geometry.glsl) alone for ray-query kernels.
     [[nodiscard]] static std::vector<std::pair<std::uint32_t, VkFormat>> geometryTexelBindings();
     [[nodiscard]] static std::vector<std::pair<std::uint32_t, VkFormat>> sceneTexelBindings();
-    // Whether the kernels traverse the BVH in unit steps (the stack in memory: a tree that the
-    // register stack does not hold, or not known before the pipelines) or in node steps.
-    [[nodiscard]] bool bvhUnitSteps() const { return bvhRegisterStack() == 0; }
-    // Completes the build of `kernel` that the scene's tree takes (bvhUnitSteps) into the
-    // descriptor of a kernel that reads the scene: the scene bindings plus `extraBindings`,
-    // `pushBytes` of push constants, the scene's feature specialisation constants and the
-    // workgroup size.
-    [[nodiscard]] vk::KernelDesc kernelDesc(const TracingKernel& kernel, WorkgroupSize wg,
-                                            const std::vector<std::uint32_t>& extraBindings,
+    // Whether the kernels on `device` traverse the BVH in unit steps or in node steps
+    // (bvh_traverse.glsl): unit steps where the stack is in memory (a tree that the register
+    // stack does not hold, or not known before the pipelines) on lavapipe before Mesa 23, the
+    // driver they were measured to pay on (bench/RESULTS.md, "Unit steps for large trees"), and
+    // node steps everywhere else. GDPT_BVH_STEPS=nodes|units in the environment overrides the
+    // device's choice (units still only with the stack in memory); throws for another value.
+    [[nodiscard]] bool bvhUnitSteps(const vk::DeviceInfo& device) const;
+    // Completes the build of `kernel` that the scene's tree takes on `device` (bvhUnitSteps)
+    // into the descriptor of a kernel that reads the scene: the scene bindings plus
+    // `extraBindings`, `pushBytes` of push constants, the scene's feature specialisation
+    // constants and the workgroup size.
+    [[nodiscard]] vk::KernelDesc kernelDesc(const TracingKernel& kernel, const vk::DeviceInfo& device,
+                                            WorkgroupSize wg, const std::vector<std::uint32_t>& extraBindings,
                                             std::uint32_t pushBytes = sizeof(gpu::FrameParams)) const;
 
 private:

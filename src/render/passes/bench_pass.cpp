@@ -14,7 +14,8 @@ BenchRaysPass::BenchRaysPass(const vk::Context& ctx, const SceneGpu& scene, Work
     : ctx_(ctx),
       width_(scene.constants().width),
       height_(scene.constants().height),
-      kernel_(ctx, scene.kernelDesc(GDPT_TRACING_KERNEL("bench_rays", bench_rays), wg, {gpu::kBindCounters})),
+      kernel_(ctx, scene.kernelDesc(GDPT_TRACING_KERNEL("bench_rays", bench_rays), ctx.info(), wg,
+                                    {gpu::kBindCounters})),
       counters_(ctx, sizeof(gpu::Counters), "bench counters") {
     scene.bindTo(kernel_);
     kernel_.bind(gpu::kBindCounters, counters_);

@@ -44,7 +44,7 @@ EdgePass::EdgePass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize
                    "edge probe"),
       list_(ctx, 0, "edge list") {
     if (!enabled()) return;
-    vk::KernelDesc d = scene.kernelDesc(GDPT_TRACING_KERNEL("edge", edge), wg,
+    vk::KernelDesc d = scene.kernelDesc(GDPT_TRACING_KERNEL("edge", edge), ctx.info(), wg,
                                         {gpu::kBindGptEdgeMask, gpu::kBindGptEdgeProbe}, 0);
     kernel_.emplace(ctx, d, creation);
     kernel_->bindAddress(gpu::kBindGptEdgeMask, maskBuffer_);

@@ -50,7 +50,7 @@ EmitterSupersamplingPass::EmitterSupersamplingPass(const vk::Context& ctx, const
       counter_(ctx, sizeof(gpu::VisibleCounter), "emitter-supersampling counter") {
     if (!enabled()) return;
     vk::KernelDesc d = scene.kernelDesc(
-        GDPT_TRACING_KERNEL("emitter_supersampling", emitter_supersampling), wg,
+        GDPT_TRACING_KERNEL("emitter_supersampling", emitter_supersampling), ctx.info(), wg,
         {gpu::kBindCounters, gpu::kBindVisibleStats, gpu::kBindVisibleProbe, gpu::kBindVisibleCounter},
         sizeof(gpu::VisibleParams));
     kernel_.emplace(ctx, d, creation);

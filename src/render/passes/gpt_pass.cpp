@@ -32,14 +32,15 @@ bool splitBounceFor(const vk::DeviceInfo& device, GptPassOptions::SplitBounce s)
     return s == GptPassOptions::SplitBounce::On;
 }
 
-vk::KernelDesc gptDesc(const SceneSpec& scene, WorkgroupSize wg, bool halfVector, bool splitBounce,
-                       bool demodulate, const EmitterSupersamplingPass& visible) {
+vk::KernelDesc gptDesc(const SceneSpec& scene, const vk::DeviceInfo& device, WorkgroupSize wg,
+                       bool halfVector, bool splitBounce, bool demodulate,
+                       const EmitterSupersamplingPass& visible) {
     std::vector<std::uint32_t> extra = {gpu::kBindCounters, gpu::kBindGptDemodMask, gpu::kBindGptModulation,
                                         gpu::kBindGptStreamKey};
     for (std::uint32_t i = 0; i < kNumStats; ++i) extra.push_back(gpu::kBindGptCentral + i);
     vk::KernelDesc d = scene.kernelDesc(
-        splitBounce ? GDPT_TRACING_KERNEL("gpt", gpt_split) : GDPT_TRACING_KERNEL("gpt", gpt), wg, extra,
-        sizeof(gpu::GptFrameParams));
+        splitBounce ? GDPT_TRACING_KERNEL("gpt", gpt_split) : GDPT_TRACING_KERNEL("gpt", gpt), device, wg,
+        extra, sizeof(gpu::GptFrameParams));
     for (auto& [id, value] : d.specConstants)
         if (id == gpu::kSpecHasGlossy) value = halfVector ? 1u : 0u;
     d.specConstants.push_back({gpu::kSpecGptDemodulate, demodulate ? 1u : 0u});
@@ -150,7 +151,9 @@ GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize w
       counters_(ctx, sizeof(gpu::Counters), "gpt counters"),
       emitterSupersampling_(ctx, scene, wg, options.emitterSupersampling, counters_, creation),
       edges_(ctx, scene, wg, options.edgeSamples, creation, options.demodulate),
-      kernel_(ctx, gptDesc(scene, wg, halfVector_, splitBounce_, options.demodulate, emitterSupersampling_),
+      kernel_(ctx,
+              gptDesc(scene, ctx.info(), wg, halfVector_, splitBounce_, options.demodulate,
+                      emitterSupersampling_),
               creation),
       resolveKernel_(ctx, resolveDesc(wg, emitterSupersampling_), creation),
       stats_(makeStats(ctx, std::uint64_t{width_} * height_)),

@@ -15,11 +15,13 @@ namespace {
 // Chains (or samples) per row of a dispatch: mlt.comp numbers its items row by row.
 constexpr std::uint32_t kItemsPerRow = 256;
 
-vk::KernelDesc mltDesc(const SceneSpec& scene, WorkgroupSize wg, bool baseOnly) {
+vk::KernelDesc mltDesc(const SceneSpec& scene, const vk::DeviceInfo& device, WorkgroupSize wg,
+                       bool baseOnly) {
     const std::vector<std::uint32_t> extra = {
         gpu::kBindCounters,     gpu::kBindMltChains, gpu::kBindMltPss,   gpu::kBindMltRecords,
         gpu::kBindMltBootstrap, gpu::kBindMltStarts, gpu::kBindMltDirect};
-    vk::KernelDesc d = scene.kernelDesc(GDPT_TRACING_KERNEL("mlt", mlt), wg, extra, sizeof(gpu::MltParams));
+    vk::KernelDesc d =
+        scene.kernelDesc(GDPT_TRACING_KERNEL("mlt", mlt), device, wg, extra, sizeof(gpu::MltParams));
     for (auto& [id, value] : d.specConstants)
         if (id == gpu::kSpecHasGlossy) value = gptNeedsHalfVector(scene) ? 1u : 0u;
     d.specConstants.push_back({gpu::kSpecMltBaseOnly, baseOnly ? 1u : 0u});
@@ -45,7 +47,7 @@ MltPass::MltPass(const vk::Context& ctx, const SceneSpec& spec, WorkgroupSize wg
       starts_(ctx, std::uint64_t{options.chains} * sizeof(std::uint32_t), "mlt chain starts"),
       direct_(ctx, std::uint64_t{width_} * height_ * 4 * sizeof(float), "mlt direct"),
       bootstrap_(ctx, 0, "mlt bootstrap"),
-      kernel_(ctx, mltDesc(spec, wg, options.baseOnly), creation) {
+      kernel_(ctx, mltDesc(spec, ctx.info(), wg, options.baseOnly), creation) {
     GDPT_CHECK(options.chains > 0 && options.stepsPerBatch > 0);
     kernel_.bind(gpu::kBindCounters, counters_);
     kernel_.bind(gpu::kBindMltChains, chains_);

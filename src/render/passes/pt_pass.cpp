@@ -19,9 +19,10 @@ constexpr std::uint64_t kMaxPixelSamplesPerDispatch = 1u << 20;
 }  // namespace
 
 namespace {
-vk::KernelDesc ptDesc(const SceneSpec& scene, WorkgroupSize wg, const EmitterSupersamplingPass& visible) {
+vk::KernelDesc ptDesc(const SceneSpec& scene, const vk::DeviceInfo& device, WorkgroupSize wg,
+                      const EmitterSupersamplingPass& visible) {
     vk::KernelDesc d =
-        scene.kernelDesc(GDPT_TRACING_KERNEL("pt", pt), wg, {gpu::kBindAccum, gpu::kBindCounters});
+        scene.kernelDesc(GDPT_TRACING_KERNEL("pt", pt), device, wg, {gpu::kBindAccum, gpu::kBindCounters});
     visible.configure(d);
     return d;
 }
@@ -64,7 +65,7 @@ PtPass::PtPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize wg,
                 {"the emitter-supersampling probe", sizeof(std::uint32_t)}}),
       counters_(ctx, sizeof(gpu::Counters), "pt counters"),
       emitterSupersampling_(ctx, scene, wg, emitterSupersampling, counters_, creation),
-      kernel_(ctx, ptDesc(scene, wg, emitterSupersampling_), creation),
+      kernel_(ctx, ptDesc(scene, ctx.info(), wg, emitterSupersampling_), creation),
       accum_(ctx, std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats), "pt pixel statistics") {
     kernel_.bindAddress(gpu::kBindAccum, accum_);
     kernel_.bind(gpu::kBindCounters, counters_);
