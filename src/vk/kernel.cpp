@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdlib>
 #include <memory>
 #include <string>
 #include <utility>
 
+#include "util/env_choice.h"
 #include "vk/buffer.h"
 #include "vk/context.h"
 #include "vk/pipeline_cache.h"
@@ -164,12 +164,7 @@ VkFormat texelFormat(const std::vector<std::pair<std::uint32_t, VkFormat>>& texe
 }
 
 bool useOptimizedSpirv(const DeviceInfo& device) {
-    const char* env = std::getenv("GDPT_SPIRV");
-    const std::string v = env != nullptr ? env : "";
-    if (v.empty() || v == "auto") return device.lavapipeBeforeMesa23;
-    if (v == "opt") return true;
-    if (v == "raw") return false;
-    throw Error("GDPT_SPIRV='" + v + "': expected auto, raw or opt");
+    return envChoice("GDPT_SPIRV", "raw", "opt", device.lavapipeBeforeMesa23);
 }
 
 Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation creation)

@@ -1,9 +1,8 @@
 #include "render/device_scene/scene_spec.h"
 
 #include <algorithm>
-#include <cstdlib>
-#include <string>
 
+#include "util/env_choice.h"
 #include "util/error.h"
 #include "util/timer.h"
 
@@ -97,17 +96,8 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> SceneSpec::specConstants() 
 }
 
 bool SceneSpec::bvhUnitSteps(const vk::DeviceInfo& device) const {
-    const char* env = std::getenv("GDPT_BVH_STEPS");
-    const std::string v = env != nullptr ? env : "";
-    bool units = device.lavapipeBeforeMesa23;
-    if (v == "units") {
-        units = true;
-    } else if (v == "nodes") {
-        units = false;
-    } else if (!v.empty() && v != "auto") {
-        throw Error("GDPT_BVH_STEPS='" + v + "': expected auto, nodes or units");
-    }
-    return units && bvhRegisterStack() == 0;
+    return envChoice("GDPT_BVH_STEPS", "nodes", "units", device.lavapipeBeforeMesa23) &&
+           bvhRegisterStack() == 0;
 }
 
 vk::KernelDesc SceneSpec::kernelDesc(const TracingKernel& kernel, const vk::DeviceInfo& device,

@@ -5,6 +5,7 @@
 // the register traversal stack (kSpecBvhRegisterStack, chosen from the tree SceneSpec builds
 // for a small scene).
 #include <gtest/gtest.h>
+#include <stdlib.h>
 
 #include "gpu_fixture.h"
 #include "integrator/gpt_sampler.h"
@@ -15,6 +16,7 @@
 #include "same_bits.h"
 #include "scene/gltf_loader.h"
 #include "scene/procedural.h"
+#include "util/error.h"
 
 namespace gdpt {
 namespace {
@@ -118,6 +120,15 @@ TEST(BvhRegisterStack, SpecPicksTheSmallestStackThatHoldsTheTree) {
     EXPECT_EQ(registerStack(large), 0u);
     EXPECT_TRUE(large.bvhUnitSteps(lavapipe22));
     EXPECT_FALSE(large.bvhUnitSteps(otherDevice)) << "node steps on drivers not measured to gain";
+    // GDPT_BVH_STEPS overrides the device's choice, units only with the stack in memory.
+    ::setenv("GDPT_BVH_STEPS", "nodes", 1);
+    EXPECT_FALSE(large.bvhUnitSteps(lavapipe22));
+    ::setenv("GDPT_BVH_STEPS", "units", 1);
+    EXPECT_TRUE(large.bvhUnitSteps(otherDevice));
+    EXPECT_FALSE(SceneSpec(makeCornellBox(), o).bvhUnitSteps(otherDevice)) << "its stack is in registers";
+    ::setenv("GDPT_BVH_STEPS", "fast", 1);
+    EXPECT_THROW((void)large.bvhUnitSteps(lavapipe22), Error);
+    ::unsetenv("GDPT_BVH_STEPS");
     o.genericFeatures = 1u << gpu::kSpecBvhRegisterStack;
     EXPECT_EQ(registerStack(SceneSpec(makeCornellBox(), o)), 0u) << "the generic kernel keeps it in memory";
     EXPECT_TRUE(SceneSpec(makeCornellBox(), o).bvhUnitSteps(lavapipe22));
