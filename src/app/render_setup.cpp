@@ -13,6 +13,7 @@
 #include "util/interrupt.h"
 #include "util/memory.h"
 #include "vk/context.h"
+#include "vk/spirv_specialise.h"
 
 namespace gdpt {
 namespace {
@@ -149,6 +150,19 @@ RenderOptions renderOptionsFor(const RenderArgs& args) {
     return o;
 }
 
+namespace {
+
+// Who folds the kernels' specialisation constants (vk/spirv_specialise.h), and where gdpt's
+// modules came from.
+json specialisationJson(const vk::Context& ctx) {
+    const vk::SpecialiseCounts c = vk::specialiseCounts();
+    return {{"by", vk::useSpecialisedSpirv(ctx.info()) ? "gdpt" : "driver"},
+            {"from_cache", c.fromCache},
+            {"by_optimizer", c.byOptimizer}};
+}
+
+}  // namespace
+
 json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrator& integrator,
                  const RenderStats& s, double seconds, double reserved, double finishReserved,
                  double writeMs) {
@@ -166,6 +180,7 @@ json summaryJson(const RenderArgs& args, const vk::Context& ctx, const Integrato
               {"bvh_register_stack", s.bvhRegisterStack},
               {"bvh_steps", s.bvhUnitSteps ? "units" : "nodes"},
               {"light_selection", args.lightSelection},
+              {"kernels_specialised", specialisationJson(ctx)},
               {"time_s",
                {{"total", seconds},
                 {"bvh_build", s.bvhBuildMs * 1e-3},

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "image/atomic_write.h"
+#include "util/cache_dir.h"
 #include "util/timer.h"
 #include "vk/context.h"
 
@@ -29,14 +30,8 @@ double calibrateReconSeconds(PoissonSolverGpu& solver, const SolveOptions& optio
 }
 
 std::string ReconTimeCache::defaultPath() {
-    namespace fs = std::filesystem;
-    if (const char* d = std::getenv("GDPT_CACHE_DIR"); d && *d)
-        return (fs::path(d) / "recon_times.json").string();
-    if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d)
-        return (fs::path(d) / "gdpt" / "recon_times.json").string();
-    if (const char* d = std::getenv("HOME"); d && *d)
-        return (fs::path(d) / ".cache" / "gdpt" / "recon_times.json").string();
-    return {};
+    const std::filesystem::path dir = cacheDirectory();
+    return dir.empty() ? std::string() : (dir / "recon_times.json").string();
 }
 
 namespace {

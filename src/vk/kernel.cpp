@@ -2,14 +2,17 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <utility>
 
+#include "util/cache_dir.h"
 #include "util/env_choice.h"
 #include "vk/buffer.h"
 #include "vk/context.h"
 #include "vk/pipeline_cache.h"
+#include "vk/spirv_specialise.h"
 #include "vk/timing.h"
 #include "vk/vk_check.h"
 
@@ -20,13 +23,42 @@ namespace {
 struct PipelineJob {
     VkDevice device = VK_NULL_HANDLE;
     VkShaderModule module = VK_NULL_HANDLE;
+    // Or, when the kernel is specialised first (spirv_specialise.h), its SPIR-V, from which
+    // the job makes a module of its own (destroyed once the pipeline exists), and the cache.
+    std::vector<std::uint32_t> spirv;
+    std::filesystem::path cacheDirectory;
     VkPipelineLayout layout = VK_NULL_HANDLE;
     std::vector<VkSpecializationMapEntry> entries;
     std::vector<std::uint32_t> values;
     std::string name;
 };
 
+// A module of the job's SPIR-V with its specialisation constants folded in (through the cache).
+Handle<VkShaderModule> specialisedModule(const PipelineJob& job) {
+    SpecConstants constants;
+    for (std::size_t i = 0; i < job.entries.size(); ++i)
+        constants.emplace_back(job.entries[i].constantID, job.values[i]);
+    std::vector<std::uint32_t> words;
+    try {
+        words = specialiseCached(job.spirv.data(), job.spirv.size(), constants, job.cacheDirectory).words;
+    } catch (const Error& e) {
+        throw e.withContext("creating pipeline '" + job.name + "'");
+    }
+    VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    moduleInfo.codeSize = words.size() * sizeof(std::uint32_t);
+    moduleInfo.pCode = words.data();
+    VkShaderModule module = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateShaderModule(job.device, &moduleInfo, nullptr, &module));
+    const VkDevice device = job.device;
+    return Handle<VkShaderModule>(module,
+                                  [device](VkShaderModule m) { vkDestroyShaderModule(device, m, nullptr); });
+}
+
 VkPipeline createPipeline(const PipelineJob& job) {
+    // A module may be destroyed once its pipelines exist.
+    Handle<VkShaderModule> specialised;
+    if (!job.spirv.empty()) specialised = specialisedModule(job);
+
     VkSpecializationInfo spec{};
     spec.mapEntryCount = static_cast<std::uint32_t>(job.entries.size());
     spec.pMapEntries = job.entries.data();
@@ -36,7 +68,7 @@ VkPipeline createPipeline(const PipelineJob& job) {
     VkComputePipelineCreateInfo pipeInfo{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
     pipeInfo.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
     pipeInfo.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    pipeInfo.stage.module = job.module;
+    pipeInfo.stage.module = specialised ? specialised.get() : job.module;
     pipeInfo.stage.pName = "main";
     pipeInfo.stage.pSpecializationInfo = job.entries.empty() ? nullptr : &spec;
     pipeInfo.layout = job.layout;
@@ -59,18 +91,33 @@ struct PipelineObjects {
     std::size_t bindingCount = 0;
 };
 
+// The SPIR-V form the device gets (KernelDesc::spirvOptimized), as words.
+std::pair<const std::uint32_t*, std::size_t> chosenSpirv(const Context& ctx, const KernelDesc& desc) {
+    const bool optimized = desc.spirvOptimized != nullptr && useOptimizedSpirv(ctx.info());
+    return optimized ? std::make_pair(desc.spirvOptimized, desc.spirvOptimizedBytes / sizeof(std::uint32_t))
+                     : std::make_pair(desc.spirv, desc.spirvBytes / sizeof(std::uint32_t));
+}
+
+// Whether the pipeline job specialises the kernel's SPIR-V itself (spirv_specialise.h).
+bool specialises(const Context& ctx, const KernelDesc& desc) {
+    return !desc.specConstants.empty() && chosenSpirv(ctx, desc).second >= kSpecialiseMinWords &&
+           useSpecialisedSpirv(ctx.info());
+}
+
 PipelineObjects makeObjects(const Context& ctx, const KernelDesc& desc) {
     const VkDevice device = ctx.device();
     PipelineObjects o;
-    VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    const bool optimized = desc.spirvOptimized != nullptr && useOptimizedSpirv(ctx.info());
-    moduleInfo.codeSize = optimized ? desc.spirvOptimizedBytes : desc.spirvBytes;
-    moduleInfo.pCode = optimized ? desc.spirvOptimized : desc.spirv;
-    VkShaderModule module = VK_NULL_HANDLE;
-    VK_CHECK(vkCreateShaderModule(device, &moduleInfo, nullptr, &module));
-    o.module = Handle<VkShaderModule>(
-        module, [device](VkShaderModule m) { vkDestroyShaderModule(device, m, nullptr); });
-    ctx.setName(VK_OBJECT_TYPE_SHADER_MODULE, reinterpret_cast<std::uint64_t>(module), desc.name);
+    if (!specialises(ctx, desc)) {
+        const auto [words, count] = chosenSpirv(ctx, desc);
+        VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+        moduleInfo.codeSize = count * sizeof(std::uint32_t);
+        moduleInfo.pCode = words;
+        VkShaderModule module = VK_NULL_HANDLE;
+        VK_CHECK(vkCreateShaderModule(device, &moduleInfo, nullptr, &module));
+        o.module = Handle<VkShaderModule>(
+            module, [device](VkShaderModule m) { vkDestroyShaderModule(device, m, nullptr); });
+        ctx.setName(VK_OBJECT_TYPE_SHADER_MODULE, reinterpret_cast<std::uint64_t>(module), desc.name);
+    }
 
     std::vector<VkDescriptorSetLayoutBinding> bindings;
     for (const auto& [b, format] : desc.texelBindings)
@@ -109,11 +156,17 @@ PipelineObjects makeObjects(const Context& ctx, const KernelDesc& desc) {
 }
 
 // The job that creates a pipeline of `desc` with `module` and `layout`.
-PipelineJob pipelineJob(VkDevice device, const KernelDesc& desc, VkShaderModule module,
+// Without a module (makeObjects made none), the job specialises the SPIR-V itself.
+PipelineJob pipelineJob(const Context& ctx, const KernelDesc& desc, VkShaderModule module,
                         VkPipelineLayout layout) {
     PipelineJob job;
-    job.device = device;
+    job.device = ctx.device();
     job.module = module;
+    if (module == VK_NULL_HANDLE) {
+        const auto [words, count] = chosenSpirv(ctx, desc);
+        job.spirv.assign(words, words + count);
+        job.cacheDirectory = cacheDirectory();
+    }
     job.layout = layout;
     job.name = desc.name;
     for (const auto& [id, value] : desc.specConstants) {
@@ -210,7 +263,7 @@ Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation crea
         // long as it (the kernel binds its set with its own, identical, layout).
         shared_ = cache->get(pipelineKey(ctx, desc), [&] {
             auto owned = std::make_shared<PipelineObjects>(makeObjects(ctx, desc));
-            PipelineJob job = pipelineJob(device, desc, owned->module.get(), owned->pipelineLayout.get());
+            PipelineJob job = pipelineJob(ctx, desc, owned->module.get(), owned->pipelineLayout.get());
             std::shared_future<VkPipeline> pipeline =
                 creation == PipelineCreation::Background
                     ? std::async(std::launch::async, [job = std::move(job)] { return createPipeline(job); })
@@ -224,7 +277,7 @@ Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation crea
         if (creation == PipelineCreation::Now) (void)wait();
         return;
     }
-    PipelineJob job = pipelineJob(device, desc, module_.get(), pipelineLayout_.get());
+    PipelineJob job = pipelineJob(ctx, desc, module_.get(), pipelineLayout_.get());
     if (creation == PipelineCreation::Background) {
         pending_ = std::async(std::launch::async, [job = std::move(job)] { return createPipeline(job); });
     } else {

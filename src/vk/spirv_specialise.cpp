@@ -1,0 +1,201 @@
+#include "vk/spirv_specialise.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <spirv-tools/libspirv.h>
+#include <spirv-tools/optimizer.hpp>
+#include <string>
+#include <system_error>
+#include <unordered_map>
+
+#include "util/env_choice.h"
+#include "util/error.h"
+#include "util/output_files.h"
+#include "vk/context.h"
+
+namespace gdpt::vk {
+namespace {
+
+// The passes, in order: set and freeze the constants, fold the expressions of constants
+// (OpSpecConstantOp) and merge equal constants, then drop the branches whose conditions became
+// constant, the blocks and code left dead, and the functions no longer called. A change here
+// changes kPassesTag, which is part of every cache key.
+constexpr const char* kPassesTag = "set,freeze,fold,unify,dead-branches,merge-blocks,adce,dead-functions;v1";
+
+std::uint64_t fnv1a(std::uint64_t h, const void* data, std::size_t bytes) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < bytes; ++i) {
+        h ^= p[i];
+        h *= 0x100000001b3ull;
+    }
+    return h;
+}
+
+std::atomic<std::uint64_t> gFromCache{0}, gByOptimizer{0};
+
+constexpr std::uint64_t kFnvOffset = 0xcbf29ce484222325ull;
+
+std::uint64_t cacheKey(const std::uint32_t* words, std::size_t count, const SpecConstants& constants) {
+    std::uint64_t h = fnv1a(kFnvOffset, kPassesTag, std::strlen(kPassesTag));
+    const char* tools = spvSoftwareVersionDetailsString();
+    h = fnv1a(h, tools, std::strlen(tools));
+    const std::uint64_t n = count;
+    h = fnv1a(h, &n, sizeof n);
+    h = fnv1a(h, words, count * sizeof(std::uint32_t));
+    for (const auto& [id, value] : constants) {
+        const std::uint32_t pair[2] = {id, value};
+        h = fnv1a(h, pair, sizeof pair);
+    }
+    return h;
+}
+
+// A cache file: this header, then the specialised module's words.
+struct CacheHeader {
+    std::uint32_t magic = 0x43534447u;  // "GDSC"
+    std::uint32_t version = 1u;
+    std::uint64_t key = 0;       // cacheKey of the input (also the file's name)
+    std::uint64_t words = 0;     // the module's length in words
+    std::uint64_t checksum = 0;  // fnv1a of the module's words
+};
+
+std::string hex64(std::uint64_t v) {
+    static const char* digits = "0123456789abcdef";
+    std::string s(16, '0');
+    for (int i = 15; i >= 0; --i, v >>= 4) s[static_cast<std::size_t>(i)] = digits[v & 15u];
+    return s;
+}
+
+std::filesystem::path cachePath(const std::filesystem::path& directory, std::uint64_t key) {
+    return directory / "spirv" / (hex64(key) + ".spv");
+}
+
+// The cached module, or nothing if the file is missing, short, or not what the key names.
+std::vector<std::uint32_t> readCached(const std::filesystem::path& path, std::uint64_t key) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return {};
+    CacheHeader h;
+    if (!in.read(reinterpret_cast<char*>(&h), sizeof h)) return {};
+    const CacheHeader expected;
+    if (h.magic != expected.magic || h.version != expected.version || h.key != key || h.words < 5 ||
+        h.words > (std::uint64_t{1} << 26))
+        return {};
+    std::vector<std::uint32_t> words(static_cast<std::size_t>(h.words));
+    if (!in.read(reinterpret_cast<char*>(words.data()),
+                 static_cast<std::streamsize>(words.size() * sizeof(std::uint32_t))))
+        return {};
+    if (in.peek() != std::ifstream::traits_type::eof()) return {};  // trailing bytes
+    if (fnv1a(kFnvOffset, words.data(), words.size() * sizeof(std::uint32_t)) != h.checksum) return {};
+    if (words[0] != 0x07230203u) return {};  // SPIR-V's magic number
+    return words;
+}
+
+void evictOldest(const std::filesystem::path& folder) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    std::vector<std::pair<fs::file_time_type, fs::path>> files;
+    for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+        if (it->path().extension() != ".spv") continue;
+        const fs::file_time_type t = it->last_write_time(ec);
+        if (!ec) files.emplace_back(t, it->path());
+    }
+    if (files.size() <= kSpecialiseCacheFiles) return;
+    std::sort(files.begin(), files.end());
+    const std::size_t remove = files.size() - kSpecialiseCacheFiles * 3 / 4;
+    for (std::size_t i = 0; i < remove; ++i) fs::remove(files[i].second, ec);
+}
+
+// Writes the module under its key, staged and renamed (concurrent runs each write a whole
+// file); any failure leaves the cache as it was.
+void writeCached(const std::filesystem::path& path, std::uint64_t key, const std::vector<std::uint32_t>& words) {
+    try {
+        std::error_code ec;
+        std::filesystem::create_directories(path.parent_path(), ec);
+        if (ec) return;
+        CacheHeader h;
+        h.key = key;
+        h.words = words.size();
+        h.checksum = fnv1a(kFnvOffset, words.data(), words.size() * sizeof(std::uint32_t));
+        std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
+        bytes.append(reinterpret_cast<const char*>(words.data()), words.size() * sizeof(std::uint32_t));
+        StagedFile file(path.string());
+        writeBytes(file.tmpPath(), bytes.data(), bytes.size());
+        file.commit();
+        evictOldest(path.parent_path());
+    } catch (const std::exception&) {
+        // An unwritable cache costs the next run the optimizer's time, nothing else.
+    }
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> specialiseSpirv(const std::uint32_t* words, std::size_t count,
+                                           const SpecConstants& constants) {
+    spvtools::Optimizer optimizer(SPV_ENV_VULKAN_1_2);
+    std::string messages;
+    optimizer.SetMessageConsumer(
+        [&messages](spv_message_level_t level, const char*, const spv_position_t&, const char* message) {
+            if (level <= SPV_MSG_ERROR) messages += std::string("\n  ") + message;
+        });
+    std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> values;
+    for (const auto& [id, value] : constants) values[id] = {value};
+    optimizer.RegisterPass(spvtools::CreateSetSpecConstantDefaultValuePass(values))
+        .RegisterPass(spvtools::CreateFreezeSpecConstantValuePass())
+        .RegisterPass(spvtools::CreateFoldSpecConstantOpAndCompositePass())
+        .RegisterPass(spvtools::CreateUnifyConstantPass())
+        .RegisterPass(spvtools::CreateDeadBranchElimPass())
+        .RegisterPass(spvtools::CreateBlockMergePass())
+        .RegisterPass(spvtools::CreateAggressiveDCEPass())
+        .RegisterPass(spvtools::CreateEliminateDeadFunctionsPass());
+    // The input comes from this build's shader compiler and spirv-opt, validated by their
+    // runs (and by the validation layers in the tests); validating it again here would take
+    // as long as the passes.
+    spvtools::OptimizerOptions options;
+    options.set_run_validator(false);
+    std::vector<std::uint32_t> out;
+    if (!optimizer.Run(words, count, &out, options))
+        throw Error("specialising a kernel's SPIR-V failed:" + (messages.empty() ? std::string(" (no message)") : messages));
+    return out;
+}
+
+std::filesystem::path specialisedCachePath(const std::uint32_t* words, std::size_t count,
+                                           const SpecConstants& constants,
+                                           const std::filesystem::path& directory) {
+    return cachePath(directory, cacheKey(words, count, constants));
+}
+
+SpecialisedSpirv specialiseCached(const std::uint32_t* words, std::size_t count, const SpecConstants& constants,
+                                  const std::filesystem::path& directory) {
+    SpecialisedSpirv result;
+    if (directory.empty()) {
+        result.words = specialiseSpirv(words, count, constants);
+        ++gByOptimizer;
+        return result;
+    }
+    const std::uint64_t key = cacheKey(words, count, constants);
+    const std::filesystem::path path = cachePath(directory, key);
+    result.words = readCached(path, key);
+    if (!result.words.empty()) {
+        std::error_code ec;  // marks it used for the eviction; a failure does not matter
+        std::filesystem::last_write_time(path, std::filesystem::file_time_type::clock::now(), ec);
+        result.source = SpecialiseSource::Cache;
+        ++gFromCache;
+        return result;
+    }
+    result.words = specialiseSpirv(words, count, constants);
+    ++gByOptimizer;
+    writeCached(path, key, result.words);
+    return result;
+}
+
+SpecialiseCounts specialiseCounts() {
+    return {gFromCache.load(), gByOptimizer.load()};
+}
+
+bool useSpecialisedSpirv(const DeviceInfo& device) {
+    return envChoice("GDPT_SPECIALISE", "off", "on", device.isCpu);
+}
+
+}  // namespace gdpt::vk
