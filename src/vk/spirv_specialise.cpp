@@ -1,11 +1,12 @@
 #include "vk/spirv_specialise.h"
 
+#include <spirv-tools/libspirv.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cstring>
 #include <fstream>
 #include <iterator>
-#include <spirv-tools/libspirv.h>
 #include <spirv-tools/optimizer.hpp>
 #include <string>
 #include <system_error>
@@ -109,7 +110,8 @@ void evictOldest(const std::filesystem::path& folder) {
 
 // Writes the module under its key, staged and renamed (concurrent runs each write a whole
 // file); any failure leaves the cache as it was.
-void writeCached(const std::filesystem::path& path, std::uint64_t key, const std::vector<std::uint32_t>& words) {
+void writeCached(const std::filesystem::path& path, std::uint64_t key,
+                 const std::vector<std::uint32_t>& words) {
     try {
         std::error_code ec;
         std::filesystem::create_directories(path.parent_path(), ec);
@@ -156,7 +158,8 @@ std::vector<std::uint32_t> specialiseSpirv(const std::uint32_t* words, std::size
     options.set_run_validator(false);
     std::vector<std::uint32_t> out;
     if (!optimizer.Run(words, count, &out, options))
-        throw Error("specialising a kernel's SPIR-V failed:" + (messages.empty() ? std::string(" (no message)") : messages));
+        throw Error("specialising a kernel's SPIR-V failed:" +
+                    (messages.empty() ? std::string(" (no message)") : messages));
     return out;
 }
 
@@ -166,8 +169,8 @@ std::filesystem::path specialisedCachePath(const std::uint32_t* words, std::size
     return cachePath(directory, cacheKey(words, count, constants));
 }
 
-SpecialisedSpirv specialiseCached(const std::uint32_t* words, std::size_t count, const SpecConstants& constants,
-                                  const std::filesystem::path& directory) {
+SpecialisedSpirv specialiseCached(const std::uint32_t* words, std::size_t count,
+                                  const SpecConstants& constants, const std::filesystem::path& directory) {
     SpecialisedSpirv result;
     if (directory.empty()) {
         result.words = specialiseSpirv(words, count, constants);
@@ -195,7 +198,7 @@ SpecialiseCounts specialiseCounts() {
 }
 
 bool useSpecialisedSpirv(const DeviceInfo& device) {
-    return envChoice("GDPT_SPECIALISE", "off", "on", device.isCpu);
+    return envChoice("GDPT_SPECIALISE", "off", "on", device.isCpu && !device.lavapipeBeforeMesa23);
 }
 
 }  // namespace gdpt::vk

@@ -65,10 +65,13 @@ std::filesystem::path specialisedCachePath(const std::uint32_t* words, std::size
 // lavapipe milliseconds, less than a cache lookup could save (bench/RESULTS.md).
 constexpr std::size_t kSpecialiseMinWords = 8192;
 
-// Whether this device's kernels are specialised by gdpt: on CPU devices (lavapipe 22.3 and
-// 25 both create the G-PT pipeline in about two thirds of the time); not on other devices,
-// whose compilers fold the constants themselves and where it is not measured.
-// GDPT_SPECIALISE=on|off|auto overrides (util/env_choice.h).
+// Whether this device's kernels are specialised by gdpt: on CPU devices from Mesa 23 on
+// (lavapipe 25 creates the G-PT pipeline in half the time and runs it as fast). Not on
+// lavapipe before Mesa 23, which creates it in two thirds of the time but runs the specialised
+// module 1.5-3.5 % slower per sample (no gain at 4 s budgets, a loss beyond), nor on other
+// devices, whose compilers fold the constants themselves and where it is not measured
+// (bench/RESULTS.md, "Kernels specialised before the driver"). GDPT_SPECIALISE=on|off|auto
+// overrides (util/env_choice.h).
 bool useSpecialisedSpirv(const DeviceInfo& device);
 
 }  // namespace gdpt::vk

@@ -3,7 +3,6 @@
 // specialisation, the constants and the code they switch off gone from the module, and a
 // cache on disk that survives corrupt, foreign and unwritable files.
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <algorithm>
@@ -83,7 +82,8 @@ TEST_F(SpirvSpecialise, ConstantsAndTheCodeTheySwitchOffAreGone) {
     ASSERT_NE(std::find(before.begin(), before.end(), gpu::kSpecHasTextures), before.end());
 
     vk::SpecConstants off, on;
-    for (std::uint32_t id : {gpu::kSpecHasTextures, gpu::kSpecHasEnv, gpu::kSpecHasGlossy, gpu::kSpecHasAlphaMask}) {
+    for (std::uint32_t id :
+         {gpu::kSpecHasTextures, gpu::kSpecHasEnv, gpu::kSpecHasGlossy, gpu::kSpecHasAlphaMask}) {
         off.emplace_back(id, 0u);
         on.emplace_back(id, 1u);
     }
@@ -123,7 +123,8 @@ TEST_F(SpirvSpecialise, TheCacheReturnsWhatTheOptimizerMade) {
     // Other values are another file.
     const vk::SpecConstants other = {{gpu::kSpecHasTextures, 0u}, {gpu::kSpecMaxDepth, 10u}};
     EXPECT_NE(vk::specialisedCachePath(words.data(), words.size(), other, dir), file);
-    EXPECT_EQ(vk::specialiseCached(words.data(), words.size(), other, dir).source, vk::SpecialiseSource::Optimizer);
+    EXPECT_EQ(vk::specialiseCached(words.data(), words.size(), other, dir).source,
+              vk::SpecialiseSource::Optimizer);
     // No temporary files are left beside them.
     EXPECT_EQ(listing("cache/spirv").size(), 2u);
 }
@@ -132,7 +133,8 @@ TEST_F(SpirvSpecialise, DamagedCacheFilesAreReplaced) {
     const std::vector<std::uint32_t> words = ptWords();
     const vk::SpecConstants constants = {{gpu::kSpecHasEnv, 1u}};
     const fs::path dir = path("cache");
-    const std::vector<std::uint32_t> good = vk::specialiseCached(words.data(), words.size(), constants, dir).words;
+    const std::vector<std::uint32_t> good =
+        vk::specialiseCached(words.data(), words.size(), constants, dir).words;
     const fs::path file = vk::specialisedCachePath(words.data(), words.size(), constants, dir);
     const std::string bytes = test::readText(file.string());
     ASSERT_GT(bytes.size(), 1000u);
@@ -173,7 +175,8 @@ TEST_F(SpirvSpecialise, TheCacheStaysBoundedAndKeepsWhatWasUsedLast) {
         fs::last_write_time(f, old + std::chrono::seconds(i));
     }
     fs::last_write_time(usedFile, old - std::chrono::hours(1));
-    EXPECT_EQ(vk::specialiseCached(words.data(), words.size(), used, dir).source, vk::SpecialiseSource::Cache);
+    EXPECT_EQ(vk::specialiseCached(words.data(), words.size(), used, dir).source,
+              vk::SpecialiseSource::Cache);
     // A write past the bound evicts the oldest.
     const vk::SpecConstants fresh = {{gpu::kSpecHasEnv, 0u}};
     (void)vk::specialiseCached(words.data(), words.size(), fresh, dir);
@@ -192,7 +195,8 @@ TEST_F(SpirvSpecialise, AnUnwritableCacheOnlyCostsTime) {
     // The cache directory is a regular file: nothing can be created under it.
     std::ofstream(path("file")) << "x";
     for (int i = 0; i < 2; ++i) {
-        const vk::SpecialisedSpirv s = vk::specialiseCached(words.data(), words.size(), constants, path("file"));
+        const vk::SpecialisedSpirv s =
+            vk::specialiseCached(words.data(), words.size(), constants, path("file"));
         EXPECT_EQ(s.source, vk::SpecialiseSource::Optimizer);
         EXPECT_EQ(s.words, expected);
     }
@@ -200,16 +204,20 @@ TEST_F(SpirvSpecialise, AnUnwritableCacheOnlyCostsTime) {
     EXPECT_EQ(vk::specialiseCached(words.data(), words.size(), constants, fs::path()).words, expected);
 }
 
-TEST(SpirvSpecialiseChoice, CpuDevicesByDefaultAndTheEnvironmentOverrides) {
+TEST(SpirvSpecialiseChoice, LavapipeFromMesa23ByDefaultAndTheEnvironmentOverrides) {
     vk::DeviceInfo cpu;
     cpu.isCpu = true;
+    vk::DeviceInfo mesa22 = cpu;
+    mesa22.lavapipeBeforeMesa23 = true;
     vk::DeviceInfo gpu;
     ::unsetenv("GDPT_SPECIALISE");
     EXPECT_TRUE(vk::useSpecialisedSpirv(cpu));
+    EXPECT_FALSE(vk::useSpecialisedSpirv(mesa22));
     EXPECT_FALSE(vk::useSpecialisedSpirv(gpu));
     {
         ScopedEnv e("GDPT_SPECIALISE", "on");
         EXPECT_TRUE(vk::useSpecialisedSpirv(gpu));
+        EXPECT_TRUE(vk::useSpecialisedSpirv(mesa22));
     }
     {
         ScopedEnv e("GDPT_SPECIALISE", "off");
@@ -291,7 +299,8 @@ TEST_F(SpirvSpecialiseGpu, ASecondRenderFindsItsKernelsInTheCache) {
     const vk::SpecialiseCounts start = vk::specialiseCounts();
     const RenderResultGpt first = renderGpt(ctx(), scene, o);
     const vk::SpecialiseCounts afterFirst = vk::specialiseCounts();
-    EXPECT_GE(afterFirst.byOptimizer - start.byOptimizer, 2u) << "the path kernel and the edge kernel at least";
+    EXPECT_GE(afterFirst.byOptimizer - start.byOptimizer, 2u)
+        << "the path kernel and the edge kernel at least";
     EXPECT_EQ(afterFirst.fromCache, start.fromCache);
     const RenderResultGpt second = renderGpt(ctx(), scene, o);
     const vk::SpecialiseCounts afterSecond = vk::specialiseCounts();
