@@ -35,9 +35,9 @@ struct RenderArgs {
     std::string lightSelection = "probe";  // power, uniform, mixed, probe (LightSelection)
     std::string splitBounce = "auto";      // G-PT: auto, on, off (GptPassOptions::SplitBounce)
     std::uint32_t emitterSupersampling =
-        kDefaultEmitterSupersampling;                 // render/passes/emitter_supersampling_pass.h
-    std::uint32_t edgeSamples = kDefaultEdgeSamples;  // G-PT: render/passes/edge_pass.h
-    std::string demodulate = "auto";  // G-PT: auto, on, off (Demodulation, render/passes/gpt_pass.h)
+        kDefaultEmitterSupersampling;  // render/passes/emitter_supersampling_pass.h
+    std::string edgeSamples = "auto";  // G-PT: "auto" or 0-64 (render/passes/edge_options.h)
+    std::string demodulate = "auto";   // G-PT: auto, on, off (Demodulation, render/passes/gpt_pass.h)
     std::string recon = "l1";
     double alpha = 0.2;
     double tolerance = 1e-4;

@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "app/bench_util.h"
+#include "app/edge_samples_option.h"
 #include "app/subcommand.h"
 #include "image/atomic_write.h"
 #include "image/exr_io.h"
@@ -53,7 +54,7 @@ struct ConvergeArgs {
     std::string device;
     bool validate = false;
     std::uint32_t emitterSupersampling = kDefaultEmitterSupersampling;
-    std::uint32_t edgeSamples = kDefaultEdgeSamples;
+    std::string edgeSamples = "auto";
     std::string demodulate = "auto";
     int debiasCells = kDefaultDebiasCells;
 };
@@ -146,7 +147,7 @@ private:
 
     MethodOptions methodOptions() const {
         MethodOptions m;
-        m.gpt.sampling.edgeSamples = a_.edgeSamples;
+        m.gpt.sampling.edgeSamples = parseEdgeSamples(a_.edgeSamples, "--edge-samples");
         m.gpt.sampling.demodulate = parseDemodulation(a_.demodulate);
         m.gpt.debiasCells = a_.debiasCells;
         return m;
@@ -457,11 +458,9 @@ Subcommand addConvergeCommand(CLI::App& app) {
                   "(as gdpt render; 0 = off)")
         ->capture_default_str()
         ->check(CLI::Range(0u, kMaxEmitterSupersampling));
-    c->add_option("--edge-samples", a->edgeSamples,
-                  "G-PT methods: extra camera samples per camera sample in the pixels a geometric edge "
-                  "crosses (as gdpt render; 0 = off)")
+    c->add_option("--edge-samples", a->edgeSamples, std::string("(as gdpt render) ") + kEdgeSamplesHelp)
         ->capture_default_str()
-        ->check(CLI::Range(0u, kMaxEdgeSamples));
+        ->check(edgeSamplesValidator());
     c->add_option("--demodulate", a->demodulate,
                   "G-PT methods: first-hit texture demodulation (as gdpt render: auto, on, off)")
         ->capture_default_str()

@@ -14,6 +14,7 @@
 
 #include "app/bench_util.h"
 #include "app/commands.h"
+#include "app/edge_samples_option.h"
 #include "app/input_file.h"
 #include "app/render_setup.h"
 #include "app/subcommand.h"
@@ -91,7 +92,11 @@ RenderArgs renderArgsFromJson(const std::string& text, const std::string& where)
         // Renders written before the choice picked lights by power.
         a.lightSelection = j.value("light_selection", std::string("power"));
         a.shiftThreshold = j.at("shift_threshold").get<float>();
-        a.edgeSamples = j.at("edge_samples").get<std::uint32_t>();
+        // A number, or "auto" (earlier renders wrote numbers only).
+        const json& edge = j.at("edge_samples");
+        a.edgeSamples =
+            edge.is_string() ? edge.get<std::string>() : std::to_string(edge.get<std::uint32_t>());
+        (void)parseEdgeSamples(a.edgeSamples, "edge_samples");
         a.demodulate = j.at("demodulate").get<std::string>();
         a.splitBounce = j.at("split_bounce").get<std::string>();
         a.recon = j.at("recon").get<std::string>();
@@ -462,10 +467,9 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(0.0f, 1.0f))
         ->group(gpt);
-    r->add_option("--edge-samples", a.edgeSamples,
-                  "Extra camera samples per sample in pixels a geometric edge crosses (0 = off)")
+    r->add_option("--edge-samples", a.edgeSamples, kEdgeSamplesHelp)
         ->capture_default_str()
-        ->check(CLI::Range(0u, kMaxEdgeSamples))
+        ->check(edgeSamplesValidator())
         ->group(gpt);
     r->add_option("--demodulate", a.demodulate,
                   "First-hit texture demodulation: auto (on for textured Lambertian scenes), on, off")

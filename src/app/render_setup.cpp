@@ -7,6 +7,7 @@
 
 #include "app/bench_util.h"
 #include "integrator/recon_reserve.h"
+#include "render/passes/edge_options.h"
 #include "render/passes/pixel_buffers.h"
 #include "scene/light_sources.h"
 #include "util/error.h"
@@ -91,7 +92,7 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
     g.sampling.splitBounce = args.splitBounce == "on"    ? GptPassOptions::SplitBounce::On
                              : args.splitBounce == "off" ? GptPassOptions::SplitBounce::Off
                                                          : GptPassOptions::SplitBounce::Auto;
-    g.sampling.edgeSamples = args.edgeSamples;
+    g.sampling.edgeSamples = parseEdgeSamples(args.edgeSamples, "--edge-samples");
     g.sampling.demodulate = parseDemodulation(args.demodulate);
     g.reconstructions = {parseReconstruction(args.recon)};
     if (args.allRecon)

@@ -165,11 +165,18 @@ Checkpoint readCheckpoint(const std::string& path) {
     const std::vector<BufferRole> roles = bufferLayout(path, cp.identity);
     const std::string method = cp.identity.at("method");
 
-    // G-PT's edge pixels hold edge_samples more samples per camera sample (edge_pass.h).
+    // G-PT's edge pixels hold edge_samples more samples per camera sample (edge_pass.h). With
+    // "auto" the render's probe chose the factor (at most kAutoEdgeSamplesMax): the first edge
+    // pixel's count says which, and every other edge pixel must have the same.
     const double spp = s.spp;
     double edgeCount = spp;
-    if (attributes.count("gdpt.id.edge_samples"))
-        edgeCount *= 1.0 + parseCount(path, attributes, "gdpt.id.edge_samples", kMaxEdgeSamples);
+    bool edgeFactorOpen = false;
+    if (attributes.count("gdpt.id.edge_samples")) {
+        if (attributes.at("gdpt.id.edge_samples") == "auto")
+            edgeFactorOpen = true;
+        else
+            edgeCount *= 1.0 + parseCount(path, attributes, "gdpt.id.edge_samples", kMaxEdgeSamples);
+    }
 
     std::map<std::string, Image> layers;
     for (NamedLayer& layer : readExr(path)) layers[layer.name] = std::move(layer.image);
@@ -217,11 +224,19 @@ Checkpoint readCheckpoint(const std::string& path) {
                     throw Error(path + where + pixelName(i, width) + " has sample count " + countText(got) +
                                 ", expected 0 or " + countText(spp) + " (gdpt.spp)");
             } else if (k == 0) {
+                if (edgeFactorOpen && got != spp && spp > 0 && got > spp && std::fmod(got, spp) == 0.0 &&
+                    got / spp - 1.0 <= kAutoEdgeSamplesMax) {
+                    edgeCount = got;
+                    edgeFactorOpen = false;
+                }
                 if (got != spp && got != edgeCount)
                     throw Error(path + where + pixelName(i, width) + " has sample count " + countText(got) +
                                 ", expected " + countText(spp) + " (gdpt.spp)" +
                                 (edgeCount != spp ? " or " + countText(edgeCount) +
                                                         " (gdpt.spp x (1 + edge_samples) in an edge pixel)"
+                                 : edgeFactorOpen ? " or gdpt.spp x (1 + K), K from 1 to " +
+                                                        std::to_string(kAutoEdgeSamplesMax) +
+                                                        " (edge_samples auto, in an edge pixel)"
                                                   : std::string()));
             } else if (got != s.buffers[0][i].count) {
                 throw Error(path + where + pixelName(i, width) + " has sample count " + countText(got) +

@@ -27,7 +27,7 @@ std::uint32_t GptIntegrator::maxBatchSpp(int width, int height) const {
 
 ExrAttributes GptIntegrator::identity(const Scene& scene, const RenderOptions& options) const {
     return {{"shift_threshold", exactFloat(options.scene.shiftThreshold)},
-            {"edge_samples", std::to_string(options_.sampling.edgeSamples)},
+            {"edge_samples", edgeSamplesText(options_.sampling.edgeSamples)},
             {"demodulate", demodulates(scene, options_.sampling.demodulate) ? "on" : "off"}};
 }
 

@@ -30,7 +30,7 @@ struct GptSamplingOptions {
     bool forceHalfVector = false;
     // Extra camera samples per camera sample in the pixels a geometric edge crosses
     // (render/passes/edge_pass.h); 0 = off.
-    std::uint32_t edgeSamples = kDefaultEdgeSamples;
+    std::uint32_t edgeSamples = kEdgeSamplesAuto;
     Demodulation demodulate = Demodulation::Auto;
     // Where each pixel's camera samples come from, or null for the pixel's own stream
     // (GptPassOptions::streams).

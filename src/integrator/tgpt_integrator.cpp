@@ -181,7 +181,7 @@ std::uint32_t TgptIntegrator::maxBatchSpp(int width, int height) const {
 ExrAttributes TgptIntegrator::identity(const Scene& scene, const RenderOptions& options) const {
     (void)scene;
     return {{"shift_threshold", exactFloat(options.scene.shiftThreshold)},
-            {"edge_samples", std::to_string(options_.sampling.edgeSamples)},
+            {"edge_samples", edgeSamplesText(options_.sampling.edgeSamples)},
             {"window", std::to_string(options_.window)},
             {"temporal_shift", temporalShiftName(options_.shift)}};
 }

@@ -12,7 +12,7 @@
 namespace gdpt {
 namespace {
 std::uint32_t checkedFactor(std::uint32_t samplesPerSpp) {
-    if (samplesPerSpp > kMaxEdgeSamples)
+    if (samplesPerSpp > kMaxEdgeSamples && samplesPerSpp != kEdgeSamplesAuto)
         throw Error("edge samples " + std::to_string(samplesPerSpp) + " is above the maximum " +
                     std::to_string(kMaxEdgeSamples));
     return samplesPerSpp;
@@ -76,6 +76,7 @@ void EdgePass::find(vk::CommandStream& stream) {
     for (std::uint32_t i = 0; i < mask_.size(); ++i)
         if (mask_[i] != 0) list.push_back(i);
     count_ = static_cast<std::uint32_t>(list.size());
+    if (samplesPerSpp_ == kEdgeSamplesAuto) samplesPerSpp_ = autoEdgeSamples(count_, mask_.size());
     if (count_ > 0) {
         list_ = vk::Buffer(ctx_, list.size() * sizeof(std::uint32_t), "edge list");
         list_.uploadVector(list);

@@ -26,8 +26,9 @@ class CommandStream;
 
 class EdgePass {
 public:
-    // samplesPerSpp in [0, kMaxEdgeSamples]; 0 without maskNeeded disables the pass (no
-    // pipeline, no pixels). maskNeeded: probe for mask() even without extra samples (G-PT's
+    // samplesPerSpp in [0, kMaxEdgeSamples], or kEdgeSamplesAuto: find() sets the factor from
+    // the edge pixels' share (autoEdgeSamples, edge_options.h). 0 without maskNeeded disables
+    // the pass (no pipeline, no pixels). maskNeeded: probe for mask() even without extra samples (G-PT's
     // first-hit demodulation keeps away from the edges).
     EdgePass(const vk::Context& ctx, const SceneSpec& spec, WorkgroupSize wg, std::uint32_t samplesPerSpp,
              vk::PipelineCreation creation, bool maskNeeded = false);
@@ -36,6 +37,7 @@ public:
     double waitForPipeline() const { return kernel_ ? kernel_->wait() : 0.0; }
 
     [[nodiscard]] bool enabled() const { return samplesPerSpp_ > 0 || maskNeeded_; }
+    // The factor (with kEdgeSamplesAuto: kEdgeSamplesAuto until find() has chosen it).
     [[nodiscard]] std::uint32_t samplesPerSpp() const { return samplesPerSpp_; }
     // Adds the list binding (kBindGptEdgeList) to a kernel's descriptor.
     static void configure(vk::KernelDesc& desc);

@@ -41,7 +41,7 @@ struct GptPassOptions {
     std::uint32_t emitterSupersampling = kDefaultEmitterSupersampling;
     // Extra camera samples per camera sample in the pixels a geometric edge crosses
     // (edge_pass.h; 0 = off).
-    std::uint32_t edgeSamples = kDefaultEdgeSamples;
+    std::uint32_t edgeSamples = kEdgeSamplesAuto;
     // First-hit texture demodulation (gpt.comp, kSpecGptDemodulate) in the pixels that
     // demodulationMask keeps (away from the edge probe's edges and from neighbours whose probe
     // saw another surface); GptImages::modulation then holds m̄ and primal/dx/dy are of

@@ -175,6 +175,29 @@ TEST_F(EdgeSamples, EdgePixelsGetTheirExtraSamplesAndOnlyThey) {
     EXPECT_EQ(wrong, 0);
 }
 
+// With kEdgeSamplesAuto the probe's count sets the factor by the rule (edge_options.h), and
+// the edge pixels get that many extra samples (the square's 132 outline pixels of kSize²:
+// 3.2 %, factor 4; gdpt render's JSON test has a share that lowers it).
+TEST_F(EdgeSamples, TheAutomaticFactorFollowsTheEdgePixelsShare) {
+    StepPass step(ctx(), kEdgeSamplesAuto);
+    GptPass& pass = step.pass;
+    ASSERT_EQ(pass.edges().count(), 132u);
+    const std::uint32_t k = autoEdgeSamples(132, std::uint64_t{kSize} * kSize);
+    EXPECT_EQ(pass.edges().samplesPerSpp(), k);
+    ASSERT_GT(k, 0u) << "the test needs a factor that adds samples";
+    pass.record(step.stream.begin(), 0, 2, 7, nullptr);
+    step.stream.submitAndWait();
+    const auto stats = pass.downloadStats();
+    const auto outline = squareOutline();
+    int wrong = 0;
+    for (int y = 0; y < kSize; ++y)
+        for (int x = 0; x < kSize; ++x) {
+            const std::uint32_t expected = outline.count({x, y}) ? 2u * (1u + k) : 2u;
+            if (stats[0][std::size_t(y) * kSize + x].count != expected) ++wrong;
+        }
+    EXPECT_EQ(wrong, 0);
+}
+
 TEST_F(EdgeSamples, OffMeansNoProbeAndNoExtraSamples) {
     StepPass step(ctx(), 0);
     GptPass& pass = step.pass;

@@ -1,0 +1,32 @@
+// edge_samples_option.h — `--edge-samples auto|K` of `gdpt render` and `gdpt converge`
+// (render/passes/edge_options.h holds the rule).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "render/passes/edge_options.h"
+#include "util/error.h"
+
+namespace gdpt {
+
+inline constexpr const char* kEdgeSamplesHelp =
+    "G-PT: extra camera samples per camera sample in the pixels a geometric edge crosses: auto "
+    "(4, fewer where edge pixels are more than 3.75 % of the image: floor(0.15 / their share), "
+    "so that they add at most about 15 % to a sample pass), or 0 to 64 (0 = off)";
+
+// Accepts what parseEdgeSamples accepts.
+inline CLI::Validator edgeSamplesValidator() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            try {
+                (void)parseEdgeSamples(text, "value");
+            } catch (const Error&) {
+                return "'" + text + "' is not auto or a whole number from 0 to " + std::to_string(kMaxEdgeSamples);
+            }
+            return {};
+        },
+        "auto|0..64");
+}
+
+}  // namespace gdpt
