@@ -22,7 +22,8 @@ inline CLI::Validator edgeSamplesValidator() {
             try {
                 (void)parseEdgeSamples(text, "value");
             } catch (const Error&) {
-                return "'" + text + "' is not auto or a whole number from 0 to " + std::to_string(kMaxEdgeSamples);
+                return "'" + text + "' is not auto or a whole number from 0 to " +
+                       std::to_string(kMaxEdgeSamples);
             }
             return {};
         },

@@ -26,6 +26,7 @@ struct PipelineJob {
     // Or, when the kernel is specialised first (spirv_specialise.h), its SPIR-V, from which
     // the job makes a module of its own (destroyed once the pipeline exists), and the cache.
     std::vector<std::uint32_t> spirv;
+    std::vector<std::uint32_t> kept;  // KernelDesc::driverSpecConstants
     std::filesystem::path cacheDirectory;
     VkPipelineLayout layout = VK_NULL_HANDLE;
     std::vector<VkSpecializationMapEntry> entries;
@@ -40,7 +41,8 @@ Handle<VkShaderModule> specialisedModule(const PipelineJob& job) {
         constants.emplace_back(job.entries[i].constantID, job.values[i]);
     std::vector<std::uint32_t> words;
     try {
-        words = specialiseCached(job.spirv.data(), job.spirv.size(), constants, job.cacheDirectory).words;
+        words = specialiseCached(job.spirv.data(), job.spirv.size(), constants, job.cacheDirectory, job.kept)
+                    .words;
     } catch (const Error& e) {
         throw e.withContext("creating pipeline '" + job.name + "'");
     }
@@ -165,6 +167,7 @@ PipelineJob pipelineJob(const Context& ctx, const KernelDesc& desc, VkShaderModu
     if (module == VK_NULL_HANDLE) {
         const auto [words, count] = chosenSpirv(ctx, desc);
         job.spirv.assign(words, words + count);
+        job.kept = desc.driverSpecConstants;
         job.cacheDirectory = cacheDirectory();
     }
     job.layout = layout;

@@ -43,6 +43,9 @@ struct KernelDesc {
     std::vector<std::pair<std::uint32_t, VkFormat>> texelBindings;
     std::uint32_t pushConstantBytes = 0;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> specConstants;  // (id, 32-bit value)
+    // Ids of specConstants that stay specialisation constants when gdpt folds the others into
+    // the SPIR-V (spirv_specialise.h): the driver specialises these itself.
+    std::vector<std::uint32_t> driverSpecConstants;
     std::uint32_t localSizeX = 1;  // workgroup size, for dispatch-by-items helpers
     std::uint32_t localSizeY = 1;
 };

@@ -20,11 +20,12 @@
 namespace gdpt::vk {
 namespace {
 
-// The passes, in order: set and freeze the constants, fold the expressions of constants
-// (OpSpecConstantOp) and merge equal constants, then drop the branches whose conditions became
-// constant, the blocks and code left dead, and the functions no longer called. A change here
-// changes kPassesTag, which is part of every cache key.
-constexpr const char* kPassesTag = "set,freeze,fold,unify,dead-branches,merge-blocks,adce,dead-functions;v1";
+// After the constants are frozen (freezeConstants), the passes fold the expressions of
+// constants (OpSpecConstantOp) and merge equal constants, then drop the branches whose
+// conditions became constant, the blocks and code left dead, and the functions no longer
+// called. A change here or in freezeConstants changes kPassesTag, part of every cache key.
+constexpr const char* kPassesTag =
+    "freeze-except,fold,unify,dead-branches,merge-blocks,adce,dead-functions;v2";
 
 std::uint64_t fnv1a(std::uint64_t h, const void* data, std::size_t bytes) {
     const auto* p = static_cast<const unsigned char*>(data);
@@ -39,7 +40,8 @@ std::atomic<std::uint64_t> gFromCache{0}, gByOptimizer{0};
 
 constexpr std::uint64_t kFnvOffset = 0xcbf29ce484222325ull;
 
-std::uint64_t cacheKey(const std::uint32_t* words, std::size_t count, const SpecConstants& constants) {
+std::uint64_t cacheKey(const std::uint32_t* words, std::size_t count, const SpecConstants& constants,
+                       const std::vector<std::uint32_t>& kept) {
     std::uint64_t h = fnv1a(kFnvOffset, kPassesTag, std::strlen(kPassesTag));
     const char* tools = spvSoftwareVersionDetailsString();
     h = fnv1a(h, tools, std::strlen(tools));
@@ -50,6 +52,9 @@ std::uint64_t cacheKey(const std::uint32_t* words, std::size_t count, const Spec
         const std::uint32_t pair[2] = {id, value};
         h = fnv1a(h, pair, sizeof pair);
     }
+    const std::uint64_t k = kept.size();
+    h = fnv1a(h, &k, sizeof k);
+    if (!kept.empty()) h = fnv1a(h, kept.data(), kept.size() * sizeof(std::uint32_t));
     return h;
 }
 
@@ -131,21 +136,91 @@ void writeCached(const std::filesystem::path& path, std::uint64_t key,
     }
 }
 
+// SPIR-V opcodes and the decoration this file rewrites.
+constexpr std::uint32_t kOpDecorate = 71, kDecorationSpecId = 1;
+constexpr std::uint32_t kOpConstantTrue = 41, kOpConstantFalse = 42, kOpConstant = 43;
+constexpr std::uint32_t kOpSpecConstantTrue = 48, kOpSpecConstantFalse = 49, kOpSpecConstant = 50;
+
+// The module with every specialisation constant but those of `kept` turned into a constant:
+// its value from `constants`, else its default; its SpecId decoration removed. (SPIRV-Tools'
+// freeze pass freezes all of them.)
+std::vector<std::uint32_t> freezeConstants(const std::uint32_t* words, std::size_t count,
+                                           const SpecConstants& constants,
+                                           const std::vector<std::uint32_t>& kept) {
+    if (count < 5 || words[0] != 0x07230203u)
+        throw Error("specialising a kernel's SPIR-V failed: not a SPIR-V module");
+    // An instruction's word count, checked against the module's end.
+    const auto length = [&](std::size_t i) {
+        const std::uint32_t n = words[i] >> 16;
+        if (n == 0 || i + n > count)
+            throw Error("specialising a kernel's SPIR-V failed: a truncated instruction at word " +
+                        std::to_string(i));
+        return n;
+    };
+    std::unordered_map<std::uint32_t, std::uint32_t> specIdOf;  // result id -> SpecId
+    for (std::size_t i = 5; i < count; i += length(i))
+        if ((words[i] & 0xFFFFu) == kOpDecorate && (words[i] >> 16) >= 4 && words[i + 2] == kDecorationSpecId)
+            specIdOf[words[i + 1]] = words[i + 3];
+    // The SpecId of a result id that is to be frozen, if it is one.
+    const auto frozenSpecId = [&](std::uint32_t result) -> const std::uint32_t* {
+        const auto it = specIdOf.find(result);
+        if (it == specIdOf.end() || std::find(kept.begin(), kept.end(), it->second) != kept.end())
+            return nullptr;
+        return &it->second;
+    };
+    const auto givenValue = [&](std::uint32_t specId) -> const std::uint32_t* {
+        for (const auto& c : constants)
+            if (c.first == specId) return &c.second;
+        return nullptr;
+    };
+    std::vector<std::uint32_t> out(words, words + 5);
+    out.reserve(count);
+    for (std::size_t i = 5; i < count;) {
+        const std::uint32_t n = length(i), op = words[i] & 0xFFFFu;
+        if (op == kOpDecorate && n >= 4 && words[i + 2] == kDecorationSpecId && frozenSpecId(words[i + 1])) {
+            i += n;  // a constant has no SpecId
+            continue;
+        }
+        const std::uint32_t* spec =
+            (op == kOpSpecConstantTrue || op == kOpSpecConstantFalse || op == kOpSpecConstant) && n >= 3
+                ? frozenSpecId(words[i + 2])
+                : nullptr;
+        if (spec) {
+            const std::uint32_t* given = givenValue(*spec);
+            if (op == kOpSpecConstant) {
+                if (given && n != 4)
+                    throw Error("specialising a kernel's SPIR-V failed: constant " + std::to_string(*spec) +
+                                " is not 32 bits wide");
+                out.push_back((n << 16) | kOpConstant);
+                out.insert(out.end(), words + i + 1, words + i + n);
+                if (given) out.back() = *given;
+            } else {
+                const bool value = given ? *given != 0 : op == kOpSpecConstantTrue;
+                out.push_back((3u << 16) | (value ? kOpConstantTrue : kOpConstantFalse));
+                out.push_back(words[i + 1]);
+                out.push_back(words[i + 2]);
+            }
+        } else {
+            out.insert(out.end(), words + i, words + i + n);
+        }
+        i += n;
+    }
+    return out;
+}
+
 }  // namespace
 
 std::vector<std::uint32_t> specialiseSpirv(const std::uint32_t* words, std::size_t count,
-                                           const SpecConstants& constants) {
+                                           const SpecConstants& constants,
+                                           const std::vector<std::uint32_t>& kept) {
+    const std::vector<std::uint32_t> frozen = freezeConstants(words, count, constants, kept);
     spvtools::Optimizer optimizer(SPV_ENV_VULKAN_1_2);
     std::string messages;
     optimizer.SetMessageConsumer(
         [&messages](spv_message_level_t level, const char*, const spv_position_t&, const char* message) {
             if (level <= SPV_MSG_ERROR) messages += std::string("\n  ") + message;
         });
-    std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> values;
-    for (const auto& [id, value] : constants) values[id] = {value};
-    optimizer.RegisterPass(spvtools::CreateSetSpecConstantDefaultValuePass(values))
-        .RegisterPass(spvtools::CreateFreezeSpecConstantValuePass())
-        .RegisterPass(spvtools::CreateFoldSpecConstantOpAndCompositePass())
+    optimizer.RegisterPass(spvtools::CreateFoldSpecConstantOpAndCompositePass())
         .RegisterPass(spvtools::CreateUnifyConstantPass())
         .RegisterPass(spvtools::CreateDeadBranchElimPass())
         .RegisterPass(spvtools::CreateBlockMergePass())
@@ -157,7 +232,7 @@ std::vector<std::uint32_t> specialiseSpirv(const std::uint32_t* words, std::size
     spvtools::OptimizerOptions options;
     options.set_run_validator(false);
     std::vector<std::uint32_t> out;
-    if (!optimizer.Run(words, count, &out, options))
+    if (!optimizer.Run(frozen.data(), frozen.size(), &out, options))
         throw Error("specialising a kernel's SPIR-V failed:" +
                     (messages.empty() ? std::string(" (no message)") : messages));
     return out;
@@ -165,19 +240,21 @@ std::vector<std::uint32_t> specialiseSpirv(const std::uint32_t* words, std::size
 
 std::filesystem::path specialisedCachePath(const std::uint32_t* words, std::size_t count,
                                            const SpecConstants& constants,
-                                           const std::filesystem::path& directory) {
-    return cachePath(directory, cacheKey(words, count, constants));
+                                           const std::filesystem::path& directory,
+                                           const std::vector<std::uint32_t>& kept) {
+    return cachePath(directory, cacheKey(words, count, constants, kept));
 }
 
 SpecialisedSpirv specialiseCached(const std::uint32_t* words, std::size_t count,
-                                  const SpecConstants& constants, const std::filesystem::path& directory) {
+                                  const SpecConstants& constants, const std::filesystem::path& directory,
+                                  const std::vector<std::uint32_t>& kept) {
     SpecialisedSpirv result;
     if (directory.empty()) {
-        result.words = specialiseSpirv(words, count, constants);
+        result.words = specialiseSpirv(words, count, constants, kept);
         ++gByOptimizer;
         return result;
     }
-    const std::uint64_t key = cacheKey(words, count, constants);
+    const std::uint64_t key = cacheKey(words, count, constants, kept);
     const std::filesystem::path path = cachePath(directory, key);
     result.words = readCached(path, key);
     if (!result.words.empty()) {
@@ -187,7 +264,7 @@ SpecialisedSpirv specialiseCached(const std::uint32_t* words, std::size_t count,
         ++gFromCache;
         return result;
     }
-    result.words = specialiseSpirv(words, count, constants);
+    result.words = specialiseSpirv(words, count, constants, kept);
     ++gByOptimizer;
     writeCached(path, key, result.words);
     return result;
@@ -198,7 +275,7 @@ SpecialiseCounts specialiseCounts() {
 }
 
 bool useSpecialisedSpirv(const DeviceInfo& device) {
-    return envChoice("GDPT_SPECIALISE", "off", "on", device.isCpu && !device.lavapipeBeforeMesa23);
+    return envChoice("GDPT_SPECIALISE", "off", "on", device.isCpu);
 }
 
 }  // namespace gdpt::vk

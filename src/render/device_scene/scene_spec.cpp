@@ -111,6 +111,10 @@ vk::KernelDesc SceneSpec::kernelDesc(const TracingKernel& kernel, const vk::Devi
     base.specConstants = specConstants();
     base.specConstants.push_back({gpu::kSpecWorkgroupX, wg.x});
     base.specConstants.push_back({gpu::kSpecWorkgroupY, wg.y});
+    // Folded before lavapipe 22.3, the register-stack constant's branches inside the traversal
+    // loop (bvh_traverse.glsl) change the loop's shape, and 22.3 runs it slower (bench/RESULTS.md,
+    // "Kernels specialised before the driver"): the driver specialises it.
+    base.driverSpecConstants = {gpu::kSpecBvhRegisterStack};
     base.localSizeX = wg.x;
     base.localSizeY = wg.y;
     return base;

@@ -99,6 +99,12 @@ TEST_F(SpirvSpecialise, ConstantsAndTheCodeTheySwitchOffAreGone) {
     EXPECT_LT(a.size() * 10, words.size() * 9) << "less than a tenth removed with four features off";
     // Deterministic.
     EXPECT_EQ(vk::specialiseSpirv(words.data(), words.size(), off), a);
+    // A constant left to the driver stays a specialisation constant (with its id), the rest
+    // are frozen as before.
+    const std::vector<std::uint32_t> kept =
+        vk::specialiseSpirv(words.data(), words.size(), off, {gpu::kSpecBvhRegisterStack});
+    EXPECT_EQ(specIds(kept), std::vector<std::uint32_t>{gpu::kSpecBvhRegisterStack});
+    EXPECT_GT(kept.size(), a.size()) << "its branches are not folded";
 }
 
 TEST_F(SpirvSpecialise, BadInputIsAnErrorNotACrash) {
@@ -120,6 +126,8 @@ TEST_F(SpirvSpecialise, TheCacheReturnsWhatTheOptimizerMade) {
     const vk::SpecialisedSpirv second = vk::specialiseCached(words.data(), words.size(), constants, dir);
     EXPECT_EQ(second.source, vk::SpecialiseSource::Cache);
     EXPECT_EQ(second.words, first.words);
+    // Another constant left to the driver is another file too.
+    EXPECT_NE(vk::specialisedCachePath(words.data(), words.size(), constants, dir, {gpu::kSpecHasEnv}), file);
     // Other values are another file.
     const vk::SpecConstants other = {{gpu::kSpecHasTextures, 0u}, {gpu::kSpecMaxDepth, 10u}};
     EXPECT_NE(vk::specialisedCachePath(words.data(), words.size(), other, dir), file);
@@ -204,7 +212,7 @@ TEST_F(SpirvSpecialise, AnUnwritableCacheOnlyCostsTime) {
     EXPECT_EQ(vk::specialiseCached(words.data(), words.size(), constants, fs::path()).words, expected);
 }
 
-TEST(SpirvSpecialiseChoice, LavapipeFromMesa23ByDefaultAndTheEnvironmentOverrides) {
+TEST(SpirvSpecialiseChoice, CpuDevicesByDefaultAndTheEnvironmentOverrides) {
     vk::DeviceInfo cpu;
     cpu.isCpu = true;
     vk::DeviceInfo mesa22 = cpu;
@@ -212,7 +220,7 @@ TEST(SpirvSpecialiseChoice, LavapipeFromMesa23ByDefaultAndTheEnvironmentOverride
     vk::DeviceInfo gpu;
     ::unsetenv("GDPT_SPECIALISE");
     EXPECT_TRUE(vk::useSpecialisedSpirv(cpu));
-    EXPECT_FALSE(vk::useSpecialisedSpirv(mesa22));
+    EXPECT_TRUE(vk::useSpecialisedSpirv(mesa22));
     EXPECT_FALSE(vk::useSpecialisedSpirv(gpu));
     {
         ScopedEnv e("GDPT_SPECIALISE", "on");
@@ -222,6 +230,7 @@ TEST(SpirvSpecialiseChoice, LavapipeFromMesa23ByDefaultAndTheEnvironmentOverride
     {
         ScopedEnv e("GDPT_SPECIALISE", "off");
         EXPECT_FALSE(vk::useSpecialisedSpirv(cpu));
+        EXPECT_FALSE(vk::useSpecialisedSpirv(mesa22));
     }
     {
         ScopedEnv e("GDPT_SPECIALISE", "yes");
