@@ -4,39 +4,9 @@
 #include <vector>
 
 #include "integrator/integrator.h"
+#include "util/fnv1a.h"
 
 namespace gdpt {
-namespace {
-
-class Fnv1a {
-public:
-    void bytes(const void* data, std::size_t n) {
-        const auto* p = static_cast<const unsigned char*>(data);
-        for (std::size_t i = 0; i < n; ++i) hash_ = (hash_ ^ p[i]) * 1099511628211ull;
-    }
-    template <typename T>
-    void vector(const std::vector<T>& v) {
-        const std::uint64_t n = v.size();
-        bytes(&n, sizeof n);  // so that moving an element between arrays changes the hash
-        if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
-    }
-    template <typename T>
-    void value(const T& v) {
-        bytes(&v, sizeof v);
-    }
-    [[nodiscard]] std::uint64_t hash() const { return hash_; }
-
-private:
-    std::uint64_t hash_ = 1469598103934665603ull;
-};
-
-std::string hex(std::uint64_t v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
-    return buf;
-}
-
-}  // namespace
 
 std::string exactFloat(float v) {
     char buf[32];

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <spirv-tools/optimizer.hpp>
@@ -14,6 +13,7 @@
 
 #include "util/env_choice.h"
 #include "util/error.h"
+#include "util/fnv1a.h"
 #include "util/output_files.h"
 #include "vk/context.h"
 
@@ -27,35 +27,28 @@ namespace {
 constexpr const char* kPassesTag =
     "freeze-except,fold,unify,dead-branches,merge-blocks,adce,dead-functions;v2";
 
-std::uint64_t fnv1a(std::uint64_t h, const void* data, std::size_t bytes) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < bytes; ++i) {
-        h ^= p[i];
-        h *= 0x100000001b3ull;
-    }
-    return h;
-}
-
 std::atomic<std::uint64_t> gFromCache{0}, gByOptimizer{0};
-
-constexpr std::uint64_t kFnvOffset = 0xcbf29ce484222325ull;
 
 std::uint64_t cacheKey(const std::uint32_t* words, std::size_t count, const SpecConstants& constants,
                        const std::vector<std::uint32_t>& kept) {
-    std::uint64_t h = fnv1a(kFnvOffset, kPassesTag, std::strlen(kPassesTag));
-    const char* tools = spvSoftwareVersionDetailsString();
-    h = fnv1a(h, tools, std::strlen(tools));
-    const std::uint64_t n = count;
-    h = fnv1a(h, &n, sizeof n);
-    h = fnv1a(h, words, count * sizeof(std::uint32_t));
+    Fnv1a h;
+    h.text(kPassesTag);
+    h.text(spvSoftwareVersionDetailsString());
+    h.value(std::uint64_t{count});  // as Fnv1a::vector, without copying the words
+    h.bytes(words, count * sizeof(std::uint32_t));
     for (const auto& [id, value] : constants) {
-        const std::uint32_t pair[2] = {id, value};
-        h = fnv1a(h, pair, sizeof pair);
+        h.value(id);
+        h.value(value);
     }
-    const std::uint64_t k = kept.size();
-    h = fnv1a(h, &k, sizeof k);
-    if (!kept.empty()) h = fnv1a(h, kept.data(), kept.size() * sizeof(std::uint32_t));
-    return h;
+    h.vector(kept);
+    return h.hash();
+}
+
+// The checksum of a cached module's words.
+std::uint64_t checksum(const std::vector<std::uint32_t>& words) {
+    Fnv1a h;
+    h.bytes(words.data(), words.size() * sizeof(std::uint32_t));
+    return h.hash();
 }
 
 // A cache file: this header, then the specialised module's words.
@@ -64,18 +57,11 @@ struct CacheHeader {
     std::uint32_t version = 1u;
     std::uint64_t key = 0;       // cacheKey of the input (also the file's name)
     std::uint64_t words = 0;     // the module's length in words
-    std::uint64_t checksum = 0;  // fnv1a of the module's words
+    std::uint64_t checksum = 0;  // checksum() of the module's words
 };
 
-std::string hex64(std::uint64_t v) {
-    static const char* digits = "0123456789abcdef";
-    std::string s(16, '0');
-    for (int i = 15; i >= 0; --i, v >>= 4) s[static_cast<std::size_t>(i)] = digits[v & 15u];
-    return s;
-}
-
 std::filesystem::path cachePath(const std::filesystem::path& directory, std::uint64_t key) {
-    return directory / "spirv" / (hex64(key) + ".spv");
+    return directory / "spirv" / (hex(key) + ".spv");
 }
 
 // The cached module, or nothing if the file is missing, short, or not what the key names.
@@ -93,7 +79,7 @@ std::vector<std::uint32_t> readCached(const std::filesystem::path& path, std::ui
                  static_cast<std::streamsize>(words.size() * sizeof(std::uint32_t))))
         return {};
     if (in.peek() != std::ifstream::traits_type::eof()) return {};  // trailing bytes
-    if (fnv1a(kFnvOffset, words.data(), words.size() * sizeof(std::uint32_t)) != h.checksum) return {};
+    if (checksum(words) != h.checksum) return {};
     if (words[0] != 0x07230203u) return {};  // SPIR-V's magic number
     return words;
 }
@@ -124,7 +110,7 @@ void writeCached(const std::filesystem::path& path, std::uint64_t key,
         CacheHeader h;
         h.key = key;
         h.words = words.size();
-        h.checksum = fnv1a(kFnvOffset, words.data(), words.size() * sizeof(std::uint32_t));
+        h.checksum = checksum(words);
         std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
         bytes.append(reinterpret_cast<const char*>(words.data()), words.size() * sizeof(std::uint32_t));
         StagedFile file(path.string());
