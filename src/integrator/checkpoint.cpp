@@ -224,7 +224,7 @@ Checkpoint readCheckpoint(const std::string& path) {
                     throw Error(path + where + pixelName(i, width) + " has sample count " + countText(got) +
                                 ", expected 0 or " + countText(spp) + " (gdpt.spp)");
             } else if (k == 0) {
-                if (edgeFactorOpen && got != spp && spp > 0 && got > spp && std::fmod(got, spp) == 0.0 &&
+                if (edgeFactorOpen && spp > 0 && got > spp && std::fmod(got, spp) == 0.0 &&
                     got / spp - 1.0 <= kAutoEdgeSamplesMax) {
                     edgeCount = got;
                     edgeFactorOpen = false;

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <atomic>
 #include <fstream>
-#include <iterator>
 #include <spirv-tools/optimizer.hpp>
 #include <string>
 #include <system_error>

@@ -28,8 +28,8 @@ class EdgePass {
 public:
     // samplesPerSpp in [0, kMaxEdgeSamples], or kEdgeSamplesAuto: find() sets the factor from
     // the edge pixels' share (autoEdgeSamples, edge_options.h). 0 without maskNeeded disables
-    // the pass (no pipeline, no pixels). maskNeeded: probe for mask() even without extra samples (G-PT's
-    // first-hit demodulation keeps away from the edges).
+    // the pass (no pipeline, no pixels). maskNeeded: probe for mask() even without extra
+    // samples (G-PT's first-hit demodulation keeps away from the edges).
     EdgePass(const vk::Context& ctx, const SceneSpec& spec, WorkgroupSize wg, std::uint32_t samplesPerSpp,
              vk::PipelineCreation creation, bool maskNeeded = false);
     void attach(const SceneGpu& scene);

@@ -40,7 +40,7 @@ struct GptPassOptions {
     // Rays per camera sample of emitter supersampling (emitter_supersampling_pass.h; 0 = off).
     std::uint32_t emitterSupersampling = kDefaultEmitterSupersampling;
     // Extra camera samples per camera sample in the pixels a geometric edge crosses
-    // (edge_pass.h; 0 = off).
+    // (edge_pass.h; 0 = off, kEdgeSamplesAuto = the rule of edge_options.h).
     std::uint32_t edgeSamples = kEdgeSamplesAuto;
     // First-hit texture demodulation (gpt.comp, kSpecGptDemodulate) in the pixels that
     // demodulationMask keeps (away from the edge probe's edges and from neighbours whose probe
