@@ -8,10 +8,10 @@
 # the defaults on 2 cores).
 #
 #   scripts/converge-set.sh [-o OUT] [--times 4,8,16,32] [--repeats 3] [--reference-spp 4096]
-#                           [--methods pt,gpt-l1,gpt-l2,gpt-wl2] [--size 256] [--scenes a,b,...]
+#                           [--methods pt,gpt-wl1,gpt-l1,gpt-l2] [--size 256] [--scenes a,b,...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-out=converge-set times=4,8,16,32 repeats=3 refspp=4096 methods=pt,gpt-l1,gpt-l2,gpt-wl2 size=256
+out=converge-set times=4,8,16,32 repeats=3 refspp=4096 methods=pt,gpt-wl1,gpt-l1,gpt-l2 size=256
 scenes=cbox,cornell_box,glossy_cornell,small_light,indirect_gap,textured,furnace,open_scene
 while (($#)); do
   case "$1" in

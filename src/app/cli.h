@@ -38,7 +38,7 @@ struct RenderArgs {
         kDefaultEmitterSupersampling;  // render/passes/emitter_supersampling_pass.h
     std::string edgeSamples = "auto";  // G-PT: "auto" or 0-64 (render/passes/edge_options.h)
     std::string demodulate = "auto";   // G-PT: auto, on, off (Demodulation, render/passes/gpt_pass.h)
-    std::string recon = "l1";
+    std::string recon = "auto";        // the final image's reconstruction; auto: resolvedRecon
     double alpha = 0.2;
     double tolerance = 1e-4;
     int debiasCells = kDefaultDebiasCells;  // poisson/debias.h

@@ -446,8 +446,9 @@ Subcommand addConvergeCommand(CLI::App& app) {
         ->check(InputFile);
     c->add_option("--make-reference", a->makeReference,
                   "Render a PT reference with this many spp (cached by scene hash)");
-    c->add_option("--methods", a->methods,
-                  "Methods: pt, gpt (= gpt-l1), gpt-l1, gpt-l2, gpt-wl2, gpt-wl1, pssmlt, gmlt")
+    c->add_option(
+         "--methods", a->methods,
+         "Methods: pt, gpt (= gpt-wl1, the render default), gpt-l1, gpt-l2, gpt-wl2, gpt-wl1, pssmlt, gmlt")
         ->capture_default_str();
     c->add_option("--times", a->times, "Time budgets in seconds (comma-separated)")->capture_default_str();
     c->add_option("--repeats", a->repeats, "Independent repeats per budget (median reported)")

@@ -362,7 +362,9 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
     return validationExitStatus(ctx);
 }
 
-int runRender(const RenderArgs& args) {
+int runRender(const RenderArgs& given) {
+    RenderArgs args = given;
+    args.recon = resolvedRecon(args.method, args.recon);  // as the render's settings record it
     if (!args.frames.empty()) return runSequence(args);
     return runRender(args, nullptr);
 }
@@ -437,12 +439,13 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->group(sampling);
 
     const char* gpt = "G-PT";
-    r->add_option("--recon", a.recon,
-                  "Reconstruction of the final image: l1, l2, wl2 or wl1 (docs/reconstruction.md; for tgpt "
-                  "the space-time solve's, its wl* weighting dt by the paired samples' variance: "
-                  "docs/animation.md)")
+    r->add_option(
+         "--recon", a.recon,
+         "Reconstruction of the final image: auto (wl1 for gpt, l1 for gmlt and tgpt), l1, l2, wl2 or "
+         "wl1 (docs/reconstruction.md; for tgpt the space-time solve's, its wl* weighting dt by the "
+         "paired samples' variance: docs/animation.md)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"l1", "l2", "wl2", "wl1"}))
+        ->check(CLI::IsMember({"auto", "l1", "l2", "wl2", "wl1"}))
         ->group(gpt);
     r->add_flag("--all-recon", a.allRecon, "Also write the other reconstructions as layers recon_*")
         ->group(gpt);

@@ -240,6 +240,11 @@ int validationExitStatus(const vk::Context& ctx) {
     return 1;
 }
 
+std::string resolvedRecon(const std::string& method, const std::string& recon) {
+    if (recon != "auto") return recon;
+    return method == "gpt" ? toString(GptOptions{}.reconstructions.front()) : "l1";
+}
+
 // Usage errors that the option checks alone cannot see (exit 2 before any work).
 void checkArgs(const RenderArgs& args) {
     const bool l1 = args.recon == "l1" || args.recon == "wl1" || args.allRecon;

@@ -58,5 +58,9 @@ int validationExitStatus(const vk::Context& ctx);
 // Usage errors that the option checks alone cannot see (throws gdpt::UsageError, exit 2,
 // before any work).
 void checkArgs(const RenderArgs& args);
+// --recon auto: the method's default reconstruction, wl1 for gpt (GptOptions), l1 for gmlt
+// (its chains give no per-pixel variances) and tgpt (its space-time solve's default); any
+// other value as it is.
+std::string resolvedRecon(const std::string& method, const std::string& recon);
 
 }  // namespace gdpt

@@ -37,6 +37,7 @@ struct SolveArgs {
     double irlsRegIter = SolveOptions{}.irlsRegIter;
     double irlsInnerTolerance = 0.0;  // 0: the solver's default
     int debiasCells = kDefaultDebiasCells;
+    double weightContrast = kDefaultVarianceWeightContrast;
     std::string primal, dx, dy;
     std::string device;
     bool quiet = false;
@@ -120,6 +121,7 @@ int runSolve(const SolveArgs& a) {
     o.irlsIterations = a.irlsIterations;
     o.irlsRegInit = a.irlsRegInit;
     o.irlsRegIter = a.irlsRegIter;
+    o.varianceWeightContrast = a.weightContrast;
     if (a.irlsInnerTolerance > 0.0) o.irlsInnerTolerance = a.irlsInnerTolerance;
 
     std::vector<NamedLayer> layers;
@@ -246,6 +248,9 @@ Subcommand addSolveCommand(CLI::App& app) {
         ->capture_default_str();
     sub->add_option("--debias-cells", a->debiasCells, kDebiasCellsHelp)
         ->check(CLI::Range(0, kMaxDebiasCells))
+        ->capture_default_str();
+    sub->add_option("--weight-contrast", a->weightContrast, kVarianceWeightContrastHelp)
+        ->check(CLI::Range(1.0, 1e12) | CLI::IsMember({0.0}))
         ->capture_default_str();
     sub->add_option("--solver", a->solver, kSolverHelp)
         ->check(CLI::IsMember(std::vector<std::string>(std::begin(kSolverChoices), std::end(kSolverChoices))))

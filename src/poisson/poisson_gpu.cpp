@@ -103,6 +103,21 @@ double inverseFilteredVariance(float filtered, double eps) {
     return filtered < 0.0f ? 0.0 : 1.0 / (double(filtered) + eps);
 }
 
+void boundWeightContrast(std::vector<float>& weights, double contrast) {
+    if (!(contrast >= 1.0)) return;
+    std::vector<float> positive;
+    positive.reserve(weights.size());
+    for (float w : weights)
+        if (w > 0.0f) positive.push_back(w);
+    if (positive.empty()) return;
+    const auto middle = positive.begin() + static_cast<std::ptrdiff_t>(positive.size() / 2);
+    std::nth_element(positive.begin(), middle, positive.end());
+    const double median = *middle;
+    const auto lo = static_cast<float>(median / contrast), hi = static_cast<float>(median * contrast);
+    for (float& w : weights)
+        if (w > 0.0f) w = std::clamp(w, lo, hi);
+}
+
 std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& nonFinite,
                                        std::size_t& negative) {
     const int w = var.width(), h = var.height();
@@ -559,16 +574,27 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
     std::vector<float> weights(3 * n, 1.0f);
     const bool wl2 = o.method == Reconstruction::WeightedL2;
     const bool wl1 = o.method == Reconstruction::WeightedL1;
-    std::vector<float> varP, varX, varY;  // WL1: box-filtered variances (-1 = none valid)
+    // WL1: each row's inverse box-filtered variance (primal, dx, dy planes; 0 where none is
+    // valid, and for the rows past the last column / row, which do not exist), its contrast
+    // bounded.
+    std::vector<float> varianceWeights;
     if (wl1) {
         NonFiniteCounts& nf = report.nonFinite;
-        varP = boxFilteredVariance(*in.varPrimal, o.varianceFilterRadius, nf.variance, nf.negativeVariance);
-        varX = boxFilteredVariance(*in.varDx, o.varianceFilterRadius, nf.variance, nf.negativeVariance);
-        varY = boxFilteredVariance(*in.varDy, o.varianceFilterRadius, nf.variance, nf.negativeVariance);
+        varianceWeights.assign(3 * n, 0.0f);
+        for (std::size_t k = 0; k < 3; ++k) {
+            const Image& var = *(k == 0 ? in.varPrimal : k == 1 ? in.varDx : in.varDy);
+            const std::vector<float> filtered =
+                boxFilteredVariance(var, o.varianceFilterRadius, nf.variance, nf.negativeVariance);
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x) {
+                    if ((k == 1 && x + 1 == w) || (k == 2 && y + 1 == h)) continue;
+                    const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+                    varianceWeights[k * n + i] =
+                        static_cast<float>(inverseFilteredVariance(filtered[i], o.varianceEpsilon));
+                }
+        }
+        boundWeightContrast(varianceWeights, o.varianceWeightContrast);
     }
-    const auto inverseFiltered = [&](const std::vector<float>& v, std::size_t i) {
-        return static_cast<float>(inverseFilteredVariance(v[i], o.varianceEpsilon));
-    };
     const auto inverse = [&](const Image& var, std::size_t i) {
         return static_cast<float>(inverseVariance(var, i, o.varianceEpsilon, report.nonFinite));
     };
@@ -592,9 +618,9 @@ SolveReport PoissonSolverGpu::solve(const PoissonInput& in, const SolveOptions& 
             *wy *= inverse(*in.varDy, i);
         }
         if (wl1) {
-            *wp *= inverseFiltered(varP, i);
-            *wx *= inverseFiltered(varX, i);
-            *wy *= inverseFiltered(varY, i);
+            *wp *= varianceWeights[i];
+            *wx *= varianceWeights[n + i];
+            *wy *= varianceWeights[2 * n + i];
         }
         if (!okP[i]) *wp = 0.0f;
         if (!okX[i]) *wx = 0.0f;

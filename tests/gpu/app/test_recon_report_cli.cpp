@@ -5,10 +5,14 @@
 // "NOT converged" and --json record converged = false; the default tolerance (1e-4) is met
 // on the same render (the test's power check: the flag is not always false). And the
 // debiasing (--debias-cells) is reported: its node spacing and mean change in the JSON and a
-// line, on L1 by default, not with --debias-cells 0 and not on L2; bad values are usage errors.
+// line, on the default WL1, not with --debias-cells 0 and not on L2; bad values are usage
+// errors. `--recon auto` (the default) is each method's own reconstruction: wl1 for gpt, l1 for
+// gmlt (its chains give no per-pixel variances, which wl1 needs), and the render's recorded
+// settings name the resolved one.
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -53,10 +57,34 @@ TEST_F(ReconReportCli, RenderReportsAReconstructionThatDidNotConverge) {
     EXPECT_EQ(r.output.find("NOT converged"), std::string::npos) << r.output;
     ASSERT_TRUE(normal.is_array() && normal.size() == 1u) << normal.dump();
     EXPECT_TRUE(normal[0]["converged"].get<bool>()) << normal.dump();
-    EXPECT_EQ(normal[0]["method"].get<std::string>(), "l1");
+    EXPECT_EQ(normal[0]["method"].get<std::string>(), "wl1");  // G-PT's default (--recon auto)
     // auto: host-pcg on a CPU device, mg-pcg on a GPU.
     const std::string solver = normal[0]["solver"].get<std::string>();
     EXPECT_TRUE(solver == "host-pcg" || solver == "mg-pcg") << solver;
+}
+
+TEST_F(ReconReportCli, TheAutomaticReconstructionIsEachMethodsOwn) {
+    RunResult r;
+    const nlohmann::json gpt = render("", r);
+    ASSERT_EQ(r.code, 0) << r.output;
+    ASSERT_EQ(gpt.size(), 1u) << gpt.dump();
+    EXPECT_EQ(gpt[0]["method"].get<std::string>(), "wl1");
+    const nlohmann::json gmlt = render("--method gmlt", r);
+    ASSERT_EQ(r.code, 0) << r.output;
+    ASSERT_EQ(gmlt.size(), 1u) << gmlt.dump();
+    EXPECT_EQ(gmlt[0]["method"].get<std::string>(), "l1");
+    // Asked for explicitly, wl1 is refused for gmlt (the power of the line above: auto must not
+    // have resolved to it).
+    render("--method gmlt --recon wl1", r);
+    EXPECT_EQ(r.code, 2) << r.output;
+    // A shard's recorded settings (what `gdpt merge` renders the image with) name the resolved
+    // reconstruction.
+    r = runGdpt("render " + kScene + " --width 16 --height 16 --spp 2 --shard 1/2 -o " + path("s.exr"));
+    ASSERT_EQ(r.code, 0) << r.output;
+    std::ifstream exr(path("s.exr"), std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(exr)), std::istreambuf_iterator<char>());
+    EXPECT_NE(bytes.find("\"recon\":\"wl1\""), std::string::npos) << "render_args do not name wl1";
+    EXPECT_EQ(bytes.find("\"recon\":\"auto\""), std::string::npos);
 }
 
 TEST_F(ReconReportCli, RenderReportsTheDebiasing) {

@@ -4,8 +4,9 @@
 //     per block (t = (mean − PT) / sqrt(s²/N + var_PT), N − 1 degrees of freedom, which is
 //     conservative: the PT term only adds degrees of freedom), Šidák-corrected to a family
 //     level of 1e-3 over the blocks of a scene; and the whole image's mean the same way;
-//   - power: the same test on the published L1 reconstruction (--debias-cells 0) of the same
-//     samples must reject, on the scenes where it is biased -- so the test can fail;
+//   - power: the same test on the default reconstruction without its debiasing
+//     (--debias-cells 0) of the same samples must reject, on the scenes where it is biased --
+//     so the test can fail;
 //   - the white furnace (every pixel exactly 1): the image mean of every --recon within its
 //     noise of 1;
 //   - the integrator's final image is the debiased reconstruction + direct, bit for bit.
@@ -96,9 +97,9 @@ protected:
                            bool publishedBiased);
 };
 
-// N seeds of the default G-PT (debiased L1) and of the published L1 (the same samples),
-// against a PT render of `ptSpp`: the default passes the block test, the published one must
-// fail it where `publishedBiased`.
+// N seeds of the default G-PT (its default reconstruction, debiased) and of the same
+// reconstruction undebiased (the same samples), against a PT render of `ptSpp`: the default
+// passes the block test, the undebiased one must fail it where `publishedBiased`.
 void GptBias::checkScene(const char* file, int size, std::uint32_t spp, int seeds, std::uint32_t ptSpp,
                          bool publishedBiased) {
     const vk::Context& ctx = keeping();
@@ -117,29 +118,31 @@ void GptBias::checkScene(const char* file, int size, std::uint32_t spp, int seed
 
     GptOptions published;
     published.debiasCells = 0;
+    const std::string reconLayer = std::string("recon_") + toString(published.reconstructions.front());
     GptIntegrator integrator("gpt", published);
     SeedStats debiased, raw;
     for (int s = 0; s < seeds; ++s) {
         const RenderOutput out =
             integrator.render(ctx, scene, renderOptions(size, size, spp, 1000u + unsigned(s)));
         ASSERT_EQ(out.stats.nanSamples, 0u);
-        Image recon = out.layer("recon_l1");
+        Image recon = out.layer(reconLayer);
         raw.add(withImageMean(blockMeans(out.layer(""), block)));
         debiasImage(recon, out.layer("primal"), kDefaultDebiasCells);
         debiased.add(withImageMean(blockMeans(addImages(recon, out.layer("direct")), block)));
     }
     const double limit = test::twoSidedT(test::sidakAlpha(1e-3, int(expected.size())), seeds - 1);
     const TResult d = tTest(debiased, expected, expectedVar), p = tTest(raw, expected, expectedVar);
-    EXPECT_LE(d.maxT, limit) << file << ": the debiased L1's block " << d.where << " is off by "
-                             << 100.0 * d.relativeBias << " % (t " << d.maxT << ")";
+    EXPECT_LE(d.maxT, limit) << file << ": the debiased " << reconLayer << "'s block " << d.where
+                             << " is off by " << 100.0 * d.relativeBias << " % (t " << d.maxT << ")";
     if (publishedBiased) {
-        EXPECT_GT(p.maxT, limit) << file << ": the test has no power: the published L1's worst block "
-                                 << p.where << " is off by " << 100.0 * p.relativeBias << " %, t " << p.maxT;
+        EXPECT_GT(p.maxT, limit) << file << ": the test has no power: the undebiased " << reconLayer
+                                 << "'s worst block " << p.where << " is off by " << 100.0 * p.relativeBias
+                                 << " %, t " << p.maxT;
     }
     std::printf(
-        "%s: limit %.2f; debiased worst t %.2f (%+.2f %%); published worst t %.2f (%+.2f %%), image mean "
-        "%+.2f %%\n",
-        file, limit, d.maxT, 100.0 * d.relativeBias, p.maxT, 100.0 * p.relativeBias,
+        "%s (%s): limit %.2f; debiased worst t %.2f (%+.2f %%); undebiased worst t %.2f (%+.2f %%), image "
+        "mean %+.2f %%\n",
+        file, reconLayer.c_str(), limit, d.maxT, 100.0 * d.relativeBias, p.maxT, 100.0 * p.relativeBias,
         100.0 * (raw.mean(expected.size() - 1) / expected.back() - 1.0));
 }
 
@@ -197,9 +200,10 @@ TEST_F(GptBias, TheFinalImageIsTheDebiasedReconstructionPlusDirect) {
     o.debiasCells = 0;
     GptIntegrator published("gpt", o);
     const RenderOutput raw = published.render(keeping(), scene, renderOptions(48, 40, 2, 9));
-    Image recon = raw.layer("recon_l1");
+    const std::string layer = std::string("recon_") + toString(o.reconstructions.front());
+    Image recon = raw.layer(layer);
     const DebiasReport r = debiasImage(recon, raw.layer("primal"), kDefaultDebiasCells);
-    test::expectSameBits(out.layer("recon_l1"), recon, "recon_l1");
+    test::expectSameBits(out.layer(layer), recon, layer);
     test::expectSameBits(out.layer(""), addImages(recon, out.layer("direct")), "final");
     EXPECT_NE(r.meanCorrection, 0.0);
     ASSERT_EQ(out.stats.reconstructions.size(), 1u);

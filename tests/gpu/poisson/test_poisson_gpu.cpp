@@ -687,37 +687,90 @@ TEST(BoxFilteredVariance, ZerosAfterAFireflyAverageToZero) {
     for (float v : f) EXPECT_GE(v, 0.0f);
 }
 
-// WL1 is L1 (IRLS) whose rows are weighted by the inverse of the box-filtered variances:
-// the same solve as L1 given those weights explicitly, and not the unweighted L1.
+// boundWeightContrast: the positive weights clamped into [m/K, m·K] around their median m
+// (the upper middle one of an even count), zeros kept, K < 1 (or 0) changing nothing.
+TEST(BoundWeightContrast, ClampsAroundTheMedianOfThePositiveWeights) {
+    // Positive: 0.01, 0.5, 1, 2, 3, 400 (six: the upper middle is 2).
+    const std::vector<float> w = {0.5f, 0.0f, 400.0f, 2.0f, 0.01f, 0.0f, 1.0f, 3.0f};
+    std::vector<float> b = w;
+    boundWeightContrast(b, 4.0);
+    EXPECT_EQ(b, (std::vector<float>{0.5f, 0.0f, 8.0f, 2.0f, 0.5f, 0.0f, 1.0f, 3.0f}));
+    b = w;
+    boundWeightContrast(b, 1.0);  // every positive weight becomes the median
+    EXPECT_EQ(b, (std::vector<float>{2.0f, 0.0f, 2.0f, 2.0f, 2.0f, 0.0f, 2.0f, 2.0f}));
+    for (double none : {0.0, 0.5}) {
+        b = w;
+        boundWeightContrast(b, none);
+        EXPECT_EQ(b, w) << none;
+    }
+    std::vector<float> zeros(5, 0.0f);
+    boundWeightContrast(zeros, 4.0);
+    EXPECT_EQ(zeros, std::vector<float>(5, 0.0f));
+}
+
+// The inverse box-filtered variances of a problem's three row families as WL1 weights them
+// (the rows past the last column / row do not exist: 0), their contrast bounded by K.
+std::vector<float> wl1Weights(const VarianceProblem& p, const SolveOptions& o, double contrast) {
+    const int w = p.primal.width(), h = p.primal.height();
+    const std::size_t n = p.primal.pixelCount();
+    std::vector<float> all(3 * n, 0.0f);
+    const Image* vars[3] = {&p.vp, &p.vx, &p.vy};
+    for (std::size_t k = 0; k < 3; ++k) {
+        std::size_t nonFinite = 0, negative = 0;
+        const std::vector<float> f =
+            boxFilteredVariance(*vars[k], o.varianceFilterRadius, nonFinite, negative);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                if (!((k == 1 && x + 1 == w) || (k == 2 && y + 1 == h))) {
+                    const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+                    all[k * n + i] = static_cast<float>(1.0 / (double(f[i]) + o.varianceEpsilon));
+                }
+    }
+    boundWeightContrast(all, contrast);
+    return all;
+}
+
+// WL1 is L1 (IRLS) whose rows are weighted by the inverse of the box-filtered variances,
+// bounded to SolveOptions::varianceWeightContrast around their median: the same solve as L1
+// given those weights explicitly (bounded by default, raw with the bound off), and not the
+// unweighted L1. The variances here span 200x, so the default bound of 4 changes the weights.
 TEST_F(PoissonGpu, WeightedL1IsL1WithFilteredInverseVarianceWeights) {
     const VarianceProblem p0 = varianceProblem(26, 19, 71, {0.001, 0.1}, {0.01, 2.0});
-    const Image &primal = p0.primal, &dx = p0.dx, &dy = p0.dy, &vp = p0.vp, &vx = p0.vx, &vy = p0.vy;
-    SolveOptions o;
-    o.method = Reconstruction::WeightedL1;
-    o.tolerance = 1e-6;
+    const Image &primal = p0.primal, &dx = p0.dx, &dy = p0.dy;
+    const std::size_t n = primal.pixelCount();
     const PoissonInput vars = p0.variances();
-    Image wl1, explicitWeights, l1;
-    const SolveReport r = solve(primal, dx, dy, o, wl1, &vars);
-    EXPECT_EQ(r.irlsIterations, o.irlsIterations);
-    const auto inverse = [&](const Image& v) {
-        std::size_t nonFinite = 0, negative = 0;
-        std::vector<float> f = boxFilteredVariance(v, o.varianceFilterRadius, nonFinite, negative);
-        for (float& x : f) x = static_cast<float>(1.0 / (double(x) + o.varianceEpsilon));
-        return f;
-    };
-    const std::vector<float> wp = inverse(vp), wx = inverse(vx), wy = inverse(vy);
-    PoissonInput weighted;
-    weighted.weightPrimal = &wp;
-    weighted.weightDx = &wx;
-    weighted.weightDy = &wy;
-    SolveOptions plain = o;
+    Image l1;
+    SolveOptions plain;
     plain.method = Reconstruction::L1;
-    solve(primal, dx, dy, plain, explicitWeights, &weighted);
+    plain.tolerance = 1e-6;
     solve(primal, dx, dy, plain, l1);
-    for (int c = 0; c < 3; ++c) {
-        Field a = channel(wl1, c), b = channel(explicitWeights, c), u = channel(l1, c);
-        EXPECT_LT(relError(a, b), 1e-4) << c;
-        EXPECT_GT(relError(a, u), 1e-3) << c << ": the weights should change the solution";
+    Image bounded;
+    for (double contrast : {kDefaultVarianceWeightContrast, 0.0}) {
+        SolveOptions o = plain;
+        o.method = Reconstruction::WeightedL1;
+        o.varianceWeightContrast = contrast;
+        Image wl1, explicitWeights;
+        const SolveReport r = solve(primal, dx, dy, o, wl1, &vars);
+        EXPECT_EQ(r.irlsIterations, o.irlsIterations);
+        const std::vector<float> all = wl1Weights(p0, o, contrast);
+        const std::vector<float> wp(all.begin(), all.begin() + std::ptrdiff_t(n)),
+            wx(all.begin() + std::ptrdiff_t(n), all.begin() + std::ptrdiff_t(2 * n)),
+            wy(all.begin() + std::ptrdiff_t(2 * n), all.end());
+        PoissonInput weighted;
+        weighted.weightPrimal = &wp;
+        weighted.weightDx = &wx;
+        weighted.weightDy = &wy;
+        solve(primal, dx, dy, plain, explicitWeights, &weighted);
+        for (int c = 0; c < 3; ++c) {
+            Field a = channel(wl1, c), b = channel(explicitWeights, c), u = channel(l1, c);
+            EXPECT_LT(relError(a, b), 1e-4) << "contrast " << contrast << ", channel " << c;
+            EXPECT_GT(relError(a, u), 1e-3) << c << ": the weights should change the solution";
+            if (contrast == 0.0) {
+                EXPECT_GT(relError(a, channel(bounded, c)), 1e-3)
+                    << c << ": the bound should change the solution";
+            }
+        }
+        if (contrast != 0.0) bounded = wl1;
     }
 }
 
