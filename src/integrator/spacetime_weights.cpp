@@ -30,7 +30,7 @@ void appendWeights(Field& to, const std::vector<Image>& images, std::size_t pixe
 }  // namespace
 
 void setVarianceWeights(SpaceTimeProblem& problem, const RowVariances& v, bool filtered, double epsilon,
-                        int radius) {
+                        int radius, double contrast) {
     const std::size_t frames = std::size_t(problem.frames), pixels = problem.pixels();
     const bool mixed = problem.gamma > 0.0, previous = !problem.previous[0].empty();
     const auto count = [&](const std::vector<Image>& images, std::size_t want, const char* what) {
@@ -70,6 +70,11 @@ void setVarianceWeights(SpaceTimeProblem& problem, const RowVariances& v, bool f
         appendWeights(problem.weightDxtPrevious, {v.dxtPrevious}, pixels, filtered, epsilon, radius, "dxt");
         appendWeights(problem.weightDytPrevious, {v.dytPrevious}, pixels, filtered, epsilon, radius, "dyt");
     }
+    if (filtered)
+        boundWeightContrast({&problem.weightPrimal, &problem.weightDx, &problem.weightDy, &problem.weightDt,
+                             &problem.weightDxt, &problem.weightDyt, &problem.weightDtPrevious,
+                             &problem.weightDxtPrevious, &problem.weightDytPrevious},
+                            contrast);
     double sum = 0.0, rows = 0.0;
     for (const Field* f : fields)
         for (double w : *f)

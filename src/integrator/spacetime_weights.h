@@ -4,14 +4,17 @@
 // pixel (var_primal, var_dx, var_dy of each frame; the paired differences' variances of dt, dxt,
 // dyt from the halves' sample groups, sample_groups.h), for wl1 first averaged over a
 // (2r+1)² box (boxFilteredVariance) so that a row's weight is not an estimate from its own
-// samples; 0 where the variance is not finite or negative. The weights are then renormalised
-// to mean 1 over the rows that have one (a common scale, which moves no minimiser).
+// samples, and bounded to `contrast` around the median of all the window's rows
+// (boundWeightContrast: a still scene's dt has variance 0, whose rows would otherwise weigh 10⁸
+// times a firefly's); 0 where the variance is not finite or negative. The weights are then
+// renormalised to mean 1 over the rows that have one (a common scale, which moves no minimiser).
 #pragma once
 
 #include <vector>
 
 #include "image/image.h"
 #include "poisson/poisson_spacetime.h"
+#include "poisson/weight_contrast.h"
 
 namespace gdpt {
 
@@ -28,6 +31,6 @@ struct RowVariances {
 // dyt with γ > 0, dtPrevious with problem.previous, dxtPrevious and dytPrevious with
 // problem.dxtPrevious). Throws gdpt::Error if the counts or sizes disagree.
 void setVarianceWeights(SpaceTimeProblem& problem, const RowVariances& v, bool filtered, double epsilon,
-                        int radius);
+                        int radius, double contrast = kDefaultVarianceWeightContrast);
 
 }  // namespace gdpt

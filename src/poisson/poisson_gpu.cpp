@@ -103,21 +103,6 @@ double inverseFilteredVariance(float filtered, double eps) {
     return filtered < 0.0f ? 0.0 : 1.0 / (double(filtered) + eps);
 }
 
-void boundWeightContrast(std::vector<float>& weights, double contrast) {
-    if (!(contrast >= 1.0)) return;
-    std::vector<float> positive;
-    positive.reserve(weights.size());
-    for (float w : weights)
-        if (w > 0.0f) positive.push_back(w);
-    if (positive.empty()) return;
-    const auto middle = positive.begin() + static_cast<std::ptrdiff_t>(positive.size() / 2);
-    std::nth_element(positive.begin(), middle, positive.end());
-    const double median = *middle;
-    const auto lo = static_cast<float>(median / contrast), hi = static_cast<float>(median * contrast);
-    for (float& w : weights)
-        if (w > 0.0f) w = std::clamp(w, lo, hi);
-}
-
 std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& nonFinite,
                                        std::size_t& negative) {
     const int w = var.width(), h = var.height();

@@ -45,6 +45,7 @@
 
 #include "image/image.h"
 #include "poisson/poisson_gpu_engine.h"
+#include "poisson/weight_contrast.h"
 #include "vk/commands.h"
 #include "vk/timing.h"
 
@@ -79,12 +80,6 @@ std::optional<GpuSolver> parseSolverChoice(const std::string& text);
 // The solver of a choice on `ctx`: the chosen one, or for auto host-pcg on a CPU device
 // (lavapipe, where the host's threads solve 2-5x faster) and mg-pcg on any other.
 GpuSolver resolveSolver(std::optional<GpuSolver> choice, const vk::Context& ctx);
-
-// SolveOptions::varianceWeightContrast's default, and the help of the options that set it.
-inline constexpr double kDefaultVarianceWeightContrast = 4.0;
-inline constexpr const char* kVarianceWeightContrastHelp =
-    "wl1: the largest factor by which a row's inverse-variance weight may differ from the median row's "
-    "(0 = unbounded); bounded weights keep wl1's lower error and its solve near l1's time";
 
 struct SolveOptions {
     Reconstruction method = Reconstruction::L2;
@@ -202,11 +197,6 @@ double inverseFilteredVariance(float filtered, double eps);
 // `negative`; a box with no valid value gives -1 (the caller's weight 0).
 std::vector<float> boxFilteredVariance(const Image& var, int radius, std::size_t& nonFinite,
                                        std::size_t& negative);
-
-// Bounds the contrast of row weights: every positive weight is clamped into [m/K, m·K], m the
-// median of the positive weights (the upper middle one of an even count) and K = `contrast`
-// (> 1; 0 or below 1: nothing changes); zeros stay zero.
-void boundWeightContrast(std::vector<float>& weights, double contrast);
 
 class PoissonSolverGpu {
 public:

@@ -47,7 +47,8 @@ TEST_F(GptWl1, BoundedWeightsKeepAFireflyHeavySolveNearL1s) {
     const int l1 = iterations(Reconstruction::L1, 0.0);
     const int bounded = iterations(Reconstruction::WeightedL1, kDefaultVarianceWeightContrast);
     const int unbounded = iterations(Reconstruction::WeightedL1, 0.0);
-    std::printf("door ajar, 64x64, 8 spp: iterations L1 %d, WL1 bounded %d, unbounded %d\n", l1, bounded, unbounded);
+    std::printf("door ajar, 64x64, 8 spp: iterations L1 %d, WL1 bounded %d, unbounded %d\n", l1, bounded,
+                unbounded);
     EXPECT_LE(bounded, 3 * l1) << "L1 " << l1 << ", unbounded WL1 " << unbounded;
     // Power: without the bound the same solve takes several times as many iterations.
     EXPECT_GT(unbounded, 3 * bounded) << "L1 " << l1 << ", bounded WL1 " << bounded;
