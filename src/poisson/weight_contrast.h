@@ -1,7 +1,8 @@
 // weight_contrast.h — bounds the contrast of a reconstruction's row weights (WL1's inverse
 // variances, 2D and space-time): every positive weight is clamped into [m/K, m·K], m the
 // median of the positive weights of all the given families together (the upper middle one of
-// an even count) and K the contrast (> 1; 0 or below 1: nothing changes); zeros stay zero.
+// an even count) and K the contrast (1 makes every positive weight the median; 0 or any K
+// below 1 changes nothing); zeros stay zero.
 // Why: the inverse variances of a firefly-heavy render span orders of magnitude, and the
 // conjugate gradients then need many times the iterations of unweighted rows, while the
 // extremes add nothing to the accuracy (bench/RESULTS.md, "Weighted L1 with bounded weights").
