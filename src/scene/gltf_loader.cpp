@@ -15,6 +15,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
+#include <initializer_list>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -320,9 +321,39 @@ void addLight(gltf::Context& ctx, const tinygltf::Value& ext, const glm::dmat4& 
     ctx.scene.punctualLights.push_back(out);
 }
 
+// A file that is neither a .glb (magic "glTF") nor JSON whose first character (after a
+// UTF-8 byte order mark and white space) opens an object is refused by what it is, before a
+// JSON check reads an image's bytes as brackets.
+void refuseNonGltf(const std::vector<unsigned char>& bytes) {
+    if (isGlb(bytes)) return;
+    const auto starts = [&](std::initializer_list<unsigned char> magic) {
+        return bytes.size() >= magic.size() && std::equal(magic.begin(), magic.end(), bytes.begin());
+    };
+    std::size_t i = starts({0xEF, 0xBB, 0xBF}) ? 3 : 0;
+    while (i < bytes.size() && (bytes[i] == ' ' || bytes[i] == '\t' || bytes[i] == '\n' || bytes[i] == '\r'))
+        ++i;
+    if (i < bytes.size() && bytes[i] == '{') return;
+    std::string what;
+    if (bytes.empty() || i == bytes.size())
+        what = "the file is empty";
+    else if (starts({0x76, 0x2F, 0x31, 0x01}))
+        what = "this is an OpenEXR image";
+    else if (starts({0x89, 'P', 'N', 'G'}))
+        what = "this is a PNG image";
+    else if (starts({0xFF, 0xD8, 0xFF}))
+        what = "this is a JPEG image";
+    else {
+        char byte[8];
+        std::snprintf(byte, sizeof byte, "0x%02X", static_cast<unsigned>(bytes[i]));
+        what = std::string("it starts with byte ") + byte + " at offset " + std::to_string(i);
+    }
+    throw Error("not a glTF 2.0 file (a .gltf is a JSON object, a .glb starts with \"glTF\"): " + what);
+}
+
 // The checks of the file's JSON (precheckJson) and the estimate of what loading it costs;
 // an empty estimate if the JSON is not parseable (tinygltf reports that).
 SceneEstimate precheck(const std::vector<unsigned char>& jsonBytes) {
+    refuseNonGltf(jsonBytes);
     return gltf::precheckJson(jsonText(jsonBytes, isGlb(jsonBytes))).value_or(SceneEstimate{});
 }
 

@@ -6,6 +6,8 @@
 #include <stb/stb_image_write.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <limits>
 
 #include "gltf_test_writer.h"
@@ -53,7 +55,35 @@ TEST(GltfErrors, BadJson) {
 TEST(GltfErrors, EmptyFile) {
     const std::string path = test::testDir() + "/empty.gltf";
     TestGltf::writeBytes(path, {});
-    expectError(path, {"parse error"});
+    expectError(path, {"not a glTF 2.0 file", "the file is empty"});
+    TestGltf::writeBytes(path, {' ', '\n', '\t'});
+    expectError(path, {"not a glTF 2.0 file", "the file is empty"});
+}
+
+// A file that is not a glTF document is refused by what it is (an image passed where a
+// scene belongs), not by what a JSON check makes of its bytes; a JSON document that is not an
+// object names its first character. A byte order mark and white space before the object are
+// accepted (the base file with them loads).
+TEST(GltfErrors, AnImageOrOtherJsonInsteadOfAScene) {
+    const std::string dir = test::testDir();
+    const std::vector<std::pair<std::vector<unsigned char>, std::string>> cases = {
+        {{0x76, 0x2F, 0x31, 0x01, 2, 0, 0, 0, '[', '[', '['}, "this is an OpenEXR image"},
+        {{0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'}, "this is a PNG image"},
+        {{0xFF, 0xD8, 0xFF, 0xE0}, "this is a JPEG image"},
+        {{' ', '[', '1', ']'}, "it starts with byte 0x5B at offset 1"},
+    };
+    for (const auto& [bytes, what] : cases) {
+        const std::string path = dir + "/not_a_scene.gltf";
+        TestGltf::writeBytes(path, bytes);
+        expectError(path, {"not a glTF 2.0 file", what});
+    }
+    const std::string ok = test::oneTriangle().writeGltf(dir, "bom");
+    std::ifstream in(ok, std::ios::binary);
+    std::vector<unsigned char> bytes = {0xEF, 0xBB, 0xBF, ' ', '\n'};
+    bytes.insert(bytes.end(), std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    in.close();
+    TestGltf::writeBytes(ok, bytes);
+    EXPECT_EQ(loadGltf(ok).triangles.size(), 1u);
 }
 
 TEST(GltfErrors, MissingBufferFile) {
