@@ -43,7 +43,7 @@ using nlohmann::json;
 struct ConvergeArgs {
     std::string scene;
     std::string reference;
-    std::string methods = "pt,gpt-l1,gpt-l2";
+    std::string methods = "pt,gpt,gpt-l1";  // gpt: the render default (gpt-wl1)
     std::string times = "1,2,4,8";
     int repeats = 3;
     int width = 256;
