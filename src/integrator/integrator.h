@@ -103,7 +103,7 @@ struct GptOptions {
     // image; each is written as layer recon_<name>. Empty: none; the final image is then the
     // primal (× modulation) + direct, the estimate before reconstruction. The default, WL1
     // (L1 whose rows are weighted by their box-filtered inverse variances, bounded to 4x of the
-    // median's), had 3-14 % lower relMSE than L1 on every scene of the set at equal samples and
+    // median's), had 4-14 % lower relMSE than L1 on every scene of the set at equal samples and
     // lower at equal time (bench/RESULTS.md, "Weighted L1 with bounded weights").
     std::vector<Reconstruction> reconstructions = {Reconstruction::WeightedL1};
     double alpha = 0.2;       // weight of the primal term
