@@ -22,8 +22,7 @@ inline CLI::Validator edgeSamplesValidator() {
             try {
                 (void)parseEdgeSamples(text, "value");
             } catch (const Error&) {
-                return "'" + text + "' is not auto or a whole number from 0 to " +
-                       std::to_string(kMaxEdgeSamples);
+                return edgeSamplesRefusal(text);
             }
             return {};
         },

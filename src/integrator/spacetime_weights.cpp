@@ -27,6 +27,23 @@ void appendWeights(Field& to, const std::vector<Image>& images, std::size_t pixe
     }
 }
 
+// Weight 0 for the rows the solve does not have (unitWeights in poisson_spacetime.cpp): dx of
+// each frame's last column, dy of its last row, dt and the rows to the previous frame where a
+// pixel has no temporal partner. They then count neither in the bound's median nor in the
+// renormalisation, as in the 2D weights (poisson_gpu.cpp). The mixed rows' own conditions
+// (rigidMixedRows) are left to the solve.
+void zeroAbsentRows(SpaceTimeProblem& p) {
+    const std::size_t w = std::size_t(p.width), np = p.pixels();
+    for (std::size_t i = 0; i < p.weightDx.size(); ++i)
+        if ((i % np) % w + 1 == w) p.weightDx[i] = 0.0;
+    for (std::size_t i = 0; i < p.weightDy.size(); ++i)
+        if ((i % np) + w >= np) p.weightDy[i] = 0.0;
+    for (std::size_t i = 0; i < p.temporalPartner.size() && i < p.weightDt.size(); ++i)
+        if (p.temporalPartner[i] == kNoTemporalPartner) p.weightDt[i] = 0.0;
+    for (std::size_t j = 0; j < p.previousPartner.size() && j < p.weightDtPrevious.size(); ++j)
+        if (p.previousPartner[j] == kNoTemporalPartner) p.weightDtPrevious[j] = 0.0;
+}
+
 }  // namespace
 
 void setVarianceWeights(SpaceTimeProblem& problem, const RowVariances& v, bool filtered, double epsilon,
@@ -70,6 +87,7 @@ void setVarianceWeights(SpaceTimeProblem& problem, const RowVariances& v, bool f
         appendWeights(problem.weightDxtPrevious, {v.dxtPrevious}, pixels, filtered, epsilon, radius, "dxt");
         appendWeights(problem.weightDytPrevious, {v.dytPrevious}, pixels, filtered, epsilon, radius, "dyt");
     }
+    zeroAbsentRows(problem);
     if (filtered)
         boundWeightContrast({&problem.weightPrimal, &problem.weightDx, &problem.weightDy, &problem.weightDt,
                              &problem.weightDxt, &problem.weightDyt, &problem.weightDtPrevious,

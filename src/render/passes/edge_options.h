@@ -37,6 +37,11 @@ inline std::string edgeSamplesText(std::uint32_t factor) {
     return factor == kEdgeSamplesAuto ? std::string("auto") : std::to_string(factor);
 }
 
+// What is wrong with a refused value (parseEdgeSamples's message, and the CLI's).
+inline std::string edgeSamplesRefusal(const std::string& text) {
+    return "'" + text + "' is not auto or a whole number from 0 to " + std::to_string(kMaxEdgeSamples);
+}
+
 // Parses "auto" or a whole number in [0, kMaxEdgeSamples]; throws gdpt::Error naming `what`.
 inline std::uint32_t parseEdgeSamples(const std::string& text, const std::string& what) {
     if (text == "auto") return kEdgeSamplesAuto;
@@ -46,9 +51,7 @@ inline std::uint32_t parseEdgeSamples(const std::string& text, const std::string
         if (c < '0' || c > '9') ok = false;
         v = v * 10 + static_cast<std::uint32_t>(c - '0');
     }
-    if (!ok || v > kMaxEdgeSamples)
-        throw Error(what + ": '" + text + "' is not auto or a whole number from 0 to " +
-                    std::to_string(kMaxEdgeSamples));
+    if (!ok || v > kMaxEdgeSamples) throw Error(what + ": " + edgeSamplesRefusal(text));
     return v;
 }
 
