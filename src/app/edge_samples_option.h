@@ -11,9 +11,10 @@
 namespace gdpt {
 
 inline constexpr const char* kEdgeSamplesHelp =
-    "G-PT: extra camera samples per camera sample in the pixels a geometric edge crosses: auto "
-    "(4, fewer where edge pixels are more than 3.75 % of the image: floor(0.15 / their share), "
-    "so that they add at most about 15 % to a sample pass), or 0 to 64 (0 = off)";
+    "G-PT: extra camera samples per camera sample in the pixels a geometric edge crosses and their "
+    "four neighbours: auto (2, fewer where those pixels are more than 30 % of the image: "
+    "floor(0.6 / their share), so that they add at most about 60 % to a sample pass), or 0 to 64 "
+    "(0 = off)";
 
 // Accepts what parseEdgeSamples accepts.
 inline CLI::Validator edgeSamplesValidator() {

@@ -45,8 +45,9 @@ std::uint32_t parseCount(const std::string& path, const ExrAttributes& a, const 
 // What a checkpoint's statistics buffer holds (sampler_state.h), which fixes how its sample
 // counts relate to gdpt.spp. A checkpoint is written at a batch boundary of a run without a
 // partial pass (sampling_loop.h), so every pixel has had the same camera samples:
-//   Path     the path kernels' statistics: spp samples in every pixel, and in G-PT's edge
-//            pixels spp x (1 + edge_samples) (edge_pass.h); every Path buffer of a pixel
+//   Path     the path kernels' statistics: spp samples in every pixel, and in the pixels of
+//            G-PT's edge samples (the edge pixels and their neighbours)
+//            spp x (1 + edge_samples) (edge_pass.h); every Path buffer of a pixel
 //            merged the same samples, so they all hold the same count;
 //   Visible  emitter supersampling's: spp samples in the pixels it refines, 0 elsewhere.
 enum class BufferKind { Path, Visible };
@@ -165,9 +166,10 @@ Checkpoint readCheckpoint(const std::string& path) {
     const std::vector<BufferRole> roles = bufferLayout(path, cp.identity);
     const std::string method = cp.identity.at("method");
 
-    // G-PT's edge pixels hold edge_samples more samples per camera sample (edge_pass.h). With
-    // "auto" the render's probe chose the factor (at most kAutoEdgeSamplesMax): the first edge
-    // pixel's count says which, and every other edge pixel must have the same.
+    // The pixels of G-PT's edge samples hold edge_samples more samples per camera sample
+    // (edge_pass.h). With "auto" the render's probe chose the factor (at most
+    // kAutoEdgeSamplesMax): the first such pixel's count says which, and every other one must
+    // have the same.
     const double spp = s.spp;
     double edgeCount = spp;
     bool edgeFactorOpen = false;
@@ -232,11 +234,12 @@ Checkpoint readCheckpoint(const std::string& path) {
                 if (got != spp && got != edgeCount)
                     throw Error(path + where + pixelName(i, width) + " has sample count " + countText(got) +
                                 ", expected " + countText(spp) + " (gdpt.spp)" +
-                                (edgeCount != spp ? " or " + countText(edgeCount) +
-                                                        " (gdpt.spp x (1 + edge_samples) in an edge pixel)"
+                                (edgeCount != spp
+                                     ? " or " + countText(edgeCount) +
+                                           " (gdpt.spp x (1 + edge_samples) in an edge-sample pixel)"
                                  : edgeFactorOpen ? " or gdpt.spp x (1 + K), K from 1 to " +
                                                         std::to_string(kAutoEdgeSamplesMax) +
-                                                        " (edge_samples auto, in an edge pixel)"
+                                                        " (edge_samples auto, in an edge-sample pixel)"
                                                   : std::string()));
             } else if (got != s.buffers[0][i].count) {
                 throw Error(path + where + pixelName(i, width) + " has sample count " + countText(got) +

@@ -28,6 +28,7 @@ std::uint32_t GptIntegrator::maxBatchSpp(int width, int height) const {
 ExrAttributes GptIntegrator::identity(const Scene& scene, const RenderOptions& options) const {
     return {{"shift_threshold", exactFloat(options.scene.shiftThreshold)},
             {"edge_samples", edgeSamplesText(options_.sampling.edgeSamples)},
+            {"edge_sample_pixels", kEdgeSamplePixels},
             {"demodulate", demodulates(scene, options_.sampling.demodulate) ? "on" : "off"}};
 }
 
@@ -84,7 +85,8 @@ RenderOutput GptIntegrator::render(const vk::Context& ctx, const Scene& scene, c
 
 void GptIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
     j["gpt_split_bounce"] = s.gptSplitBounce;
-    j["edge_samples"] = {{"factor", s.edgeSamples}, {"pixels", s.edgePixels}};
+    j["edge_samples"] = {
+        {"factor", s.edgeSamples}, {"pixels", s.edgePixels}, {"edge_pixels", s.edgeProbePixels}};
     j["demodulation"] = {{"on", s.demodulated}, {"pixels", s.demodulatedPixels}};
     j["reconstructions"] = reconstructionsJson(s);
 }
@@ -93,7 +95,7 @@ std::string GptIntegrator::summary(const RenderStats& s) const {
     std::string text;
     if (s.edgePixels)
         text += ", x" + std::to_string(1 + s.edgeSamples) + " in " + std::to_string(s.edgePixels) +
-                " edge pixels";
+                " pixels around " + std::to_string(s.edgeProbePixels) + " edge pixels";
     if (s.demodulated) text += ", demodulated in " + std::to_string(s.demodulatedPixels) + " pixels";
     return text;
 }

@@ -99,6 +99,7 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     const std::uint32_t factor = pass->edges().samplesPerSpp();
     stats.edgeSamples = factor == kEdgeSamplesAuto ? 0 : factor;
     stats.edgePixels = stats.edgeSamples > 0 ? pass->edges().count() : 0;
+    stats.edgeProbePixels = stats.edgeSamples > 0 ? pass->edges().edgeCount() : 0;
     stats.demodulated = pass->demodulating();
     stats.demodulatedPixels = pass->demodulatedPixels();
     sampling.finish();

@@ -189,7 +189,8 @@ struct RenderStats {
     std::uint32_t emitterRaysPerSample = 0;       // rays per camera sample it took (after its ray budget)
     std::uint32_t emitterSupersampledPixels = 0;  // pixels it covered
     std::uint32_t edgeSamples = 0;        // G-PT: extra samples per camera sample in edge pixels (0 = off)
-    std::uint32_t edgePixels = 0;         // G-PT: pixels a geometric edge crosses
+    std::uint32_t edgePixels = 0;         // G-PT: pixels with the extra samples (edge pixels and neighbours)
+    std::uint32_t edgeProbePixels = 0;    // G-PT: pixels a geometric edge crosses (the probe's)
     bool demodulated = false;             // G-PT: first-hit texture demodulation was on
     std::uint32_t demodulatedPixels = 0;  // G-PT: pixels it acted in (away from the edges)
     bool cancelled = false;

@@ -182,6 +182,7 @@ ExrAttributes TgptIntegrator::identity(const Scene& scene, const RenderOptions& 
     (void)scene;
     return {{"shift_threshold", exactFloat(options.scene.shiftThreshold)},
             {"edge_samples", edgeSamplesText(options_.sampling.edgeSamples)},
+            {"edge_sample_pixels", kEdgeSamplePixels},
             {"window", std::to_string(options_.window)},
             {"temporal_shift", temporalShiftName(options_.shift)}};
 }
@@ -485,7 +486,8 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
 }
 
 void TgptIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
-    j["edge_samples"] = {{"factor", s.edgeSamples}, {"pixels", s.edgePixels}};
+    j["edge_samples"] = {
+        {"factor", s.edgeSamples}, {"pixels", s.edgePixels}, {"edge_pixels", s.edgeProbePixels}};
     j["reconstructions"] = reconstructionsJson(s);
     j["tgpt"] = {{"window_first", s.tgpt.windowFirst},
                  {"window_frames", s.tgpt.windowFrames},

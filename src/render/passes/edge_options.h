@@ -4,33 +4,61 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "util/error.h"
 
 namespace gdpt {
 
 // The factor by default (`--edge-samples auto`): the extra camera samples per camera sample
-// in an edge pixel follow the edge pixels' share of the image,
+// in the pixels of edgeSampleList (the edge pixels and their four neighbours) follow those
+// pixels' share of the image,
 //   K = min(kAutoEdgeSamplesMax, floor(kEdgeSampleShare / share)),
-// so the edge samples add at most about 15 % to a sample pass. The Cornell box (2 % edge
-// pixels at 256²) and the open scene (3.3 %) keep 4, where 2, 4 and 8 were level and 4 paid
-// over none; a detailed asset (2CylinderEngine, 8.9 %) gets 1, where 4 was the worst factor
-// and 1 the best at equal time (bench/RESULTS.md, "The factor on a detailed asset"). The
-// choice depends on the geometry alone (the probe), so renders stay reproducible.
-constexpr std::uint32_t kAutoEdgeSamplesMax = 4;
-constexpr double kEdgeSampleShare = 0.15;
+// so the edge samples add at most about 60 % of a sample pass. At equal time K = 2 was as low as
+// 3 and 4 and below 1 on the set's scenes, on a 110,000-triangle engine (25 % of its pixels
+// listed) and at 64² and 128² (10-17 %); above 30 % of the image K falls to 1, above 60 % to
+// 0, where the list is most of the image and its samples are a denser pass everywhere
+// (bench/RESULTS.md, "Edge samples for both pixels of a pair"). The choice depends on the
+// geometry alone (the probe), so renders stay reproducible.
+constexpr std::uint32_t kAutoEdgeSamplesMax = 2;
+constexpr double kEdgeSampleShare = 0.6;
 // The value that asks for that rule (EdgePass resolves it after its probe).
 constexpr std::uint32_t kEdgeSamplesAuto = 0xFFFFFFFFu;
 // Upper bound of an explicit factor: keeps the edge samples' Sobol' index ((sample + 1) ×
 // factor) within 32 bits up to the 2^24 samples per pixel that PixelStats counts exactly.
 constexpr std::uint32_t kMaxEdgeSamples = 64;
 
-// The rule's factor for `edgePixels` of `pixels`.
-inline std::uint32_t autoEdgeSamples(std::uint64_t edgePixels, std::uint64_t pixels) {
-    if (edgePixels == 0) return kAutoEdgeSamplesMax;
-    const double k = kEdgeSampleShare * static_cast<double>(pixels) / static_cast<double>(edgePixels);
+// The rule's factor for `listed` pixels (edgeSampleList's) of `pixels`.
+inline std::uint32_t autoEdgeSamples(std::uint64_t listed, std::uint64_t pixels) {
+    if (listed == 0) return kAutoEdgeSamplesMax;
+    const double k = kEdgeSampleShare * static_cast<double>(pixels) / static_cast<double>(listed);
     return k >= kAutoEdgeSamplesMax ? kAutoEdgeSamplesMax : static_cast<std::uint32_t>(k);
 }
+
+// The pixels that get the extra samples, in ascending order: every pixel of `mask` (W·H, non-zero
+// = a geometric edge crosses it) and its four neighbours. Each pair's gradient, and its part of
+// the primal, is estimated from the samples of both of its pixels, each part averaged over its
+// own pixel's samples, with MIS weights that treat the two ends alike (gpt_resolve.comp); extra
+// samples at the edge pixel alone leave the neighbour's part of every pair it shares with the
+// edge at the base rate, and that part's noise then dominates the pair.
+inline std::vector<std::uint32_t> edgeSampleList(const std::vector<std::uint32_t>& mask, std::uint32_t width,
+                                                 std::uint32_t height) {
+    std::vector<std::uint32_t> list;
+    if (mask.size() != std::size_t{width} * height) return list;
+    for (std::uint32_t y = 0; y < height; ++y)
+        for (std::uint32_t x = 0; x < width; ++x) {
+            const std::size_t i = std::size_t{y} * width + x;
+            const bool listed = mask[i] != 0 || (x > 0 && mask[i - 1] != 0) ||
+                                (x + 1 < width && mask[i + 1] != 0) || (y > 0 && mask[i - width] != 0) ||
+                                (y + 1 < height && mask[i + width] != 0);
+            if (listed) list.push_back(static_cast<std::uint32_t>(i));
+        }
+    return list;
+}
+
+// The rule of edgeSampleList as checkpoints and shards record it (`edge_sample_pixels`): one
+// written with the edge pixels alone (before 2026-12-05) has other pixels' counts and is refused.
+inline constexpr const char* kEdgeSamplePixels = "edges+neighbours";
 
 // "auto" or the number, as the command line, `--json` and checkpoints write it.
 inline std::string edgeSamplesText(std::uint32_t factor) {

@@ -1,5 +1,6 @@
 #include "render/passes/edge_pass.h"
 
+#include <algorithm>
 #include <string>
 
 #include "edge.spv.h"
@@ -72,9 +73,9 @@ void EdgePass::find(vk::CommandStream& stream) {
     stream.submitAndWait();
     mask_ = maskBuffer_.downloadVector<std::uint32_t>(std::size_t{width_} * height_);
     if (maskNeeded_) probes_ = probeBuffer_.downloadVector<gpu::EdgeProbe>(std::size_t{width_} * height_);
-    std::vector<std::uint32_t> list;
-    for (std::uint32_t i = 0; i < mask_.size(); ++i)
-        if (mask_[i] != 0) list.push_back(i);
+    edgeCount_ = static_cast<std::uint32_t>(
+        std::count_if(mask_.begin(), mask_.end(), [](std::uint32_t m) { return m != 0; }));
+    const std::vector<std::uint32_t> list = edgeSampleList(mask_, width_, height_);
     count_ = static_cast<std::uint32_t>(list.size());
     if (samplesPerSpp_ == kEdgeSamplesAuto) samplesPerSpp_ = autoEdgeSamples(count_, mask_.size());
     if (count_ > 0) {

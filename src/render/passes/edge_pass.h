@@ -3,8 +3,9 @@
 // the gradients as much as in the primal, so the reconstruction cannot remove it and they
 // hold most of a G-PT image's error. find() probes the image once (four rays per pixel at
 // fixed positions: the choice depends on the geometry alone, so every pixel's estimate stays
-// unbiased) and keeps the edge pixels' indices, in ascending order, in a buffer that gpt.comp
-// reads in its edge-list mode (GptFrameParams::listCount).
+// unbiased) and keeps the indices of the edge pixels and their four neighbours
+// (edgeSampleList), in ascending order, in a buffer that gpt.comp reads in its edge-list mode
+// (GptFrameParams::listCount).
 #pragma once
 
 #include <cstdint>
@@ -47,8 +48,11 @@ public:
     // Probes the image on `stream` (submits and waits) and uploads the list. Once per pass;
     // later calls return at once. Nothing when disabled.
     void find(vk::CommandStream& stream);
-    // Edge pixels found (0 before find() or when disabled).
+    // Pixels that get the extra samples (edgeSampleList: the edge pixels and their four
+    // neighbours; 0 before find() or when disabled).
     [[nodiscard]] std::uint32_t count() const { return count_; }
+    // Edge pixels the probe found (0 before find() or when disabled).
+    [[nodiscard]] std::uint32_t edgeCount() const { return edgeCount_; }
     // The per-pixel mask of the last find() (1 = edge); empty before.
     [[nodiscard]] const std::vector<std::uint32_t>& mask() const { return mask_; }
     // What each pixel's first probe ray hit (with maskNeeded; empty before find() or without).
@@ -66,6 +70,7 @@ private:
     std::vector<std::uint32_t> mask_;
     std::vector<gpu::EdgeProbe> probes_;
     std::uint32_t count_ = 0;
+    std::uint32_t edgeCount_ = 0;
     bool found_ = false;
 };
 

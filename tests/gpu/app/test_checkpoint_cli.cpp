@@ -22,6 +22,7 @@
 
 #include "cli_runner.h"
 #include "image/exr_io.h"
+#include "render/passes/edge_options.h"
 #include "same_bits.h"
 
 namespace gdpt {
@@ -252,64 +253,73 @@ TEST_F(CheckpointRefusal, CheckpointWithInconsistentStatisticsIsRefused) {
 // direct) merged the same samples, so one differing count is a corrupt checkpoint.
 TEST_F(CheckpointRefusal, GptCheckpointWithInconsistentCountsIsRefused) {
     const std::string c = path("g.exr");
+    // No edge samples: every pixel's counts are then gdpt.spp (the edge samples' own checks are
+    // the next test's).
     const RunResult r = test::runGdpt("render " + kScene + kSize + "--spp 2 --seed 7 --method gpt --quiet " +
-                                      "--checkpoint " + c + " -o " + path("g_out.exr"));
+                                      "--edge-samples 0 --checkpoint " + c + " -o " + path("g_out.exr"));
     ASSERT_EQ(r.code, 0) << r.output;
     editCheckpoint(c, path("g3.exr"), "state3.count", 2, 9, 4.0f);
     expectRefused(
-        path("g3.exr"), kSize + "--spp 4 --seed 7 --method gpt",
+        path("g3.exr"), kSize + "--spp 4 --seed 7 --method gpt --edge-samples 0",
         "state3.count (gpt neighbor left): pixel (2, 9) has sample count 4, but state0.count has 2");
 }
 
 // With --edge-samples auto the checkpoint records "auto" and its counts carry the factor the
-// probe chose: it resumes, and an edge pixel whose count implies another factor, or one above
+// probe chose: it resumes, and a listed pixel whose count implies another factor, or one above
 // the rule's largest, is refused.
 TEST_F(CheckpointRefusal, GptCheckpointWithTheAutomaticEdgeFactorResumesAndIsChecked) {
     const std::string c = path("e.exr");
-    const std::string size = " --width 64 --height 64 ";  // the Cornell box's rule gives 4 here
+    const std::string size = " --width 64 --height 64 ";  // the Cornell box's rule gives 2 here
     const RunResult r =
         test::runGdpt("render " + kScene + size + "--spp 2 --seed 7 --method gpt --quiet " + "--checkpoint " +
                       c + " -o " + path("e_out.exr") + " --json " + path("e.json"));
     ASSERT_EQ(r.code, 0) << r.output;
     EXPECT_EQ(readExrAttributes(c).at("gdpt.id.edge_samples"), "auto");
+    EXPECT_EQ(readExrAttributes(c).at("gdpt.id.edge_sample_pixels"), kEdgeSamplePixels);
     std::ifstream in(path("e.json"));
     const int factor = nlohmann::json::parse(in)["edge_samples"]["factor"].get<int>();
-    ASSERT_EQ(factor, 4);
-    // Two edge pixels of the checkpoint (count 2 x (1 + 4)).
+    ASSERT_EQ(factor, int(kAutoEdgeSamplesMax));
+    const float listedCount = 2.0f * float(1 + factor);  // 2 spp x (1 + 2)
+    // Two listed pixels of the checkpoint.
     std::vector<std::pair<int, int>> edges;
     for (const NamedLayer& l : readExr(c))
         if (l.name == "state0.count")
             for (int y = 0; y < l.image.height(); ++y)
                 for (int x = 0; x < l.image.width(); ++x)
-                    if (l.image.at(x, y, 0) == 10.0f) edges.emplace_back(x, y);
+                    if (l.image.at(x, y, 0) == listedCount) edges.emplace_back(x, y);
     ASSERT_GE(edges.size(), 2u);
     const RunResult resumed =
         test::runGdpt("render " + kScene + size + "--spp 4 --seed 7 --method gpt --quiet " + "--resume " + c +
                       " -o " + path("r.exr"));
     EXPECT_EQ(resumed.code, 0) << resumed.output;
-    // Another factor in the second edge pixel than in the first.
+    // Another factor (1) in the second listed pixel than in the first.
     const auto [x, y] = edges[1];
     const std::string where = "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")";
     const std::string flags = size + "--spp 4 --seed 7 --method gpt";
     auto layers = readExr(c);
     for (NamedLayer& l : layers)
         if (l.name.size() > 6 && l.name.substr(l.name.size() - 6) == ".count" && l.name != "state1.count" &&
-            l.image.at(x, y, 0) == 10.0f)
-            for (int ch = 0; ch < 3; ++ch) l.image.at(x, y, ch) = 6.0f;
+            l.image.at(x, y, 0) == listedCount)
+            for (int ch = 0; ch < 3; ++ch) l.image.at(x, y, ch) = 4.0f;
     writeExr(path("mixed.exr"), layers, readExrAttributes(c));
-    expectRefused(path("mixed.exr"), flags, where + " has sample count 6, expected 2 (gdpt.spp) or 10");
-    // A factor the rule never gives, in every edge pixel: the first one is named.
+    expectRefused(path("mixed.exr"), flags, where + " has sample count 4, expected 2 (gdpt.spp) or 6");
+    // A factor the rule never gives (3), in every listed pixel: the first one is named.
     layers = readExr(c);
     for (NamedLayer& l : layers)
         if (l.name.size() > 6 && l.name.substr(l.name.size() - 6) == ".count")
             for (int yy = 0; yy < l.image.height(); ++yy)
                 for (int xx = 0; xx < l.image.width(); ++xx)
-                    if (l.image.at(xx, yy, 0) == 10.0f)
-                        for (int ch = 0; ch < 3; ++ch) l.image.at(xx, yy, ch) = 12.0f;
-    writeExr(path("six.exr"), layers, readExrAttributes(c));
+                    if (l.image.at(xx, yy, 0) == listedCount)
+                        for (int ch = 0; ch < 3; ++ch) l.image.at(xx, yy, ch) = 8.0f;
+    writeExr(path("eight.exr"), layers, readExrAttributes(c));
     const auto [x0, y0] = edges[0];
-    expectRefused(path("six.exr"), flags,
-                  "pixel (" + std::to_string(x0) + ", " + std::to_string(y0) + ") has sample count 12");
+    expectRefused(path("eight.exr"), flags,
+                  "pixel (" + std::to_string(x0) + ", " + std::to_string(y0) + ") has sample count 8");
+    // A checkpoint from before the neighbours were listed (no edge_sample_pixels) is refused.
+    ExrAttributes older = readExrAttributes(c);
+    older.erase("gdpt.id.edge_sample_pixels");
+    writeExr(path("older.exr"), readExr(c), older);
+    expectRefused(path("older.exr"), flags, "does not record edge_sample_pixels");
 }
 
 // Guards the class "a refused resume names the real difference": another method or size

@@ -288,22 +288,24 @@ TEST_F(Cli, GptRenderReportsItsEdgeSamples) {
     EXPECT_EQ(render(" --edge-samples 65").code, 2);
     EXPECT_EQ(render(" --edge-samples four").code, 2);
 
-    // auto (the default): the factor follows the edge pixels' share. At 32² the box's edges
-    // are 8 % of the pixels (factor 1); at 64², 3.3 % (factor 4).
+    // auto (the default): the factor follows the share of the pixels listed for the edge
+    // samples (the edge pixels and their neighbours). At 32² the box's are 24 % of the pixels
+    // (factor 2); at 24², 35 % (factor 1).
     r = render("");
     ASSERT_EQ(r.code, 0) << r.output;
     j = readJson();
     EXPECT_EQ(j["edge_samples"]["pixels"].get<int>(), pixels);
+    EXPECT_GT(pixels, j["edge_samples"]["edge_pixels"].get<int>());
     EXPECT_EQ(j["edge_samples"]["factor"].get<std::uint32_t>(), autoEdgeSamples(pixels, 32 * 32));
-    EXPECT_EQ(j["edge_samples"]["factor"].get<int>(), 1);
-    EXPECT_EQ(j["paths_completed"].get<long>(), 2L * (32 * 32 + pixels));
+    EXPECT_EQ(j["edge_samples"]["factor"].get<int>(), 2);
+    EXPECT_EQ(j["paths_completed"].get<long>(), 2L * (32 * 32 + 2 * pixels));
     r = run("render " + kScene + " --method gpt -o " + path("e.exr") +
-            " --width 64 --height 64 --spp 1 --quiet --json " + path("e.json"));
+            " --width 24 --height 24 --spp 1 --quiet --json " + path("e.json"));
     ASSERT_EQ(r.code, 0) << r.output;
     j = readJson();
     EXPECT_EQ(j["edge_samples"]["factor"].get<std::uint32_t>(),
-              autoEdgeSamples(j["edge_samples"]["pixels"].get<std::uint64_t>(), 64 * 64));
-    EXPECT_EQ(j["edge_samples"]["factor"].get<int>(), 4);
+              autoEdgeSamples(j["edge_samples"]["pixels"].get<std::uint64_t>(), 24 * 24));
+    EXPECT_EQ(j["edge_samples"]["factor"].get<int>(), 1);
 }
 
 // A textured scene demodulates by default: the JSON says where, the EXR gains the modulation

@@ -78,7 +78,7 @@ std::set<std::pair<int, int>> probe(const vk::Context& ctx, const Scene& scene) 
     EXPECT_EQ(mask.size(), std::size_t{kSize} * kSize);
     for (std::size_t i = 0; i < mask.size(); ++i)
         if (mask[i] != 0) out.insert({int(i % kSize), int(i / kSize)});
-    EXPECT_EQ(out.size(), pass.count());
+    EXPECT_EQ(out.size(), pass.edgeCount());
     return out;
 }
 
@@ -93,6 +93,16 @@ std::set<std::pair<int, int>> squareOutline() {
         out.insert({i, 15});
         out.insert({i, 48});
     }
+    return out;
+}
+
+// The pixels that get the edge samples (edgeSampleList): those of `pixels` and their four
+// neighbours inside the kSize² image.
+std::set<std::pair<int, int>> withNeighbours(const std::set<std::pair<int, int>>& pixels) {
+    std::set<std::pair<int, int>> out;
+    for (const auto& [x, y] : pixels)
+        for (const auto& [dx, dy] : {std::pair{0, 0}, {1, 0}, {-1, 0}, {0, 1}, {0, -1}})
+            if (x + dx >= 0 && y + dy >= 0 && x + dx < kSize && y + dy < kSize) out.insert({x + dx, y + dy});
     return out;
 }
 
@@ -145,13 +155,18 @@ struct StepPass {
     vk::CommandStream stream;
 };
 
-// Each edge pixel's statistics count (1 + edgeSamples) × spp samples, every other pixel spp;
-// a partial pass (rows < height) adds no edge samples.
-TEST_F(EdgeSamples, EdgePixelsGetTheirExtraSamplesAndOnlyThey) {
+// Each edge pixel's and each of its four neighbours' statistics count (1 + edgeSamples) × spp
+// samples, every other pixel spp; a partial pass (rows < height) adds no edge samples.
+TEST_F(EdgeSamples, EdgePixelsAndTheirNeighboursGetTheExtraSamplesAndOnlyThey) {
     StepPass step(ctx(), 3);
     GptPass& pass = step.pass;
     vk::CommandStream& stream = step.stream;
-    ASSERT_EQ(pass.edges().count(), 132u);
+    const auto listed = withNeighbours(squareOutline());
+    ASSERT_EQ(pass.edges().edgeCount(), 132u);
+    ASSERT_EQ(pass.edges().count(), listed.size());
+    // The outline (a 34-pixel square ring, 132) and the rings just outside (36-pixel square,
+    // less its 4 corners, which only touch the outline diagonally: 136) and inside (124).
+    ASSERT_EQ(listed.size(), 132u + 136u + 124u);
     const std::uint32_t seed = 7;
     auto batch = [&](std::uint32_t first, std::uint32_t n, std::uint32_t rows) {
         pass.record(stream.begin(), first, n, seed, nullptr, rows);
@@ -161,12 +176,11 @@ TEST_F(EdgeSamples, EdgePixelsGetTheirExtraSamplesAndOnlyThey) {
     batch(2, 3, kSize);
     batch(5, 1, 10);  // partial pass: rows 0..9 only
     const auto stats = pass.downloadStats();
-    const auto outline = squareOutline();
     const std::vector<gpu::PixelStats>& central = stats[0];
     int wrong = 0;
     for (int y = 0; y < kSize; ++y)
         for (int x = 0; x < kSize; ++x) {
-            const std::uint32_t expected = (outline.count({x, y}) ? 5u * 4u : 5u) + (y < 10 ? 1u : 0u);
+            const std::uint32_t expected = (listed.count({x, y}) ? 5u * 4u : 5u) + (y < 10 ? 1u : 0u);
             const std::uint32_t got = central[std::size_t(y) * kSize + x].count;
             if (got != expected && wrong++ < 5)
                 ADD_FAILURE() << "pixel " << x << "," << y << ": " << got << " samples, expected "
@@ -175,24 +189,25 @@ TEST_F(EdgeSamples, EdgePixelsGetTheirExtraSamplesAndOnlyThey) {
     EXPECT_EQ(wrong, 0);
 }
 
-// With kEdgeSamplesAuto the probe's count sets the factor by the rule (edge_options.h), and
-// the edge pixels get that many extra samples (the square's 132 outline pixels of kSize²:
-// 3.2 %, factor 4; gdpt render's JSON test has a share that lowers it).
-TEST_F(EdgeSamples, TheAutomaticFactorFollowsTheEdgePixelsShare) {
+// With kEdgeSamplesAuto the count of the listed pixels sets the factor by the rule
+// (edge_options.h), and they get that many extra samples (the square's outline and its
+// neighbours, 392 of kSize²: 9.6 %, factor 2; gdpt render's JSON test has a share that lowers it).
+TEST_F(EdgeSamples, TheAutomaticFactorFollowsTheListedPixelsShare) {
     StepPass step(ctx(), kEdgeSamplesAuto);
     GptPass& pass = step.pass;
-    ASSERT_EQ(pass.edges().count(), 132u);
-    const std::uint32_t k = autoEdgeSamples(132, std::uint64_t{kSize} * kSize);
+    const auto listed = withNeighbours(squareOutline());
+    ASSERT_EQ(pass.edges().count(), listed.size());
+    const std::uint32_t k = autoEdgeSamples(listed.size(), std::uint64_t{kSize} * kSize);
+    EXPECT_EQ(k, 2u);
     EXPECT_EQ(pass.edges().samplesPerSpp(), k);
     ASSERT_GT(k, 0u) << "the test needs a factor that adds samples";
     pass.record(step.stream.begin(), 0, 2, 7, nullptr);
     step.stream.submitAndWait();
     const auto stats = pass.downloadStats();
-    const auto outline = squareOutline();
     int wrong = 0;
     for (int y = 0; y < kSize; ++y)
         for (int x = 0; x < kSize; ++x) {
-            const std::uint32_t expected = outline.count({x, y}) ? 2u * (1u + k) : 2u;
+            const std::uint32_t expected = listed.count({x, y}) ? 2u * (1u + k) : 2u;
             if (stats[0][std::size_t(y) * kSize + x].count != expected) ++wrong;
         }
     EXPECT_EQ(wrong, 0);
