@@ -85,8 +85,7 @@ RenderOutput GptIntegrator::render(const vk::Context& ctx, const Scene& scene, c
 
 void GptIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
     j["gpt_split_bounce"] = s.gptSplitBounce;
-    j["edge_samples"] = {
-        {"factor", s.edgeSamples}, {"pixels", s.edgePixels}, {"edge_pixels", s.edgeProbePixels}};
+    j["edge_samples"] = edgeSamplesJson(s);
     j["demodulation"] = {{"on", s.demodulated}, {"pixels", s.demodulatedPixels}};
     j["reconstructions"] = reconstructionsJson(s);
 }

@@ -1,6 +1,7 @@
 #include "integrator/gpt_sampler.h"
 
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 
@@ -105,6 +106,10 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     sampling.finish();
     result.stats = stats;
     return result;
+}
+
+nlohmann::json edgeSamplesJson(const RenderStats& s) {
+    return {{"factor", s.edgeSamples}, {"pixels", s.edgePixels}, {"edge_pixels", s.edgeProbePixels}};
 }
 
 }  // namespace gdpt

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 
 #include "integrator/render_options.h"
@@ -62,6 +63,10 @@ struct RenderResultGpt {
 // the size, kGptBatchPixelSamples); per-kernel ms in stats.kernels ("gpt", "gpt_resolve", ...).
 RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const RenderOptions& options,
                           const GptSamplingOptions& gpt = {});
+
+// `render --json`'s "edge_samples" of a G-PT-family render (gpt, tgpt): the factor, the pixels
+// that got the edge samples and the probe's edge pixels.
+nlohmann::json edgeSamplesJson(const RenderStats& stats);
 
 // "auto" | "on" | "off"; throws gdpt::UsageError otherwise.
 Demodulation parseDemodulation(const std::string& text);

@@ -33,11 +33,10 @@ void appendWeights(Field& to, const std::vector<Image>& images, std::size_t pixe
 // renormalisation, as in the 2D weights (poisson_gpu.cpp). The mixed rows' own conditions
 // (rigidMixedRows) are left to the solve.
 void zeroAbsentRows(SpaceTimeProblem& p) {
-    const std::size_t w = std::size_t(p.width), np = p.pixels();
     for (std::size_t i = 0; i < p.weightDx.size(); ++i)
-        if ((i % np) % w + 1 == w) p.weightDx[i] = 0.0;
+        if (!spaceTimeHasDx(p, i)) p.weightDx[i] = 0.0;
     for (std::size_t i = 0; i < p.weightDy.size(); ++i)
-        if ((i % np) + w >= np) p.weightDy[i] = 0.0;
+        if (!spaceTimeHasDy(p, i)) p.weightDy[i] = 0.0;
     for (std::size_t i = 0; i < p.temporalPartner.size() && i < p.weightDt.size(); ++i)
         if (p.temporalPartner[i] == kNoTemporalPartner) p.weightDt[i] = 0.0;
     for (std::size_t j = 0; j < p.previousPartner.size() && j < p.weightDtPrevious.size(); ++j)

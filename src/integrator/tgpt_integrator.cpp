@@ -486,8 +486,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
 }
 
 void TgptIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
-    j["edge_samples"] = {
-        {"factor", s.edgeSamples}, {"pixels", s.edgePixels}, {"edge_pixels", s.edgeProbePixels}};
+    j["edge_samples"] = edgeSamplesJson(s);
     j["reconstructions"] = reconstructionsJson(s);
     j["tgpt"] = {{"window_first", s.tgpt.windowFirst},
                  {"window_frames", s.tgpt.windowFrames},

@@ -304,8 +304,8 @@ void unitWeights(const SpaceTimeProblem& p, Weights& wt) {
         if (!p.weightPrimal.empty()) wt.primal[i] = p.weightPrimal[i];
         if (!p.weightDx.empty()) wt.dx[i] = p.weightDx[i];
         if (!p.weightDy.empty()) wt.dy[i] = p.weightDy[i];
-        if ((i % np) % w + 1 == w) wt.dx[i] = 0.0;
-        if ((i % np) + w >= np) wt.dy[i] = 0.0;
+        if (!spaceTimeHasDx(p, i)) wt.dx[i] = 0.0;
+        if (!spaceTimeHasDy(p, i)) wt.dy[i] = 0.0;
     }
     if (!p.weightDt.empty()) std::copy(p.weightDt.begin(), p.weightDt.end(), wt.dt.begin());
     if (!p.weightDtPrevious.empty() && !wt.boundary.empty())

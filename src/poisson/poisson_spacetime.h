@@ -102,6 +102,16 @@ struct SpaceTimeProblem {
     [[nodiscard]] std::size_t size() const { return pixels() * std::size_t(frames); }
 };
 
+// Whether the spatial rows of frame-major pixel i of `p` exist: dx not in its frame's last
+// column, dy not in its last row (the solve's weights are 0 there; setVarianceWeights leaves
+// them out of its statistics too).
+inline bool spaceTimeHasDx(const SpaceTimeProblem& p, std::size_t i) {
+    return (i % p.pixels()) % std::size_t(p.width) + 1 != std::size_t(p.width);
+}
+inline bool spaceTimeHasDy(const SpaceTimeProblem& p, std::size_t i) {
+    return (i % p.pixels()) + std::size_t(p.width) < p.pixels();
+}
+
 struct SpaceTimeOptions {
     bool l1 = true;  // else L2
     // IRLS (L1): the 2D device solver's schedule (poisson_gpu.h SolveOptions).
