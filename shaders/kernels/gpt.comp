@@ -9,7 +9,8 @@
 // row), built by the shift mapping (shift.glsl): reconnection when base current, base next
 // and offset current vertices are rough, else the half-vector copy; NEE shifted with the
 // same light point. Each pixel pair (p, p+δ_i) is estimated with MIS between the forward and
-// reverse shift (power heuristic, Veach 1997 eq. 9.13, in ratio form, shift.glsl). The steps
+// reverse shift (power heuristic, Veach 1997 eq. 9.13, in ratio form, shift.glsl), counting
+// the two pixels' sample counts where the edge samples make them differ. The steps
 // of a bounce are named functions (gpt_steps.glsl), put together in gpt_bounce.glsl.
 //
 // Offset state (ratio form, shift.glsl): beta' = f'/p (offset contribution over the
@@ -74,6 +75,8 @@ GDPT_PIXEL_BUFFER(kBindGptDirect, PixelStatsArray, statDirect);
 #define statDirect statDirect_.v
 GDPT_PIXEL_BUFFER(kBindGptEdgeList, UintArray, edgeList);
 #define edgeList edgeList_.v
+GDPT_PIXEL_BUFFER(kBindGptSampleRate, UintArray, sampleRate);
+#define sampleRate sampleRate_.v
 GDPT_PIXEL_BUFFER(kBindGptDemodMask, UintArray, demodMask);
 #define demodMask demodMask_.v
 layout(buffer_reference, scalar, buffer_reference_align = 4) buffer PixelStreamArray { PixelStream v[]; };
@@ -162,13 +165,26 @@ void main() {
         stream = ps.key;
         jitterShift = vec2(ps.jitterShift & 0xFFFFu, ps.jitterShift >> 16u) * (1.0 / 65536.0);
     }
+    // n_q / n_p of each pair (p, q = p + δ_i): the two pixels' sample counts per camera sample
+    // of the image, which the pair's MIS weights count (shift.glsl). 1 where every pixel takes
+    // the same number, or the pair does not exist.
+    vec4 countRatio = vec4(1.0);
+    if (frame.sampleRates != 0u) {
+        float own = float(sampleRate[pixel]);
+        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+            if (!gptPairExists(x, y, i)) continue;
+            ivec2 q = ivec2(x, y) + kOffsetDelta[i];
+            countRatio[i] = float(sampleRate[uint(q.y) * scene.width + uint(q.x)]) / own;
+        }
+    }
     for (uint s = 0u; s < frame.samplesPerPixel; ++s) {
         // Same stream as pt.comp's sample s: the base path is PT's path.
         Rng rng = rngInit(stream, frame.sampleBase + s, frame.seed);
         LdSample lds = ldSampleInit(stream, frame.sampleBase + s, frame.seed);
         vec2 jitter = fract(ldGet2(lds, kLdDimPixel) + jitterShift);
         vec3 direct, baseModulation;
-        traceSample(lds, rng, vec2(x, y) + jitter, x, y, countDirect, rays, direct, baseModulation, offs);
+        traceSample(lds, rng, vec2(x, y) + jitter, x, y, countDirect, countRatio, rays, direct, baseModulation,
+                    offs);
         if (kDemodulate) {
             for (uint i = 0u; i < kGptNumOffsets; ++i) {
                 offs[i].baseSum /= baseModulation;

@@ -144,7 +144,9 @@ Evaluated evaluate(uint stream, uint fresh, inout uint rays, inout uint nan) {
     } else {
         OffsetPath offs[kGptNumOffsets];
         vec3 direct, baseModulation;
-        traceSample(lds, rng, e.film, px, py, false, rays, direct, baseModulation, offs);
+        // Every film position is one chain's: no pixel counts differ, the pairs weigh both ends
+        // alike.
+        traceSample(lds, rng, e.film, px, py, false, vec4(1.0), rays, direct, baseModulation, offs);
         for (uint i = 0u; i < kGptNumOffsets; ++i) {
             central += offs[i].baseSum;
             neighborSum += offs[i].offSum;

@@ -51,7 +51,8 @@
             if (!gptPairCounted(px, py, i)) continue;
             bool own = offs[i].alive && ownVertex(offs[i], GDPT_GPT_GENERAL);
             OffsetNee on = gptPairNee(offs[i], offV[i], own, lightStrategy[i], nee, bsdf, sh.p, rays);
-            float w = gptMisWeight(ls.pdf, nee.pdfBsdf, on.qLight, on.qBsdf);
+            float c = offs[i].countRatio;
+            float w = gptMisWeight(ls.pdf, nee.pdfBsdf, c * on.qLight, c * on.qBsdf);
             if (on.counts) addPair(offs[i], w, nee.fBase, on.f);
         }
     }

@@ -16,6 +16,9 @@ struct OffsetPath {
     vec3 beta;        // f'/p: offset throughput over the base path's pdf (Jacobians included)
     float r;          // J·p'/p: offset density in the base's measure over the base's density
     float rLight;     // ratio applying to the light strategy of the current vertex's emission
+    float countRatio; // n_q / n_p: samples of the offset's pixel q over the base's pixel p, per
+                      // camera sample of the image; scales the offset's densities in every
+                      // MIS weight of the pair (shift.glsl, "sample counts")
     uint state;       // kShiftNotConnected / kShiftRecentlyConnected / kShiftConnected
     bool alive;       // false: pair absent (image border) or shift failed -> base-only weights
     bool shifted;     // the pair exists and the base's primary ray hit: a shift was attempted

@@ -341,7 +341,7 @@ void gptPairEnvironment(inout OffsetPath o, vec3 beta, vec3 le) {
     if (!o.alive)
         addPair(o, 1.0, beta * le, vec3(0.0));
     else
-        addPair(o, gptMisWeightPair(o.r), beta * le, o.beta * le);
+        addPair(o, gptMisWeightPair(o.countRatio * o.r), beta * le, o.beta * le);
 }
 
 // An emitter at the base's next vertex (emission le, reached with BSDF density pdfBsdf, light
@@ -354,11 +354,12 @@ void gptPairEmitter(inout OffsetPath o, bool own, vec3 beta, vec3 le, float pdfB
     if (own && o.alive) {
         vec3 leO = surfaceEmission(o.hit);
         if (maxComponent(le) > 0.0 || maxComponent(leO) > 0.0)
-            addPair(o, gptMisWeightPair(o.r), beta * le, o.beta * leO);
+            addPair(o, gptMisWeightPair(o.countRatio * o.r), beta * le, o.beta * leO);
     } else if (maxComponent(le) > 0.0) {
         bool alive = o.alive;
         float w =
-            gptMisWeight(pdfBsdf, pdfLight, alive ? o.r * pdfBsdf : 0.0, alive ? o.rLight * pdfLight : 0.0);
+            gptMisWeight(pdfBsdf, pdfLight, alive ? o.countRatio * o.r * pdfBsdf : 0.0,
+                         alive ? o.countRatio * o.rLight * pdfLight : 0.0);
         addPair(o, w, beta * le, alive ? o.beta * le : vec3(0.0));
     }
 }

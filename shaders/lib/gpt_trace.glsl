@@ -24,10 +24,12 @@ bool ownVertex(OffsetPath o, bool general) { return general && o.state == kShift
 // Base + 4 offsets for one camera sample at pixelPos (continuous pixel coordinates).
 // countDirect false: the emission seen by the camera ray is left to emitter-silhouette
 // supersampling (visible_emission.glsl) and `direct` stays zero.
+// countRatio[i]: n_q / n_p, the sample counts of pair i's two pixels (OffsetPath::countRatio).
 // baseModulation: the base's first-hit modulation (1 unless kDemodulate; offs[i].modulation
 // the offsets').
-void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, bool countDirect, inout uint rays,
-                 out vec3 direct, out vec3 baseModulation, inout OffsetPath offs[kGptNumOffsets]) {
+void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, bool countDirect, vec4 countRatio,
+                 inout uint rays, out vec3 direct, out vec3 baseModulation,
+                 inout OffsetPath offs[kGptNumOffsets]) {
     direct = vec3(0.0);
     baseModulation = vec3(1.0);
     for (uint i = 0u; i < kGptNumOffsets; ++i) {
@@ -39,6 +41,7 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
         offs[i].beta = vec3(1.0);  // pinhole, box filter: camera weight 1 for every pixel
         offs[i].r = 1.0;           // image-plane translation: Jacobian 1, same pixel pdf
         offs[i].rLight = 1.0;
+        offs[i].countRatio = countRatio[i];
         offs[i].state = kShiftNotConnected;
     }
 

@@ -238,6 +238,15 @@ GDPT_INLINE SegmentShift shiftSegment(vec3 f, float pdfOffset, float jacobian, f
 // last segment's Jacobian, i.e. already in the base's measure. The sum is normalised by its
 // largest term first, so no square overflows or underflows (GGX pdfs reach 1e20). A zero
 // pOther/qOther removes that strategy. Returns 0 for pOwn <= 0 or any NaN.
+//
+// Sample counts: where the pair's two pixels take different numbers of samples (n_p at the
+// base's pixel, n_q at the offset's: G-PT's edge samples), the caller multiplies qOwn and
+// qOther (and r in gptMisWeightPair) by c = n_q / n_p, which is Veach's multi-sample power
+// heuristic w_i = (n_i p_i)² / Σ_k (n_k p_k)² (Veach 1997 eq. 9.13 with n_i) divided by n_p².
+// The reverse shift, sampled at q, uses 1/c, so a pair's weights still sum to 1 for any fixed
+// c: the estimate stays unbiased whatever the counts are, and the better-sampled pixel carries
+// more of the pair. With c = 3 and equal densities the weights are 0.9 / 0.1 instead of
+// 0.5 / 0.5, and the pair's variance σ²(0.81 / 3 + 0.01) instead of σ²(0.25 / 3 + 0.25).
 GDPT_INLINE float gptMisWeight(float pOwn, float pOther, float qOwn, float qOther) {
     if (!(pOwn > 0.0f) || !(pOther >= 0.0f) || !(qOwn >= 0.0f) || !(qOther >= 0.0f)) {
         return 0.0f;

@@ -20,7 +20,7 @@ GDPT_CONST uint kGptLeft = 2u;
 GDPT_CONST uint kGptUp = 3u;
 GDPT_CONST uint kGptNumOffsets = 4u;
 
-// Per-batch push constants of gpt.comp and gpt_resolve.comp (<= 128 bytes). 40 bytes.
+// Per-batch push constants of gpt.comp and gpt_resolve.comp (<= 128 bytes). 44 bytes.
 struct GptFrameParams {
     uint sampleBase;       // index of the first sample of this batch (per pixel)
     uint samplesPerPixel;  // samples per pixel in this batch
@@ -38,6 +38,9 @@ struct GptFrameParams {
                            // stream kBindGptStreamKey[p] names instead of stream p, and shift
                            // their position in the pixel by its jitter shift (temporal G-PT's
                            // motion-carried shift, motion_map.h); 0: stream p, unshifted
+    uint sampleRates;      // 1: pixels take different numbers of samples (edge samples), in the
+                           // proportions kBindGptSampleRate holds, and each pair's MIS weights
+                           // count them (shift.glsl); 0: every pixel the same number
 };
 
 // Where pixel p's camera samples come from when GptFrameParams::streamKeys is 1. 8 bytes.
@@ -100,12 +103,15 @@ kBindGptCentral = 40u,        // base's MIS-weighted radiance summed over the pa
     kBindGptModulation = 54u,  // PixelStats per pixel: m at the base paths' first hits (1 where
                                // not demodulated, also on a miss)
     kBindGptEdgeProbe = 55u,   // EdgeProbe per pixel written by edge.comp
-    kBindGptStreamKey = 56u    // PixelStream per pixel: where its camera samples come from (read
+    kBindGptStreamKey = 56u,   // PixelStream per pixel: where its camera samples come from (read
                                // when GptFrameParams::streamKeys is 1)
+    kBindGptSampleRate = 57u   // uint per pixel: its camera samples per camera sample of the
+                               // image, 1 + edge factor in the listed pixels, else 1 (read when
+                               // GptFrameParams::sampleRates is 1)
     GDPT_ENUM_END();
 
 #ifdef __cplusplus
-static_assert(sizeof(GptFrameParams) == 40, "GptFrameParams layout");
+static_assert(sizeof(GptFrameParams) == 44, "GptFrameParams layout");
 static_assert(sizeof(GptResolved) == 96, "GptResolved layout (scalar)");
 static_assert(sizeof(EdgeProbe) == 32, "EdgeProbe layout (scalar)");
 static_assert(sizeof(PixelStream) == 8, "PixelStream layout (scalar)");

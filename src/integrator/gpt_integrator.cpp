@@ -29,6 +29,7 @@ ExrAttributes GptIntegrator::identity(const Scene& scene, const RenderOptions& o
     return {{"shift_threshold", exactFloat(options.scene.shiftThreshold)},
             {"edge_samples", edgeSamplesText(options_.sampling.edgeSamples)},
             {"edge_sample_pixels", kEdgeSamplePixels},
+            {"pair_weights", kPairWeights},
             {"demodulate", demodulates(scene, options_.sampling.demodulate) ? "on" : "off"}};
 }
 

@@ -183,6 +183,7 @@ ExrAttributes TgptIntegrator::identity(const Scene& scene, const RenderOptions& 
     return {{"shift_threshold", exactFloat(options.scene.shiftThreshold)},
             {"edge_samples", edgeSamplesText(options_.sampling.edgeSamples)},
             {"edge_sample_pixels", kEdgeSamplePixels},
+            {"pair_weights", kPairWeights},
             {"window", std::to_string(options_.window)},
             {"temporal_shift", temporalShiftName(options_.shift)}};
 }

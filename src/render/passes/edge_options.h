@@ -56,6 +56,23 @@ inline std::vector<std::uint32_t> edgeSampleList(const std::vector<std::uint32_t
     return list;
 }
 
+// Each pixel's camera samples per camera sample of the image (kBindGptSampleRate): 1 + factor
+// in the pixels of `list` (edgeSampleList's), 1 elsewhere. gpt.comp weighs each pair's two
+// ends by these counts (shift.glsl, "sample counts in the weights").
+inline std::vector<std::uint32_t> edgeSampleRates(const std::vector<std::uint32_t>& list,
+                                                  std::uint32_t factor, std::uint32_t width,
+                                                  std::uint32_t height) {
+    std::vector<std::uint32_t> rates(std::size_t{width} * height, 1u);
+    for (std::uint32_t p : list)
+        if (p < rates.size()) rates[p] = 1u + factor;
+    return rates;
+}
+
+// How G-PT's pair weights treat the two ends' sample counts, as checkpoints and shards record
+// it (`pair_weights`): a checkpoint written before the counts entered the weights (2026-12-05)
+// holds samples weighted otherwise, and resuming it would not be the render the output names.
+inline constexpr const char* kPairWeights = "sample-counts";
+
 // The rule of edgeSampleList as checkpoints and shards record it (`edge_sample_pixels`): one
 // written with the edge pixels alone (before 2026-12-05) has other pixels' counts and is refused.
 inline constexpr const char* kEdgeSamplePixels = "edges+neighbours";

@@ -43,7 +43,8 @@ EdgePass::EdgePass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize
       maskBuffer_(ctx, enabled() ? std::uint64_t{width_} * height_ * sizeof(std::uint32_t) : 0, "edge mask"),
       probeBuffer_(ctx, enabled() ? std::uint64_t{width_} * height_ * sizeof(gpu::EdgeProbe) : 0,
                    "edge probe"),
-      list_(ctx, 0, "edge list") {
+      list_(ctx, 0, "edge list"),
+      rates_(ctx, 0, "edge sample rates") {
     if (!enabled()) return;
     vk::KernelDesc d = scene.kernelDesc(GDPT_TRACING_KERNEL("edge", edge), ctx.info(), wg,
                                         {gpu::kBindGptEdgeMask, gpu::kBindGptEdgeProbe}, 0);
@@ -58,10 +59,12 @@ void EdgePass::attach(const SceneGpu& scene) {
 
 void EdgePass::configure(vk::KernelDesc& desc) {
     desc.bindings.push_back(gpu::kBindGptEdgeList);
+    desc.bindings.push_back(gpu::kBindGptSampleRate);
 }
 
 void EdgePass::bindTo(vk::Kernel& kernel) const {
     kernel.bindAddress(gpu::kBindGptEdgeList, list_);
+    kernel.bindAddress(gpu::kBindGptSampleRate, rates_);
 }
 
 void EdgePass::find(vk::CommandStream& stream) {
@@ -81,6 +84,8 @@ void EdgePass::find(vk::CommandStream& stream) {
     if (count_ > 0) {
         list_ = vk::Buffer(ctx_, list.size() * sizeof(std::uint32_t), "edge list");
         list_.uploadVector(list);
+        rates_ = vk::Buffer(ctx_, mask_.size() * sizeof(std::uint32_t), "edge sample rates");
+        rates_.uploadVector(edgeSampleRates(list, samplesPerSpp_, width_, height_));
     }
     found_ = true;
 }

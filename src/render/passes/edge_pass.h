@@ -40,10 +40,11 @@ public:
     [[nodiscard]] bool enabled() const { return samplesPerSpp_ > 0 || maskNeeded_; }
     // The factor (with kEdgeSamplesAuto: kEdgeSamplesAuto until find() has chosen it).
     [[nodiscard]] std::uint32_t samplesPerSpp() const { return samplesPerSpp_; }
-    // Adds the list binding (kBindGptEdgeList) to a kernel's descriptor.
+    // Adds the list and sample-rate bindings (kBindGptEdgeList, kBindGptSampleRate) to a
+    // kernel's descriptor.
     static void configure(vk::KernelDesc& desc);
-    // Binds the list to such a kernel (a placeholder before find() or when disabled); call
-    // again after find().
+    // Binds the list and the rates to such a kernel (placeholders before find() or when
+    // disabled); call again after find().
     void bindTo(vk::Kernel& kernel) const;
     // Probes the image on `stream` (submits and waits) and uploads the list. Once per pass;
     // later calls return at once. Nothing when disabled.
@@ -51,6 +52,9 @@ public:
     // Pixels that get the extra samples (edgeSampleList: the edge pixels and their four
     // neighbours; 0 before find() or when disabled).
     [[nodiscard]] std::uint32_t count() const { return count_; }
+    // Whether the listed pixels take more samples than the others (after find(): some pixel
+    // listed and a factor above 0): gpt.comp then reads the rates (GptFrameParams::sampleRates).
+    [[nodiscard]] bool ratesDiffer() const { return count_ > 0 && samplesPerSpp_ > 0 && found_; }
     // Edge pixels the probe found (0 before find() or when disabled).
     [[nodiscard]] std::uint32_t edgeCount() const { return edgeCount_; }
     // The per-pixel mask of the last find() (1 = edge); empty before.
@@ -67,6 +71,7 @@ private:
     vk::Buffer maskBuffer_;
     vk::Buffer probeBuffer_;
     vk::Buffer list_;
+    vk::Buffer rates_;  // edgeSampleRates per pixel once the list has pixels
     std::vector<std::uint32_t> mask_;
     std::vector<gpu::EdgeProbe> probes_;
     std::uint32_t count_ = 0;

@@ -68,6 +68,7 @@ std::vector<PixelBuffer> pixelBuffers(const GptPassOptions& options) {
                                   {"the emitter-supersampling statistics", sizeof(gpu::PixelStats)},
                                   {"the emitter-supersampling probe", sizeof(std::uint32_t)},
                                   {"the edge mask", sizeof(std::uint32_t)},
+                                  {"the edge sample rates", sizeof(std::uint32_t)},
                                   {"the edge probe", sizeof(gpu::EdgeProbe)}};
     if (options.demodulate) {
         b.push_back({"the demodulation mask", sizeof(std::uint32_t)});
@@ -223,6 +224,7 @@ gpu::GptFrameParams GptPass::frameParams() const {
     p.width = width_;
     p.height = height_;
     p.streamKeys = options_.streams ? 1u : 0u;
+    p.sampleRates = edges_.ratesDiffer() ? 1u : 0u;
     return p;
 }
 

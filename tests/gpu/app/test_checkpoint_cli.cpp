@@ -320,6 +320,12 @@ TEST_F(CheckpointRefusal, GptCheckpointWithTheAutomaticEdgeFactorResumesAndIsChe
     older.erase("gdpt.id.edge_sample_pixels");
     writeExr(path("older.exr"), readExr(c), older);
     expectRefused(path("older.exr"), flags, "does not record edge_sample_pixels");
+    // One from before the pairs' weights counted the two pixels' samples is refused too.
+    EXPECT_EQ(readExrAttributes(c).at("gdpt.id.pair_weights"), kPairWeights);
+    ExrAttributes equalWeights = readExrAttributes(c);
+    equalWeights.erase("gdpt.id.pair_weights");
+    writeExr(path("equal_weights.exr"), readExr(c), equalWeights);
+    expectRefused(path("equal_weights.exr"), flags, "does not record pair_weights");
 }
 
 // Guards the class "a refused resume names the real difference": another method or size

@@ -47,6 +47,17 @@ TEST(EdgeOptions, TheSampledPixelsAreTheEdgePixelsAndTheirFourNeighbours) {
     EXPECT_TRUE(edgeSampleList(mask, w, h + 1).empty());  // a mask of another size
 }
 
+// The rate of each pixel (gpt.comp's sample counts in the pair weights): 1 + factor in the
+// listed pixels, 1 in the others; a list entry outside the image is ignored.
+TEST(EdgeOptions, SampleRatesAreOnePlusTheFactorInTheListedPixels) {
+    const std::uint32_t w = 4, h = 3;
+    const std::vector<std::uint32_t> rates = edgeSampleRates({1, 5, 6, 11, 12}, 2, w, h);
+    const std::vector<std::uint32_t> expected = {1, 3, 1, 1, 1, 3, 3, 1, 1, 1, 1, 3};
+    EXPECT_EQ(rates, expected);
+    EXPECT_EQ(edgeSampleRates({}, 2, w, h), std::vector<std::uint32_t>(w * h, 1u));
+    EXPECT_EQ(edgeSampleRates({0, 1}, 0, w, h), std::vector<std::uint32_t>(w * h, 1u));
+}
+
 TEST(EdgeOptions, ParsesAutoAndWholeNumbersAndRefusesTheRest) {
     EXPECT_EQ(parseEdgeSamples("auto", "x"), kEdgeSamplesAuto);
     EXPECT_EQ(parseEdgeSamples("0", "x"), 0u);

@@ -395,6 +395,36 @@ TEST(ShiftMis, FourStrategyWeightsOfForwardAndReverseSumToOne) {
     }
 }
 
+// Pixels with different sample counts (edge samples): the forward weights with c = n_q / n_p
+// times the offset's densities and the reverse ones with 1 / c still sum to one (so any fixed
+// counts keep a pair unbiased), and they are Veach's multi-sample power heuristic with the
+// counts, (n_p p)² / Σ (n_k p_k)², computed here in double precision.
+TEST(ShiftMis, SampleCountsKeepTheWeightsSummingToOneAsVeachsMultiSampleHeuristic) {
+    Source src(33);
+    const double counts[][2] = {{3, 1}, {1, 3}, {65, 1}, {2, 5}, {1, 1}};
+    for (const auto& n : counts) {
+        const float c = static_cast<float>(n[1] / n[0]);  // n_q / n_p, p the base's pixel
+        for (int i = 0; i < 500; ++i) {
+            const double pB = std::pow(10.0, src.uniform(-3, 3)), pL = std::pow(10.0, src.uniform(-3, 3));
+            const double qB = std::pow(10.0, src.uniform(-3, 3)), qL = std::pow(10.0, src.uniform(-3, 3));
+            // Four strategies: base BSDF and light at p's rate, the offset's at q's.
+            const float fB = gptMisWeight(float(pB), float(pL), c * float(qB), c * float(qL));
+            const float fL = gptMisWeight(float(pL), float(pB), c * float(qL), c * float(qB));
+            const float rB = gptMisWeight(float(qB), float(qL), float(pB) / c, float(pL) / c);
+            const float rL = gptMisWeight(float(qL), float(qB), float(pL) / c, float(pB) / c);
+            EXPECT_NEAR(fB + fL + rB + rL, 1.0f, 2e-5f) << c << " " << i;
+            const auto sq = [](double v) { return v * v; };
+            const double all = sq(n[0] * pB) + sq(n[0] * pL) + sq(n[1] * qB) + sq(n[1] * qL);
+            EXPECT_NEAR(fB, sq(n[0] * pB) / all, 1e-5) << c << " " << i;
+            // Two strategies (half-vector branch, environment): r = J p' / p.
+            const float r = static_cast<float>(qB / pB);
+            EXPECT_NEAR(gptMisWeightPair(c * r) + gptMisWeightPair((1.0f / c) / r), 1.0f, 1e-5f);
+        }
+    }
+    // Equal densities, three samples at p for one at q: p's paths carry 0.9 of the pair.
+    EXPECT_NEAR(gptMisWeightPair(1.0f / 3.0f), 0.9f, 1e-6f);
+}
+
 TEST(ShiftMis, RatioFormSurvivesExtremePdfsAndRejectsBadInput) {
     EXPECT_NEAR(gptMisWeight(1e30f, 1e25f, 1e20f, 0.0f), 1.0f, 1e-6f);
     EXPECT_NEAR(gptMisWeight(1e-30f, 1e-30f, 1e-30f, 1e-30f), 0.25f, 1e-6f);
