@@ -38,9 +38,10 @@ inline std::uint32_t autoEdgeSamples(std::uint64_t listed, std::uint64_t pixels)
 // The pixels that get the extra samples, in ascending order: every pixel of `mask` (W·H, non-zero
 // = a geometric edge crosses it) and its four neighbours. Each pair's gradient, and its part of
 // the primal, is estimated from the samples of both of its pixels, each part averaged over its
-// own pixel's samples, with MIS weights that treat the two ends alike (gpt_resolve.comp); extra
-// samples at the edge pixel alone leave the neighbour's part of every pair it shares with the
-// edge at the base rate, and that part's noise then dominates the pair.
+// own pixel's samples (gpt_resolve.comp); extra samples at the edge pixel alone leave the
+// neighbour's part of every pair it shares with the edge at the base rate, and that part's noise
+// then dominated the pair when the MIS weights treated both ends alike, which is when this list
+// was measured (the weights now count the two ends' samples, shift.glsl).
 inline std::vector<std::uint32_t> edgeSampleList(const std::vector<std::uint32_t>& mask, std::uint32_t width,
                                                  std::uint32_t height) {
     std::vector<std::uint32_t> list;
