@@ -224,7 +224,7 @@ gpu::GptFrameParams GptPass::frameParams() const {
     p.width = width_;
     p.height = height_;
     p.streamKeys = options_.streams ? 1u : 0u;
-    p.sampleRates = edges_.ratesDiffer() ? 1u : 0u;
+    p.sampleRates = options_.countWeights && edges_.ratesDiffer() ? 1u : 0u;
     return p;
 }
 

@@ -42,6 +42,10 @@ struct GptPassOptions {
     // Extra camera samples per camera sample in the pixels a geometric edge crosses
     // (edge_pass.h; 0 = off, kEdgeSamplesAuto = the rule of edge_options.h).
     std::uint32_t edgeSamples = kEdgeSamplesAuto;
+    // The pair weights count the two pixels' sample counts where the edge samples make them
+    // differ (shift.glsl, "Sample counts"); false: both ends alike, as before 2026-12-05 (tests
+    // and measurements).
+    bool countWeights = true;
     // First-hit texture demodulation (gpt.comp, kSpecGptDemodulate) in the pixels that
     // demodulationMask keeps (away from the edge probe's edges and from neighbours whose probe
     // saw another surface); GptImages::modulation then holds m̄ and primal/dx/dy are of

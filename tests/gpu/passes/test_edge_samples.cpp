@@ -139,15 +139,16 @@ TEST_F(EdgeSamples, SmoothSphereSeenFromInsideHasNoEdges) {
 
 // A G-PT pass over stepScene() at kSize² with `edgeSamples`, its edges found.
 struct StepPass {
-    StepPass(const vk::Context& ctx, std::uint32_t edgeSamples)
+    StepPass(const vk::Context& ctx, std::uint32_t edgeSamples, bool countWeights = true)
         : gpu(ctx, stepScene(), sizeOptions()),
-          pass(ctx, gpu, WorkgroupSize{}, passOptions(edgeSamples)),
+          pass(ctx, gpu, WorkgroupSize{}, passOptions(edgeSamples, countWeights)),
           stream(ctx, "edge test") {
         pass.findEdges(stream);
     }
-    static GptPassOptions passOptions(std::uint32_t edgeSamples) {
+    static GptPassOptions passOptions(std::uint32_t edgeSamples, bool countWeights) {
         GptPassOptions o;
         o.edgeSamples = edgeSamples;
+        o.countWeights = countWeights;
         return o;
     }
     SceneGpu gpu;
@@ -211,6 +212,67 @@ TEST_F(EdgeSamples, TheAutomaticFactorFollowsTheListedPixelsShare) {
             if (stats[0][std::size_t(y) * kSize + x].count != expected) ++wrong;
         }
     EXPECT_EQ(wrong, 0);
+}
+
+// The pair weights count the two ends' samples (shift.glsl): the same samples weighted with and
+// without the counts give bit-identical statistics wherever a pixel and all its neighbours have
+// one rate, and where an unlisted pixel q borders the list, its primal (the average of its pair
+// estimators) takes the listed neighbour p's (1 + K) × spp paths at weight 16/17 instead of 1/2
+// (K = 3, equal densities): var_primal(q) falls to about 0.71 of the equal weights' (the pair
+// (q, p): 0.3125 σ²/n → 0.225 σ²/n; with the three other pairs and the shared central term,
+// 0.30 → 0.21 σ²/n; measured 0.70). Summed over the 256 such pixels, each variance estimated
+// from 16 samples (relative noise sqrt(2/15) per pixel, about 2.3 % on the sum), the test asks
+// for below 0.85 (and above 0.5): weights reversed (c for 1/c) or not counted fail it.
+TEST_F(EdgeSamples, PairWeightsCountTheSamplesOfBothEnds) {
+    constexpr std::uint32_t kFactor = 3, kSpp = 16, kSeed = 11;
+    auto render = [&](bool countWeights) {
+        StepPass step(ctx(), kFactor, countWeights);
+        step.pass.record(step.stream.begin(), 0, kSpp, kSeed, nullptr);
+        step.stream.submitAndWait();
+        VkCommandBuffer cmd = step.stream.begin();
+        step.pass.resolve(cmd, nullptr);
+        step.stream.submitAndWait();
+        return std::pair{step.pass.downloadStats(), step.pass.readback()};
+    };
+    const auto [countedStats, counted] = render(true);
+    const auto [equalStats, equal] = render(false);
+    const auto listed = withNeighbours(squareOutline());
+    const auto rate = [&](int x, int y) { return listed.count({x, y}) ? 1 + kFactor : 1u; };
+    const auto uniform = [&](int x, int y) {  // the pixel and its neighbours share one rate
+        for (const auto& [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+            const int u = x + dx, v = y + dy;
+            if (u >= 0 && v >= 0 && u < kSize && v < kSize && rate(u, v) != rate(x, y)) return false;
+        }
+        return true;
+    };
+    int differingUniform = 0, differingBorder = 0, border = 0;
+    double varCounted = 0.0, varEqual = 0.0;
+    for (int y = 0; y < kSize; ++y)
+        for (int x = 0; x < kSize; ++x) {
+            const std::size_t i = std::size_t(y) * kSize + x;
+            bool same = true;
+            for (std::size_t b = 0; b < 9; ++b)  // central, neighbours, gradients
+                for (int c = 0; c < 3; ++c)
+                    same = same && countedStats[b][i].mean[c] == equalStats[b][i].mean[c] &&
+                           countedStats[b][i].m2[c] == equalStats[b][i].m2[c];
+            if (uniform(x, y)) {
+                differingUniform += same ? 0 : 1;
+                continue;
+            }
+            differingBorder += same ? 0 : 1;
+            if (rate(x, y) != 1) continue;  // an unlisted pixel next to the list
+            ++border;
+            for (int c = 0; c < 3; ++c) {
+                varCounted += counted.varPrimal.at(x, y, c);
+                varEqual += equal.varPrimal.at(x, y, c);
+            }
+        }
+    EXPECT_EQ(differingUniform, 0);
+    EXPECT_GT(differingBorder, border);  // both sides of the list's border changed
+    EXPECT_GT(border, 100);
+    ASSERT_GT(varEqual, 0.0);
+    EXPECT_LT(varCounted / varEqual, 0.85) << varCounted << " / " << varEqual;
+    EXPECT_GT(varCounted / varEqual, 0.5) << varCounted << " / " << varEqual;
 }
 
 TEST_F(EdgeSamples, OffMeansNoProbeAndNoExtraSamples) {
