@@ -172,9 +172,7 @@ void main() {
     if (frame.sampleRates != 0u) {
         float own = float(sampleRate[pixel]);
         for (uint i = 0u; i < kGptNumOffsets; ++i) {
-            if (!gptPairExists(x, y, i)) continue;
-            ivec2 q = ivec2(x, y) + kOffsetDelta[i];
-            countRatio[i] = float(sampleRate[uint(q.y) * scene.width + uint(q.x)]) / own;
+            if (gptPairExists(x, y, i)) countRatio[i] = float(sampleRate[gptPairPixel(x, y, i)]) / own;
         }
     }
     for (uint s = 0u; s < frame.samplesPerPixel; ++s) {

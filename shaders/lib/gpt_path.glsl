@@ -33,6 +33,13 @@ bool gptPairExists(uint px, uint py, uint i) {
     return q.x >= 0 && q.y >= 0 && q.x < int(scene.width) && q.y < int(scene.height);
 }
 
+// The index (y·width + x) of pixel p + δ_i, the other end of pair i; only for a pair that
+// exists (gptPairExists).
+uint gptPairPixel(uint px, uint py, uint i) {
+    ivec2 q = ivec2(px, py) + kOffsetDelta[i];
+    return uint(q.y) * scene.width + uint(q.x);
+}
+
 // Whether the base path accumulates the pair (p, p + δ_i): every existing pair, and in a 1x1
 // image, which has none, the right one as a pair whose shift always fails (its offset is never
 // alive, gpt.comp). Its weights are then the lone base's, the path tracer's (MIS of NEE and

@@ -70,8 +70,8 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
         offs[i].hit = makeSurfaceHit(hi.triangle, hi.u, hi.v, di);
         offs[i].woWorld = -di;
         if (kDemodulate) {
-            ivec2 q = ivec2(px, py) + kOffsetDelta[i];  // inside the image: the pair exists
-            offs[i].modulation = firstHitModulation(offs[i].hit, uint(q.y) * scene.width + uint(q.x));
+            // The offset is alive, so its pair exists and q is inside the image.
+            offs[i].modulation = firstHitModulation(offs[i].hit, gptPairPixel(px, py, i));
         }
     }
 

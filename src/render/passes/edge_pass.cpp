@@ -84,6 +84,8 @@ void EdgePass::find(vk::CommandStream& stream) {
     if (count_ > 0) {
         list_ = vk::Buffer(ctx_, list.size() * sizeof(std::uint32_t), "edge list");
         list_.uploadVector(list);
+    }
+    if (ratesDiffer()) {  // else gpt.comp reads no rate (a probe for demodulation alone: factor 0)
         rates_ = vk::Buffer(ctx_, mask_.size() * sizeof(std::uint32_t), "edge sample rates");
         rates_.uploadVector(edgeSampleRates(list, samplesPerSpp_, width_, height_));
     }

@@ -54,7 +54,7 @@ public:
     [[nodiscard]] std::uint32_t count() const { return count_; }
     // Whether the listed pixels take more samples than the others (after find(): some pixel
     // listed and a factor above 0): gpt.comp then reads the rates (GptFrameParams::sampleRates).
-    [[nodiscard]] bool ratesDiffer() const { return count_ > 0 && samplesPerSpp_ > 0 && found_; }
+    [[nodiscard]] bool ratesDiffer() const { return count_ > 0 && samplesPerSpp_ > 0; }
     // Edge pixels the probe found (0 before find() or when disabled).
     [[nodiscard]] std::uint32_t edgeCount() const { return edgeCount_; }
     // The per-pixel mask of the last find() (1 = edge); empty before.
@@ -71,7 +71,7 @@ private:
     vk::Buffer maskBuffer_;
     vk::Buffer probeBuffer_;
     vk::Buffer list_;
-    vk::Buffer rates_;  // edgeSampleRates per pixel once the list has pixels
+    vk::Buffer rates_;  // edgeSampleRates per pixel where they differ (ratesDiffer)
     std::vector<std::uint32_t> mask_;
     std::vector<gpu::EdgeProbe> probes_;
     std::uint32_t count_ = 0;
