@@ -21,6 +21,13 @@
 // Offset i has a vertex of its own (NOT_CONNECTED); never in the fast form (general false).
 bool ownVertex(OffsetPath o, bool general) { return general && o.state == kShiftNotConnected; }
 
+// Some live offset has a vertex of its own.
+bool anyOwnVertex(OffsetPath offs[kGptNumOffsets]) {
+    bool own = false;
+    for (uint i = 0u; i < kGptNumOffsets; ++i) own = own || (offs[i].alive && ownVertex(offs[i], true));
+    return own;
+}
+
 // Base + 4 offsets for one camera sample at pixelPos (continuous pixel coordinates).
 // countDirect false: the emission seen by the camera ray is left to emitter-silhouette
 // supersampling (visible_emission.glsl) and `direct` stays zero.
@@ -78,22 +85,30 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     vec3 beta = vec3(1.0);  // base f/p
     uint depth = 0u;
     bool pathEnded = false;
-    // General bounces; in the split build only while some live offset has a vertex of its
-    // own (the first bounce always, if any offset hit), then the fast form.
-    for (; depth < kMaxDepth && depth < scene.maxDepth; ++depth) {
 #ifdef GDPT_GPT_SPLIT_BOUNCE
-        bool own = false;
-        for (uint i = 0u; i < kGptNumOffsets; ++i) own = own || (offs[i].alive && ownVertex(offs[i], true));
-        if (!own) break;
-#endif
+    // General bounces while some live offset has a vertex of its own, then the fast form. The
+    // test comes at the end of the general body: lavapipe before Mesa 23 runs a loop's body
+    // under an empty lane mask rather than skip it, so a loop that every lane leaves at its
+    // head still costs a whole general bounce (3-4 % of a sample, bench/RESULTS.md). The
+    // first bounce is general for every lane, which is right whatever the offsets' states.
+    for (; depth < kMaxDepth && depth < scene.maxDepth; ++depth) {
 #define GDPT_GPT_GENERAL true
 #include "lib/gpt_bounce.glsl"
 #undef GDPT_GPT_GENERAL
+        if (!anyOwnVertex(offs)) {
+            ++depth;
+            break;
+        }
     }
-#ifdef GDPT_GPT_SPLIT_BOUNCE
     if (pathEnded) return;
     for (; depth < kMaxDepth && depth < scene.maxDepth; ++depth) {
 #define GDPT_GPT_GENERAL false
+#include "lib/gpt_bounce.glsl"
+#undef GDPT_GPT_GENERAL
+    }
+#else
+    for (; depth < kMaxDepth && depth < scene.maxDepth; ++depth) {
+#define GDPT_GPT_GENERAL true
 #include "lib/gpt_bounce.glsl"
 #undef GDPT_GPT_GENERAL
     }
