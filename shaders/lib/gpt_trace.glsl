@@ -89,16 +89,16 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     // General bounces while some live offset has a vertex of its own, then the fast form. The
     // test comes at the end of the general body: lavapipe before Mesa 23 runs a loop's body
     // under an empty lane mask rather than skip it, so a loop that every lane leaves at its
-    // head still costs a whole general bounce (3-4 % of a sample, bench/RESULTS.md). The
-    // first bounce is general for every lane, which is right whatever the offsets' states.
-    for (; depth < kMaxDepth && depth < scene.maxDepth; ++depth) {
+    // head still costs a whole general bounce (2-4 % of a sample, for about 25 ms more
+    // pipeline creation; bench/RESULTS.md "Loop tests after the body"). The first bounce is
+    // general for every lane, which is right whatever the offsets' states.
+    if (depth < kMaxDepth && depth < scene.maxDepth) {
+        do {
 #define GDPT_GPT_GENERAL true
 #include "lib/gpt_bounce.glsl"
 #undef GDPT_GPT_GENERAL
-        if (!anyOwnVertex(offs)) {
             ++depth;
-            break;
-        }
+        } while (depth < kMaxDepth && depth < scene.maxDepth && anyOwnVertex(offs));
     }
     if (pathEnded) return;
     for (; depth < kMaxDepth && depth < scene.maxDepth; ++depth) {
