@@ -345,7 +345,7 @@ void gptHalfVectorDone(inout OffsetPath o, BaseSegment s, bool offCurRough, vec3
 // closest-hit query (for the reconnection's visibility, any hit before tMax occludes: the
 // same answer as traceAny's): lavapipe before Mesa 23 runs every branch that any lane of a
 // SIMD vector takes, so two call sites cost two traversal loops wherever a vector holds
-// offsets of both kinds (glossy_cornell: 4-6 % less time per sample, the same bits).
+// offsets of both kinds (glossy_cornell: 2.5 % less time per sample, the same bits).
 void gptOwnVertexShift(inout OffsetPath o, OffsetVertex v, BaseSegment s, bool reconnect, bool offCurRough,
                        inout uint rays) {
     ConnectionShift c;
