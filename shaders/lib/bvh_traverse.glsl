@@ -552,11 +552,22 @@ bool traceAny(vec3 orig, vec3 dir, float tMin, float tMax) {
 // coordinate near 0 in an 85 m scene) and moves the ray towards the target's plane -- next-
 // event estimation from a floor at y = 0 of a large scene to a lamp 3 m above it was occluded
 // for most light points.
-bool occludedTowards(vec3 origin, vec3 target) {
+//
+// towardsTarget gives that ray (unit direction, tMax) for callers that trace it themselves; it
+// is false for a zero or NaN distance, where nothing occludes.
+bool towardsTarget(vec3 origin, vec3 target, out vec3 dir, out float tMax) {
     vec3 d = target - origin;
     float len = length(d);
-    if (!(len > 0.0)) return false;
-    return traceAny(origin, d / len, 0.0, len * (1.0 - 1e-4));
+    dir = d / len;
+    tMax = len * (1.0 - 1e-4);
+    return len > 0.0;
+}
+
+bool occludedTowards(vec3 origin, vec3 target) {
+    vec3 dir;
+    float tMax;
+    if (!towardsTarget(origin, target, dir, tMax)) return false;
+    return traceAny(origin, dir, 0.0, tMax);
 }
 #endif  // !__cplusplus
 

@@ -261,8 +261,7 @@ ShiftRay noShiftRay(vec3 origin) {
 // NOT_CONNECTED offset, reconnection shift, first half: to the base's next vertex, or the
 // environment shift in the same direction. Afterwards the offset shares every later vertex
 // with the base (RECENTLY_CONNECTED). The ray is the visibility test (occludedTowards's for a
-// vertex: aimed from the offset origin, stopped a relative 1e-4 short of the target); any hit
-// on it occludes.
+// vertex, towardsTarget); any hit on it occludes.
 ShiftRay gptReconnectRay(inout OffsetPath o, OffsetVertex v, BaseSegment s, out ConnectionShift c) {
     SurfaceHit oh = o.hit;
     ShiftRay ray = noShiftRay(offsetRayOriginScaled(oh.p, oh.ng, scene.sceneRadius));
@@ -279,13 +278,7 @@ ShiftRay gptReconnectRay(inout OffsetPath o, OffsetVertex v, BaseSegment s, out 
         o.state = kShiftRecentlyConnected;
         ray.dir = c.wi;
         ray.trace = true;
-        if (!s.missed) {
-            vec3 d = s.next.p - ray.origin;
-            float len = length(d);
-            ray.trace = len > 0.0;
-            ray.dir = ray.trace ? d / len : c.wi;
-            ray.tMax = len * (1.0 - 1e-4);
-        }
+        if (!s.missed) ray.trace = towardsTarget(ray.origin, s.next.p, ray.dir, ray.tMax);
     }
     return ray;
 }
