@@ -173,6 +173,23 @@ GDPT_INLINE uvec4 wideCounts(BvhWideNode n) {
     return uvec4(c & 255u, (c >> 8u) & 255u, (c >> 16u) & 255u, c >> 24u);
 }
 
+// Slab tests of four boxes, given per axis as their lower and upper bounds (one vec4 component
+// per child slot), for (tMin, tFarLimit): intersectBox, four at once; hit[k] is false for an
+// empty slot (child[k] = kInvalidIndex).
+GDPT_INLINE void wideSlabs(vec4 loX, vec4 hiX, vec4 loY, vec4 hiY, vec4 loZ, vec4 hiZ, uvec4 child, vec3 orig,
+                           vec3 invDir, float tMin, float tFarLimit, GDPT_OUT(vec4) tNear, GDPT_OUT(bvec4) hit) {
+    vec4 t0x = (loX - orig.x) * invDir.x;
+    vec4 t1x = (hiX - orig.x) * invDir.x;
+    vec4 t0y = (loY - orig.y) * invDir.y;
+    vec4 t1y = (hiY - orig.y) * invDir.y;
+    vec4 t0z = (loZ - orig.z) * invDir.z;
+    vec4 t1z = (hiZ - orig.z) * invDir.z;
+    tNear = max(max(min(t0x, t1x), min(t0y, t1y)), max(min(t0z, t1z), vec4(tMin)));
+    vec4 tFar = min(min(max(t0x, t1x), max(t0y, t1y)), min(max(t0z, t1z), vec4(tFarLimit))) * kBvhSlabFarScale;
+    hit = bvec4(tNear.x <= tFar.x && child.x != kInvalidIndex, tNear.y <= tFar.y && child.y != kInvalidIndex,
+                tNear.z <= tFar.z && child.z != kInvalidIndex, tNear.w <= tFar.w && child.w != kInvalidIndex);
+}
+
 // Slab tests of a wide node's four children (their decoded boxes) for (tMin, tFarLimit):
 // intersectBox, four at once; hit[k] is false for empty slots.
 GDPT_INLINE void wideNodeBoxes(BvhWideNode n, vec3 orig, vec3 invDir, float tMin, float tFarLimit,
@@ -180,16 +197,22 @@ GDPT_INLINE void wideNodeBoxes(BvhWideNode n, vec3 orig, vec3 invDir, float tMin
     float sx = wideAxisScale(n.exponents, 0u);
     float sy = wideAxisScale(n.exponents, 1u);
     float sz = wideAxisScale(n.exponents, 2u);
-    vec4 t0x = (wideDecodeAxis(n.origin.x, n.qMin.x, sx) - orig.x) * invDir.x;
-    vec4 t1x = (wideDecodeAxis(n.origin.x, n.qMax.x, sx) - orig.x) * invDir.x;
-    vec4 t0y = (wideDecodeAxis(n.origin.y, n.qMin.y, sy) - orig.y) * invDir.y;
-    vec4 t1y = (wideDecodeAxis(n.origin.y, n.qMax.y, sy) - orig.y) * invDir.y;
-    vec4 t0z = (wideDecodeAxis(n.origin.z, n.qMin.z, sz) - orig.z) * invDir.z;
-    vec4 t1z = (wideDecodeAxis(n.origin.z, n.qMax.z, sz) - orig.z) * invDir.z;
-    tNear = max(max(min(t0x, t1x), min(t0y, t1y)), max(min(t0z, t1z), vec4(tMin)));
-    vec4 tFar = min(min(max(t0x, t1x), max(t0y, t1y)), min(max(t0z, t1z), vec4(tFarLimit))) * kBvhSlabFarScale;
-    hit = bvec4(tNear.x <= tFar.x && n.child.x != kInvalidIndex, tNear.y <= tFar.y && n.child.y != kInvalidIndex,
-                tNear.z <= tFar.z && n.child.z != kInvalidIndex, tNear.w <= tFar.w && n.child.w != kInvalidIndex);
+    wideSlabs(wideDecodeAxis(n.origin.x, n.qMin.x, sx), wideDecodeAxis(n.origin.x, n.qMax.x, sx),
+              wideDecodeAxis(n.origin.y, n.qMin.y, sy), wideDecodeAxis(n.origin.y, n.qMax.y, sy),
+              wideDecodeAxis(n.origin.z, n.qMin.z, sz), wideDecodeAxis(n.origin.z, n.qMax.z, sz), n.child, orig,
+              invDir, tMin, tFarLimit, tNear, hit);
+}
+
+// The same for the children's boxes grown by `pad` (>= 0) on every side (a beam's node test).
+GDPT_INLINE void wideNodeBoxesGrown(BvhWideNode n, vec3 pad, vec3 orig, vec3 invDir, float tMin, float tFarLimit,
+                                    GDPT_OUT(vec4) tNear, GDPT_OUT(bvec4) hit) {
+    float sx = wideAxisScale(n.exponents, 0u);
+    float sy = wideAxisScale(n.exponents, 1u);
+    float sz = wideAxisScale(n.exponents, 2u);
+    wideSlabs(wideDecodeAxis(n.origin.x, n.qMin.x, sx) - pad.x, wideDecodeAxis(n.origin.x, n.qMax.x, sx) + pad.x,
+              wideDecodeAxis(n.origin.y, n.qMin.y, sy) - pad.y, wideDecodeAxis(n.origin.y, n.qMax.y, sy) + pad.y,
+              wideDecodeAxis(n.origin.z, n.qMin.z, sz) - pad.z, wideDecodeAxis(n.origin.z, n.qMax.z, sz) + pad.z,
+              n.child, orig, invDir, tMin, tFarLimit, tNear, hit);
 }
 
 // Triangle counts of the hit leaf children (0 for a slot that is not a hit leaf).
@@ -568,6 +591,181 @@ bool occludedTowards(vec3 origin, vec3 target) {
     float tMax;
     if (!towardsTarget(origin, target, dir, tMax)) return false;
     return traceAny(origin, dir, 0.0, tMax);
+}
+
+// ---- Occlusion beams: up to four occlusion rays with one end or one direction ----
+//
+// G-PT's offset paths connect their own vertices, about a pixel apart, to one point (the
+// base's light point, the base's next vertex) or leave them in one direction (the
+// environment): four occlusion rays that, traced one by one, walk nearly the same nodes. A
+// beam walks them once. A node is entered if the beam's centre ray (from the centre c of the
+// origins' bounding box, of half-width h) enters its box grown by h; a leaf's triangles are
+// tested against every ray of the beam not yet occluded. At any parameter λ in [0, 1] a ray
+// from o_i to the shared end T lies (1 - λ)(o_i - c) from the centre ray's point, within h on
+// every axis (parallel rays: o_i - c), so every box that ray i enters, its grown box the centre
+// ray enters; since a hit point lies in its leaf's box (padded by the builder), the beam tests
+// every triangle that ray i's own traversal would find occluding, with the same triangle test
+// on the same ray. Each answer is occludedTowards's (or traceAny's to infinity) bit for bit;
+// the nodes are walked once, the stack and the loop run once, and on lavapipe, where every
+// traversal call site is a loop that runs until its slowest lane ends, one loop replaces four.
+const float kBvhInfinity = 1.0 / 0.0;
+
+struct OcclusionBeam {
+    vec3 o0, o1, o2, o3;  // the rays' origins ...
+    vec3 d0, d1, d2, d3;  // ... unit directions (as towardsTarget gives them) ...
+    vec4 tMax;            // ... and ends
+    bvec4 want;           // rays to trace; the others are not occluded
+    vec3 centre;          // the centre ray: from the origins' box centre ...
+    vec3 centreDir;       // ... along this (to the shared end: length 1 in t) ...
+    float centreTMax;
+    vec3 grow;            // ... against boxes grown by the half-width, plus a rounding margin
+};
+
+// The centre and half-width of the wanted origins, and the rounding margin of the grown boxes:
+// 2^-20 of the coordinates' magnitude, a few ulps of each quantity the node test combines
+// (the builder's box padding covers the triangle test's own tolerance).
+void beamSpan(inout OcclusionBeam b, float endMagnitude) {
+    vec3 lo = vec3(kBvhInfinity), hi = vec3(-kBvhInfinity);
+    if (b.want.x) lo = min(lo, b.o0), hi = max(hi, b.o0);
+    if (b.want.y) lo = min(lo, b.o1), hi = max(hi, b.o1);
+    if (b.want.z) lo = min(lo, b.o2), hi = max(hi, b.o2);
+    if (b.want.w) lo = min(lo, b.o3), hi = max(hi, b.o3);
+    bool some = any(b.want);
+    b.centre = some ? 0.5 * (lo + hi) : vec3(0.0);
+    vec3 halfWidth = some ? 0.5 * (hi - lo) : vec3(0.0);
+    float margin = (maxComponent(abs(b.centre)) + maxComponent(halfWidth) + endMagnitude) * (1.0 / 1048576.0);
+    b.grow = halfWidth + vec3(margin);
+}
+
+// Ray from o towards `target` as occludedTowards traces it; false (not traced) for a zero or
+// NaN distance, where nothing occludes.
+bool beamRayTowards(bool want, vec3 o, vec3 target, out vec3 dir, inout vec4 tMax, uint j) {
+    float t;
+    bool ok = towardsTarget(o, target, dir, t);
+    tMax[j] = t;
+    return want && ok;
+}
+
+// Rays from o0..o3 (want) towards `target`, each as occludedTowards traces it.
+OcclusionBeam beamTowards(vec3 o0, vec3 o1, vec3 o2, vec3 o3, bvec4 want, vec3 target) {
+    OcclusionBeam b;
+    b.o0 = o0;
+    b.o1 = o1;
+    b.o2 = o2;
+    b.o3 = o3;
+    b.tMax = vec4(0.0);
+    b.want.x = beamRayTowards(want.x, o0, target, b.d0, b.tMax, 0u);
+    b.want.y = beamRayTowards(want.y, o1, target, b.d1, b.tMax, 1u);
+    b.want.z = beamRayTowards(want.z, o2, target, b.d2, b.tMax, 2u);
+    b.want.w = beamRayTowards(want.w, o3, target, b.d3, b.tMax, 3u);
+    beamSpan(b, maxComponent(abs(target)));
+    b.centreDir = target - b.centre;
+    b.centreTMax = 1.0;
+    return b;
+}
+
+// Rays from o0..o3 (want) along `dir` to infinity, as traceAny(o, dir, 0, ∞).
+OcclusionBeam beamAlong(vec3 o0, vec3 o1, vec3 o2, vec3 o3, bvec4 want, vec3 dir) {
+    OcclusionBeam b;
+    b.o0 = o0;
+    b.o1 = o1;
+    b.o2 = o2;
+    b.o3 = o3;
+    b.d0 = dir;
+    b.d1 = dir;
+    b.d2 = dir;
+    b.d3 = dir;
+    b.tMax = vec4(kBvhInfinity);
+    b.want = want;
+    beamSpan(b, 0.0);
+    b.centreDir = dir;
+    b.centreTMax = kBvhInfinity;
+    return b;
+}
+
+// One ray of a beam against triangle g (anyHitAt's test).
+bool beamRayHits(vec3 o, vec3 d, float tMax, TriangleGeom g, uint tri) {
+    float tCand = tMax;
+    float u;
+    float v;
+    return intersectTriangleGeom(o, d, g.v0, g.e1, g.e2, 0.0, tCand, u, v) && GDPT_ANYHIT_FILTER(tri, u, v);
+}
+
+// Triangle `tri` against every ray of the beam still unoccluded.
+void beamTriangle(OcclusionBeam b, uint tri, inout bvec4 occluded) {
+    TriangleGeom g = triangleGeom(tri);
+    if (b.want.x && !occluded.x) occluded.x = beamRayHits(b.o0, b.d0, b.tMax.x, g, tri);
+    if (b.want.y && !occluded.y) occluded.y = beamRayHits(b.o1, b.d1, b.tMax.y, g, tri);
+    if (b.want.z && !occluded.z) occluded.z = beamRayHits(b.o2, b.d2, b.tMax.z, g, tri);
+    if (b.want.w && !occluded.w) occluded.w = beamRayHits(b.o3, b.d3, b.tMax.w, g, tri);
+}
+
+// Every wanted ray is occluded: nothing left to find.
+bool beamDone(OcclusionBeam b, bvec4 occluded) {
+    return (occluded.x || !b.want.x) && (occluded.y || !b.want.y) && (occluded.z || !b.want.z) &&
+           (occluded.w || !b.want.w);
+}
+
+// Per ray of the beam: occluded (false for a ray not wanted). traceAny's walk (both builds,
+// GDPT_BVH_UNIT_STEPS as there) with the grown boxes and the beam's triangle test.
+bvec4 traceAnyBeam(OcclusionBeam b) {
+    bvec4 occluded = bvec4(false);
+    if (!any(b.want)) return occluded;
+    vec3 invDir = bvhSafeInverse(b.centreDir);
+    GDPT_BVH_STACK_DECLARE();
+    uint node = 0u;
+#ifdef GDPT_BVH_UNIT_STEPS
+    uvec4 leafFirst = uvec4(0u);
+    uvec4 leafCount = uvec4(0u);
+    uint k = 0u;
+    uint kEnd = 0u;
+    while (true) {
+        while (k < kEnd) {
+            beamTriangle(b, wideLeafTriangle(leafFirst, k, leafCount), occluded);
+            ++k;
+            if (kBvhRegisterStack == 0u) break;
+        }
+        if (beamDone(b, occluded)) break;
+        if (k < kEnd) continue;
+        if (node == kInvalidIndex) {
+            if (stackSize == 0u) break;
+            float unusedNear;
+            GDPT_BVH_STACK_POP(node, unusedNear);
+        }
+        BvhWideNode n = bvhNode(node);
+        vec4 tNear;
+        bvec4 h;
+        wideNodeBoxesGrown(n, b.grow, b.centre, invDir, 0.0, b.centreTMax, tNear, h);
+        uvec4 count = wideCounts(n);
+        leafFirst = n.child;
+        leafCount = wideLeafCounts(count, h);
+        k = 0u;
+        kEnd = leafCount.x + leafCount.y + leafCount.z + leafCount.w;
+        uint next = kInvalidIndex;
+        GDPT_BVH_ANY_ORDER(n, h, count, next);
+        node = next;
+    }
+#else
+    while (true) {
+        BvhWideNode n = bvhNode(node);
+        vec4 tNear;
+        bvec4 h;
+        wideNodeBoxesGrown(n, b.grow, b.centre, invDir, 0.0, b.centreTMax, tNear, h);
+        uvec4 count = wideCounts(n);
+        uvec4 c = wideLeafCounts(count, h);
+        for (uint k = 0u; k < c.x + c.y + c.z + c.w; ++k) beamTriangle(b, wideLeafTriangle(n.child, k, c), occluded);
+        if (beamDone(b, occluded)) break;
+        uint next = kInvalidIndex;
+        GDPT_BVH_ANY_ORDER(n, h, count, next);
+        if (next == kInvalidIndex) {
+            if (stackSize == 0u) break;
+            float unusedNear;
+            GDPT_BVH_STACK_POP(next, unusedNear);
+        }
+        node = next;
+    }
+#endif
+    return occluded;
 }
 #endif  // !__cplusplus
 

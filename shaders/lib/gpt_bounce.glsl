@@ -2,9 +2,12 @@
 // traceSample's bounce loop, in the steps of Kettunen et al. 2015 §4 (gpt_pair.glsl):
 //   1. the vertices: the base's BSDF and frame, each offset's (gptOffsetVertex);
 //   2. next-event estimation with the base's light point for every pair (gptBaseNee,
-//      gptPairNee), MIS between base and offset over four strategies (gptMisWeight);
+//      gptPairNeeBegin/End, the offsets' own shadow rays as one beam), MIS between base and
+//      offset over four strategies (gptMisWeight);
 //   3. BSDF sampling and Russian roulette of the base (gptContinueBase);
-//   4. the shift of every live offset over the base's new segment (gptShiftOffset);
+//   4. the shift of every live offset over the base's new segment (gptShiftOffset; without
+//      glossy vertices the reconnections' rays as one beam: gptShiftOffsetBegin, traceAnyBeam,
+//      gptReconnectDone);
 //   5. the emission the pairs reach there, MIS-weighted (gptPairEnvironment, gptPairEmitter).
 //
 // Not a function: gpt.comp includes this text twice, into two loops, once with
@@ -47,10 +50,22 @@
     LightSample ls;
     if (!bsdfIsDeltaOnly(bsdf) && sampleLight(sh.p, ul, ls) && dot(ls.wi, sh.ng) > 0.0) {
         BaseNee nee = gptBaseNee(ls, ul, bsdf, woLocal, t, b, sh.ns, origin, beta, rays);
+        PairNee pairNee[kGptNumOffsets];
+        vec3 neeOrigin[4];
+        bvec4 neeTrace = bvec4(false);
+        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+            bool own = offs[i].alive && ownVertex(offs[i], GDPT_GPT_GENERAL);
+            pairNee[i] = gptPairNeeBegin(offs[i], offV[i], own, lightStrategy[i], nee, bsdf, sh.p);
+            neeOrigin[i] = pairNee[i].origin;
+            neeTrace[i] = gptPairCounted(px, py, i) && pairNee[i].trace;
+        }
+        // The own vertices' shadow rays all end at the light point: one beam (the fast form
+        // has no own vertices, and no beam).
+        bvec4 neeOccluded = bvec4(false);
+        if (GDPT_GPT_GENERAL) neeOccluded = traceAnyBeam(beamTowards(neeOrigin[0], neeOrigin[1], neeOrigin[2], neeOrigin[3], neeTrace, nee.ls.pLight));
         for (uint i = 0u; i < kGptNumOffsets; ++i) {
             if (!gptPairCounted(px, py, i)) continue;
-            bool own = offs[i].alive && ownVertex(offs[i], GDPT_GPT_GENERAL);
-            OffsetNee on = gptPairNee(offs[i], offV[i], own, lightStrategy[i], nee, bsdf, sh.p, rays);
+            OffsetNee on = gptPairNeeEnd(offs[i], pairNee[i], nee, neeOccluded[i], rays);
             float c = offs[i].countRatio;
             float w = gptMisWeight(ls.pdf, nee.pdfBsdf, c * on.qLight, c * on.qBsdf);
             if (on.counts) addPair(offs[i], w, nee.fBase, on.f);
@@ -78,8 +93,30 @@
     }
 
     // ---- 4. Shift every live offset over this segment ----
-    for (uint i = 0u; i < kGptNumOffsets; ++i) {
-        if (offs[i].alive) gptShiftOffset(offs[i], offV[i], seg, GDPT_GPT_GENERAL, rays);
+    if (!kHasGlossy && GDPT_GPT_GENERAL) {
+        // Every own-vertex shift reconnects, to the base's next vertex or along its direction
+        // to the environment: the visibility rays as one beam.
+        ConnectionShift conn[kGptNumOffsets];
+        ShiftRay shiftRay[kGptNumOffsets];
+        bvec4 reconnecting;
+        for (uint i = 0u; i < kGptNumOffsets; ++i)
+            shiftRay[i] = gptShiftOffsetBegin(offs[i], offV[i], seg, conn[i], reconnecting[i], rays);
+        bvec4 trace = bvec4(reconnecting.x && shiftRay[0].trace, reconnecting.y && shiftRay[1].trace,
+                            reconnecting.z && shiftRay[2].trace, reconnecting.w && shiftRay[3].trace);
+        OcclusionBeam beam =
+            seg.missed
+                ? beamAlong(shiftRay[0].origin, shiftRay[1].origin, shiftRay[2].origin, shiftRay[3].origin, trace,
+                            seg.wi)
+                : beamTowards(shiftRay[0].origin, shiftRay[1].origin, shiftRay[2].origin, shiftRay[3].origin,
+                              trace, seg.next.p);
+        bvec4 shiftOccluded = traceAnyBeam(beam);
+        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+            if (reconnecting[i]) gptReconnectDone(offs[i], offV[i], seg, conn[i], shiftOccluded[i]);
+        }
+    } else {
+        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+            if (offs[i].alive) gptShiftOffset(offs[i], offV[i], seg, GDPT_GPT_GENERAL, rays);
+        }
     }
 
     // ---- 5. Emission reached by the BSDF sample: the environment or an emitter ----

@@ -140,20 +140,19 @@ OffsetNee gptNeeSharedVertex(OffsetPath o, BaseNee nee, vec3 fEval, float pdfEva
     return r;
 }
 
-// Own vertex reconnected to the light point (c.ok): its own shadow ray. The offset's
-// visibility matters for its contribution and for its BSDF density, which enters the base's
-// weight. Light strategy in the base's measure: p'_L·J = p_L (same light point, area
-// measure); BSDF strategy p'_B·J.
-OffsetNee gptNeeOwnVertex(OffsetPath o, BaseNee nee, LightConnection c, vec3 fEval, float pdfEval,
-                          inout uint rays) {
+// Own vertex reconnected to the light point (c.ok), with its own shadow ray where `traced`
+// (gptPairNeeBegin's choice) and that ray's answer. The offset's visibility matters for its
+// contribution and for its BSDF density, which enters the base's weight. Light strategy in
+// the base's measure: p'_L·J = p_L (same light point, area measure); BSDF strategy p'_B·J.
+OffsetNee gptNeeOwnVertex(OffsetPath o, BaseNee nee, LightConnection c, vec3 fEval, float pdfEval, bool traced,
+                          bool occluded, inout uint rays) {
     OffsetNee r;
     r.f = vec3(0.0);
     vec3 fo = fEval * c.li;
     float pdfBsdfO = nee.ls.isDelta != 0u ? 0.0 : pdfEval;
-    if (maxComponent(fo) > 0.0 || (pdfBsdfO > 0.0 && maxComponent(nee.fBase) > 0.0)) {
+    if (traced) {
         rays++;
-        vec3 origin = offsetRayOriginScaled(o.hit.p, o.hit.ng, scene.sceneRadius);
-        if (!occludedTowards(origin, nee.ls.pLight))
+        if (!occluded)
             r.f = o.beta * fo * (c.jacobian / nee.ls.pdf);
         else
             pdfBsdfO = 0.0;
@@ -164,34 +163,58 @@ OffsetNee gptNeeOwnVertex(OffsetPath o, BaseNee nee, LightConnection c, vec3 fEv
     return r;
 }
 
-// One pair's NEE sample (Kettunen et al. 2015 §4: the offset takes the base's light point).
+// One pair's NEE sample (Kettunen et al. 2015 §4: the offset takes the base's light point),
+// in two halves around the offset's own shadow ray, so that the four offsets' rays, which all
+// end at the light point, are traced as one beam (traceAnyBeam).
 // An offset with a vertex of its own (NOT_CONNECTED) reconnects to that point only where the
 // pair has the light strategy or the light is punctual; otherwise the sample counts for
 // neither (weight 0). One BSDF evaluation per pair, whichever case: lavapipe before Mesa 23
 // runs every branch under lane masks, so each case's own copy would cost its time.
-OffsetNee gptPairNee(OffsetPath o, OffsetVertex v, bool own, bool lightStrategy, BaseNee nee, BsdfParams bsdf,
-                     vec3 pBase, inout uint rays) {
-    bool sharedVertex = o.alive && !own;
-    bool counts = !own || nee.ls.isDelta != 0u || lightStrategy;
-    LightConnection c = gptConnectToLight(nee, pBase, o.hit, v, own && counts);
+struct PairNee {
+    LightConnection c;
+    vec3 fEval;     // the offset's BSDF along its light direction, and its density
+    float pdfEval;
+    bool sharedVertex;
+    bool ownConnected;  // own vertex, connected to the light point (c.ok)
+    bool counts;
+    bool trace;     // the own vertex's shadow ray is worth tracing: a contribution or a density
+    vec3 origin;    // its origin
+};
+
+PairNee gptPairNeeBegin(OffsetPath o, OffsetVertex v, bool own, bool lightStrategy, BaseNee nee, BsdfParams bsdf,
+                        vec3 pBase) {
+    PairNee p;
+    p.sharedVertex = o.alive && !own;
+    p.counts = !own || nee.ls.isDelta != 0u || lightStrategy;
+    p.c = gptConnectToLight(nee, pBase, o.hit, v, own && p.counts);
     // The offset's own incoming direction at a shared vertex (RECENTLY_CONNECTED), or its own
     // vertex; a CONNECTED offset has the base's f and density.
-    bool evaluate = own ? c.ok : sharedVertex && o.state == kShiftRecentlyConnected;
-    vec3 fEval = nee.f;
-    float pdfEval = nee.pdfBsdf;
+    bool evaluate = own ? p.c.ok : p.sharedVertex && o.state == kShiftRecentlyConnected;
+    p.fEval = nee.f;
+    p.pdfEval = nee.pdfBsdf;
     if (evaluate) {
         BsdfParams evalBsdf = own ? v.bsdf : bsdf;
-        vec3 evalWi = own ? c.wiLocal : nee.wiLocal;
-        fEval = bsdfEval(evalBsdf, v.wo, evalWi);
-        pdfEval = bsdfPdf(evalBsdf, v.wo, evalWi);
+        vec3 evalWi = own ? p.c.wiLocal : nee.wiLocal;
+        p.fEval = bsdfEval(evalBsdf, v.wo, evalWi);
+        p.pdfEval = bsdfPdf(evalBsdf, v.wo, evalWi);
     }
+    p.ownConnected = own && p.c.ok;
+    float pdfBsdfO = nee.ls.isDelta != 0u ? 0.0 : p.pdfEval;
+    p.trace = p.ownConnected &&
+              (maxComponent(p.fEval * p.c.li) > 0.0 || (pdfBsdfO > 0.0 && maxComponent(nee.fBase) > 0.0));
+    p.origin = offsetRayOriginScaled(o.hit.p, o.hit.ng, scene.sceneRadius);
+    return p;
+}
+
+// The pair's side once its shadow ray's answer is known (`occluded`: false if not traced).
+OffsetNee gptPairNeeEnd(OffsetPath o, PairNee p, BaseNee nee, bool occluded, inout uint rays) {
     OffsetNee r;
     r.f = vec3(0.0);
     r.qLight = 0.0;
     r.qBsdf = 0.0;
-    if (sharedVertex) r = gptNeeSharedVertex(o, nee, fEval, pdfEval);
-    if (own && c.ok) r = gptNeeOwnVertex(o, nee, c, fEval, pdfEval, rays);
-    r.counts = counts;
+    if (p.sharedVertex) r = gptNeeSharedVertex(o, nee, p.fEval, p.pdfEval);
+    if (p.ownConnected) r = gptNeeOwnVertex(o, nee, p.c, p.fEval, p.pdfEval, p.trace, occluded, rays);
+    r.counts = p.counts;
     return r;
 }
 
@@ -360,17 +383,16 @@ void gptOwnVertexShift(inout OffsetPath o, OffsetVertex v, BaseSegment s, bool r
     }
 }
 
-// Shifts one live offset over the base's new segment s (the connection states of Kettunen et
-// al. 2015 §4.2). CONNECTED: same vertices, same f and p. RECENTLY_CONNECTED: the base's
-// vertex with the offset's own incoming direction, f and p re-evaluated (never Dirac: a
-// reconnection target has no Dirac lobe, shiftRoughnessAll), Jacobian 1. NOT_CONNECTED
-// (only where `general`; the fast loop has none): reconnection where the base's current and
-// next and the offset's current vertex are rough, else the half-vector copy.
-void gptShiftOffset(inout OffsetPath o, OffsetVertex v, BaseSegment s, bool general, inout uint rays) {
+// Shifts one live offset that shares the base's vertex over the base's new segment s (the
+// connection states of Kettunen et al. 2015 §4.2). CONNECTED: same vertices, same f and p.
+// RECENTLY_CONNECTED: the base's vertex with the offset's own incoming direction, f and p
+// re-evaluated (never Dirac: a reconnection target has no Dirac lobe, shiftRoughnessAll),
+// Jacobian 1.
+void gptShiftSharedOffset(inout OffsetPath o, OffsetVertex v, BaseSegment s) {
     if (o.state == kShiftConnected) {
         o.beta *= s.bs.weight * s.rrInv;
         o.rLight = o.r;
-    } else if (o.state == kShiftRecentlyConnected) {
+    } else {
         vec3 fo = bsdfEval(s.bsdf, v.wo, s.bs.wi);
         float po = bsdfPdf(s.bsdf, v.wo, s.bs.wi);
         SegmentShift seg = shiftSegment(fo, po, 1.0, s.rrInv, s.bs.pdf);
@@ -378,6 +400,16 @@ void gptShiftOffset(inout OffsetPath o, OffsetVertex v, BaseSegment s, bool gene
         o.r *= seg.pdfRatio;
         o.rLight = o.r;
         o.state = kShiftConnected;
+    }
+}
+
+// Shifts one live offset over the base's new segment s: gptShiftSharedOffset, or for a
+// NOT_CONNECTED one (only where `general`; the fast loop has none) reconnection where the
+// base's current and next and the offset's current vertex are rough, else the half-vector
+// copy.
+void gptShiftOffset(inout OffsetPath o, OffsetVertex v, BaseSegment s, bool general, inout uint rays) {
+    if (o.state != kShiftNotConnected) {
+        gptShiftSharedOffset(o, v, s);
     } else if (general) {
         bool offCurRough = roughAll(v.bsdf);
         bool reconnect = shiftUseReconnection(s.curRough, s.nextRough, offCurRough);
@@ -386,6 +418,35 @@ void gptShiftOffset(inout OffsetPath o, OffsetVertex v, BaseSegment s, bool gene
         else
             o.alive = false;  // unreachable when every vertex is rough
     }
+}
+
+// gptShiftOffset in a general bounce of a scene without glossy vertices, where every
+// own-vertex shift is a reconnection, split around the reconnection's visibility ray so that
+// the four offsets' rays, which all end at the base's next vertex (or leave along its
+// direction to the environment), are traced as one beam (traceAnyBeam, gpt_bounce.glsl).
+// First half: the shift of an offset that shares the base's vertex, or the reconnection's
+// ray (`reconnecting`: then finish it with gptReconnectDone).
+ShiftRay gptShiftOffsetBegin(inout OffsetPath o, OffsetVertex v, BaseSegment s, out ConnectionShift c,
+                             out bool reconnecting, inout uint rays) {
+    ShiftRay ray = noShiftRay(vec3(0.0));
+    c.wi = vec3(0.0);
+    c.dist = 0.0;
+    c.jacobian = 0.0;
+    c.ok = false;
+    reconnecting = false;
+    if (o.alive) {
+        if (o.state != kShiftNotConnected) {
+            gptShiftSharedOffset(o, v, s);
+        } else if (!shiftUseReconnection(s.curRough, s.nextRough, roughAll(v.bsdf))) {
+            o.alive = false;  // unreachable when every vertex is rough
+        } else {
+            ray = gptReconnectRay(o, v, s, c);
+            // A live reconnection's zero-length connection traces nothing but counts its ray.
+            if (o.alive) rays++;
+            reconnecting = o.alive;
+        }
+    }
+    return ray;
 }
 
 // ---- Emission the pairs reach, with MIS between base and offset ----

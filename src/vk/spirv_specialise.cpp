@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <exception>
 #include <fstream>
 #include <spirv-tools/optimizer.hpp>
 #include <string>
@@ -217,7 +218,15 @@ std::vector<std::uint32_t> specialiseSpirv(const std::uint32_t* words, std::size
     spvtools::OptimizerOptions options;
     options.set_run_validator(false);
     std::vector<std::uint32_t> out;
-    if (!optimizer.Run(frozen.data(), frozen.size(), &out, options))
+    bool ok = false;
+    try {
+        ok = optimizer.Run(frozen.data(), frozen.size(), &out, options);
+    } catch (const std::exception& e) {
+        // Without its validator SPIRV-Tools may throw on a malformed module (a truncated one
+        // threw std::out_of_range from a map lookup) rather than report it.
+        messages += std::string("\n  ") + e.what();
+    }
+    if (!ok)
         throw Error("specialising a kernel's SPIR-V failed:" +
                     (messages.empty() ? std::string(" (no message)") : messages));
     return out;
