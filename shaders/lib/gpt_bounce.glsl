@@ -2,12 +2,13 @@
 // traceSample's bounce loop, in the steps of Kettunen et al. 2015 §4 (gpt_pair.glsl):
 //   1. the vertices: the base's BSDF and frame, each offset's (gptOffsetVertex);
 //   2. next-event estimation with the base's light point for every pair (gptBaseNee,
-//      gptPairNeeBegin/End, the offsets' own shadow rays as one beam), MIS between base and
-//      offset over four strategies (gptMisWeight);
+//      gptPairNee; with GDPT_GPT_BEAMS, gpt_trace.glsl, its halves around one beam of the
+//      offsets' own shadow rays), MIS between base and offset over four strategies
+//      (gptMisWeight);
 //   3. BSDF sampling and Russian roulette of the base (gptContinueBase);
-//   4. the shift of every live offset over the base's new segment (gptShiftOffset; without
-//      glossy vertices the reconnections' rays as one beam: gptShiftOffsetBegin, traceAnyBeam,
-//      gptReconnectDone);
+//   4. the shift of every live offset over the base's new segment (gptShiftOffset; with
+//      GDPT_GPT_BEAMS and no glossy vertices, the reconnections' rays as one beam:
+//      gptShiftOffsetBegin, traceAnyBeam, gptReconnectDone);
 //   5. the emission the pairs reach there, MIS-weighted (gptPairEnvironment, gptPairEmitter).
 //
 // Not a function: gpt.comp includes this text twice, into two loops, once with
@@ -50,6 +51,7 @@
     LightSample ls;
     if (!bsdfIsDeltaOnly(bsdf) && sampleLight(sh.p, ul, ls) && dot(ls.wi, sh.ng) > 0.0) {
         BaseNee nee = gptBaseNee(ls, ul, bsdf, woLocal, t, b, sh.ns, origin, beta, rays);
+#ifdef GDPT_GPT_BEAMS
         PairNee pairNee[kGptNumOffsets];
         vec3 neeOrigin[4];
         bvec4 neeTrace = bvec4(false);
@@ -62,10 +64,18 @@
         // The own vertices' shadow rays all end at the light point: one beam (the fast form
         // has no own vertices, and no beam).
         bvec4 neeOccluded = bvec4(false);
-        if (GDPT_GPT_GENERAL) neeOccluded = traceAnyBeam(beamTowards(neeOrigin[0], neeOrigin[1], neeOrigin[2], neeOrigin[3], neeTrace, nee.ls.pLight));
+        if (GDPT_GPT_GENERAL)
+            neeOccluded =
+                traceAnyBeam(beamTowards(neeOrigin[0], neeOrigin[1], neeOrigin[2], neeOrigin[3], neeTrace, nee.ls.pLight));
+#endif
         for (uint i = 0u; i < kGptNumOffsets; ++i) {
             if (!gptPairCounted(px, py, i)) continue;
+#ifdef GDPT_GPT_BEAMS
             OffsetNee on = gptPairNeeEnd(offs[i], pairNee[i], nee, neeOccluded[i], rays);
+#else
+            bool own = offs[i].alive && ownVertex(offs[i], GDPT_GPT_GENERAL);
+            OffsetNee on = gptPairNee(offs[i], offV[i], own, lightStrategy[i], nee, bsdf, sh.p, rays);
+#endif
             float c = offs[i].countRatio;
             float w = gptMisWeight(ls.pdf, nee.pdfBsdf, c * on.qLight, c * on.qBsdf);
             if (on.counts) addPair(offs[i], w, nee.fBase, on.f);
@@ -93,6 +103,7 @@
     }
 
     // ---- 4. Shift every live offset over this segment ----
+#ifdef GDPT_GPT_BEAMS
     if (!kHasGlossy && GDPT_GPT_GENERAL) {
         // Every own-vertex shift reconnects, to the base's next vertex or along its direction
         // to the environment: the visibility rays as one beam.
@@ -113,7 +124,9 @@
         for (uint i = 0u; i < kGptNumOffsets; ++i) {
             if (reconnecting[i]) gptReconnectDone(offs[i], offV[i], seg, conn[i], shiftOccluded[i]);
         }
-    } else {
+    } else
+#endif
+    {
         for (uint i = 0u; i < kGptNumOffsets; ++i) {
             if (offs[i].alive) gptShiftOffset(offs[i], offV[i], seg, GDPT_GPT_GENERAL, rays);
         }

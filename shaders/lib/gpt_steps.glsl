@@ -165,7 +165,7 @@ OffsetNee gptNeeOwnVertex(OffsetPath o, BaseNee nee, LightConnection c, vec3 fEv
 
 // One pair's NEE sample (Kettunen et al. 2015 §4: the offset takes the base's light point),
 // in two halves around the offset's own shadow ray, so that the four offsets' rays, which all
-// end at the light point, are traced as one beam (traceAnyBeam).
+// end at the light point, can be traced as one beam (traceAnyBeam; gpt_bounce.glsl).
 // An offset with a vertex of its own (NOT_CONNECTED) reconnects to that point only where the
 // pair has the light strategy or the light is punctual; otherwise the sample counts for
 // neither (weight 0). One BSDF evaluation per pair, whichever case: lavapipe before Mesa 23
@@ -216,6 +216,14 @@ OffsetNee gptPairNeeEnd(OffsetPath o, PairNee p, BaseNee nee, bool occluded, ino
     if (p.ownConnected) r = gptNeeOwnVertex(o, nee, p.c, p.fEval, p.pdfEval, p.trace, occluded, rays);
     r.counts = p.counts;
     return r;
+}
+
+// Both halves with the offset's own shadow ray traced between them, by itself.
+OffsetNee gptPairNee(OffsetPath o, OffsetVertex v, bool own, bool lightStrategy, BaseNee nee, BsdfParams bsdf,
+                     vec3 pBase, inout uint rays) {
+    PairNee p = gptPairNeeBegin(o, v, own, lightStrategy, nee, bsdf, pBase);
+    bool occluded = p.trace && occludedTowards(p.origin, nee.ls.pLight);
+    return gptPairNeeEnd(o, p, nee, occluded, rays);
 }
 
 // ---- BSDF sampling and Russian roulette of the base ----
