@@ -175,6 +175,35 @@ double tTolerance(const gpu::TriangleGeom& g, const glm::vec3& orig, const glm::
 // The traversal loop's two builds (shaders/lib/bvh_traverse.glsl).
 enum class Steps { Nodes, Units };
 
+// A test kernel's description: the scene's geometry bindings, `outputs` more, 64 invocations per
+// workgroup, `pushBytes` of push constants.
+vk::KernelDesc testKernelDesc(vk::KernelDesc desc, std::vector<std::uint32_t> outputs,
+                              std::uint32_t pushBytes) {
+    desc.bindings = {gpu::kBindTriGeom, gpu::kBindBvh, gpu::kBindTestInput};
+    desc.bindings.insert(desc.bindings.end(), outputs.begin(), outputs.end());
+    desc.texelBindings = SceneSpec::geometryTexelBindings();
+    desc.pushConstantBytes = pushBytes;
+    desc.localSizeX = 64;
+    return desc;
+}
+
+// A soup's triangles and wide tree and the test rays, on the device and bound to `kernel`.
+struct DeviceScene {
+    vk::Buffer geoms, nodes, rays;
+    DeviceScene(const vk::Context& ctx, vk::Kernel& kernel, const std::vector<gpu::TriangleGeom>& g,
+                const WideBvh& wide, const std::vector<gpu::TestRay>& r)
+        : geoms(ctx, g.size() * sizeof(gpu::TriangleGeom), "geoms"),
+          nodes(ctx, wide.nodes.size() * sizeof(gpu::BvhWideNode), "nodes"),
+          rays(ctx, r.size() * sizeof(gpu::TestRay), "rays") {
+        geoms.uploadVector(g);
+        nodes.uploadVector(wide.nodes);
+        rays.uploadVector(r);
+        kernel.bind(gpu::kBindTriGeom, geoms);
+        kernel.bind(gpu::kBindBvh, nodes);
+        kernel.bind(gpu::kBindTestInput, rays);
+    }
+};
+
 class BvhGpu : public test::GpuTest {
 protected:
     // registerStack: kSpecBvhRegisterStack (0 = the stack in memory); the tree must fit it.
@@ -187,31 +216,19 @@ protected:
         const auto rays = randomRays(rayCount, seed);
 
         ASSERT_TRUE(steps == Steps::Nodes || registerStack == 0) << "unit steps keep the stack in memory";
-        vk::KernelDesc desc = steps == Steps::Units
-                                  ? vk::kernelDesc("trace_rays", GDPT_KERNEL_SPIRV(trace_rays_units))
-                                  : vk::kernelDesc("trace_rays", GDPT_KERNEL_SPIRV(trace_rays));
-        desc.bindings = {gpu::kBindTriGeom, gpu::kBindBvh, gpu::kBindTestInput, gpu::kBindTestOutput,
-                         gpu::kBindTestOutput2};
-        desc.texelBindings = SceneSpec::geometryTexelBindings();
-        desc.pushConstantBytes = sizeof(std::uint32_t);
-        desc.localSizeX = 64;
+        vk::KernelDesc desc = testKernelDesc(
+            steps == Steps::Units ? vk::kernelDesc("trace_rays", GDPT_KERNEL_SPIRV(trace_rays_units))
+                                  : vk::kernelDesc("trace_rays", GDPT_KERNEL_SPIRV(trace_rays)),
+            {gpu::kBindTestOutput, gpu::kBindTestOutput2}, sizeof(std::uint32_t));
         const WideBvh wide = collapseToWide(bvh.nodes);
         if (registerStack != 0) {
             ASSERT_LE(wide.maxStack, registerStack) << "the tree does not fit the register stack";
             desc.specConstants = {{gpu::kSpecBvhRegisterStack, registerStack}};
         }
         vk::Kernel kernel(ctx(), desc, creation);
-        vk::Buffer geomBuf(ctx(), geoms.size() * sizeof(gpu::TriangleGeom), "geoms");
-        vk::Buffer nodeBuf(ctx(), wide.nodes.size() * sizeof(gpu::BvhWideNode), "nodes");
-        vk::Buffer rayBuf(ctx(), rays.size() * sizeof(gpu::TestRay), "rays");
+        const DeviceScene scene(ctx(), kernel, geoms, wide, rays);
         vk::Buffer hitBuf(ctx(), rays.size() * sizeof(glm::vec4), "hits");
         vk::Buffer anyBuf(ctx(), rays.size() * sizeof(std::uint32_t), "any");
-        geomBuf.uploadVector(geoms);
-        nodeBuf.uploadVector(wide.nodes);
-        rayBuf.uploadVector(rays);
-        kernel.bind(gpu::kBindTriGeom, geomBuf);
-        kernel.bind(gpu::kBindBvh, nodeBuf);
-        kernel.bind(gpu::kBindTestInput, rayBuf);
         kernel.bind(gpu::kBindTestOutput, hitBuf);
         kernel.bind(gpu::kBindTestOutput2, anyBuf);
         vk::CommandStream cmd(ctx(), "trace_rays");
@@ -257,29 +274,18 @@ protected:
         const Bvh bvh = buildBvh(soup.positions, soup.triangles);
         const auto geoms = makeTriangleGeoms(soup.positions, soup.triangles, bvh.triangleOrder);
         const auto rays = randomBeams(beamCount, seed, spread, soup);
-        vk::KernelDesc desc = steps == Steps::Units
-                                  ? vk::kernelDesc("trace_beams", GDPT_KERNEL_SPIRV(trace_beams_units))
-                                  : vk::kernelDesc("trace_beams", GDPT_KERNEL_SPIRV(trace_beams));
-        desc.bindings = {gpu::kBindTriGeom, gpu::kBindBvh, gpu::kBindTestInput, gpu::kBindTestOutput};
-        desc.texelBindings = SceneSpec::geometryTexelBindings();
-        desc.pushConstantBytes = 2 * sizeof(std::uint32_t);
-        desc.localSizeX = 64;
+        vk::KernelDesc desc = testKernelDesc(
+            steps == Steps::Units ? vk::kernelDesc("trace_beams", GDPT_KERNEL_SPIRV(trace_beams_units))
+                                  : vk::kernelDesc("trace_beams", GDPT_KERNEL_SPIRV(trace_beams)),
+            {gpu::kBindTestOutput}, 2 * sizeof(std::uint32_t));
         const WideBvh wide = collapseToWide(bvh.nodes);
         if (registerStack != 0) {
             EXPECT_LE(wide.maxStack, registerStack) << "the tree does not fit the register stack";
             desc.specConstants = {{gpu::kSpecBvhRegisterStack, registerStack}};
         }
         vk::Kernel kernel(ctx(), desc);
-        vk::Buffer geomBuf(ctx(), geoms.size() * sizeof(gpu::TriangleGeom), "geoms");
-        vk::Buffer nodeBuf(ctx(), wide.nodes.size() * sizeof(gpu::BvhWideNode), "nodes");
-        vk::Buffer rayBuf(ctx(), rays.size() * sizeof(gpu::TestRay), "beams");
+        const DeviceScene scene(ctx(), kernel, geoms, wide, rays);
         vk::Buffer outBuf(ctx(), rays.size() * sizeof(glm::vec4), "answers");
-        geomBuf.uploadVector(geoms);
-        nodeBuf.uploadVector(wide.nodes);
-        rayBuf.uploadVector(rays);
-        kernel.bind(gpu::kBindTriGeom, geomBuf);
-        kernel.bind(gpu::kBindBvh, nodeBuf);
-        kernel.bind(gpu::kBindTestInput, rayBuf);
         kernel.bind(gpu::kBindTestOutput, outBuf);
         const std::uint32_t push[2] = {beamCount, noGrowth};
         vk::CommandStream cmd(ctx(), "trace_beams");
@@ -319,12 +325,9 @@ TEST_F(BvhGpu, BackgroundPipelineMatchesBruteForce) {
 // A kernel whose background creation is never waited for is destroyed cleanly (the
 // destructor joins the worker and destroys the pipeline; validation reports any leak).
 TEST_F(BvhGpu, UnusedBackgroundPipelineIsDestroyed) {
-    vk::KernelDesc desc = vk::kernelDesc("trace_rays", GDPT_KERNEL_SPIRV(trace_rays));
-    desc.bindings = {gpu::kBindTriGeom, gpu::kBindBvh, gpu::kBindTestInput, gpu::kBindTestOutput,
-                     gpu::kBindTestOutput2};
-    desc.texelBindings = SceneSpec::geometryTexelBindings();
-    desc.pushConstantBytes = sizeof(std::uint32_t);
-    desc.localSizeX = 64;
+    const vk::KernelDesc desc =
+        testKernelDesc(vk::kernelDesc("trace_rays", GDPT_KERNEL_SPIRV(trace_rays)),
+                       {gpu::kBindTestOutput, gpu::kBindTestOutput2}, sizeof(std::uint32_t));
     { vk::Kernel unused(ctx(), desc, vk::PipelineCreation::Background); }
     vk::Kernel waited(ctx(), desc, vk::PipelineCreation::Background);
     EXPECT_GE(waited.wait(), 0.0);
