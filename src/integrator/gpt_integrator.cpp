@@ -86,6 +86,7 @@ RenderOutput GptIntegrator::render(const vk::Context& ctx, const Scene& scene, c
 
 void GptIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
     j["gpt_split_bounce"] = s.gptSplitBounce;
+    j["gpt_occlusion_beams"] = s.gptOcclusionBeams;
     j["edge_samples"] = edgeSamplesJson(s);
     j["demodulation"] = {{"on", s.demodulated}, {"pixels", s.demodulatedPixels}};
     j["reconstructions"] = reconstructionsJson(s);

@@ -97,6 +97,7 @@ RenderResultGpt renderGpt(const vk::Context& ctx, const Scene& scene, const Rend
     RenderStats& stats = sampling.stats();
     stats.readbackMs = phase.ms();
     stats.gptSplitBounce = pass->splitBounceCompiled();
+    stats.gptOcclusionBeams = pass->occlusionBeamsCompiled();
     const std::uint32_t factor = pass->edges().samplesPerSpp();
     stats.edgeSamples = factor == kEdgeSamplesAuto ? 0 : factor;
     stats.edgePixels = stats.edgeSamples > 0 ? pass->edges().count() : 0;

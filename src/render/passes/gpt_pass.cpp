@@ -148,6 +148,7 @@ GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize w
       options_(options),
       halfVector_(options.forceHalfVector || gptNeedsHalfVector(scene)),
       splitBounce_(splitBounceFor(ctx.info(), options.splitBounce)),
+      occlusionBeams_(splitBounce_ && !scene.bvhUnitSteps(ctx.info())),
       checked_(ctx, width_, height_, pixelBuffers(options)),
       counters_(ctx, sizeof(gpu::Counters), "gpt counters"),
       emitterSupersampling_(ctx, scene, wg, options.emitterSupersampling, counters_, creation),

@@ -132,6 +132,9 @@ public:
     void uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats) override;
     // Whether the kernel is the split bounce loop build (gpt_split, see gpt.comp).
     [[nodiscard]] bool splitBounceCompiled() const { return splitBounce_; }
+    // Whether the kernel traces the offsets' occlusion rays as beams (GDPT_GPT_BEAMS,
+    // shaders/lib/gpt_trace.glsl: the split build in node steps).
+    [[nodiscard]] bool occlusionBeamsCompiled() const { return occlusionBeams_; }
     [[nodiscard]] bool demodulating() const { return options_.demodulate; }
     // Pixels marked for demodulation by the last findEdges() (0 before).
     [[nodiscard]] std::uint32_t demodulatedPixels() const { return demodulatedPixels_; }
@@ -150,6 +153,7 @@ private:
     GptPassOptions options_;
     bool halfVector_ = false;
     bool splitBounce_ = false;
+    bool occlusionBeams_ = false;
     PixelBuffersChecked checked_;  // before any buffer below exists
     vk::Buffer counters_;
     EmitterSupersamplingPass emitterSupersampling_;

@@ -274,6 +274,9 @@ TEST_F(Cli, GptRenderReportsItsEdgeSamples) {
     ASSERT_EQ(r.code, 0) << r.output;
     nlohmann::json j = readJson();
     EXPECT_EQ(j["edge_samples"]["factor"].get<int>(), 3);
+    // The kernel variant: occlusion beams exactly in the split build traversing in node steps.
+    EXPECT_EQ(j["gpt_occlusion_beams"].get<bool>(),
+              j["gpt_split_bounce"].get<bool>() && j["bvh_steps"].get<std::string>() == "nodes");
     const int pixels = j["edge_samples"]["pixels"].get<int>();
     EXPECT_GT(pixels, 0) << "the Cornell box's walls and boxes have edges";
     EXPECT_LT(pixels, 32 * 32 / 2);
