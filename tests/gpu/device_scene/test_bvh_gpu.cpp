@@ -306,7 +306,9 @@ protected:
         EXPECT_EQ(unwantedOccluded, 0) << "a ray not wanted is never occluded";
         EXPECT_GT(occluded, wanted / 10) << "the beams should meet occluders often";
         EXPECT_LT(occluded, wanted * 9 / 10) << "and miss them often";
-        if (noGrowth == 0) EXPECT_EQ(differ, 0) << "beam answers that are not the single rays' answers";
+        if (noGrowth == 0) {
+            EXPECT_EQ(differ, 0) << "beam answers that are not the single rays' answers";
+        }
         return differ;
     }
 };
