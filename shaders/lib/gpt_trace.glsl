@@ -21,11 +21,12 @@
 // Occlusion beams (GDPT_GPT_BEAMS; bvh_traverse.glsl, traceAnyBeam): the offsets' own shadow
 // rays, and without glossy vertices their reconnections' visibility rays, traced as one beam
 // per bounce instead of one ray each, in the build for lavapipe before Mesa 23 (the split
-// build) on trees small enough for node steps. Measured (bench/RESULTS.md, "Occlusion beams"):
-// 11-18 % less time per G-PT sample there on the scene set, for about 0.1 s more pipeline
-// creation; in unit steps (trees of 10^5 triangles) level or slower, and on Mesa 25, which
-// skips the branches no lane takes, slower on the Cornell box and a 200k-triangle terrain.
-// The same images either way.
+// build) on trees small enough for node steps. Measured (bench/RESULTS.md, "Occlusion beams
+// for the offsets' rays"): 11-18 % less time per G-PT sample there on the scene set (4 % on the
+// glossy box, whose reconnections stay single rays), for about 0.1 s more pipeline creation; in
+// unit steps (trees of 10^5 triangles) level or slower, and on Mesa 25, which skips the
+// branches no lane takes, slower on the Cornell box and a 200k-triangle terrain. The same
+// images either way.
 #if defined(GDPT_GPT_SPLIT_BOUNCE) && !defined(GDPT_BVH_UNIT_STEPS)
 #define GDPT_GPT_BEAMS
 #endif
