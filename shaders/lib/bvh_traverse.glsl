@@ -637,27 +637,18 @@ void beamSpan(inout OcclusionBeam b, float endMagnitude) {
     b.grow = halfWidth + vec3(margin);
 }
 
-// Ray from o towards `target` as occludedTowards traces it; false (not traced) for a zero or
-// NaN distance, where nothing occludes.
-bool beamRayTowards(bool want, vec3 o, vec3 target, out vec3 dir, inout vec4 tMax, uint j) {
-    float t;
-    bool ok = towardsTarget(o, target, dir, t);
-    tMax[j] = t;
-    return want && ok;
-}
-
-// Rays from o0..o3 (want) towards `target`, each as occludedTowards traces it.
+// Rays from o0..o3 (want) towards `target`, each as occludedTowards traces it (towardsTarget;
+// a ray of zero or NaN length is not traced: nothing occludes it).
 OcclusionBeam beamTowards(vec3 o0, vec3 o1, vec3 o2, vec3 o3, bvec4 want, vec3 target) {
     OcclusionBeam b;
     b.o0 = o0;
     b.o1 = o1;
     b.o2 = o2;
     b.o3 = o3;
-    b.tMax = vec4(0.0);
-    b.want.x = beamRayTowards(want.x, o0, target, b.d0, b.tMax, 0u);
-    b.want.y = beamRayTowards(want.y, o1, target, b.d1, b.tMax, 1u);
-    b.want.z = beamRayTowards(want.z, o2, target, b.d2, b.tMax, 2u);
-    b.want.w = beamRayTowards(want.w, o3, target, b.d3, b.tMax, 3u);
+    b.want.x = towardsTarget(o0, target, b.d0, b.tMax.x) && want.x;
+    b.want.y = towardsTarget(o1, target, b.d1, b.tMax.y) && want.y;
+    b.want.z = towardsTarget(o2, target, b.d2, b.tMax.z) && want.z;
+    b.want.w = towardsTarget(o3, target, b.d3, b.tMax.w) && want.w;
     beamSpan(b, maxComponent(abs(target)));
     b.centreDir = target - b.centre;
     b.centreTMax = 1.0;

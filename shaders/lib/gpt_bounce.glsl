@@ -112,8 +112,8 @@
         bvec4 reconnecting;
         for (uint i = 0u; i < kGptNumOffsets; ++i)
             shiftRay[i] = gptShiftOffsetBegin(offs[i], offV[i], seg, conn[i], reconnecting[i], rays);
-        bvec4 trace = bvec4(reconnecting.x && shiftRay[0].trace, reconnecting.y && shiftRay[1].trace,
-                            reconnecting.z && shiftRay[2].trace, reconnecting.w && shiftRay[3].trace);
+        // (Only a reconnection traces: trace implies reconnecting.)
+        bvec4 trace = bvec4(shiftRay[0].trace, shiftRay[1].trace, shiftRay[2].trace, shiftRay[3].trace);
         OcclusionBeam beam =
             seg.missed
                 ? beamAlong(shiftRay[0].origin, shiftRay[1].origin, shiftRay[2].origin, shiftRay[3].origin, trace,
