@@ -758,6 +758,137 @@ bvec4 traceAnyBeam(OcclusionBeam b) {
 #endif
     return occluded;
 }
+
+#ifndef GDPT_BVH_UNIT_STEPS
+// ---- Primary fans: up to five closest-hit rays from one origin ----
+//
+// G-PT's camera sample traces the base's primary ray and its four offsets' (the same film
+// position one pixel right, down, left and up): five closest-hit queries from the camera whose
+// directions differ by about a pixel's angle, each of which lavapipe runs as a traversal loop
+// until its slowest lane ends. A fan walks the tree once for the five. A node is entered if the
+// centre ray (the base's) enters its box grown by `grow`: ray i's point at parameter t lies
+// within t·|d_i − d_0| of the centre ray's point on every axis, and no box holds a point
+// farther than `reach` (the farthest corner of the root's bounds) from the origin, so every box
+// that ray i enters, the centre ray enters grown by reach·|d_i − d_0| (plus a rounding margin).
+// Its entry distance along the centre ray is then at most ray i's, so a node is skipped only
+// when the centre ray enters it beyond every wanted ray's closest hit so far. Each leaf
+// triangle is tested against every ray with closerHit's test, so each ray gets the closest
+// accepted hit of its own traversal: the same t, u, v and triangle, except where two
+// triangles are hit at exactly the same t (duplicated or coplanar-overlapping triangles),
+// where either may be reported, as the single ray's own visiting order decides.
+struct PrimaryFan {
+    vec3 o;                   // the shared origin
+    vec3 d0, d1, d2, d3, d4;  // unit directions: d0 the centre ray, always traced
+    bvec4 want;               // rays d1..d4 to trace; the others stay misses
+    vec3 grow;                // box growth: reach · spread + a rounding margin
+};
+
+// The scene's bounds: the union of the root's child boxes.
+void bvhRootBounds(out vec3 lo, out vec3 hi) {
+    BvhWideNode n = bvhNode(0u);
+    float sx = wideAxisScale(n.exponents, 0u);
+    float sy = wideAxisScale(n.exponents, 1u);
+    float sz = wideAxisScale(n.exponents, 2u);
+    vec4 loX = wideDecodeAxis(n.origin.x, n.qMin.x, sx), hiX = wideDecodeAxis(n.origin.x, n.qMax.x, sx);
+    vec4 loY = wideDecodeAxis(n.origin.y, n.qMin.y, sy), hiY = wideDecodeAxis(n.origin.y, n.qMax.y, sy);
+    vec4 loZ = wideDecodeAxis(n.origin.z, n.qMin.z, sz), hiZ = wideDecodeAxis(n.origin.z, n.qMax.z, sz);
+    lo = vec3(kBvhInfinity);
+    hi = vec3(-kBvhInfinity);
+    for (uint j = 0u; j < 4u; ++j) {
+        if (n.child[j] == kInvalidIndex) continue;
+        lo = min(lo, vec3(loX[j], loY[j], loZ[j]));
+        hi = max(hi, vec3(hiX[j], hiY[j], hiZ[j]));
+    }
+}
+
+PrimaryFan fanFrom(vec3 o, vec3 d0, vec3 d1, vec3 d2, vec3 d3, vec3 d4, bvec4 want) {
+    PrimaryFan f;
+    f.o = o;
+    f.d0 = d0;
+    f.d1 = d1;
+    f.d2 = d2;
+    f.d3 = d3;
+    f.d4 = d4;
+    f.want = want;
+    vec3 spread = vec3(0.0);
+    if (want.x) spread = max(spread, abs(d1 - d0));
+    if (want.y) spread = max(spread, abs(d2 - d0));
+    if (want.z) spread = max(spread, abs(d3 - d0));
+    if (want.w) spread = max(spread, abs(d4 - d0));
+    vec3 lo;
+    vec3 hi;
+    bvhRootBounds(lo, hi);
+    float reach = length(max(abs(lo - o), abs(hi - o)));
+    float margin = (maxComponent(abs(o)) + reach) * (1.0 / 1048576.0);
+    f.grow = spread * reach + vec3(margin);
+    return f;
+}
+
+// Triangle `tri` against ray d of the fan: closerHit's test on the fetched triangle.
+void fanCloser(vec3 o, vec3 d, TriangleGeom g, uint tri, inout Hit hit) {
+    float tCand = hit.t;
+    float u;
+    float v;
+    if (intersectTriangleGeom(o, d, g.v0, g.e1, g.e2, 0.0, tCand, u, v) && GDPT_ANYHIT_FILTER(tri, u, v)) {
+        hit.t = tCand;
+        hit.u = u;
+        hit.v = v;
+        hit.triangle = tri;
+    }
+}
+
+// The farthest closest-hit distance so far over the wanted rays: nothing nearer is skipped.
+float fanReach(PrimaryFan f, Hit h0, Hit h1, Hit h2, Hit h3, Hit h4) {
+    float t = h0.t;
+    if (f.want.x) t = max(t, h1.t);
+    if (f.want.y) t = max(t, h2.t);
+    if (f.want.z) t = max(t, h3.t);
+    if (f.want.w) t = max(t, h4.t);
+    return t;
+}
+
+// Per ray of the fan: traceClosest(o, d_i, 0, ∞) (a miss for a ray not wanted). traceClosest's
+// walk (node steps) with the grown boxes, the centre ray's order and every ray's triangle test.
+void traceClosestFan(PrimaryFan f, out Hit h0, out Hit h1, out Hit h2, out Hit h3, out Hit h4) {
+    h0 = missHit(kBvhInfinity);
+    h1 = h0;
+    h2 = h0;
+    h3 = h0;
+    h4 = h0;
+    vec3 invDir = bvhSafeInverse(f.d0);
+    GDPT_BVH_STACK_DECLARE();
+    uint node = 0u;
+    while (true) {
+        BvhWideNode n = bvhNode(node);
+        vec4 tNear;
+        bvec4 h;
+        wideNodeBoxesGrown(n, f.grow, f.o, invDir, 0.0, fanReach(f, h0, h1, h2, h3, h4), tNear, h);
+        uvec4 count = wideCounts(n);
+        uvec4 c = wideLeafCounts(count, h);
+        for (uint k = 0u; k < c.x + c.y + c.z + c.w; ++k) {
+            uint tri = wideLeafTriangle(n.child, k, c);
+            TriangleGeom g = triangleGeom(tri);
+            fanCloser(f.o, f.d0, g, tri, h0);
+            if (f.want.x) fanCloser(f.o, f.d1, g, tri, h1);
+            if (f.want.y) fanCloser(f.o, f.d2, g, tri, h2);
+            if (f.want.z) fanCloser(f.o, f.d3, g, tri, h3);
+            if (f.want.w) fanCloser(f.o, f.d4, g, tri, h4);
+        }
+        float limit = fanReach(f, h0, h1, h2, h3, h4);
+        WideOrder o = wideSortInner(n, count, h, tNear, limit);
+        uint next = o.child.x;
+        GDPT_BVH_PUSH_FARTHER(o);
+        while (next == kInvalidIndex && stackSize > 0u) {
+            uint popped;
+            float poppedNear;
+            GDPT_BVH_STACK_POP(popped, poppedNear);
+            if (poppedNear <= limit) next = popped;
+        }
+        if (next == kInvalidIndex) break;
+        node = next;
+    }
+}
+#endif  // !GDPT_BVH_UNIT_STEPS
 #endif  // !__cplusplus
 
 #endif  // GDPT_LIB_BVH_TRAVERSE

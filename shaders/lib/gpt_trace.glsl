@@ -68,7 +68,18 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     // Primary rays. Emission at the base's first hit is "very direct": direct buffer only.
     vec3 o = scene.camPosition;
     vec3 d = cameraRay(pixelPos);
+#ifdef GDPT_GPT_BEAMS
+    // The base's and the offsets' primary rays as one fan (bvh_traverse.glsl, traceClosestFan).
+    vec3 dOff[kGptNumOffsets];
+    for (uint i = 0u; i < kGptNumOffsets; ++i) dOff[i] = cameraRay(pixelPos + vec2(kOffsetDelta[i]));
+    Hit hit;
+    Hit hOff[kGptNumOffsets];
+    traceClosestFan(fanFrom(o, d, dOff[0], dOff[1], dOff[2], dOff[3],
+                            bvec4(offs[0].alive, offs[1].alive, offs[2].alive, offs[3].alive)),
+                    hit, hOff[0], hOff[1], hOff[2], hOff[3]);
+#else
     Hit hit = traceClosest(o, d, 0.0, kInf);
+#endif
     rays++;
     if (hit.triangle == kInvalidIndex) {
         if (kHasEnv && countDirect) direct += scene.envRadiance;
@@ -80,8 +91,13 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     for (uint i = 0u; i < kGptNumOffsets; ++i) {
         offs[i].shifted = offs[i].alive;
         if (!offs[i].alive) continue;
+#ifdef GDPT_GPT_BEAMS
+        vec3 di = dOff[i];
+        Hit hi = hOff[i];
+#else
         vec3 di = cameraRay(pixelPos + vec2(kOffsetDelta[i]));
         Hit hi = traceClosest(o, di, 0.0, kInf);
+#endif
         rays++;
         if (hi.triangle == kInvalidIndex) {
             offs[i].alive = false;  // base hit, offset missed: no shift
