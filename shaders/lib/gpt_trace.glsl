@@ -26,7 +26,9 @@
 // glossy box, whose reconnections stay single rays), for about 0.1 s more pipeline creation; in
 // unit steps (trees of 10^5 triangles) level or slower, and on Mesa 25, which skips the
 // branches no lane takes, slower on the Cornell box and a 200k-triangle terrain. The same
-// images either way.
+// images either way. The same build traces the base's and the offsets' primary rays as one
+// closest-hit fan (traceClosestFan): 16-24 % less time per sample on the Cornell box and the
+// open scene ("A primary fan for the camera rays"); the same hits, up to exact ties.
 #if defined(GDPT_GPT_SPLIT_BOUNCE) && !defined(GDPT_BVH_UNIT_STEPS)
 #define GDPT_GPT_BEAMS
 #endif
