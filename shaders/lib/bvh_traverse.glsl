@@ -759,6 +759,7 @@ bvec4 traceAnyBeam(OcclusionBeam b) {
     return occluded;
 }
 
+#ifndef GDPT_BVH_UNIT_STEPS
 // ---- Primary fans: up to five closest-hit rays from one origin ----
 //
 // G-PT's camera sample traces the base's primary ray and its four offsets' (the same film
@@ -846,19 +847,8 @@ float fanReach(PrimaryFan f, Hit h0, Hit h1, Hit h2, Hit h3, Hit h4) {
     return t;
 }
 
-// Triangle `tri` against every wanted ray of the fan.
-void fanTriangle(PrimaryFan f, uint tri, inout Hit h0, inout Hit h1, inout Hit h2, inout Hit h3, inout Hit h4) {
-    TriangleGeom g = triangleGeom(tri);
-    fanCloser(f.o, f.d0, g, tri, h0);
-    if (f.want.x) fanCloser(f.o, f.d1, g, tri, h1);
-    if (f.want.y) fanCloser(f.o, f.d2, g, tri, h2);
-    if (f.want.z) fanCloser(f.o, f.d3, g, tri, h3);
-    if (f.want.w) fanCloser(f.o, f.d4, g, tri, h4);
-}
-
 // Per ray of the fan: traceClosest(o, d_i, 0, ∞) (a miss for a ray not wanted). traceClosest's
-// walk (both builds, GDPT_BVH_UNIT_STEPS as there) with the grown boxes, the centre ray's order
-// and every ray's triangle test.
+// walk (node steps) with the grown boxes, the centre ray's order and every ray's triangle test.
 void traceClosestFan(PrimaryFan f, out Hit h0, out Hit h1, out Hit h2, out Hit h3, out Hit h4) {
     h0 = missHit(kBvhInfinity);
     h1 = h0;
@@ -868,48 +858,6 @@ void traceClosestFan(PrimaryFan f, out Hit h0, out Hit h1, out Hit h2, out Hit h
     vec3 invDir = bvhSafeInverse(f.d0);
     GDPT_BVH_STACK_DECLARE();
     uint node = 0u;
-#ifdef GDPT_BVH_UNIT_STEPS
-    float nodeNear = 0.0;
-    uvec4 leafFirst = uvec4(0u);
-    uvec4 leafCount = uvec4(0u);
-    uint k = 0u;
-    uint kEnd = 0u;
-    while (true) {
-        while (k < kEnd) {
-            fanTriangle(f, wideLeafTriangle(leafFirst, k, leafCount), h0, h1, h2, h3, h4);
-            ++k;
-            if (kBvhRegisterStack == 0u) break;
-        }
-        if (k < kEnd) continue;
-        float limit = fanReach(f, h0, h1, h2, h3, h4);
-        if (node == kInvalidIndex || nodeNear > limit) {
-            node = kInvalidIndex;
-            while (node == kInvalidIndex && stackSize > 0u) {
-                uint popped;
-                float poppedNear;
-                GDPT_BVH_STACK_POP(popped, poppedNear);
-                if (poppedNear <= limit) {
-                    node = popped;
-                    nodeNear = poppedNear;
-                }
-            }
-            if (node == kInvalidIndex) break;
-        }
-        BvhWideNode n = bvhNode(node);
-        vec4 tNear;
-        bvec4 h;
-        wideNodeBoxesGrown(n, f.grow, f.o, invDir, 0.0, limit, tNear, h);
-        uvec4 count = wideCounts(n);
-        leafFirst = n.child;
-        leafCount = wideLeafCounts(count, h);
-        k = 0u;
-        kEnd = leafCount.x + leafCount.y + leafCount.z + leafCount.w;
-        WideOrder o = wideSortInner(n, count, h, tNear, limit);
-        node = o.child.x;
-        nodeNear = o.t.x;
-        GDPT_BVH_PUSH_FARTHER(o);
-    }
-#else
     while (true) {
         BvhWideNode n = bvhNode(node);
         vec4 tNear;
@@ -917,7 +865,15 @@ void traceClosestFan(PrimaryFan f, out Hit h0, out Hit h1, out Hit h2, out Hit h
         wideNodeBoxesGrown(n, f.grow, f.o, invDir, 0.0, fanReach(f, h0, h1, h2, h3, h4), tNear, h);
         uvec4 count = wideCounts(n);
         uvec4 c = wideLeafCounts(count, h);
-        for (uint k = 0u; k < c.x + c.y + c.z + c.w; ++k) fanTriangle(f, wideLeafTriangle(n.child, k, c), h0, h1, h2, h3, h4);
+        for (uint k = 0u; k < c.x + c.y + c.z + c.w; ++k) {
+            uint tri = wideLeafTriangle(n.child, k, c);
+            TriangleGeom g = triangleGeom(tri);
+            fanCloser(f.o, f.d0, g, tri, h0);
+            if (f.want.x) fanCloser(f.o, f.d1, g, tri, h1);
+            if (f.want.y) fanCloser(f.o, f.d2, g, tri, h2);
+            if (f.want.z) fanCloser(f.o, f.d3, g, tri, h3);
+            if (f.want.w) fanCloser(f.o, f.d4, g, tri, h4);
+        }
         float limit = fanReach(f, h0, h1, h2, h3, h4);
         WideOrder o = wideSortInner(n, count, h, tNear, limit);
         uint next = o.child.x;
@@ -931,8 +887,8 @@ void traceClosestFan(PrimaryFan f, out Hit h0, out Hit h1, out Hit h2, out Hit h
         if (next == kInvalidIndex) break;
         node = next;
     }
-#endif
 }
+#endif  // !GDPT_BVH_UNIT_STEPS
 #endif  // !__cplusplus
 
 #endif  // GDPT_LIB_BVH_TRAVERSE

@@ -26,20 +26,13 @@
 // glossy box, whose reconnections stay single rays), for about 0.1 s more pipeline creation; in
 // unit steps (trees of 10^5 triangles) level or slower, and on Mesa 25, which skips the
 // branches no lane takes, slower on the Cornell box and a 200k-triangle terrain. The same
-// images either way.
+// images either way. The same build traces the base's and the offsets' primary rays as one
+// closest-hit fan (traceClosestFan): 18-29 % less time per sample on the scene set (the glossy
+// box 3 %; "A primary fan for the camera rays"), the same hits up to exact ties (two triangles
+// at the same t); in unit steps 12 % faster on a 110k-triangle asset but 3-13 % slower on a
+// 200k-triangle terrain, so not there either.
 #if defined(GDPT_GPT_SPLIT_BOUNCE) && !defined(GDPT_BVH_UNIT_STEPS)
 #define GDPT_GPT_BEAMS
-#endif
-
-// A primary fan (GDPT_GPT_PRIMARY_FAN; bvh_traverse.glsl, traceClosestFan): the base's and the
-// offsets' primary rays traced as one closest-hit fan in the split build (both step forms).
-// Measured (bench/RESULTS.md, "A primary fan for the camera rays"): 18-29 % less time per G-PT
-// sample on the scene set on lavapipe 22.3 (the glossy box 3 %), 12 % on a 110k-triangle asset
-// in unit steps, for about 0.1 s more pipeline creation. The same hits, up to exact ties (two
-// triangles at the same t), so the same images but for such pixels. Not measured on Mesa 25,
-// whose default single loop does not have it.
-#ifdef GDPT_GPT_SPLIT_BOUNCE
-#define GDPT_GPT_PRIMARY_FAN
 #endif
 
 // Offset i has a vertex of its own (NOT_CONNECTED); never in the fast form (general false).
@@ -79,7 +72,7 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     // Primary rays. Emission at the base's first hit is "very direct": direct buffer only.
     vec3 o = scene.camPosition;
     vec3 d = cameraRay(pixelPos);
-#ifdef GDPT_GPT_PRIMARY_FAN
+#ifdef GDPT_GPT_BEAMS
     // The base's and the offsets' primary rays as one fan (bvh_traverse.glsl, traceClosestFan).
     vec3 dOff[kGptNumOffsets];
     for (uint i = 0u; i < kGptNumOffsets; ++i) dOff[i] = cameraRay(pixelPos + vec2(kOffsetDelta[i]));
@@ -102,7 +95,7 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     for (uint i = 0u; i < kGptNumOffsets; ++i) {
         offs[i].shifted = offs[i].alive;
         if (!offs[i].alive) continue;
-#ifdef GDPT_GPT_PRIMARY_FAN
+#ifdef GDPT_GPT_BEAMS
         vec3 di = dOff[i];
         Hit hi = hOff[i];
 #else

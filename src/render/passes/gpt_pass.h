@@ -130,11 +130,10 @@ public:
     // their replacement (before the next record()) to continue a checkpointed render.
     [[nodiscard]] std::vector<std::vector<gpu::PixelStats>> downloadStats() const override;
     void uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats) override;
-    // Whether the kernel is the split bounce loop build (gpt_split, see gpt.comp), which also
-    // traces the five primary rays as one fan (GDPT_GPT_PRIMARY_FAN, shaders/lib/gpt_trace.glsl).
+    // Whether the kernel is the split bounce loop build (gpt_split, see gpt.comp).
     [[nodiscard]] bool splitBounceCompiled() const { return splitBounce_; }
-    // Whether the kernel traces the offsets' occlusion rays as beams (GDPT_GPT_BEAMS,
-    // shaders/lib/gpt_trace.glsl: the split build in node steps).
+    // Whether the kernel traces the offsets' occlusion rays as beams and the five primary rays as
+    // one fan (GDPT_GPT_BEAMS, shaders/lib/gpt_trace.glsl: the split build in node steps).
     [[nodiscard]] bool occlusionBeamsCompiled() const { return occlusionBeams_; }
     [[nodiscard]] bool demodulating() const { return options_.demodulate; }
     // Pixels marked for demodulation by the last findEdges() (0 before).
