@@ -368,17 +368,22 @@ bool intersectTriangle(vec3 orig, vec3 dir, uint tri, float tMin, inout float tM
     return intersectTriangleGeom(orig, dir, g.v0, g.e1, g.e2, tMin, tMax, u, v);
 }
 
-// Triangle `tri` against the ray: shrinks `hit` to it if it is accepted and closer.
-void closerHit(vec3 orig, vec3 dir, uint tri, float tMin, inout Hit hit) {
+// Triangle `tri`, fetched as g, against the ray: shrinks `hit` to it if it is accepted and closer.
+void closerHitGeom(vec3 orig, vec3 dir, TriangleGeom g, uint tri, float tMin, inout Hit hit) {
     float tCand = hit.t;
     float u;
     float v;
-    if (intersectTriangle(orig, dir, tri, tMin, tCand, u, v) && GDPT_ANYHIT_FILTER(tri, u, v)) {
+    if (intersectTriangleGeom(orig, dir, g.v0, g.e1, g.e2, tMin, tCand, u, v) && GDPT_ANYHIT_FILTER(tri, u, v)) {
         hit.t = tCand;
         hit.u = u;
         hit.v = v;
         hit.triangle = tri;
     }
+}
+
+// Triangle `tri` against the ray: shrinks `hit` to it if it is accepted and closer.
+void closerHit(vec3 orig, vec3 dir, uint tri, float tMin, inout Hit hit) {
+    closerHitGeom(orig, dir, triangleGeom(tri), tri, tMin, hit);
 }
 
 // Triangle `tri` is hit and accepted with tMin < t < tMax.
@@ -824,19 +829,6 @@ PrimaryFan fanFrom(vec3 o, vec3 d0, vec3 d1, vec3 d2, vec3 d3, vec3 d4, bvec4 wa
     return f;
 }
 
-// Triangle `tri` against ray d of the fan: closerHit's test on the fetched triangle.
-void fanCloser(vec3 o, vec3 d, TriangleGeom g, uint tri, inout Hit hit) {
-    float tCand = hit.t;
-    float u;
-    float v;
-    if (intersectTriangleGeom(o, d, g.v0, g.e1, g.e2, 0.0, tCand, u, v) && GDPT_ANYHIT_FILTER(tri, u, v)) {
-        hit.t = tCand;
-        hit.u = u;
-        hit.v = v;
-        hit.triangle = tri;
-    }
-}
-
 // The farthest closest-hit distance so far over the wanted rays: nothing nearer is skipped.
 float fanReach(PrimaryFan f, Hit h0, Hit h1, Hit h2, Hit h3, Hit h4) {
     float t = h0.t;
@@ -868,11 +860,11 @@ void traceClosestFan(PrimaryFan f, out Hit h0, out Hit h1, out Hit h2, out Hit h
         for (uint k = 0u; k < c.x + c.y + c.z + c.w; ++k) {
             uint tri = wideLeafTriangle(n.child, k, c);
             TriangleGeom g = triangleGeom(tri);
-            fanCloser(f.o, f.d0, g, tri, h0);
-            if (f.want.x) fanCloser(f.o, f.d1, g, tri, h1);
-            if (f.want.y) fanCloser(f.o, f.d2, g, tri, h2);
-            if (f.want.z) fanCloser(f.o, f.d3, g, tri, h3);
-            if (f.want.w) fanCloser(f.o, f.d4, g, tri, h4);
+            closerHitGeom(f.o, f.d0, g, tri, 0.0, h0);
+            if (f.want.x) closerHitGeom(f.o, f.d1, g, tri, 0.0, h1);
+            if (f.want.y) closerHitGeom(f.o, f.d2, g, tri, 0.0, h2);
+            if (f.want.z) closerHitGeom(f.o, f.d3, g, tri, 0.0, h3);
+            if (f.want.w) closerHitGeom(f.o, f.d4, g, tri, 0.0, h4);
         }
         float limit = fanReach(f, h0, h1, h2, h3, h4);
         WideOrder o = wideSortInner(n, count, h, tNear, limit);

@@ -297,15 +297,15 @@ protected:
     // traversal's; with noGrowth (the power check) the beam's boxes are not grown, and the
     // number of rays on which the two differ is returned for the caller to expect above 0.
     // Also checks that the beams meet occluders often and miss them often.
-    int checkBeams(const Soup& soup, std::uint32_t seed, float spread, std::uint32_t registerStack = 0,
-                   Steps steps = Steps::Nodes, std::uint32_t noGrowth = 0, std::uint32_t beamCount = 20000) {
+    // Runs a ray-group test kernel (trace_beams, trace_fans: push constants {groups, noGrowth})
+    // over `soup` and `rays`, one invocation per group, and returns its `outputs` vec4 answers.
+    std::vector<glm::vec4> runGroups(vk::KernelDesc desc, const Soup& soup,
+                                     const std::vector<gpu::TestRay>& rays, std::uint32_t groups,
+                                     std::uint32_t noGrowth, std::uint32_t registerStack,
+                                     std::size_t outputs) {
         const Bvh bvh = buildBvh(soup.positions, soup.triangles);
         const auto geoms = makeTriangleGeoms(soup.positions, soup.triangles, bvh.triangleOrder);
-        const auto rays = randomBeams(beamCount, seed, spread, soup);
-        vk::KernelDesc desc = testKernelDesc(
-            steps == Steps::Units ? vk::kernelDesc("trace_beams", GDPT_KERNEL_SPIRV(trace_beams_units))
-                                  : vk::kernelDesc("trace_beams", GDPT_KERNEL_SPIRV(trace_beams)),
-            {gpu::kBindTestOutput}, 2 * sizeof(std::uint32_t));
+        desc = testKernelDesc(std::move(desc), {gpu::kBindTestOutput}, 2 * sizeof(std::uint32_t));
         const WideBvh wide = collapseToWide(bvh.nodes);
         if (registerStack != 0) {
             EXPECT_LE(wide.maxStack, registerStack) << "the tree does not fit the register stack";
@@ -313,14 +313,23 @@ protected:
         }
         vk::Kernel kernel(ctx(), desc);
         const DeviceScene scene(ctx(), kernel, geoms, wide, rays);
-        vk::Buffer outBuf(ctx(), rays.size() * sizeof(glm::vec4), "answers");
+        vk::Buffer outBuf(ctx(), outputs * sizeof(glm::vec4), "answers");
         kernel.bind(gpu::kBindTestOutput, outBuf);
-        const std::uint32_t push[2] = {beamCount, noGrowth};
-        vk::CommandStream cmd(ctx(), "trace_beams");
-        kernel.dispatchItems(cmd.begin(), beamCount, 1, push);
+        const std::uint32_t push[2] = {groups, noGrowth};
+        vk::CommandStream cmd(ctx(), "ray groups");
+        kernel.dispatchItems(cmd.begin(), groups, 1, push);
         vk::computeBarrier(cmd.cmd());
         cmd.submitAndWait();
-        const auto answers = outBuf.downloadVector<glm::vec4>(rays.size());
+        return outBuf.downloadVector<glm::vec4>(outputs);
+    }
+
+    int checkBeams(const Soup& soup, std::uint32_t seed, float spread, std::uint32_t registerStack = 0,
+                   Steps steps = Steps::Nodes, std::uint32_t noGrowth = 0, std::uint32_t beamCount = 20000) {
+        const auto rays = randomBeams(beamCount, seed, spread, soup);
+        const auto answers = runGroups(
+            steps == Steps::Units ? vk::kernelDesc("trace_beams", GDPT_KERNEL_SPIRV(trace_beams_units))
+                                  : vk::kernelDesc("trace_beams", GDPT_KERNEL_SPIRV(trace_beams)),
+            soup, rays, beamCount, noGrowth, registerStack, rays.size());
         int wanted = 0, occluded = 0, differ = 0, unwantedOccluded = 0;
         for (std::size_t i = 0; i < rays.size(); ++i) {
             if (rays[i].tMin != 0.0f) {
@@ -348,26 +357,9 @@ protected:
     int checkFans(const Soup& soup, std::uint32_t seed, float spread, bool ties = false,
                   std::uint32_t registerStack = 0, std::uint32_t noGrowth = 0,
                   std::uint32_t fanCount = 20000) {
-        const Bvh bvh = buildBvh(soup.positions, soup.triangles);
-        const auto geoms = makeTriangleGeoms(soup.positions, soup.triangles, bvh.triangleOrder);
         const auto rays = randomFans(fanCount, seed, spread);
-        vk::KernelDesc desc = testKernelDesc(vk::kernelDesc("trace_fans", GDPT_KERNEL_SPIRV(trace_fans)),
-                                             {gpu::kBindTestOutput}, 2 * sizeof(std::uint32_t));
-        const WideBvh wide = collapseToWide(bvh.nodes);
-        if (registerStack != 0) {
-            EXPECT_LE(wide.maxStack, registerStack) << "the tree does not fit the register stack";
-            desc.specConstants = {{gpu::kSpecBvhRegisterStack, registerStack}};
-        }
-        vk::Kernel kernel(ctx(), desc);
-        const DeviceScene scene(ctx(), kernel, geoms, wide, rays);
-        vk::Buffer outBuf(ctx(), 2 * rays.size() * sizeof(glm::vec4), "answers");
-        kernel.bind(gpu::kBindTestOutput, outBuf);
-        const std::uint32_t push[2] = {fanCount, noGrowth};
-        vk::CommandStream cmd(ctx(), "trace_fans");
-        kernel.dispatchItems(cmd.begin(), fanCount, 1, push);
-        vk::computeBarrier(cmd.cmd());
-        cmd.submitAndWait();
-        const auto answers = outBuf.downloadVector<glm::vec4>(2 * rays.size());
+        const auto answers = runGroups(vk::kernelDesc("trace_fans", GDPT_KERNEL_SPIRV(trace_fans)), soup,
+                                       rays, fanCount, noGrowth, registerStack, 2 * rays.size());
         const auto bits = [](float x) {
             std::uint32_t b;
             std::memcpy(&b, &x, sizeof b);
