@@ -765,27 +765,33 @@ bvec4 traceAnyBeam(OcclusionBeam b) {
 }
 
 #ifndef GDPT_BVH_UNIT_STEPS
-// ---- Primary fans: up to five closest-hit rays from one origin ----
+// ---- Ray bundles: up to five closest-hit rays a little apart ----
 //
-// G-PT's camera sample traces the base's primary ray and its four offsets' (the same film
-// position one pixel right, down, left and up): five closest-hit queries from the camera whose
-// directions differ by about a pixel's angle, each of which lavapipe runs as a traversal loop
-// until its slowest lane ends. A fan walks the tree once for the five. A node is entered if the
-// centre ray (the base's) enters its box grown by `grow`: ray i's point at parameter t lies
-// within t·|d_i − d_0| of the centre ray's point on every axis, and no box holds a point
-// farther than `reach` (the farthest corner of the root's bounds) from the origin, so every box
-// that ray i enters, the centre ray enters grown by reach·|d_i − d_0| (plus a rounding margin).
-// Its entry distance along the centre ray is then at most ray i's, so a node is skipped only
-// when the centre ray enters it beyond every wanted ray's closest hit so far. Each leaf
-// triangle is tested against every ray with closerHit's test, so each ray gets the closest
-// accepted hit of its own traversal: the same t, u, v and triangle, except where two
-// triangles are hit at exactly the same t (duplicated or coplanar-overlapping triangles),
-// where either may be reported, as the single ray's own visiting order decides.
-struct PrimaryFan {
-    vec3 o;                   // the shared origin
-    vec3 d0, d1, d2, d3, d4;  // unit directions: d0 the centre ray, always traced
-    bvec4 want;               // rays d1..d4 to trace; the others stay misses
-    vec3 grow;                // box growth: reach · spread + a rounding margin
+// G-PT traces groups of rays that start and point nearly alike: a camera sample's base
+// primary ray and its four offsets' (one origin, directions about a pixel's angle apart), and
+// in a glossy bounce the four offsets' own next rays (origins about a pixel apart, directions
+// near the base's), each a closest-hit query that lavapipe runs as a traversal loop until its
+// slowest lane ends. A bundle walks the tree once for up to five. A node is entered if the
+// bundle's centre ray (c, d_c) enters the node's box grown by `grow`: ray i's point at
+// parameter t lies within |o_i − c| + t·|d_i − d_c| of the centre ray's point at the same t on
+// every axis, and no ray goes farther than `reach` (the distance from c to the farthest corner
+// of the root's bounds plus the origins' spread, or the longest tMax if shorter) before
+// leaving every box, so every box that ray i enters, the centre ray enters grown by
+// max|o_i − c| + reach·max|d_i − d_c| (plus a rounding margin). Its entry distance along the
+// centre ray is then at most ray i's, so a node is skipped only when the centre ray enters it
+// beyond every ray's closest hit so far. Each leaf triangle is tested against every ray with
+// closerHit's test, so each ray gets the closest accepted hit of its own traversal: the same
+// t, u, v and triangle, except where two triangles are hit at exactly the same t (duplicated
+// or coplanar-overlapping triangles), where either may be reported, as the single ray's own
+// visiting order decides.
+struct RayBundle {
+    vec3 o0, o1, o2, o3, o4;  // the rays' origins ...
+    vec3 d0, d1, d2, d3, d4;  // ... unit directions ...
+    float tMax0;              // ... and ends: traceClosest(o_i, d_i, 0, tMax_i); 0 = not traced
+    vec4 tMax;                // (rays 1..4)
+    vec3 centre;              // the centre ray ...
+    vec3 centreDir;
+    vec3 grow;                // ... and the node boxes' growth (bundleSpan)
 };
 
 // The scene's bounds: the union of the root's child boxes.
@@ -806,67 +812,110 @@ void bvhRootBounds(out vec3 lo, out vec3 hi) {
     }
 }
 
-PrimaryFan fanFrom(vec3 o, vec3 d0, vec3 d1, vec3 d2, vec3 d3, vec3 d4, bvec4 want) {
-    PrimaryFan f;
-    f.o = o;
-    f.d0 = d0;
-    f.d1 = d1;
-    f.d2 = d2;
-    f.d3 = d3;
-    f.d4 = d4;
-    f.want = want;
-    vec3 spread = vec3(0.0);
-    if (want.x) spread = max(spread, abs(d1 - d0));
-    if (want.y) spread = max(spread, abs(d2 - d0));
-    if (want.z) spread = max(spread, abs(d3 - d0));
-    if (want.w) spread = max(spread, abs(d4 - d0));
+// Ray i's share of the bundle's spreads (if it is traced).
+void bundleSpread(vec3 o, vec3 d, float tMax, vec3 centre, vec3 centreDir, inout vec3 originSpread,
+                  inout vec3 dirSpread, inout float tFar) {
+    if (tMax > 0.0) {
+        originSpread = max(originSpread, abs(o - centre));
+        dirSpread = max(dirSpread, abs(d - centreDir));
+        tFar = max(tFar, tMax);
+    }
+}
+
+// Sets b.grow from the rays and the centre ray the caller filled in.
+void bundleSpan(inout RayBundle b) {
+    vec3 originSpread = vec3(0.0);
+    vec3 dirSpread = vec3(0.0);
+    float tFar = 0.0;
+    bundleSpread(b.o0, b.d0, b.tMax0, b.centre, b.centreDir, originSpread, dirSpread, tFar);
+    bundleSpread(b.o1, b.d1, b.tMax.x, b.centre, b.centreDir, originSpread, dirSpread, tFar);
+    bundleSpread(b.o2, b.d2, b.tMax.y, b.centre, b.centreDir, originSpread, dirSpread, tFar);
+    bundleSpread(b.o3, b.d3, b.tMax.z, b.centre, b.centreDir, originSpread, dirSpread, tFar);
+    bundleSpread(b.o4, b.d4, b.tMax.w, b.centre, b.centreDir, originSpread, dirSpread, tFar);
     vec3 lo;
     vec3 hi;
     bvhRootBounds(lo, hi);
-    float reach = length(max(abs(lo - o), abs(hi - o)));
-    float margin = (maxComponent(abs(o)) + reach) * (1.0 / 1048576.0);
-    f.grow = spread * reach + vec3(margin);
-    return f;
+    float reach = min(length(max(abs(lo - b.centre), abs(hi - b.centre))) + length(originSpread), tFar);
+    float margin = (maxComponent(abs(b.centre)) + reach) * (1.0 / 1048576.0);
+    b.grow = originSpread + dirSpread * reach + vec3(margin);
 }
 
-// The farthest closest-hit distance so far over the wanted rays: nothing nearer is skipped.
-float fanReach(PrimaryFan f, Hit h0, Hit h1, Hit h2, Hit h3, Hit h4) {
-    float t = h0.t;
-    if (f.want.x) t = max(t, h1.t);
-    if (f.want.y) t = max(t, h2.t);
-    if (f.want.z) t = max(t, h3.t);
-    if (f.want.w) t = max(t, h4.t);
-    return t;
+// A camera sample's primary rays: the base's (d0, the centre ray, always traced) and the
+// offsets' d1..d4 where `want`, all from the camera at o, to infinity.
+RayBundle fanFrom(vec3 o, vec3 d0, vec3 d1, vec3 d2, vec3 d3, vec3 d4, bvec4 want) {
+    RayBundle b;
+    b.o0 = o;
+    b.o1 = o;
+    b.o2 = o;
+    b.o3 = o;
+    b.o4 = o;
+    b.d0 = d0;
+    b.d1 = d1;
+    b.d2 = d2;
+    b.d3 = d3;
+    b.d4 = d4;
+    b.tMax0 = kBvhInfinity;
+    b.tMax = vec4(want.x ? kBvhInfinity : 0.0, want.y ? kBvhInfinity : 0.0, want.z ? kBvhInfinity : 0.0,
+                  want.w ? kBvhInfinity : 0.0);
+    b.centre = o;
+    b.centreDir = d0;
+    bundleSpan(b);
+    return b;
 }
 
-// Per ray of the fan: traceClosest(o, d_i, 0, ∞) (a miss for a ray not wanted). traceClosest's
-// walk (node steps) with the grown boxes, the centre ray's order and every ray's triangle test.
-void traceClosestFan(PrimaryFan f, out Hit h0, out Hit h1, out Hit h2, out Hit h3, out Hit h4) {
-    h0 = missHit(kBvhInfinity);
-    h1 = h0;
-    h2 = h0;
-    h3 = h0;
-    h4 = h0;
-    vec3 invDir = bvhSafeInverse(f.d0);
+// Four rays o_i + t d_i, t < tMax_i (tMax_i = 0: not traced), about the centre ray (c, d_c),
+// in slots 1..4 (slot 0 is not traced).
+RayBundle bundleOfFour(vec3 c, vec3 dc, vec3 o1, vec3 d1, vec3 o2, vec3 d2, vec3 o3, vec3 d3, vec3 o4, vec3 d4,
+                       vec4 tMax) {
+    RayBundle b;
+    b.o0 = c;
+    b.o1 = o1;
+    b.o2 = o2;
+    b.o3 = o3;
+    b.o4 = o4;
+    b.d0 = dc;
+    b.d1 = d1;
+    b.d2 = d2;
+    b.d3 = d3;
+    b.d4 = d4;
+    b.tMax0 = 0.0;
+    b.tMax = tMax;
+    b.centre = c;
+    b.centreDir = dc;
+    bundleSpan(b);
+    return b;
+}
+
+// Per ray of the bundle: traceClosest(o_i, d_i, 0, tMax_i) (a miss at t = 0 for a ray not
+// traced). traceClosest's walk (node steps) with the grown boxes, the centre ray's order and
+// every ray's triangle test; nodes are skipped beyond the farthest closest hit so far.
+void traceClosestBundle(RayBundle b, out Hit h0, out Hit h1, out Hit h2, out Hit h3, out Hit h4) {
+    h0 = missHit(b.tMax0);
+    h1 = missHit(b.tMax.x);
+    h2 = missHit(b.tMax.y);
+    h3 = missHit(b.tMax.z);
+    h4 = missHit(b.tMax.w);
+    vec3 invDir = bvhSafeInverse(b.centreDir);
     GDPT_BVH_STACK_DECLARE();
     uint node = 0u;
     while (true) {
         BvhWideNode n = bvhNode(node);
         vec4 tNear;
         bvec4 h;
-        wideNodeBoxesGrown(n, f.grow, f.o, invDir, 0.0, fanReach(f, h0, h1, h2, h3, h4), tNear, h);
+        float limit = max(max(h0.t, h1.t), max(max(h2.t, h3.t), h4.t));
+        wideNodeBoxesGrown(n, b.grow, b.centre, invDir, 0.0, limit, tNear, h);
         uvec4 count = wideCounts(n);
         uvec4 c = wideLeafCounts(count, h);
         for (uint k = 0u; k < c.x + c.y + c.z + c.w; ++k) {
             uint tri = wideLeafTriangle(n.child, k, c);
             TriangleGeom g = triangleGeom(tri);
-            closerHitGeom(f.o, f.d0, g, tri, 0.0, h0);
-            if (f.want.x) closerHitGeom(f.o, f.d1, g, tri, 0.0, h1);
-            if (f.want.y) closerHitGeom(f.o, f.d2, g, tri, 0.0, h2);
-            if (f.want.z) closerHitGeom(f.o, f.d3, g, tri, 0.0, h3);
-            if (f.want.w) closerHitGeom(f.o, f.d4, g, tri, 0.0, h4);
+            closerHitGeom(b.o0, b.d0, g, tri, 0.0, h0);
+            closerHitGeom(b.o1, b.d1, g, tri, 0.0, h1);
+            closerHitGeom(b.o2, b.d2, g, tri, 0.0, h2);
+            closerHitGeom(b.o3, b.d3, g, tri, 0.0, h3);
+            closerHitGeom(b.o4, b.d4, g, tri, 0.0, h4);
         }
-        float limit = fanReach(f, h0, h1, h2, h3, h4);
+        limit = max(max(h0.t, h1.t), max(max(h2.t, h3.t), h4.t));
         WideOrder o = wideSortInner(n, count, h, tNear, limit);
         uint next = o.child.x;
         GDPT_BVH_PUSH_FARTHER(o);
@@ -878,6 +927,53 @@ void traceClosestFan(PrimaryFan f, out Hit h0, out Hit h1, out Hit h2, out Hit h
         }
         if (next == kInvalidIndex) break;
         node = next;
+    }
+}
+
+// Ray j of four (j < 4) by a constant-free select (no dynamically indexed array).
+vec3 pickOfFour(vec3 a, vec3 b, vec3 c, vec3 d, uint j) { return j == 0u ? a : (j == 1u ? b : (j == 2u ? c : d)); }
+
+// Whether ray (o, d), up to tMax, widens a bundle about (c, dc) by at most maxGrow on every
+// axis (the reach bounded by tMax and by `extent`, an upper bound on a ray's path through the
+// scene): a cost rule, not a correctness one (bundleSpan computes the growth the rays need).
+bool bundleFits(vec3 o, vec3 d, float tMax, vec3 c, vec3 dc, float extent, float maxGrow) {
+    return maxComponent(abs(o - c)) + min(tMax, extent) * maxComponent(abs(d - dc)) <= maxGrow;
+}
+
+// Four closest-hit rays o_i + t d_i, t < tMax_i (tMax_i = 0: not traced, a miss at t = 0), in
+// as few bundles as their spread allows: each pass takes the first ray not yet traced as its
+// centre ray and bundles the rays not yet traced that fit about it (bundleFits). Rays that
+// start and point nearly alike (G-PT's offsets following the base) take one pass; rays far
+// apart (offsets on either side of a silhouette) pass alone, rather than bundled into a beam so
+// wide that it walks the whole tree. One traversal call site, in a loop of at most four passes.
+void traceClosestFour(vec3 o1, vec3 d1, vec3 o2, vec3 d2, vec3 o3, vec3 d3, vec3 o4, vec3 d4, vec4 tMax,
+                      float extent, float maxGrow, out Hit h1, out Hit h2, out Hit h3, out Hit h4) {
+    h1 = missHit(0.0);
+    h2 = h1;
+    h3 = h1;
+    h4 = h1;
+    vec4 left = tMax;
+    while (any(greaterThan(left, vec4(0.0)))) {
+        uint j = left.x > 0.0 ? 0u : (left.y > 0.0 ? 1u : (left.z > 0.0 ? 2u : 3u));
+        vec3 c = pickOfFour(o1, o2, o3, o4, j);
+        vec3 dc = pickOfFour(d1, d2, d3, d4, j);
+        bvec4 take = bvec4(left.x > 0.0 && bundleFits(o1, d1, left.x, c, dc, extent, maxGrow),
+                           left.y > 0.0 && bundleFits(o2, d2, left.y, c, dc, extent, maxGrow),
+                           left.z > 0.0 && bundleFits(o3, d3, left.z, c, dc, extent, maxGrow),
+                           left.w > 0.0 && bundleFits(o4, d4, left.w, c, dc, extent, maxGrow));
+        take[j] = true;
+        vec4 pass = mix(vec4(0.0), left, take);
+        Hit unused;
+        Hit a1;
+        Hit a2;
+        Hit a3;
+        Hit a4;
+        traceClosestBundle(bundleOfFour(c, dc, o1, d1, o2, d2, o3, d3, o4, d4, pass), unused, a1, a2, a3, a4);
+        if (take.x) h1 = a1;
+        if (take.y) h2 = a2;
+        if (take.z) h3 = a3;
+        if (take.w) h4 = a4;
+        left = mix(left, vec4(0.0), take);
     }
 }
 #endif  // !GDPT_BVH_UNIT_STEPS

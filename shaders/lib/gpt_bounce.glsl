@@ -8,7 +8,9 @@
 //   3. BSDF sampling and Russian roulette of the base (gptContinueBase);
 //   4. the shift of every live offset over the base's new segment (gptShiftOffset; with
 //      GDPT_GPT_BEAMS and no glossy vertices, the reconnections' rays as one beam:
-//      gptShiftOffsetBegin, traceAnyBeam, gptReconnectDone);
+//      gptShiftOffsetBegin, traceAnyBeam, gptReconnectDone; with glossy vertices, the
+//      reconnections' and half-vector copies' rays as bundles: gptShiftOffsetOwnBegin,
+//      traceClosestFour, gptOwnVertexHit);
 //   5. the emission the pairs reach there, MIS-weighted (gptPairEnvironment, gptPairEmitter).
 //
 // Not a function: gpt.comp includes this text twice, into two loops, once with
@@ -104,7 +106,28 @@
 
     // ---- 4. Shift every live offset over this segment ----
 #ifdef GDPT_GPT_BEAMS
-    if (!kHasGlossy && GDPT_GPT_GENERAL) {
+    if (kHasGlossy && GDPT_GPT_GENERAL) {
+        // Reconnections and half-vector copies, each a closest-hit query from the offset's own
+        // vertex: the four in as few bundles as their spread allows (traceClosestFour).
+        ConnectionShift conn[kGptNumOffsets];
+        ShiftRay shiftRay[kGptNumOffsets];
+        bool own[kGptNumOffsets];
+        bool reconnect[kGptNumOffsets];
+        bool offCurRough[kGptNumOffsets];
+        vec4 tMax = vec4(0.0);
+        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+            shiftRay[i] =
+                gptShiftOffsetOwnBegin(offs[i], offV[i], seg, conn[i], own[i], reconnect[i], offCurRough[i], rays);
+            if (shiftRay[i].trace) tMax[i] = shiftRay[i].tMax;
+        }
+        Hit ho[kGptNumOffsets];
+        traceClosestFour(shiftRay[0].origin, shiftRay[0].dir, shiftRay[1].origin, shiftRay[1].dir, shiftRay[2].origin,
+                         shiftRay[2].dir, shiftRay[3].origin, shiftRay[3].dir, tMax, 2.0 * scene.sceneRadius,
+                         kGptBundleGrow * scene.sceneRadius, ho[0], ho[1], ho[2], ho[3]);
+        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+            if (own[i]) gptOwnVertexHit(offs[i], offV[i], seg, reconnect[i], offCurRough[i], conn[i], shiftRay[i], ho[i]);
+        }
+    } else if (GDPT_GPT_GENERAL) {
         // Every own-vertex shift reconnects, to the base's next vertex or along its direction
         // to the environment: the visibility rays as one beam.
         ConnectionShift conn[kGptNumOffsets];

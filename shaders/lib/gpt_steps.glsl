@@ -364,30 +364,51 @@ void gptHalfVectorDone(inout OffsetPath o, BaseSegment s, bool offCurRough, vec3
     o.woWorld = -wi;
 }
 
-// A NOT_CONNECTED offset's shift: the reconnection where `reconnect`, else (kHasGlossy only)
-// the half-vector copy. With glossy vertices both kinds trace their ray at one call site, a
-// closest-hit query (for the reconnection's visibility, any hit before tMax occludes: the
-// same answer as traceAny's): lavapipe before Mesa 23 runs every branch that any lane of a
-// SIMD vector takes, so two call sites cost two traversal loops wherever a vector holds
-// offsets of both kinds (glossy_cornell: 2.5 % less time per sample, the same bits).
-void gptOwnVertexShift(inout OffsetPath o, OffsetVertex v, BaseSegment s, bool reconnect, bool offCurRough,
-                       inout uint rays) {
-    ConnectionShift c;
+// A NOT_CONNECTED offset's shift, first half: the reconnection's ray where `reconnect`, else
+// (kHasGlossy only) the half-vector copy's. `c` is the reconnection's (unset for a half-vector
+// copy).
+ShiftRay gptOwnVertexRay(inout OffsetPath o, OffsetVertex v, BaseSegment s, bool reconnect, out ConnectionShift c,
+                         inout uint rays) {
     ShiftRay ray;
-    if (reconnect || !kHasGlossy)  // (the constant lets the compiler drop the other branch)
+    if (reconnect || !kHasGlossy) {  // (the constant lets the compiler drop the other branch)
         ray = gptReconnectRay(o, v, s, c);
-    else
+    } else {
         ray = gptHalfVectorRay(o, v, s);
+        c.wi = vec3(0.0);
+        c.dist = 0.0;
+        c.jacobian = 0.0;
+        c.ok = false;
+    }
     // A live reconnection's zero-length connection traces nothing but counts its ray, as
     // occludedTowards's caller did.
     if (o.alive) rays++;
+    return ray;
+}
+
+// Second half with glossy vertices, once the ray's closest hit `ho` is known (for the
+// reconnection's visibility, any hit before tMax occludes: the same answer as traceAny's; a
+// ray not traced: a miss).
+void gptOwnVertexHit(inout OffsetPath o, OffsetVertex v, BaseSegment s, bool reconnect, bool offCurRough,
+                     ConnectionShift c, ShiftRay ray, Hit ho) {
+    if (o.alive && reconnect) gptReconnectDone(o, v, s, c, ho.triangle != kInvalidIndex);
+    if (o.alive && !reconnect) gptHalfVectorDone(o, s, offCurRough, ray.dir, ho);
+}
+
+// A NOT_CONNECTED offset's shift, both halves around its own ray. With glossy vertices both
+// kinds trace their ray at one call site, a closest-hit query: lavapipe before Mesa 23 runs
+// every branch that any lane of a SIMD vector takes, so two call sites cost two traversal loops
+// wherever a vector holds offsets of both kinds (glossy_cornell: 2.5 % less time per sample,
+// the same bits).
+void gptOwnVertexShift(inout OffsetPath o, OffsetVertex v, BaseSegment s, bool reconnect, bool offCurRough,
+                       inout uint rays) {
+    ConnectionShift c;
+    ShiftRay ray = gptOwnVertexRay(o, v, s, reconnect, c, rays);
     if (!kHasGlossy) {
         if (o.alive) gptReconnectDone(o, v, s, c, ray.trace && traceAny(ray.origin, ray.dir, 0.0, ray.tMax));
     } else {
         Hit ho = missHit(ray.tMax);
         if (ray.trace) ho = traceClosest(ray.origin, ray.dir, 0.0, ray.tMax);
-        if (o.alive && reconnect) gptReconnectDone(o, v, s, c, ho.triangle != kInvalidIndex);
-        if (o.alive && !reconnect) gptHalfVectorDone(o, s, offCurRough, ray.dir, ho);
+        gptOwnVertexHit(o, v, s, reconnect, offCurRough, c, ray, ho);
     }
 }
 
@@ -454,6 +475,33 @@ ShiftRay gptShiftOffsetBegin(inout OffsetPath o, OffsetVertex v, BaseSegment s, 
             reconnecting = o.alive;
         }
     }
+    return ray;
+}
+
+// gptShiftOffset in a general bounce of a scene with glossy vertices, split around the
+// own-vertex shift's closest-hit ray so that the four offsets' rays, which start about a pixel
+// apart and point near the base's new direction (a reconnection towards the base's next
+// vertex, a half-vector copy along its mirrored lobe), are traced as one bundle
+// (traceClosestBundle, gpt_bounce.glsl). First half: the shift of an offset that shares the
+// base's vertex, or the own vertex's ray (`own`: then finish it with gptOwnVertexHit; a ray
+// not to be traced has trace false).
+// How far the offsets' rays of one bundle may spread (traceClosestFour's maxGrow), as a share
+// of the scene's radius: 0.003 to 0.1 ran at the same speed on glossy_cornell (bench/RESULTS.md,
+// "Ray bundles for the glossy offsets' shifts").
+const float kGptBundleGrow = 0.03;
+
+ShiftRay gptShiftOffsetOwnBegin(inout OffsetPath o, OffsetVertex v, BaseSegment s, out ConnectionShift c,
+                                out bool own, out bool reconnect, out bool offCurRough, inout uint rays) {
+    ShiftRay ray = noShiftRay(s.from);
+    c.wi = vec3(0.0);
+    c.dist = 0.0;
+    c.jacobian = 0.0;
+    c.ok = false;
+    own = o.alive && o.state == kShiftNotConnected;
+    offCurRough = roughAll(v.bsdf);
+    reconnect = shiftUseReconnection(s.curRough, s.nextRough, offCurRough);
+    if (o.alive && !own) gptShiftSharedOffset(o, v, s);
+    if (own) ray = gptOwnVertexRay(o, v, s, reconnect, c, rays);
     return ray;
 }
 

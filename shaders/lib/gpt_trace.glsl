@@ -73,12 +73,12 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     vec3 o = scene.camPosition;
     vec3 d = cameraRay(pixelPos);
 #ifdef GDPT_GPT_BEAMS
-    // The base's and the offsets' primary rays as one fan (bvh_traverse.glsl, traceClosestFan).
+    // The base's and the offsets' primary rays as one fan (bvh_traverse.glsl, traceClosestBundle).
     vec3 dOff[kGptNumOffsets];
     for (uint i = 0u; i < kGptNumOffsets; ++i) dOff[i] = cameraRay(pixelPos + vec2(kOffsetDelta[i]));
     Hit hit;
     Hit hOff[kGptNumOffsets];
-    traceClosestFan(fanFrom(o, d, dOff[0], dOff[1], dOff[2], dOff[3],
+    traceClosestBundle(fanFrom(o, d, dOff[0], dOff[1], dOff[2], dOff[3],
                             bvec4(offs[0].alive, offs[1].alive, offs[2].alive, offs[3].alive)),
                     hit, hOff[0], hOff[1], hOff[2], hOff[3]);
 #else
