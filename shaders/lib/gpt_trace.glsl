@@ -23,14 +23,17 @@
 // per bounce instead of one ray each, in the build for lavapipe before Mesa 23 (the split
 // build) on trees small enough for node steps. Measured (bench/RESULTS.md, "Occlusion beams
 // for the offsets' rays"): 11-18 % less time per G-PT sample there on the scene set (4 % on the
-// glossy box, whose reconnections stay single rays), for about 0.1 s more pipeline creation; in
+// glossy box, whose shift rays are bundles instead, below), for about 0.1 s more pipeline creation; in
 // unit steps (trees of 10^5 triangles) level or slower, and on Mesa 25, which skips the
 // branches no lane takes, slower on the Cornell box and a 200k-triangle terrain. The same
 // images either way. The same build traces the base's and the offsets' primary rays as one
-// closest-hit fan (traceClosestFan): 18-29 % less time per sample on the scene set (the glossy
-// box 3 %; "A primary fan for the camera rays"), the same hits up to exact ties (two triangles
-// at the same t); in unit steps 12 % faster on a 110k-triangle asset but 3-13 % slower on a
-// 200k-triangle terrain, so not there either.
+// closest-hit fan (fanFrom, traceClosestBundle): 18-29 % less time per sample on the scene set
+// (the glossy box 3 %; "A primary fan for the camera rays"), the same hits up to exact ties (two
+// triangles at the same t); in unit steps 12 % faster on a 110k-triangle asset but 3-13 % slower
+// on a 200k-triangle terrain, so not there either. With glossy vertices it traces the offsets'
+// own-vertex shift rays (reconnections and half-vector copies) as ray bundles
+// (traceClosestFour, gpt_bounce.glsl): 14 % less time per sample on the glossy box, for about
+// 0.2 s more pipeline creation ("Ray bundles for the glossy offsets' shifts").
 #if defined(GDPT_GPT_SPLIT_BOUNCE) && !defined(GDPT_BVH_UNIT_STEPS)
 #define GDPT_GPT_BEAMS
 #endif
