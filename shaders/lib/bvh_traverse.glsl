@@ -840,50 +840,40 @@ void bundleSpan(inout RayBundle b) {
     b.grow = originSpread + dirSpread * reach + vec3(margin);
 }
 
-// A camera sample's primary rays: the base's (d0, the centre ray, always traced) and the
-// offsets' d1..d4 where `want`, all from the camera at o, to infinity.
-RayBundle fanFrom(vec3 o, vec3 d0, vec3 d1, vec3 d2, vec3 d3, vec3 d4, bvec4 want) {
+// The bundle of rays o_i + t d_i, t < tMax_i (0: not traced), about the centre ray (c, dc).
+RayBundle bundleAbout(vec3 c, vec3 dc, vec3 o0, vec3 d0, float tMax0, vec3 o1, vec3 d1, vec3 o2, vec3 d2, vec3 o3,
+                      vec3 d3, vec3 o4, vec3 d4, vec4 tMax) {
     RayBundle b;
-    b.o0 = o;
-    b.o1 = o;
-    b.o2 = o;
-    b.o3 = o;
-    b.o4 = o;
+    b.o0 = o0;
+    b.o1 = o1;
+    b.o2 = o2;
+    b.o3 = o3;
+    b.o4 = o4;
     b.d0 = d0;
     b.d1 = d1;
     b.d2 = d2;
     b.d3 = d3;
     b.d4 = d4;
-    b.tMax0 = kBvhInfinity;
-    b.tMax = vec4(want.x ? kBvhInfinity : 0.0, want.y ? kBvhInfinity : 0.0, want.z ? kBvhInfinity : 0.0,
-                  want.w ? kBvhInfinity : 0.0);
-    b.centre = o;
-    b.centreDir = d0;
+    b.tMax0 = tMax0;
+    b.tMax = tMax;
+    b.centre = c;
+    b.centreDir = dc;
     bundleSpan(b);
     return b;
+}
+
+// A camera sample's primary rays: the base's (d0, the centre ray, always traced) and the
+// offsets' d1..d4 where `want`, all from the camera at o, to infinity.
+RayBundle fanFrom(vec3 o, vec3 d0, vec3 d1, vec3 d2, vec3 d3, vec3 d4, bvec4 want) {
+    vec4 tMax = mix(vec4(0.0), vec4(kBvhInfinity), want);
+    return bundleAbout(o, d0, o, d0, kBvhInfinity, o, d1, o, d2, o, d3, o, d4, tMax);
 }
 
 // Four rays o_i + t d_i, t < tMax_i (tMax_i = 0: not traced), about the centre ray (c, d_c),
 // in slots 1..4 (slot 0 is not traced).
 RayBundle bundleOfFour(vec3 c, vec3 dc, vec3 o1, vec3 d1, vec3 o2, vec3 d2, vec3 o3, vec3 d3, vec3 o4, vec3 d4,
                        vec4 tMax) {
-    RayBundle b;
-    b.o0 = c;
-    b.o1 = o1;
-    b.o2 = o2;
-    b.o3 = o3;
-    b.o4 = o4;
-    b.d0 = dc;
-    b.d1 = d1;
-    b.d2 = d2;
-    b.d3 = d3;
-    b.d4 = d4;
-    b.tMax0 = 0.0;
-    b.tMax = tMax;
-    b.centre = c;
-    b.centreDir = dc;
-    bundleSpan(b);
-    return b;
+    return bundleAbout(c, dc, c, dc, 0.0, o1, d1, o2, d2, o3, d3, o4, d4, tMax);
 }
 
 // Per ray of the bundle: traceClosest(o_i, d_i, 0, tMax_i) (a miss at t = 0 for a ray not

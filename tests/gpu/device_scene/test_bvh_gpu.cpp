@@ -108,40 +108,16 @@ std::vector<gpu::TestRay> randomRays(std::uint32_t count, std::uint32_t seed) {
     return rays;
 }
 
-// `count` primary fans of trace_fans.comp (five TestRays each) from origins uniform in
-// [-1.5, 1.5]^3: the centre ray aimed at a random point of the soup's region (or, for a quarter
-// of the fans, in a random direction), the other four its direction plus a random offset of up
-// to `spread` per component (about a pixel's angle for 0.003), each wanted with probability
-// 0.85.
-std::vector<gpu::TestRay> randomFans(std::uint32_t count, std::uint32_t seed, float spread) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> pos(-1.5f, 1.5f), near(-spread, spread), unit(0.0f, 1.0f);
-    std::vector<gpu::TestRay> rays(5 * std::size_t(count));
-    for (std::uint32_t f = 0; f < count; ++f) {
-        const glm::vec3 origin(pos(rng), pos(rng), pos(rng));
-        glm::vec3 centre = rng() % 4 == 0 ? glm::vec3(pos(rng), pos(rng), pos(rng))
-                                          : glm::vec3(pos(rng), pos(rng), pos(rng)) * 0.6f - origin;
-        if (glm::length(centre) < 1e-3f) centre = glm::vec3(0, 0, 1);
-        centre = glm::normalize(centre);
-        for (std::uint32_t j = 0; j < 5; ++j) {
-            gpu::TestRay& r = rays[5 * f + j];
-            r.origin = origin;
-            r.dir = j == 0 ? centre : centre + glm::vec3(near(rng), near(rng), near(rng));
-            r.tMin = j == 0 || unit(rng) < 0.85f ? 0.0f : 1.0f;
-            r.tMax = INFINITY;
-        }
-    }
-    return rays;
-}
-
-// `count` bundles of four of trace_bundles.comp (five TestRays each, ray 0 the centre ray, not
-// traced): the centre from an origin uniform in [-1.5, 1.5]^3 towards a random point of the
-// soup's region (a quarter in a random direction); rays 1..4 from the centre's origin plus up
-// to `originSpread` per component, along its direction plus up to `dirSpread`, each wanted with
-// probability 0.85, half of the bundles to infinity and half to their own tMax in [0.2, 3] (as
-// G-PT's glossy offsets' next rays and reconnections).
-std::vector<gpu::TestRay> randomBundlesOfFour(std::uint32_t count, std::uint32_t seed, float originSpread,
-                                              float dirSpread) {
+// `count` ray bundles of trace_bundles.comp (five TestRays each). The centre ray from an origin
+// uniform in [-1.5, 1.5]^3, aimed at a random point of the soup's region (or, for a quarter of
+// the bundles, in a random direction); the other four along its direction plus a random
+// offset of up to `dirSpread` per component (about a pixel's angle for 0.003), each wanted with
+// probability 0.85. Primary fans (`four` false): every ray from the centre's origin to
+// infinity, the centre ray traced. Bundles of four: the centre ray not traced, the four from
+// its origin plus up to `originSpread` per component, half of the bundles to infinity and half
+// to their own tMax in [0.2, 3] (as G-PT's glossy offsets' next rays and reconnections).
+std::vector<gpu::TestRay> randomBundles(std::uint32_t count, std::uint32_t seed, float originSpread,
+                                        float dirSpread, bool four) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> pos(-1.5f, 1.5f), nearO(-originSpread, originSpread),
         nearD(-dirSpread, dirSpread), unit(0.0f, 1.0f), length(0.2f, 3.0f);
@@ -152,12 +128,12 @@ std::vector<gpu::TestRay> randomBundlesOfFour(std::uint32_t count, std::uint32_t
                                           : glm::vec3(pos(rng), pos(rng), pos(rng)) * 0.6f - origin;
         if (glm::length(centre) < 1e-3f) centre = glm::vec3(0, 0, 1);
         centre = glm::normalize(centre);
-        const bool bounded = f % 2 == 1;
+        const bool bounded = four && f % 2 == 1;
         for (std::uint32_t j = 0; j < 5; ++j) {
             gpu::TestRay& r = rays[5 * f + j];
-            r.origin = j == 0 ? origin : origin + glm::vec3(nearO(rng), nearO(rng), nearO(rng));
+            r.origin = j == 0 || !four ? origin : origin + glm::vec3(nearO(rng), nearO(rng), nearO(rng));
             r.dir = j == 0 ? centre : centre + glm::vec3(nearD(rng), nearD(rng), nearD(rng));
-            r.tMin = j != 0 && unit(rng) < 0.85f ? 0.0f : 1.0f;
+            r.tMin = j == 0 ? (four ? 1.0f : 0.0f) : (unit(rng) < 0.85f ? 0.0f : 1.0f);
             r.tMax = bounded && j != 0 ? length(rng) : INFINITY;
         }
     }
@@ -429,11 +405,12 @@ protected:
     }
     int checkFans(const Soup& soup, std::uint32_t seed, float spread, bool ties = false,
                   std::uint32_t registerStack = 0, std::uint32_t noGrowth = 0) {
-        return checkBundles(soup, randomFans(20000, seed, spread), false, ties, registerStack, noGrowth);
+        return checkBundles(soup, randomBundles(20000, seed, 0.0f, spread, false), false, ties, registerStack,
+                            noGrowth);
     }
     int checkBundlesOfFour(const Soup& soup, std::uint32_t seed, float originSpread, float dirSpread,
                            bool ties = false, std::uint32_t registerStack = 0, std::uint32_t noGrowth = 0) {
-        return checkBundles(soup, randomBundlesOfFour(20000, seed, originSpread, dirSpread), true, ties,
+        return checkBundles(soup, randomBundles(20000, seed, originSpread, dirSpread, true), true, ties,
                             registerStack, noGrowth);
     }
 };
