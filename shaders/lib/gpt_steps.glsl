@@ -289,6 +289,16 @@ ShiftRay noShiftRay(vec3 origin) {
     return r;
 }
 
+// No reconnection (an offset that shares the base's vertex, or a half-vector copy).
+ConnectionShift noConnectionShift() {
+    ConnectionShift c;
+    c.wi = vec3(0.0);
+    c.dist = 0.0;
+    c.jacobian = 0.0;
+    c.ok = false;
+    return c;
+}
+
 // NOT_CONNECTED offset, reconnection shift, first half: to the base's next vertex, or the
 // environment shift in the same direction. Afterwards the offset shares every later vertex
 // with the base (RECENTLY_CONNECTED). The ray is the visibility test (occludedTowards's for a
@@ -374,10 +384,7 @@ ShiftRay gptOwnVertexRay(inout OffsetPath o, OffsetVertex v, BaseSegment s, bool
         ray = gptReconnectRay(o, v, s, c);
     } else {
         ray = gptHalfVectorRay(o, v, s);
-        c.wi = vec3(0.0);
-        c.dist = 0.0;
-        c.jacobian = 0.0;
-        c.ok = false;
+        c = noConnectionShift();
     }
     // A live reconnection's zero-length connection traces nothing but counts its ray, as
     // occludedTowards's caller did.
@@ -458,10 +465,7 @@ void gptShiftOffset(inout OffsetPath o, OffsetVertex v, BaseSegment s, bool gene
 ShiftRay gptShiftOffsetBegin(inout OffsetPath o, OffsetVertex v, BaseSegment s, out ConnectionShift c,
                              out bool reconnecting, inout uint rays) {
     ShiftRay ray = noShiftRay(vec3(0.0));
-    c.wi = vec3(0.0);
-    c.dist = 0.0;
-    c.jacobian = 0.0;
-    c.ok = false;
+    c = noConnectionShift();
     reconnecting = false;
     if (o.alive) {
         if (o.state != kShiftNotConnected) {
@@ -478,25 +482,22 @@ ShiftRay gptShiftOffsetBegin(inout OffsetPath o, OffsetVertex v, BaseSegment s, 
     return ray;
 }
 
-// gptShiftOffset in a general bounce of a scene with glossy vertices, split around the
-// own-vertex shift's closest-hit ray so that the four offsets' rays, which start about a pixel
-// apart and point near the base's new direction (a reconnection towards the base's next
-// vertex, a half-vector copy along its mirrored lobe), are traced as one bundle
-// (traceClosestBundle, gpt_bounce.glsl). First half: the shift of an offset that shares the
-// base's vertex, or the own vertex's ray (`own`: then finish it with gptOwnVertexHit; a ray
-// not to be traced has trace false).
 // How far the offsets' rays of one bundle may spread (traceClosestFour's maxGrow), as a share
 // of the scene's radius: 0.003 to 0.1 ran at the same speed on glossy_cornell (bench/RESULTS.md,
 // "Ray bundles for the glossy offsets' shifts").
 const float kGptBundleGrow = 0.03;
 
+// gptShiftOffset in a general bounce of a scene with glossy vertices, split around the
+// own-vertex shift's closest-hit ray so that the four offsets' rays, which start about a pixel
+// apart and point near the base's new direction (a reconnection towards the base's next
+// vertex, a half-vector copy along its mirrored lobe), are traced as bundles
+// (traceClosestFour, gpt_bounce.glsl). First half: the shift of an offset that shares the
+// base's vertex, or the own vertex's ray (`own`: then finish it with gptOwnVertexHit; a ray
+// not to be traced has trace false).
 ShiftRay gptShiftOffsetOwnBegin(inout OffsetPath o, OffsetVertex v, BaseSegment s, out ConnectionShift c,
                                 out bool own, out bool reconnect, out bool offCurRough, inout uint rays) {
     ShiftRay ray = noShiftRay(s.from);
-    c.wi = vec3(0.0);
-    c.dist = 0.0;
-    c.jacobian = 0.0;
-    c.ok = false;
+    c = noConnectionShift();
     own = o.alive && o.state == kShiftNotConnected;
     offCurRough = roughAll(v.bsdf);
     reconnect = shiftUseReconnection(s.curRough, s.nextRough, offCurRough);
