@@ -32,7 +32,7 @@
 // triangles at the same t); in unit steps 12 % faster on a 110k-triangle asset but 3-13 % slower
 // on a 200k-triangle terrain, so not there either. With glossy vertices it traces the offsets'
 // own-vertex shift rays (reconnections and half-vector copies) as ray bundles
-// (traceClosestFour, gpt_bounce.glsl): 14 % less time per sample on the glossy box, for about
+// (traceClosestFour, gpt_bounce.glsl): 15 % less time per sample on the glossy box, for about
 // 0.2 s more pipeline creation ("Ray bundles for the glossy offsets' shifts").
 #if defined(GDPT_GPT_SPLIT_BOUNCE) && !defined(GDPT_BVH_UNIT_STEPS)
 #define GDPT_GPT_BEAMS
