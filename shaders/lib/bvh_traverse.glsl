@@ -888,11 +888,13 @@ void traceClosestBundle(RayBundle b, out Hit h0, out Hit h1, out Hit h2, out Hit
     vec3 invDir = bvhSafeInverse(b.centreDir);
     GDPT_BVH_STACK_DECLARE();
     uint node = 0u;
+    // The farthest closest hit so far: set here and after each node's triangles, the only
+    // place the hits change.
+    float limit = max(max(h0.t, h1.t), max(max(h2.t, h3.t), h4.t));
     while (true) {
         BvhWideNode n = bvhNode(node);
         vec4 tNear;
         bvec4 h;
-        float limit = max(max(h0.t, h1.t), max(max(h2.t, h3.t), h4.t));
         wideNodeBoxesGrown(n, b.grow, b.centre, invDir, 0.0, limit, tNear, h);
         uvec4 count = wideCounts(n);
         uvec4 c = wideLeafCounts(count, h);
