@@ -30,8 +30,20 @@ layout(set = 0, binding = kBindTexels) uniform utextureBuffer imageTexels;  // R
 layout(set = 0, binding = kBindLightTris) uniform utextureBuffer lightTriTexels;
 layout(set = 0, binding = kBindPunctual) uniform utextureBuffer punctualTexels;
 
+// Two frames (scene_geometry.glsl): each frame's light tables follow each other as its
+// triangles do.
+#ifdef GDPT_TWO_FRAMES
+uint frameLightBase = 0u;
+uint framePunctualBase = 0u;
+#define GDPT_FRAME_LIGHT(i) ((i) + frameLightBase)
+#define GDPT_FRAME_PUNCTUAL(i) ((i) + framePunctualBase)
+#else
+#define GDPT_FRAME_LIGHT(i) (i)
+#define GDPT_FRAME_PUNCTUAL(i) (i)
+#endif
+
 TriangleShading triangleShading(uint i) {
-    int at = int(i * kTriangleShadingTexels);
+    int at = int(GDPT_FRAME_TRIANGLE(i) * kTriangleShadingTexels);
     uvec4 a = texelFetch(triShadingTexels, at);
     uvec4 b = texelFetch(triShadingTexels, at + 1);
     uvec4 c = texelFetch(triShadingTexels, at + 2);
@@ -93,7 +105,7 @@ vec4 imageTexel(uint i) {
 }
 
 LightTriangle lightTriangle(uint i) {
-    uvec4 a = texelFetch(lightTriTexels, int(i));
+    uvec4 a = texelFetch(lightTriTexels, int(GDPT_FRAME_LIGHT(i)));
     LightTriangle l;
     l.triangle = a.x;
     l.cdf = uintBitsToFloat(a.y);
@@ -103,7 +115,7 @@ LightTriangle lightTriangle(uint i) {
 }
 
 PunctualLight punctualLight(uint i) {
-    int at = int(i * kPunctualLightTexels);
+    int at = int(GDPT_FRAME_PUNCTUAL(i) * kPunctualLightTexels);
     uvec4 a = texelFetch(punctualTexels, at);
     uvec4 b = texelFetch(punctualTexels, at + 1);
     uvec4 c = texelFetch(punctualTexels, at + 2);
@@ -117,13 +129,31 @@ PunctualLight punctualLight(uint i) {
     return l;
 }
 
-layout(set = 0, binding = kBindSceneConst, scalar) readonly buffer SceneConstBuf { SceneConstants sceneStored; };
-
 // The scene constants as a private copy that every kernel's main() fills first (loadScene),
 // so that later reads are registers: lavapipe before Mesa 23 loads a storage-buffer value
 // lane by lane, in a loop with a branch per lane and component, at every read, even at a
 // uniform address (bench/RESULTS.md, scene constants).
+#ifdef GDPT_TWO_FRAMES
+// Each frame's constants (its camera, light counts and powers); `scene` is the selected one's.
+layout(set = 0, binding = kBindSceneConst, scalar) readonly buffer SceneConstBuf { SceneConstants sceneStored[2]; };
+SceneConstants scene;
+SceneConstants frameScenes[2];
+void loadScene() {
+    frameScenes[0] = sceneStored[0];
+    frameScenes[1] = sceneStored[1];
+    scene = frameScenes[0];
+}
+// Makes every scene access (triangles, lights, camera, constants) read frame f (0 or 1).
+void selectFrame(uint f) {
+    scene = f == 0u ? frameScenes[0] : frameScenes[1];
+    frameTriangleBase = f * scene.numTriangles;
+    frameLightBase = f * scene.numLightTriangles;
+    framePunctualBase = f * scene.numPunctualLights;
+}
+#else
+layout(set = 0, binding = kBindSceneConst, scalar) readonly buffer SceneConstBuf { SceneConstants sceneStored; };
 SceneConstants scene;
 void loadScene() { scene = sceneStored; }
+#endif
 
 #endif  // GDPT_LIB_SCENE_BUFFERS

@@ -15,6 +15,18 @@
 layout(set = 0, binding = kBindTriGeom) uniform textureBuffer triGeomTexels;
 layout(set = 0, binding = kBindBvh) uniform utextureBuffer bvhTexels;
 
+// Two frames of one animation in one kernel (GDPT_TWO_FRAMES: tgpt_reconnect.comp; the host's
+// FramePairGpu): every per-triangle table holds frame 0's triangles and then frame 1's, in the
+// same leaf order, under one tree whose boxes hold both; selectFrame (scene_buffers.glsl)
+// sets the first entry of the frame that triangle index i means. Elsewhere the index is the
+// entry.
+#ifdef GDPT_TWO_FRAMES
+uint frameTriangleBase = 0u;
+#define GDPT_FRAME_TRIANGLE(i) ((i) + frameTriangleBase)
+#else
+#define GDPT_FRAME_TRIANGLE(i) (i)
+#endif
+
 // Wide node i (BvhWideNode: origin + exponents, qMin, qMax, child).
 BvhWideNode bvhNode(uint i) {
     int at = int(i * kBvhWideNodeTexels);
@@ -30,7 +42,7 @@ BvhWideNode bvhNode(uint i) {
 
 // Triangle i in leaf order (TriangleGeom: v0, e1, e2, each padded to a texel).
 TriangleGeom triangleGeom(uint i) {
-    int at = int(i * kTriangleGeomTexels);
+    int at = int(GDPT_FRAME_TRIANGLE(i) * kTriangleGeomTexels);
     TriangleGeom g;
     g.v0 = texelFetch(triGeomTexels, at).xyz;
     g.e1 = texelFetch(triGeomTexels, at + 1).xyz;
@@ -43,7 +55,7 @@ TriangleGeom triangleGeom(uint i) {
 
 // Unit normal of triangle i, normalize(e1 × e2) (counter-clockwise side; two fetches).
 vec3 triangleUnitNormal(uint i) {
-    int at = int(i * kTriangleGeomTexels);
+    int at = int(GDPT_FRAME_TRIANGLE(i) * kTriangleGeomTexels);
     return normalize(cross(texelFetch(triGeomTexels, at + 1).xyz, texelFetch(triGeomTexels, at + 2).xyz));
 }
 

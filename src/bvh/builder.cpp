@@ -628,6 +628,69 @@ void triangleBounds(glm::vec3 p0, glm::vec3 p1, glm::vec3 p2, glm::vec3& lo, glm
     hi += pad;
 }
 
+namespace {
+
+struct GrowBox {
+    glm::vec3 lo{std::numeric_limits<float>::max()};
+    glm::vec3 hi{-std::numeric_limits<float>::max()};
+    void grow(glm::vec3 l, glm::vec3 h) {
+        lo = glm::min(lo, l);
+        hi = glm::max(hi, h);
+    }
+};
+
+// The grown box of a child (a node, or a leaf's triangle range), its own box included.
+GrowBox grownChild(Bvh& bvh, const std::vector<glm::vec3>& positions,
+                   const std::vector<glm::uvec3>& triangles, uint32_t child, uint32_t count, glm::vec3 lo,
+                   glm::vec3 hi);
+
+// Grows node `n`'s two child boxes (post-order: depth <= kBvhMaxDepth) and returns their union.
+GrowBox growNode(Bvh& bvh, const std::vector<glm::vec3>& positions, const std::vector<glm::uvec3>& triangles,
+                 uint32_t n) {
+    gpu::BvhNode node = bvh.nodes[n];
+    const GrowBox l = grownChild(bvh, positions, triangles, node.left, node.leftCount, node.lmin, node.lmax);
+    const GrowBox r =
+        grownChild(bvh, positions, triangles, node.right, node.rightCount, node.rmin, node.rmax);
+    node.lmin = l.lo;
+    node.lmax = l.hi;
+    node.rmin = r.lo;
+    node.rmax = r.hi;
+    bvh.nodes[n] = node;
+    GrowBox both = l;
+    both.grow(r.lo, r.hi);
+    return both;
+}
+
+GrowBox grownChild(Bvh& bvh, const std::vector<glm::vec3>& positions,
+                   const std::vector<glm::uvec3>& triangles, uint32_t child, uint32_t count, glm::vec3 lo,
+                   glm::vec3 hi) {
+    GrowBox box;
+    box.grow(lo, hi);
+    if (count == 0) {
+        const GrowBox inner = growNode(bvh, positions, triangles, child);
+        box.grow(inner.lo, inner.hi);
+        return box;
+    }
+    for (uint32_t i = child; i < child + count; ++i) {
+        const glm::uvec3 t = triangles[bvh.triangleOrder[i]];
+        glm::vec3 tl, th;
+        triangleBounds(positions[t.x], positions[t.y], positions[t.z], tl, th);
+        box.grow(tl, th);
+    }
+    return box;
+}
+
+}  // namespace
+
+void growBvhBoxes(Bvh& bvh, const std::vector<glm::vec3>& positions,
+                  const std::vector<glm::uvec3>& triangles) {
+    if (bvh.triangleOrder.size() != triangles.size())
+        throw std::invalid_argument("growBvhBoxes: the tree holds " +
+                                    std::to_string(bvh.triangleOrder.size()) +
+                                    " triangles, the positions are of " + std::to_string(triangles.size()));
+    if (!bvh.nodes.empty()) growNode(bvh, positions, triangles, 0);
+}
+
 Bvh buildBvh(const std::vector<glm::vec3>& positions, const std::vector<glm::uvec3>& triangles,
              const BvhBuildOptions& options) {
     const auto start = std::chrono::steady_clock::now();

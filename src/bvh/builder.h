@@ -67,4 +67,11 @@ void writeTriangleGeoms(const std::vector<glm::vec3>& positions, const std::vect
 // structural tests.
 void triangleBounds(glm::vec3 p0, glm::vec3 p1, glm::vec3 p2, glm::vec3& lo, glm::vec3& hi);
 
+// Grows every box of `bvh` (built over some positions of `triangles`) so that it also holds its
+// triangles at `positions` (the same triangles moved: another frame of an animation), keeping
+// the tree and its leaf order. A ray query of either set of positions is then exact on the one
+// tree. Throws std::invalid_argument if the tree's triangle order does not fit `triangles`.
+void growBvhBoxes(Bvh& bvh, const std::vector<glm::vec3>& positions,
+                  const std::vector<glm::uvec3>& triangles);
+
 }  // namespace gdpt

@@ -15,6 +15,7 @@
 #include "util/memory.h"
 #include "util/parallel.h"
 #include "util/progress.h"
+#include "util/timer.h"
 #include "vk/context.h"
 #include "vk/kernel.h"
 
@@ -234,21 +235,89 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
     if (progress) progress->update(0.0, "BVH");
     if (!built) built = std::make_shared<const SceneBvh>(buildSceneBvh(scene));
     if (progress) progress->update(1.0, "triangle tables");
-    const Bvh& bvh = built->binary;
-    bvhInfo_.buildMs = built->buildMs;
+    upload(ctx, {&scene}, options, *built, progress);
+}
+
+namespace {
+
+SceneGpuOptions framePairOptions(SceneGpuOptions options) {
+    // The tree is frame a's with grown boxes, whose collapse may hold more stack entries than
+    // the spec's own tree: the kernels keep the stack in memory.
+    options.genericFeatures |= 1u << gpu::kSpecBvhRegisterStack;
+    return options;
+}
+
+std::shared_ptr<const SceneBvh> framePairBvh(const Scene& a, const Scene& b) {
+    Timer timer;
+    auto out = std::make_shared<SceneBvh>();
+    out->binary = buildBvh(a.positions, a.triangles);
+    growBvhBoxes(out->binary, b.positions, b.triangles);
+    out->wide = collapseToWide(out->binary.nodes);
+    out->buildMs = timer.ms();
+    return out;
+}
+
+}  // namespace
+
+SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& a, const Scene& b, const SceneGpuOptions& options)
+    : spec_(a, framePairOptions(options)) {
+    checkHasTriangles(a);
+    if (options.width < 1 || options.height < 1) throw Error("image size must be at least 1x1");
+    if (a.triangles != b.triangles)
+        throw Error("two frames on the device at once need the same triangles (" +
+                    std::to_string(a.triangles.size()) + " and " + std::to_string(b.triangles.size()) +
+                    "): a mesh's topology changes between them");
+    checkTrianglesFit(ctx.info(), 2 * a.triangles.size(), a.sourcePath);
+    std::optional<Progress> progress;
+    upload(ctx, {&a, &b}, options, *framePairBvh(a, b), progress);
+}
+
+void SceneGpu::upload(const vk::Context& ctx, const std::vector<const Scene*>& frames,
+                      const SceneGpuOptions& options, const SceneBvh& built,
+                      std::optional<Progress>& progress) {
+    const Scene& scene = *frames.front();
+    const Bvh& bvh = built.binary;
+    bvhInfo_.buildMs = built.buildMs;
     bvhInfo_.nodes = static_cast<std::uint32_t>(bvh.nodes.size());
     bvhInfo_.maxDepth = bvh.stats.maxDepth;
-    const LightTable lightTable = sceneLightTable(scene, *built, options);
-    lightShares_ = lightTable.shares;
-    lightProbed_ = lightTable.probed;
-    const std::vector<gpu::LightTriangle>& lights = lightTable.lights;
-    const double total = lightTable.totalPower;
-    // The spec counted the same lights (emitterPower) to specialise the kernels.
-    GDPT_CHECK(lights.size() == spec_.features().emissiveTriangles);
 
-    double punctualPower = 0.0;
-    for (const auto& l : scene.punctualLights)
-        punctualPower += 4.0 * kPi * std::max(1e-12, double(gpu::luminance(l.intensity)));
+    // Per frame: its light table (each frame's emitters in the same leaf order) and constants.
+    std::vector<gpu::LightTriangle> lights;
+    std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> entries;
+    std::vector<gpu::PunctualLight> punctual;
+    std::vector<gpu::SceneConstants> constants;
+    for (const Scene* frame : frames) {
+        const LightTable lightTable = sceneLightTable(*frame, built, options);
+        if (frame == frames.front()) {
+            lightShares_ = lightTable.shares;
+            lightProbed_ = lightTable.probed;
+        }
+        // The spec counted the same lights (emitterPower) to specialise the kernels.
+        if (lightTable.lights.size() != spec_.features().emissiveTriangles)
+            throw Error("the frames have different emitters (" + std::to_string(lightTable.lights.size()) +
+                        " and " + std::to_string(spec_.features().emissiveTriangles) + " light triangles)");
+        double punctualPower = 0.0;
+        for (const auto& l : frame->punctualLights)
+            punctualPower += 4.0 * kPi * std::max(1e-12, double(gpu::luminance(l.intensity)));
+        gpu::SceneConstants c{};
+        setCamera(c, renderCamera(*frame, options.camera), options.width, options.height);
+        c.envRadiance = options.envRadiance;
+        c.numLightTriangles = static_cast<std::uint32_t>(lightTable.lights.size());
+        c.numPunctualLights = static_cast<std::uint32_t>(frame->punctualLights.size());
+        c.lightTrianglePower = static_cast<float>(lightTable.totalPower);
+        c.punctualPower = static_cast<float>(punctualPower);
+        c.maxDepth = options.maxDepth;
+        c.rrDepth = options.rrDepth;
+        c.numTriangles = static_cast<std::uint32_t>(bvh.triangleOrder.size());
+        c.sceneRadius = sceneRadius(*frame);
+        if (!constants.empty() && (c.numPunctualLights != constants.front().numPunctualLights))
+            throw Error("the frames have different punctual lights");
+        constants.push_back(c);
+        entries.push_back(lightEntries(lightTable.lights));
+        lights.insert(lights.end(), lightTable.lights.begin(), lightTable.lights.end());
+        punctual.insert(punctual.end(), frame->punctualLights.begin(), frame->punctualLights.end());
+    }
+    constants_ = constants.front();
 
     // Textures: linear RGBA as packed halves.
     std::vector<gpu::TextureInfo> texInfo;
@@ -264,38 +333,38 @@ SceneGpu::SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOpt
         texInfo.push_back(info);
     }
 
-    setCamera(constants_, renderCamera(scene, options.camera), options.width, options.height);
-    constants_.envRadiance = options.envRadiance;
-    constants_.numLightTriangles = static_cast<std::uint32_t>(lights.size());
-    constants_.numPunctualLights = static_cast<std::uint32_t>(scene.punctualLights.size());
-    constants_.lightTrianglePower = static_cast<float>(total);
-    constants_.punctualPower = static_cast<float>(punctualPower);
-    constants_.maxDepth = options.maxDepth;
-    constants_.rrDepth = options.rrDepth;
-    constants_.numTriangles = static_cast<std::uint32_t>(bvh.triangleOrder.size());
-    constants_.sceneRadius = sceneRadius(scene);
-
     if (progress) progress->update(2.0, "upload");
     const std::vector<std::uint32_t>& order = bvh.triangleOrder;
+    const std::size_t count = order.size();
+    // Records [begin, end) of the frames' tables one after the other: write(frame, begin, end, out)
+    // for each frame's part, in that frame's leaf positions.
+    const auto byFrame = [&](std::size_t begin, std::size_t end, const auto& write) {
+        for (std::size_t f = begin / count; f * count < end; ++f) {
+            const std::size_t b = std::max(begin, f * count), e = std::min(end, (f + 1) * count);
+            write(f, b - f * count, e - f * count, b - begin);
+        }
+    };
     triGeom_ = makeFilledBuffer<gpu::TriangleGeom>(
-        ctx, order.size(), "triangle geometry", gpu::kBindTriGeom,
+        ctx, frames.size() * count, "triangle geometry", gpu::kBindTriGeom,
         [&](gpu::TriangleGeom* out, std::size_t begin, std::size_t end) {
-            writeTriangleGeoms(scene.positions, scene.triangles, order, begin, end, out);
+            byFrame(begin, end, [&](std::size_t f, std::size_t b, std::size_t e, std::size_t at) {
+                writeTriangleGeoms(frames[f]->positions, frames[f]->triangles, order, b, e, out + at);
+            });
         });
-    const auto entries = lightEntries(lights);
     triShading_ = makeFilledBuffer<gpu::TriangleShading>(
-        ctx, order.size(), "triangle shading", gpu::kBindTriShading,
+        ctx, frames.size() * count, "triangle shading", gpu::kBindTriShading,
         [&](gpu::TriangleShading* out, std::size_t begin, std::size_t end) {
-            writeShading(scene, order, entries, begin, end, out);
+            byFrame(begin, end, [&](std::size_t f, std::size_t b, std::size_t e, std::size_t at) {
+                writeShading(*frames[f], order, entries[f], b, e, out + at);
+            });
         });
-    bvh_ = makeBuffer(ctx, built->wide.nodes, "BVH nodes (4-wide)", gpu::kBindBvh);
+    bvh_ = makeBuffer(ctx, built.wide.nodes, "BVH nodes (4-wide)", gpu::kBindBvh);
     materials_ = makeBuffer(ctx, scene.materials, "materials", gpu::kBindMaterials);
     texInfo_ = makeBuffer(ctx, texInfo, "texture table", gpu::kBindTexInfo);
     texels_ = makeBuffer(ctx, texels, "texels", gpu::kBindTexels);
     lightTris_ = makeBuffer(ctx, lights, "light triangles", gpu::kBindLightTris);
-    punctual_ = makeBuffer(ctx, scene.punctualLights, "punctual lights", gpu::kBindPunctual);
-    sceneConst_ = makeBuffer(ctx, std::vector<gpu::SceneConstants>{constants_}, "scene constants",
-                             gpu::kBindSceneConst);
+    punctual_ = makeBuffer(ctx, punctual, "punctual lights", gpu::kBindPunctual);
+    sceneConst_ = makeBuffer(ctx, constants, "scene constants", gpu::kBindSceneConst);
     if (progress) {
         progress->update(3.0);
         progress->finish("uploaded");

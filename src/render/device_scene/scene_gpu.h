@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "render/device_scene/scene_spec.h"
 #include "scene/gltf_loader.h"
 #include "scene/scene.h"
+#include "util/progress.h"
 #include "vk/buffer.h"
 #include "vk/kernel.h"
 
@@ -66,6 +68,13 @@ public:
     SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOptions& options);
     // The same from a spec made of this scene and options already (saves recomputing it).
     SceneGpu(const vk::Context& ctx, const Scene& scene, const SceneGpuOptions& options, SceneSpec spec);
+    // Two frames of one animation at once, for kernels compiled with GDPT_TWO_FRAMES
+    // (scene_geometry.glsl; tgpt_reconnect.comp): every per-triangle and light table holds frame
+    // a's records, then frame b's, in one leaf order, under frame a's tree with its boxes grown to
+    // hold frame b's triangles too (growBvhBoxes); the scene constants are [a, b] (constants()
+    // is a's). The frames must have the same triangles, emitters and punctual lights (else
+    // gdpt::Error). The kernels keep their traversal stack in memory.
+    SceneGpu(const vk::Context& ctx, const Scene& a, const Scene& b, const SceneGpuOptions& options);
 
     // Binds the scene buffers (bindings kBindTriGeom..kBindSceneConst) to a kernel.
     void bindTo(vk::Kernel& kernel) const;
@@ -92,6 +101,10 @@ public:
     [[nodiscard]] bool lightProbed() const { return lightProbed_; }
 
 private:
+    // Builds the tables of `frames` (one, or the two of a frame pair) over `built`.
+    void upload(const vk::Context& ctx, const std::vector<const Scene*>& frames,
+                const SceneGpuOptions& options, const SceneBvh& built, std::optional<Progress>& progress);
+
     SceneSpec spec_;
     gpu::SceneConstants constants_{};
     BvhBuildInfo bvhInfo_;

@@ -1,0 +1,83 @@
+#include "integrator/temporal_reconnect.h"
+
+#include <array>
+
+#include "poisson/poisson_spacetime.h"
+#include "render/passes/temporal_reconnect_pass.h"
+#include "util/error.h"
+#include "util/timer.h"
+#include "vk/commands.h"
+#include "vk/context.h"
+
+namespace gdpt {
+namespace {
+
+// The mean and the variance of the mean of each pixel's statistics, as images.
+void toImages(const std::vector<gpu::PixelStats>& stats, int width, int height, Image& mean, Image& variance) {
+    mean = Image(width, height);
+    variance = Image(width, height);
+    for (std::size_t i = 0; i < stats.size(); ++i) {
+        const gpu::PixelStats& s = stats[i];
+        const float n = float(s.count);
+        for (int c = 0; c < 3; ++c) {
+            mean.plane(c)[i] = s.mean[c];
+            variance.plane(c)[i] = s.count > 1 ? s.m2[c] / ((n - 1.0f) * n) : 0.0f;
+        }
+    }
+}
+
+}  // namespace
+
+TemporalDifferences reconnectDifferences(const vk::Context& ctx, const Scene& a, const Scene& b, const MotionMap& map,
+                                         const SceneGpuOptions& sceneOptions, const TemporalReconnectOptions& options) {
+    Timer timer;
+    const int width = sceneOptions.width, height = sceneOptions.height;
+    const std::size_t pixels = std::size_t(width) * std::size_t(height);
+    if (map.partner.size() != pixels)
+        throw Error("temporal reconnection: a motion map of " + std::to_string(map.partner.size()) + " pixels for a " +
+                    std::to_string(width) + "x" + std::to_string(height) + " image");
+    SceneGpuOptions quiet = sceneOptions;
+    quiet.quiet = true;
+    const SceneGpu pair(ctx, a, b, quiet);
+    TemporalReconnectPass pass(ctx, pair);
+
+    // Partners both ways: p of a goes to q of b with the motion's sub-pixel part δ, q back to p
+    // with −δ (the inverse toroidal shift).
+    std::array<std::vector<gpu::TemporalPartner>, 2> partners;
+    for (auto& p : partners) p.assign(pixels, gpu::TemporalPartner{gpu::kInvalidIndex, 0.0f, 0.0f, 0});
+    for (std::size_t p = 0; p < pixels; ++p) {
+        const std::uint32_t q = map.partner[p];
+        if (q == kNoTemporalPartner) continue;
+        const glm::vec2 d = map.subpixel.empty() ? glm::vec2(0.0f) : map.subpixel[p];
+        partners[0][p] = {q, d.x, d.y, 0};
+        partners[1][q] = {static_cast<std::uint32_t>(p), -d.x, -d.y, 0};
+    }
+    pass.setPartners(partners);
+
+    vk::CommandStream stream(ctx, "temporal reconnection");
+    VkCommandBuffer cmd = stream.begin();
+    pass.record(cmd, 0, options.spp, {options.seed, options.seed + 0x9E3779B9u}, options.flags);
+    stream.submitAndWait();
+
+    TemporalDifferences out;
+    out.counters = pass.takeCounters();
+    Image forward, varForward, reverse, varReverse;
+    toImages(pass.differences(0), width, height, forward, varForward);
+    toImages(pass.differences(1), width, height, reverse, varReverse);
+    toImages(pass.bases(0), width, height, out.baseA, out.varBaseA);
+    toImages(pass.bases(1), width, height, out.baseB, out.varBaseB);
+    out.dt = Image(width, height);
+    out.varDt = Image(width, height);
+    for (std::size_t p = 0; p < pixels; ++p) {
+        const std::uint32_t q = map.partner[p];
+        if (q == kNoTemporalPartner) continue;
+        for (int c = 0; c < 3; ++c) {
+            out.dt.plane(c)[p] = forward.plane(c)[p] - reverse.plane(c)[q];
+            out.varDt.plane(c)[p] = varForward.plane(c)[p] + varReverse.plane(c)[q];
+        }
+    }
+    out.seconds = timer.seconds();
+    return out;
+}
+
+}  // namespace gdpt
