@@ -31,7 +31,7 @@ GDPT_CONST uint kTemporalFlagOneDirection = 1u;
 
 // Where pixel p of the base frame has its partner in the other frame. 16 bytes.
 struct TemporalPartner {
-    uint pixel;  // the partner pixel's index (y·width + x), or kInvalidIndex: no difference here
+    uint pixel;    // the partner pixel's index (y·width + x), or kInvalidIndex: no difference here
     float shiftX;  // a camera sample at p + u has its offset at partner + fract(u + shift)
     float shiftY;  // (a toroidal shift of the sub-pixel position, in pixels, each in (−1, 1))
     uint pad;
@@ -41,7 +41,7 @@ struct TemporalPartner {
 // address of a per-pixel buffer (pixel_buffers.glsl) with both directions' entries, the
 // direction of base frame 0's first (entry baseFrame·width·height + pixel).
 GDPT_ENUM_BEGIN(TemporalBinding)
-kBindTemporalPartner = 70u,     // TemporalPartner per pixel of the base frame
+kBindTemporalPartner = 70u,         // TemporalPartner per pixel of the base frame
     kBindTemporalDifference = 71u,  // PixelStats per pixel: Σ pair weight · (offset − base)
     kBindTemporalBase = 72u         // PixelStats per pixel: the base path's own radiance (no
                                     // emission seen directly from the camera)

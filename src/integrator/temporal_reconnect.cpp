@@ -13,7 +13,8 @@ namespace gdpt {
 namespace {
 
 // The mean and the variance of the mean of each pixel's statistics, as images.
-void toImages(const std::vector<gpu::PixelStats>& stats, int width, int height, Image& mean, Image& variance) {
+void toImages(const std::vector<gpu::PixelStats>& stats, int width, int height, Image& mean,
+              Image& variance) {
     mean = Image(width, height);
     variance = Image(width, height);
     for (std::size_t i = 0; i < stats.size(); ++i) {
@@ -28,14 +29,15 @@ void toImages(const std::vector<gpu::PixelStats>& stats, int width, int height, 
 
 }  // namespace
 
-TemporalDifferences reconnectDifferences(const vk::Context& ctx, const Scene& a, const Scene& b, const MotionMap& map,
-                                         const SceneGpuOptions& sceneOptions, const TemporalReconnectOptions& options) {
+TemporalDifferences reconnectDifferences(const vk::Context& ctx, const Scene& a, const Scene& b,
+                                         const MotionMap& map, const SceneGpuOptions& sceneOptions,
+                                         const TemporalReconnectOptions& options) {
     Timer timer;
     const int width = sceneOptions.width, height = sceneOptions.height;
     const std::size_t pixels = std::size_t(width) * std::size_t(height);
     if (map.partner.size() != pixels)
-        throw Error("temporal reconnection: a motion map of " + std::to_string(map.partner.size()) + " pixels for a " +
-                    std::to_string(width) + "x" + std::to_string(height) + " image");
+        throw Error("temporal reconnection: a motion map of " + std::to_string(map.partner.size()) +
+                    " pixels for a " + std::to_string(width) + "x" + std::to_string(height) + " image");
     SceneGpuOptions quiet = sceneOptions;
     quiet.quiet = true;
     const SceneGpu pair(ctx, a, b, quiet);

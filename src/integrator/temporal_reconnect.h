@@ -19,9 +19,9 @@ class Context;
 }
 
 struct TemporalReconnectOptions {
-    std::uint32_t spp = 8;   // camera samples per pixel in each direction
-    std::uint32_t seed = 0;  // direction 0's seed; direction 1 uses seed + 0x9E3779B9
-    std::uint32_t flags = 0; // gpu::kTemporalFlag* (tests)
+    std::uint32_t spp = 8;    // camera samples per pixel in each direction
+    std::uint32_t seed = 0;   // direction 0's seed; direction 1 uses seed + 0x9E3779B9
+    std::uint32_t flags = 0;  // gpu::kTemporalFlag* (tests)
 };
 
 struct TemporalDifferences {
@@ -39,7 +39,8 @@ struct TemporalDifferences {
 // The differences from frame `a` to frame `b` (the same triangles moved) along `map`
 // (motionBetween(a, ..., b, ...)), the scenes seen as `sceneOptions` says (size, camera, depth).
 // Throws gdpt::Error for frames whose triangles differ (SceneGpu's frame pair).
-TemporalDifferences reconnectDifferences(const vk::Context& ctx, const Scene& a, const Scene& b, const MotionMap& map,
-                                         const SceneGpuOptions& sceneOptions, const TemporalReconnectOptions& options);
+TemporalDifferences reconnectDifferences(const vk::Context& ctx, const Scene& a, const Scene& b,
+                                         const MotionMap& map, const SceneGpuOptions& sceneOptions,
+                                         const TemporalReconnectOptions& options);
 
 }  // namespace gdpt

@@ -38,7 +38,8 @@ TemporalReconnectPass::TemporalReconnectPass(const vk::Context& ctx, const Scene
     kernel_.bindAddress(gpu::kBindTemporalPartner, partners_);
     kernel_.bindAddress(gpu::kBindTemporalDifference, differences_);
     kernel_.bindAddress(gpu::kBindTemporalBase, bases_);
-    std::vector<gpu::TemporalPartner> none(2ull * width_ * height_, gpu::TemporalPartner{gpu::kInvalidIndex, 0, 0, 0});
+    std::vector<gpu::TemporalPartner> none(2ull * width_ * height_,
+                                           gpu::TemporalPartner{gpu::kInvalidIndex, 0, 0, 0});
     partners_.uploadVector(none);
     reset();
 }
@@ -49,8 +50,8 @@ void TemporalReconnectPass::setPartners(const std::array<std::vector<gpu::Tempor
     both.reserve(2 * pixels);
     for (const auto& p : partners) {
         if (p.size() != pixels)
-            throw Error("temporal partners: " + std::to_string(p.size()) + " entries for a " + std::to_string(width_) +
-                        "x" + std::to_string(height_) + " image");
+            throw Error("temporal partners: " + std::to_string(p.size()) + " entries for a " +
+                        std::to_string(width_) + "x" + std::to_string(height_) + " image");
         for (const gpu::TemporalPartner& e : p)
             if (e.pixel != gpu::kInvalidIndex && e.pixel >= pixels)
                 throw Error("temporal partners: pixel " + std::to_string(e.pixel) + " is outside the image");
@@ -66,7 +67,8 @@ void TemporalReconnectPass::reset() {
 }
 
 void TemporalReconnectPass::record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp,
-                                   std::array<std::uint32_t, 2> seeds, std::uint32_t flags, vk::GpuTimer* timer) {
+                                   std::array<std::uint32_t, 2> seeds, std::uint32_t flags,
+                                   vk::GpuTimer* timer) {
     for (std::uint32_t direction = 0; direction < 2; ++direction)
         recordTiled(cmd, ctx_.info(), width_, height_, sampleBase, spp, kMaxPixelSamplesPerDispatch,
                     [&](const DispatchTile& t) {

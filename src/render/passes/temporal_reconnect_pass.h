@@ -36,8 +36,8 @@ public:
     void reset();
     // Records `spp` samples per pixel from sample index `sampleBase` in both directions, direction
     // d with seed seeds[d]; `flags`: gpu::kTemporalFlag* (tests).
-    void record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp, std::array<std::uint32_t, 2> seeds,
-                std::uint32_t flags = 0, vk::GpuTimer* timer = nullptr);
+    void record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp,
+                std::array<std::uint32_t, 2> seeds, std::uint32_t flags = 0, vk::GpuTimer* timer = nullptr);
     // After the fence: the counters written since the last call (cleared), and direction d's
     // statistics of the differences and of the base paths' radiance (width·height each).
     gpu::Counters takeCounters();

@@ -24,6 +24,7 @@
 #include "integrator/pt_sampler.h"
 #include "integrator/temporal_reconnect.h"
 #include "poisson/poisson_spacetime.h"
+#include "render/device_scene/features.h"
 #include "scene/gltf_loader.h"
 #include "scene/procedural.h"
 #include "stats_normal.h"
@@ -77,12 +78,13 @@ Samples differencesOverSeeds(const vk::Context& ctx, const Pair& pair, int seeds
 // Student t tests of blocks of `size` pixels square (pixels with a partner) of the seeds' mean
 // against `ref` (with its variance of the mean `refVar`), per channel, at a Šidák-corrected
 // family level of 1e-3: the count rejected and the worst |t|.
-std::pair<int, double> rejected(const Samples& dt, const std::vector<double>& ref, const std::vector<double>& refVar,
-                                const MotionMap& map, int size, double sign) {
+std::pair<int, double> rejected(const Samples& dt, const std::vector<double>& ref,
+                                const std::vector<double>& refVar, const MotionMap& map, int size,
+                                double sign) {
     const int nx = kW / size, ny = kH / size;
     const int seeds = int(dt[0].size());
     int tests = 0;
-    std::vector<std::array<double, 5>> blocks;  // per block and channel: mean, m2, ref, refVar, pixels
+    std::vector<std::array<double, 4>> blocks;  // per block and channel: mean, m2, ref, refVar
     for (int c = 0; c < 3; ++c)
         for (int b = 0; b < nx * ny; ++b) {
             std::vector<double> v(std::size_t(seeds), 0.0);
@@ -90,9 +92,11 @@ std::pair<int, double> rejected(const Samples& dt, const std::vector<double>& re
             int n = 0;
             for (int y = 0; y < size; ++y)
                 for (int x = 0; x < size; ++x) {
-                    const std::size_t p = std::size_t((b / nx) * size + y) * kW + std::size_t((b % nx) * size + x);
+                    const std::size_t p =
+                        std::size_t((b / nx) * size + y) * kW + std::size_t((b % nx) * size + x);
                     if (map.partner[p] == kNoTemporalPartner) continue;
-                    for (int k = 0; k < seeds; ++k) v[std::size_t(k)] += dt[p * 3 + std::size_t(c)][std::size_t(k)];
+                    for (int k = 0; k < seeds; ++k)
+                        v[std::size_t(k)] += dt[p * 3 + std::size_t(c)][std::size_t(k)];
                     r += ref[p * 3 + std::size_t(c)];
                     rv += refVar[p * 3 + std::size_t(c)];
                     ++n;
@@ -101,7 +105,7 @@ std::pair<int, double> rejected(const Samples& dt, const std::vector<double>& re
             double mean = 0.0, m2 = 0.0;
             for (double& x : v) mean += (x /= n) / seeds;
             for (double x : v) m2 += (x - mean) * (x - mean);
-            blocks.push_back({mean, m2, sign * r / n, rv / (double(n) * n), double(n)});
+            blocks.push_back({mean, m2, sign * r / n, rv / (double(n) * n)});
             ++tests;
         }
     const double threshold = test::twoSidedT(test::sidakAlpha(1e-3, tests), seeds - 1);
@@ -124,7 +128,8 @@ void expectUnbiased(const vk::Context& ctx, const Pair& pair, const char* what) 
     TemporalReconnectOptions o;
     o.spp = 1024;
     o.seed = 424242u;
-    const TemporalDifferences reference = reconnectDifferences(ctx, pair.a, pair.b, pair.map, sceneOptions(), o);
+    const TemporalDifferences reference =
+        reconnectDifferences(ctx, pair.a, pair.b, pair.map, sceneOptions(), o);
     std::vector<double> ref(dt.size(), 0.0), refVar(dt.size(), 0.0);
     for (std::size_t p = 0; p < std::size_t(kW) * kH; ++p) {
         const std::uint32_t q = pair.map.partner[p];
@@ -135,14 +140,18 @@ void expectUnbiased(const vk::Context& ctx, const Pair& pair, const char* what) 
         }
     }
     const Samples oneDirection = differencesOverSeeds(ctx, pair, kSeeds, 16, gpu::kTemporalFlagOneDirection);
+    // Measured 2026-12-06: worst |t| of dt 1.5 / 1.8 (8 x 8 blocks, moving box / camera; threshold
+    // 5.9 at 15 degrees of freedom) and 2.5 / 3.2 (pixels, threshold 8.5); the shift without its
+    // second direction rejected in 3 / 14 blocks and 13 / 89 pixels, dt reversed in 12 / 27 and
+    // 106 / 373.
     for (const int size : {8, 1}) {
         SCOPED_TRACE("blocks of " + std::to_string(size) + " px");
         const auto [fails, worst] = rejected(dt, ref, refVar, pair.map, size, 1.0);
         EXPECT_EQ(fails, 0) << "worst |t| " << worst;
         const auto [reversed, reversedWorst] = rejected(dt, ref, refVar, pair.map, size, -1.0);
         const auto [single, singleWorst] = rejected(oneDirection, ref, refVar, pair.map, size, 1.0);
-        std::printf("%s, %d px: worst |t| %.2f; reversed %d (%.1f); one direction %d (%.1f)\n", what, size, worst,
-                    reversed, reversedWorst, single, singleWorst);
+        std::printf("%s, %d px: worst |t| %.2f; reversed %d (%.1f); one direction %d (%.1f)\n", what, size,
+                    worst, reversed, reversedWorst, single, singleWorst);
         EXPECT_GE(reversed, 3) << "the test cannot tell dt from -dt";
         EXPECT_GE(single, 1) << "the test cannot tell the shift without its second direction";
     }
@@ -154,6 +163,118 @@ TEST_F(TemporalReconnect, DifferencesOfAMovingObjectAreUnbiased) {
 
 TEST_F(TemporalReconnect, DifferencesUnderAMovingCameraAreUnbiased) {
     expectUnbiased(keeping(), animated("camera_move.gltf", 0.5, 0.75), "moving camera");
+}
+
+// The base paths are the path tracer's estimator without the emission the camera sees
+// directly: on the Cornell box, away from the pixels where camera rays meet the light (and their
+// neighbours), they must agree with pt.comp's image (4 x 4 blocks, Student t with the PT image's
+// own variance; both directions of a still pair). Power: the same comparison with the image
+// dimmed by 2 % is rejected.
+TEST_F(TemporalReconnect, BasePathsArePathTracing) {
+    const vk::Context& ctx = keeping();
+    Pair still = animated("moving_box.gltf", 0.0, 0.0);
+    // Camera rays through 8 x 8 points of each pixel (the centres of an image 8 times as large).
+    constexpr int kProbe = 8;
+    const std::vector<PrimaryHit> hits = primaryHits(still.a, -1, kProbe * kW, kProbe * kH);
+    MotionMap awayFromLight = still.map;
+    for (int Y = 0; Y < kProbe * kH; ++Y)
+        for (int X = 0; X < kProbe * kW; ++X) {
+            const PrimaryHit& h = hits[std::size_t(Y) * kProbe * kW + std::size_t(X)];
+            const int x = X / kProbe, y = Y / kProbe;
+            if (h.triangle == gpu::kInvalidIndex || !materialIsEmissive(still.a, h.triangle)) continue;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx)
+                    if (x + dx >= 0 && x + dx < kW && y + dy >= 0 && y + dy < kH)
+                        awayFromLight.partner[std::size_t(y + dy) * kW + std::size_t(x + dx)] =
+                            kNoTemporalPartner;
+        }
+    constexpr int kSeeds = 16;
+    Samples bases(std::size_t(kW) * kH * 3);
+    for (int s = 0; s < kSeeds; ++s) {
+        TemporalReconnectOptions o;
+        o.spp = 64;
+        o.seed = 77u + 31u * std::uint32_t(s);
+        const TemporalDifferences d =
+            reconnectDifferences(ctx, still.a, still.b, still.map, sceneOptions(), o);
+        for (std::size_t i = 0; i < std::size_t(kW) * kH; ++i)
+            for (int c = 0; c < 3; ++c)
+                bases[i * 3 + std::size_t(c)].push_back(s % 2 == 0 ? d.baseA.plane(c)[i]
+                                                                   : d.baseB.plane(c)[i]);
+    }
+    // Measured 2026-12-06: worst |t| 2.6 (threshold about 6.5); the dimmer image rejected in 7 blocks.
+    const RenderResult pt = renderPt(ctx, still.a, renderOptions(kW, kH, 4096, 5));
+    for (const double scale : {1.0, 0.98}) {
+        std::vector<double> ref(bases.size()), refVar(bases.size());
+        for (std::size_t i = 0; i < std::size_t(kW) * kH; ++i)
+            for (int c = 0; c < 3; ++c) {
+                ref[i * 3 + std::size_t(c)] = scale * pt.image.plane(c)[i];
+                refVar[i * 3 + std::size_t(c)] = scale * scale * pt.varianceOfMean.plane(c)[i];
+            }
+        const auto [fails, worst] = rejected(bases, ref, refVar, awayFromLight, 4, 1.0);
+        std::printf("scale %.2f: %d blocks rejected, worst |t| %.2f\n", scale, fails, worst);
+        if (scale == 1.0)
+            EXPECT_EQ(fails, 0) << "worst |t| " << worst;
+        else
+            EXPECT_GE(fails, 3) << "the test cannot tell a 2 % dimmer image (worst |t| " << worst << ")";
+    }
+}
+
+// A still scene as two frames: the offset path is the base path computed again from the other
+// frame's copy of the same data, so dt's variance is a tiny fraction of two independent paths'
+// (what is left: segments that one side's rounding finds occluded or grazing and the other's
+// not), where a moving pair's is not. Measured 2026-12-06: 3.9e-7 still, 0.011 moving (1/24 s).
+TEST_F(TemporalReconnect, AStillSceneHasAlmostNoDifference) {
+    const vk::Context& ctx = keeping();
+    TemporalReconnectOptions o;
+    o.spp = 16;
+    o.seed = 9;
+    const auto varianceRatio = [&](const Pair& pair) {
+        const TemporalDifferences d = reconnectDifferences(ctx, pair.a, pair.b, pair.map, sceneOptions(), o);
+        double dt = 0.0, unpaired = 0.0;
+        for (std::size_t p = 0; p < std::size_t(kW) * kH; ++p) {
+            const std::uint32_t q = pair.map.partner[p];
+            if (q == kNoTemporalPartner) continue;
+            for (int c = 0; c < 3; ++c) {
+                dt += d.varDt.plane(c)[p];
+                unpaired += d.varBaseA.plane(c)[p] + d.varBaseB.plane(c)[q];
+            }
+        }
+        EXPECT_GT(d.counters.shiftPairs, 0u);
+        return dt / unpaired;
+    };
+    const double still = varianceRatio(animated("moving_box.gltf", 0.0, 0.0));
+    const double moving = varianceRatio(animated("moving_box.gltf", 0.0, 1.0 / 24.0));
+    std::printf("var dt / unpaired var: still %.3g, moving %.3g\n", still, moving);
+    EXPECT_LT(still, 1e-4);
+    EXPECT_GT(moving, 1e-3);
+    EXPECT_LT(moving, 0.1) << "the shift hardly correlates the frames";
+}
+
+TEST_F(TemporalReconnect, SameSeedSameBitsAndFramesMustShareTheirTriangles) {
+    const vk::Context& ctx = keeping();
+    const Pair pair = animated("camera_move.gltf", 0.0, 0.25);
+    TemporalReconnectOptions o;
+    o.spp = 2;
+    o.seed = 11;
+    const TemporalDifferences first = reconnectDifferences(ctx, pair.a, pair.b, pair.map, sceneOptions(), o);
+    const TemporalDifferences second = reconnectDifferences(ctx, pair.a, pair.b, pair.map, sceneOptions(), o);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(first.dt.plane(c), second.dt.plane(c));
+        EXPECT_EQ(first.varDt.plane(c), second.varDt.plane(c));
+    }
+    o.seed = 12;
+    const TemporalDifferences other = reconnectDifferences(ctx, pair.a, pair.b, pair.map, sceneOptions(), o);
+    EXPECT_NE(first.dt.plane(0), other.dt.plane(0));
+
+    Scene fewer = pair.b;
+    fewer.triangles.pop_back();
+    fewer.triangleMaterial.pop_back();
+    try {
+        (void)reconnectDifferences(ctx, pair.a, fewer, pair.map, sceneOptions(), o);
+        ADD_FAILURE() << "frames with other triangles were accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("same triangles"), std::string::npos) << e.what();
+    }
 }
 
 }  // namespace
