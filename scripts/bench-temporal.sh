@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Animations at equal time: PT, per-frame G-PT and temporal G-PT (docs/animation.md; `tgpt` with
-# its default motion shift, `tgpt-replay` with --temporal-shift replay) render the same frames
+# its default motion shift, `tgpt-replay` and `tgpt-reconnect` with --temporal-shift replay and
+# reconnect) render the same frames
 # of each animated scene with the same --time for the whole sequence (`tgpt-gammaG` and
 # `tgpt-betaB`, `tgpt-reconR`: tgpt with --gamma G, --beta B or --recon R), and each sequence is
 # compared with a PT reference sequence of REFSPP samples per pixel by `gdpt diff-sequence`:
@@ -66,6 +67,7 @@ for scene in ${scenes//,/ }; do
       method=(--method "$m")
       case "$m" in
         tgpt-replay) method=(--method tgpt --temporal-shift replay) ;;
+        tgpt-reconnect) method=(--method tgpt --temporal-shift reconnect) ;;
         tgpt-gamma*) method=(--method tgpt --gamma "${m#tgpt-gamma}") ;;  # e.g. tgpt-gamma1
         tgpt-beta*) method=(--method tgpt --beta "${m#tgpt-beta}") ;;
         tgpt-recon*) method=(--method tgpt --recon "${m#tgpt-recon}") ;;  # e.g. tgpt-reconwl1

@@ -57,8 +57,8 @@ struct RenderArgs {
     bool noVideo = false;       // no MP4 of the sequence even when ffmpeg is installed
     int window = 10;            // tgpt: frames reconstructed together
     double beta = 1.0;          // tgpt: weight of the temporal rows
-    double gamma = 1.0;         // tgpt: weight of the mixed rows
-    std::string temporalShift = "motion";  // tgpt: motion | replay
+    double gamma = -1.0;        // tgpt: weight of the mixed rows (< 0: 1, or 0 with the reconnection shift)
+    std::string temporalShift = "motion";  // tgpt: motion | replay | reconnect
 };
 
 struct DiffArgs {

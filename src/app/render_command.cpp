@@ -534,8 +534,8 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->group(animation);
     r->add_option("--gamma", a.gamma,
                   "tgpt: weight of the mixed rows of the space-time solve (the change of dx and dy along "
-                  "the motion, Manzi et al. 2016's mixed differences); 0 = none")
-        ->capture_default_str()
+                  "the motion, Manzi et al. 2016's mixed differences); 0 = none. Default 1; 0 (and only 0) "
+                  "with --temporal-shift reconnect, which has no paired halves to take them from")
         ->check(CLI::Range(0.0, 1e3))
         ->needs(frames)
         ->group(animation);
@@ -543,9 +543,11 @@ Subcommand addRenderCommand(CLI::App& app) {
          "--temporal-shift", a.temporalShift,
          "tgpt: how a frame's paths are paired with the next frame's: motion = replayed in the pixel "
          "the scene's motion carries their primary hit to (motion vectors), replay = in the same "
-         "pixel")
+         "pixel, reconnect = shifted into the next frame by the reconnection shift (each path's offset "
+         "starts in that pixel and reconnects to the path's vertices carried by the animation, both "
+         "directions combined by MIS; a pass of its own per frame: docs/animation.md)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"motion", "replay"}))
+        ->check(CLI::IsMember({"motion", "replay", "reconnect"}))
         ->needs(frames)
         ->group(animation);
 

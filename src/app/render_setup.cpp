@@ -119,8 +119,8 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
     t.weighted = args.recon == "wl1" || args.recon == "wl2";
     t.alpha = args.alpha;
     t.beta = args.beta;
-    t.gamma = args.gamma;
     t.shift = parseTemporalShift(args.temporalShift);
+    t.gamma = args.gamma >= 0.0 ? args.gamma : t.shift == TemporalShift::Reconnect ? 0.0 : 1.0;
     t.tolerance = args.tolerance;
     // Timed renders remember each configuration's reconstruction time.
     if (args.time > 0.0) g.reconCache = cache;

@@ -137,9 +137,9 @@ struct MltOptions {
 // How temporal G-PT pairs a frame's paths with the next frame's (tgpt_integrator.h): Motion
 // replays each path in the pixel the scene's motion carries its primary hit to (motion_map.h),
 // Replay in the same pixel.
-enum class TemporalShift { Motion, Replay };
+enum class TemporalShift { Motion, Replay, Reconnect };
 
-// "motion" | "replay"; throws gdpt::UsageError otherwise.
+// "motion" | "replay" | "reconnect"; throws gdpt::UsageError otherwise.
 TemporalShift parseTemporalShift(const std::string& text);
 const char* temporalShiftName(TemporalShift shift);
 
@@ -152,7 +152,7 @@ struct TgptOptions {
     bool weighted = false;    // rows weighted by their inverse variances (wl1, wl2; spacetime_weights.h)
     double alpha = 0.2;       // weight of the primal rows
     double beta = 1.0;        // weight of the temporal rows
-    double gamma = 1.0;       // weight of the mixed rows (∂x∂t, ∂y∂t); 0: none
+    double gamma = 1.0;       // weight of the mixed rows (∂x∂t, ∂y∂t); 0: none (Reconnect: always)
     double tolerance = 1e-4;  // relative residual of the last solve
 };
 

@@ -154,6 +154,12 @@ struct TgptStats {
     // Groups of paired samples behind the variance of dt from the frame before (var_dt,
     // sample_groups.h): its degrees of freedom per pixel are one fewer; 0 without a dt.
     int dtVarianceGroups = 0;
+    // Reconnection shift (TemporalShift::Reconnect): the camera samples per pixel of each of its
+    // two directions from the frame before, the pass's time, and its pairs and the pairs whose
+    // shift failed at the first vertex (temporal_reconnect.h).
+    std::uint32_t temporalSpp = 0;
+    double temporalMs = 0.0;
+    std::uint64_t temporalPairs = 0, temporalFailures = 0;
 };
 
 struct RenderStats {

@@ -13,6 +13,7 @@
 #include "integrator/render_identity.h"
 #include "integrator/sample_groups.h"
 #include "integrator/spacetime_weights.h"
+#include "integrator/temporal_reconnect.h"
 #include "poisson/poisson_spacetime.h"
 #include "util/error.h"
 #include "util/memory.h"
@@ -35,6 +36,8 @@ struct FrameSamples {
     // solve's rows), from the sample groups of its second half and this first half; empty
     // without a frame before (or with fewer than two groups); dxt, dyt for weighted mixed rows.
     Image varDt, varDxt, varDyt;
+    // The reconnection shift: the differences from the frame before (at its pixels, as varDt).
+    Image dt;
     RenderStats stats;
 };
 
@@ -48,6 +51,69 @@ Image combineHalves(const Image& a, double na, const Image& b, double nb, int po
         for (std::size_t i = 0; i < out.pixelCount(); ++i)
             out.plane(c)[i] = float(wa * a.plane(c)[i] + wb * b.plane(c)[i]);
     return out;
+}
+
+// The reconnection shift gives this fraction of a timed frame's share to the frame's G-PT render
+// when there is a frame before, and the rest to the reconnection pass from it; with --spp the pass
+// takes half the frame's samples per pixel in each direction. (Measured 2026-12-06 on lavapipe:
+// a sample of the pass, both directions, costs about 1.6 G-PT samples, so half the samples take
+// about 0.8 of the render's time.)
+constexpr double kReconnectRenderShare = 0.55;
+
+// The reconnection shift's frame: one G-PT render of the frame's samples seeded σ(f), and, with a
+// frame `before`, the differences from it along map (temporal_reconnect.h), with their variance.
+// secondsPerSample: what a sample of the pass took last (0: not known yet; the pass then takes
+// half the render's samples); updated.
+FrameSamples sampleReconnected(const vk::Context& ctx, const GptSamplingOptions& sampling,
+                               const Scene* before, const Scene& scene, const MotionMap& map,
+                               const RenderOptions& options, double share, std::uint32_t seed,
+                               double& secondsPerSample) {
+    const bool timed = options.timeBudget > 0.0;
+    Timer frameTimer;
+    RenderOptions whole = options;
+    whole.whileCompiling = nullptr;
+    whole.elapsedBefore = 0.0;
+    whole.seed = seed;
+    if (timed) whole.timeBudget = before ? kReconnectRenderShare * share : share;
+    RenderResultGpt r = renderGpt(ctx, scene, whole, sampling);
+    FrameSamples f;
+    f.stats = r.stats;
+    if (r.stats.cancelled || !before) {
+        f.primal = std::move(r.primal);
+        f.dx = std::move(r.dx);
+        f.dy = std::move(r.dy);
+        f.direct = std::move(r.direct);
+        f.varPrimal = std::move(r.varPrimal);
+        f.varDx = std::move(r.varDx);
+        f.varDy = std::move(r.varDy);
+        f.varDirect = std::move(r.varDirect);
+        return f;
+    }
+    TemporalReconnectOptions t;
+    t.spp = std::max<std::uint32_t>(1, r.stats.spp / 2);
+    if (timed && secondsPerSample > 0.0)
+        t.spp = std::max<std::uint32_t>(
+            1, std::uint32_t(std::clamp((share - frameTimer.seconds()) / secondsPerSample, 0.0, 1e6)));
+    t.seed = seed ^ 0x5bd1e995u;
+    const TemporalDifferences d = reconnectDifferences(ctx, *before, scene, map, options.scene, t);
+    secondsPerSample = d.seconds / double(t.spp);
+    f.primal = std::move(r.primal);
+    f.dx = std::move(r.dx);
+    f.dy = std::move(r.dy);
+    f.direct = std::move(r.direct);
+    f.varPrimal = std::move(r.varPrimal);
+    f.varDx = std::move(r.varDx);
+    f.varDy = std::move(r.varDy);
+    f.varDirect = std::move(r.varDirect);
+    f.dt = d.dt;
+    f.varDt = d.varDt;
+    f.fromPrevious = map.partner;
+    f.stats.tgpt.temporalSpp = t.spp;
+    f.stats.tgpt.temporalMs = d.seconds * 1e3;
+    f.stats.tgpt.temporalPairs = d.counters.shiftPairs;
+    f.stats.tgpt.temporalFailures = d.counters.shiftFailures;
+    f.stats.raysTraced += d.counters.raysTraced;
+    return f;
 }
 
 // The temporal differences from `earlier` to `later`, at the earlier frame's pixels p:
@@ -162,16 +228,29 @@ void checkWindowMemory(int width, int height, int frames, bool mixed, bool weigh
 TemporalShift parseTemporalShift(const std::string& text) {
     if (text == "motion") return TemporalShift::Motion;
     if (text == "replay") return TemporalShift::Replay;
-    throw UsageError("--temporal-shift must be motion or replay, not '" + text + "'");
+    if (text == "reconnect") return TemporalShift::Reconnect;
+    throw UsageError("--temporal-shift must be motion, replay or reconnect, not '" + text + "'");
 }
 
 const char* temporalShiftName(TemporalShift shift) {
-    return shift == TemporalShift::Motion ? "motion" : "replay";
+    switch (shift) {
+        case TemporalShift::Motion:
+            return "motion";
+        case TemporalShift::Replay:
+            return "replay";
+        case TemporalShift::Reconnect:
+            break;
+    }
+    return "reconnect";
 }
 
 TgptIntegrator::TgptIntegrator(TgptOptions options) : options_(std::move(options)) {
     options_.sampling.demodulate = Demodulation::Off;
     if (options_.window < 1) throw UsageError("--window must be at least 1 frame");
+    if (options_.shift == TemporalShift::Reconnect && options_.gamma > 0.0)
+        throw UsageError(
+            "--gamma: the mixed rows pair the halves of the motion and replay shifts; the reconnection shift "
+            "renders each frame whole (leave --gamma out, or 0)");
 }
 
 std::uint32_t TgptIntegrator::maxBatchSpp(int width, int height) const {
@@ -210,6 +289,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
     if (window.startsSequence) carry_.reset();
     const bool joined = carry_ && carry_->frame == window.first - 1;
     const bool motion = options_.shift == TemporalShift::Motion;
+    const bool reconnect = options_.shift == TemporalShift::Reconnect;
     // The frame before the one being sampled, for the motion between them.
     std::shared_ptr<const Scene> previousScene = joined ? carry_->scene : nullptr;
     std::vector<PrimaryHit> previousHits = joined ? carry_->hits : std::vector<PrimaryHit>{};
@@ -219,17 +299,20 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
     // repeats (for the variance of dt).
     SampleGroups previousGroups = joined ? std::move(carry_->secondHalfGroups) : SampleGroups{};
 
-    // 1. Sampling: two half renders per frame, seeded σ(f) and σ(f+1).
+    // 1. Sampling: two half renders per frame, seeded σ(f) and σ(f+1) (the reconnection shift:
+    // one render per frame, and the differences from the frame before by the reconnection pass).
     for (int k = 0; k < window.count; ++k) {
         const int frame = window.first + k;
         const auto scene = std::make_shared<const Scene>(window.scene(frame));
+        const std::shared_ptr<const Scene> before = previousScene;
         // The motion shift: where the frame before's pixels moved, and the streams that
         // replay their paths there in this frame's first half.
         GptSamplingOptions firstSampling = options_.sampling;
         std::vector<std::uint32_t> fromPrevious;
+        std::vector<glm::vec2> subpixel;
         std::uint64_t partnered = 0;
         Timer motionTimer;
-        if (motion) {
+        if (motion || reconnect) {
             std::vector<PrimaryHit> hits = primaryHits(*scene, options.scene.camera, width, height);
             if (previousScene) {
                 MotionMap map = motionBetween(*previousScene, previousHits, *scene, hits,
@@ -239,26 +322,44 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
                                  "gdpt: warning: frames %d and %d have different triangle lists; their "
                                  "temporal differences replay paths at the same pixel\n",
                                  frame - 1, frame);
-                firstSampling.streams =
-                    std::make_shared<const std::vector<gpu::PixelStream>>(carriedStreams(map));
+                if (motion)
+                    firstSampling.streams =
+                        std::make_shared<const std::vector<gpu::PixelStream>>(carriedStreams(map));
                 partnered = map.partnered;
                 fromPrevious = std::move(map.partner);
+                subpixel = std::move(map.subpixel);
             }
             previousScene = scene;
             previousHits = std::move(hits);
         }
         const double motionMs = motionTimer.ms();
-        RenderOptions half = options;
-        half.spp = std::max<std::uint32_t>(1, options.spp / 2);
-        half.whileCompiling = nullptr;
-        half.elapsedBefore = 0.0;
         // Timed: what is left of the window's budget (less the last window's solve time),
-        // shared by the frames still to sample; each half takes half of the frame's share.
+        // shared by the frames still to sample.
         const double frameStart = timer.seconds();
         const double share =
             std::max(1e-3, (options.timeBudget - options.elapsedBefore - frameStart -
                             lastSolveSeconds_ * double(window.count) / double(lastSolveFrames_)) /
                                double(window.count - k));
+        if (reconnect) {
+            MotionMap map;
+            map.partner = fromPrevious;
+            map.subpixel = std::move(subpixel);
+            FrameSamples f = sampleReconnected(ctx, options_.sampling, before.get(), *scene, map, options,
+                                               share, window.seed(frame), secondsPerTemporalSample_);
+            if (f.stats.cancelled) {
+                outputs.push_back({{}, f.stats});
+                return outputs;
+            }
+            f.stats.tgpt.motionPartnered = partnered;
+            f.stats.tgpt.motionMs = motionMs;
+            frames.push_back(std::move(f));
+            continue;
+        }
+        RenderOptions half = options;
+        half.spp = std::max<std::uint32_t>(1, options.spp / 2);
+        half.whileCompiling = nullptr;
+        half.elapsedBefore = 0.0;
+        // Timed: each half takes half of the frame's share.
         // The first half replays the frame before's second half: the same number of samples,
         // so that every one of them is paired (timed: whatever that second half reached). A
         // second half gets half the frame's share, in whole samples: the next first half will
@@ -361,8 +462,10 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         append(problem.dx, frames[k].dx);
         append(problem.dy, frames[k].dy);
         if (k > 0) {
-            const Image dt = differenceAlong(frames[k].firstHalfPrimal, frames[k - 1].secondHalfPrimal,
-                                             frames[k].fromPrevious);
+            const Image dt = reconnect
+                                 ? frames[k].dt
+                                 : differenceAlong(frames[k].firstHalfPrimal, frames[k - 1].secondHalfPrimal,
+                                                   frames[k].fromPrevious);
             append(problem.dt, dt);
             if (mixed) {
                 // The change of each spatial difference along the motion, from the paired halves
@@ -372,15 +475,16 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
                 append(problem.dyt, differenceAlong(frames[k].firstHalfDy, frames[k - 1].secondHalfDy,
                                                     frames[k].fromPrevious));
             }
-            if (motion)
+            if (motion || reconnect)
                 problem.temporalPartner.insert(problem.temporalPartner.end(), frames[k].fromPrevious.begin(),
                                                frames[k].fromPrevious.end());
             dtToPrevious[k] = atLaterPixels(dt, frames[k].fromPrevious);
         }
     }
     if (joined) {
-        const Image dt =
-            differenceAlong(frames[0].firstHalfPrimal, carry_->secondHalfPrimal, frames[0].fromPrevious);
+        const Image dt = reconnect ? frames[0].dt
+                                   : differenceAlong(frames[0].firstHalfPrimal, carry_->secondHalfPrimal,
+                                                     frames[0].fromPrevious);
         problem.previous = carry_->recon;
         append(problem.dtPrevious, dt);
         if (mixed && !carry_->secondHalfDx.empty()) {
@@ -390,7 +494,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
             append(problem.dytPrevious,
                    differenceAlong(frames[0].firstHalfDy, carry_->secondHalfDy, frames[0].fromPrevious));
         }
-        if (motion) problem.previousPartner = frames[0].fromPrevious;
+        if (motion || reconnect) problem.previousPartner = frames[0].fromPrevious;
         dtToPrevious[0] = atLaterPixels(dt, frames[0].fromPrevious);
     }
     if (weighted) {
@@ -499,6 +603,10 @@ void TgptIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
                  {"motion_partnered", s.tgpt.motionPartnered},
                  {"motion_ms", s.tgpt.motionMs},
                  {"dt_variance_groups", s.tgpt.dtVarianceGroups},
+                 {"temporal_spp", s.tgpt.temporalSpp},
+                 {"temporal_ms", s.tgpt.temporalMs},
+                 {"temporal_pairs", s.tgpt.temporalPairs},
+                 {"temporal_failures", s.tgpt.temporalFailures},
                  {"alpha", options_.alpha},
                  {"beta", options_.beta},
                  {"gamma", options_.gamma}};

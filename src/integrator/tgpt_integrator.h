@@ -83,6 +83,8 @@ private:
     // The last window's solve, reserved (per frame) from the next window's budget.
     double lastSolveSeconds_ = 0.0;
     int lastSolveFrames_ = 1;
+    // The reconnection shift: seconds per sample of its last pass (0: none yet).
+    double secondsPerTemporalSample_ = 0.0;
 };
 
 }  // namespace gdpt
