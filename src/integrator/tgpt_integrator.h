@@ -20,8 +20,9 @@
 // each pixel's samples from the stream of the pixel of frame f whose primary hit the scene's
 // motion carried there, shifted by the motion's sub-pixel part (motion_map.h), so dt_f(p) =
 // primal(f+1, first half)(π(p)) − primal(f, second half)(p) pairs paths that start on the same
-// surface point; the space-time rows follow π. Replay: π = the same pixel. Not built: the
-// paper's reconnection of the temporal offset path at its first rough vertex (docs/animation.md).
+// surface point; the space-time rows follow π. Replay: π = the same pixel. Reconnect: each frame
+// one G-PT render, and dt along π from the reconnection shift's pass between the two frames
+// (temporal_reconnect.h; no mixed rows, which need the paired halves).
 // Texture demodulation is off (a frame's modulation differs from the next one's where something
 // moves).
 // Layers per frame: final, recon_spacetime_<l1|l2|wl1|wl2>, primal, dx, dy, dt (from the frame

@@ -318,6 +318,45 @@ TEST_F(SequenceCli, TemporalGptRendersWindowsOfFrames) {
     EXPECT_NE(missing.output.find("no such frame"), std::string::npos) << missing.output;
 }
 
+// --temporal-shift reconnect: each frame one render of the frame's samples, dt from the
+// reconnection pass with half as many per direction (joined across the window boundary too),
+// along the same motion map as the motion shift's, with the pass's variance; no mixed rows.
+TEST_F(SequenceCli, TemporalGptWithTheReconnectionShift) {
+    const std::string common = " --frames 0:2 --window 2 --spp 4 --width 16 --height 12 --no-video ";
+    const RunResult r = runGdpt("render " + kMovingBox + " --method tgpt --temporal-shift reconnect" +
+                                common + "-o " + path("c/f_%d.exr") + " --json " + path("c.json"));
+    ASSERT_EQ(r.code, 0) << r.output;
+    const RunResult m =
+        runGdpt("render " + kMovingBox + " --method tgpt" + common + "-o " + path("m/f_%d.exr"));
+    ASSERT_EQ(m.code, 0) << m.output;
+    const nlohmann::json j = readJson(path("c.json"));
+    ASSERT_EQ(j["frame_summaries"].size(), 3u);
+    for (int f = 0; f < 3; ++f) {
+        const nlohmann::json& t = j["frame_summaries"][f]["tgpt"];
+        EXPECT_EQ(t["temporal_shift"], "reconnect") << f;
+        EXPECT_EQ(t["gamma"], 0.0) << f;
+        EXPECT_EQ(j["frame_summaries"][f]["spp"], 4) << f;
+        EXPECT_EQ(t["temporal_spp"], f == 0 ? 0 : 2) << f;
+        EXPECT_EQ(t["temporal_to_previous"], f >= 1) << f;
+        if (f > 0) {
+            EXPECT_GT(t["temporal_pairs"].get<int>(), 16 * 12) << f;
+        }
+        const std::string name = "/f_" + std::to_string(f) + ".exr";
+        const Image motion = readExrLayer(path("c" + name), "motion");
+        const Image motionShift = readExrLayer(path("m" + name), "motion");
+        EXPECT_EQ(motion.plane(0), motionShift.plane(0)) << f;
+        if (f == 0) continue;
+        double varDt = 0.0;
+        const Image var = readExrLayer(path("c" + name), "var_dt");
+        for (float v : var.plane(1)) {
+            EXPECT_GE(v, 0.0f);
+            varDt += v;
+        }
+        EXPECT_GT(varDt, 0.0) << f;
+    }
+    EXPECT_TRUE(j["frame_summaries"][2]["tgpt"]["joined_previous_window"]);
+}
+
 TEST_F(SequenceCli, TemporalGptRefusesWhatItCannotDo) {
     const std::string base = "render " + kMovingBox + " --method tgpt --spp 2 ";
     const struct {
@@ -331,6 +370,8 @@ TEST_F(SequenceCli, TemporalGptRefusesWhatItCannotDo) {
         {"--window 3 -o " + path("x.exr"), "--window requires --frames", 2},
         {"--frames 0:1 --temporal-shift sideways -o " + path("f_%d.exr"), "--temporal-shift", 2},
         {"--frames 0:1 --gamma -1 -o " + path("f_%d.exr"), "--gamma", 2},
+        {"--frames 0:1 --temporal-shift reconnect --gamma 1 -o " + path("f_%d.exr"),
+         "the reconnection shift renders each frame whole", 2},
         {"--frames 0:63 --window 64 --width 4096 --height 4096 -o " + path("f_%d.exr"),
          "needs about 690.0 GiB for its space-time reconstruction", 1},
     };
