@@ -78,25 +78,6 @@ FrameSamples sampleReconnected(const vk::Context& ctx, const GptSamplingOptions&
     RenderResultGpt r = renderGpt(ctx, scene, whole, sampling);
     FrameSamples f;
     f.stats = r.stats;
-    if (r.stats.cancelled || !before) {
-        f.primal = std::move(r.primal);
-        f.dx = std::move(r.dx);
-        f.dy = std::move(r.dy);
-        f.direct = std::move(r.direct);
-        f.varPrimal = std::move(r.varPrimal);
-        f.varDx = std::move(r.varDx);
-        f.varDy = std::move(r.varDy);
-        f.varDirect = std::move(r.varDirect);
-        return f;
-    }
-    TemporalReconnectOptions t;
-    t.spp = std::max<std::uint32_t>(1, r.stats.spp / 2);
-    if (timed && secondsPerSample > 0.0)
-        t.spp = std::max<std::uint32_t>(
-            1, std::uint32_t(std::clamp((share - frameTimer.seconds()) / secondsPerSample, 0.0, 1e6)));
-    t.seed = seed ^ 0x5bd1e995u;
-    const TemporalDifferences d = reconnectDifferences(ctx, *before, scene, map, options.scene, t);
-    secondsPerSample = d.seconds / double(t.spp);
     f.primal = std::move(r.primal);
     f.dx = std::move(r.dx);
     f.dy = std::move(r.dy);
@@ -105,6 +86,15 @@ FrameSamples sampleReconnected(const vk::Context& ctx, const GptSamplingOptions&
     f.varDx = std::move(r.varDx);
     f.varDy = std::move(r.varDy);
     f.varDirect = std::move(r.varDirect);
+    if (r.stats.cancelled || !before) return f;
+    TemporalReconnectOptions t;
+    t.spp = std::max<std::uint32_t>(1, r.stats.spp / 2);
+    if (timed && secondsPerSample > 0.0)
+        t.spp = std::max<std::uint32_t>(
+            1, std::uint32_t(std::clamp((share - frameTimer.seconds()) / secondsPerSample, 0.0, 1e6)));
+    t.seed = seed ^ 0x5bd1e995u;
+    const TemporalDifferences d = reconnectDifferences(ctx, *before, scene, map, options.scene, t);
+    secondsPerSample = d.seconds / double(t.spp);
     f.dt = d.dt;
     f.varDt = d.varDt;
     f.fromPrevious = map.partner;
