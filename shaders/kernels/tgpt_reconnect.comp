@@ -122,9 +122,8 @@ struct SampleResult {
 // offset's frame (selected): the offset's contribution, and the pair ratio in `ratio` (0 where
 // the offset's own sampler would not have taken the point). pBase: the base's density of the
 // point (area measure; a punctual light's selection probability); areaBase: its triangle's area
-// in the base frame; punctual: the light's index.
-vec3 offsetLight(Offset o, LightSample ls, vec3 ul, float pBase, float areaBase, uint punctual, out float ratio,
-                 inout uint rays) {
+// in the base frame.
+vec3 offsetLight(Offset o, LightSample ls, vec3 ul, float pBase, float areaBase, out float ratio, inout uint rays) {
     ratio = 0.0;
     vec3 pLight, Le;
     float pOff;            // the offset frame's density of the carried point
@@ -145,7 +144,7 @@ vec3 offsetLight(Offset o, LightSample ls, vec3 ul, float pBase, float areaBase,
         pOff = lightTriangleSelectProb() * lightTriangle(sh.lightIndex).pmf / sh.area;
         jacobian = sh.area / areaBase;
     } else {
-        PunctualLight l = punctualLight(punctual);
+        PunctualLight l = punctualLight(ls.punctual);
         pLight = l.position;
         float falloff = 1.0;
         if (l.type == kPunctualSpot) {
@@ -292,14 +291,8 @@ SampleResult temporalSample(uint x, uint y, TemporalPartner partner, uint sample
                 // The base's density of its point: area measure, or the punctual light's choice.
                 float pBase = ls.isDelta == 0u ? ls.pdf * abs(dot(ls.nLight, ls.wi)) / (ls.dist * ls.dist) : ls.pdf;
                 float areaBase = ls.isDelta == 0u ? triangleShading(ls.triangle).area : 1.0;
-                float pTri = lightTriangleSelectProb();
-                uint punctual = 0u;
-                if (ls.isDelta != 0u) {
-                    uint n = scene.numPunctualLights;
-                    punctual = min(uint((ul.x - pTri) / (1.0 - pTri) * float(n)), n - 1u);
-                }
                 selectFrame(offFrame);
-                offset = offsetLight(o, ls, ul, pBase, areaBase, punctual, ratio, r.rays);
+                offset = offsetLight(o, ls, ul, pBase, areaBase, ratio, r.rays);
                 selectFrame(baseFrame);
             }
             r.difference += pairWeight(ratio, flags, baseFrame) * (offset - base);

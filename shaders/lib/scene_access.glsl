@@ -144,6 +144,7 @@ struct LightSample {
     vec3 nLight;    // light normal (area lights; zero for punctual)
     uint isDelta;   // 1 for punctual lights (no MIS with BSDF sampling)
     uint triangle;  // emissive triangle index, kInvalidIndex for punctual
+    uint punctual;  // punctual light index, kInvalidIndex for an emissive triangle
 };
 
 // Binary search of the power CDF of the emissive triangles.
@@ -161,6 +162,7 @@ uint pickLightTriangle(float u) {
 bool sampleLight(vec3 p, vec3 u, out LightSample ls) {
     ls.isDelta = 0u;
     ls.triangle = kInvalidIndex;
+    ls.punctual = kInvalidIndex;
     ls.nLight = vec3(0.0);
     float pTri = lightTriangleSelectProb();
     if (kHasLightTris && u.x < pTri) {
@@ -192,6 +194,7 @@ bool sampleLight(vec3 p, vec3 u, out LightSample ls) {
     float uu = (u.x - pTri) / (1.0 - pTri);
     uint idx = min(uint(uu * float(scene.numPunctualLights)), scene.numPunctualLights - 1u);
     PunctualLight l = punctualLight(idx);
+    ls.punctual = idx;
     vec3 d = l.position - p;
     float dist2 = dot(d, d);
     if (!(dist2 > 0.0)) return false;

@@ -5,12 +5,16 @@
 #include "poisson/poisson_spacetime.h"
 #include "render/passes/temporal_reconnect_pass.h"
 #include "util/error.h"
+#include "util/interrupt.h"
 #include "util/timer.h"
 #include "vk/commands.h"
 #include "vk/context.h"
 
 namespace gdpt {
 namespace {
+
+// Camera samples per pixel (each direction) of one submission.
+constexpr std::uint32_t kTemporalBatchSpp = 4;
 
 // The mean and the variance of the mean of each pixel's statistics, as images.
 void toImages(const std::vector<gpu::PixelStats>& stats, int width, int height, Image& mean,
@@ -33,6 +37,7 @@ TemporalDifferences reconnectDifferences(const vk::Context& ctx, const Scene& a,
                                          const MotionMap& map, const SceneGpuOptions& sceneOptions,
                                          const TemporalReconnectOptions& options) {
     Timer timer;
+    enterPhase("temporal reconnection");
     const int width = sceneOptions.width, height = sceneOptions.height;
     const std::size_t pixels = std::size_t(width) * std::size_t(height);
     if (map.partner.size() != pixels)
@@ -56,13 +61,28 @@ TemporalDifferences reconnectDifferences(const vk::Context& ctx, const Scene& a,
     }
     pass.setPartners(partners);
 
-    vk::CommandStream stream(ctx, "temporal reconnection");
-    VkCommandBuffer cmd = stream.begin();
-    pass.record(cmd, 0, options.spp, {options.seed, options.seed + 0x9E3779B9u}, options.flags);
-    stream.submitAndWait();
-
+    // Batches of a few samples per pixel: an interrupt stops the pass between them, and the
+    // 32-bit counters are summed per batch.
     TemporalDifferences out;
-    out.counters = pass.takeCounters();
+    vk::CommandStream stream(ctx, "temporal reconnection");
+    for (std::uint32_t first = 0; first < options.spp; first += kTemporalBatchSpp) {
+        if (interruptRequested()) {
+            out.cancelled = true;
+            return out;
+        }
+        const std::uint32_t spp = std::min(kTemporalBatchSpp, options.spp - first);
+        stream.setWhat("temporal reconnection (samples " + std::to_string(first) + ".." +
+                       std::to_string(first + spp - 1) + ")");
+        pass.record(stream.begin(), first, spp, {options.seed, options.seed + 0x9E3779B9u}, options.flags);
+        stream.submit();
+        stream.waitAll([] {});
+        const gpu::Counters c = pass.takeCounters();
+        out.rays += c.raysTraced;
+        out.pairs += c.shiftPairs;
+        out.failures += c.shiftFailures;
+        out.nanSamples += c.nanSamples;
+    }
+
     Image forward, varForward, reverse, varReverse;
     toImages(pass.differences(0), width, height, forward, varForward);
     toImages(pass.differences(1), width, height, reverse, varReverse);

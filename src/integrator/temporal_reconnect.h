@@ -32,8 +32,11 @@ struct TemporalDifferences {
     // The base paths' mean radiance (the same part of the image) per frame at its own pixels with
     // a partner, and its variance (an independent estimate of each frame, for tests).
     Image baseA, varBaseA, baseB, varBaseB;
-    gpu::Counters counters{};  // both directions' (shiftPairs, shiftFailures: at the first vertex)
-    double seconds = 0.0;      // set-up, sampling and read-back
+    // Both directions': rays, base paths whose camera ray hit a surface (pairs), those of them whose
+    // shift failed at the first vertex, and samples dropped as NaN/Inf (counted as zero).
+    std::uint64_t rays = 0, pairs = 0, failures = 0, nanSamples = 0;
+    double seconds = 0.0;    // set-up, sampling and read-back
+    bool cancelled = false;  // an interrupt stopped the pass (nothing else is set)
 };
 
 // The differences from frame `a` to frame `b` (the same triangles moved) along `map`

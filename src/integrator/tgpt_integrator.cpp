@@ -94,15 +94,20 @@ FrameSamples sampleReconnected(const vk::Context& ctx, const GptSamplingOptions&
             1, std::uint32_t(std::clamp((share - frameTimer.seconds()) / secondsPerSample, 0.0, 1e6)));
     t.seed = seed ^ 0x5bd1e995u;
     const TemporalDifferences d = reconnectDifferences(ctx, *before, scene, map, options.scene, t);
+    if (d.cancelled) {
+        f.stats.cancelled = true;
+        return f;
+    }
     secondsPerSample = d.seconds / double(t.spp);
     f.dt = d.dt;
     f.varDt = d.varDt;
     f.fromPrevious = map.partner;
     f.stats.tgpt.temporalSpp = t.spp;
     f.stats.tgpt.temporalMs = d.seconds * 1e3;
-    f.stats.tgpt.temporalPairs = d.counters.shiftPairs;
-    f.stats.tgpt.temporalFailures = d.counters.shiftFailures;
-    f.stats.raysTraced += d.counters.raysTraced;
+    f.stats.tgpt.temporalPairs = d.pairs;
+    f.stats.tgpt.temporalFailures = d.failures;
+    f.stats.raysTraced += d.rays;
+    f.stats.nanSamples += d.nanSamples;
     return f;
 }
 

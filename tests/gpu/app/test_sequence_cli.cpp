@@ -355,6 +355,18 @@ TEST_F(SequenceCli, TemporalGptWithTheReconnectionShift) {
         EXPECT_GT(varDt, 0.0) << f;
     }
     EXPECT_TRUE(j["frame_summaries"][2]["tgpt"]["joined_previous_window"]);
+
+    // An interrupt during the pass stops the sequence with the frames before it written.
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    const RunResult stopped =
+        runGdpt("render " + kMovingBox +
+                    " --method tgpt --temporal-shift reconnect --frames 0:2 --window 1 --spp 2 " +
+                    "--width 16 --height 12 --no-video -o " + path("f_%d.exr"),
+                "GDPT_TEST_SIGNAL_AT='temporal reconnection'");
+    EXPECT_EQ(stopped.code, 130) << stopped.output;
+    EXPECT_NE(stopped.output.find("continue with --frames 1:2"), std::string::npos) << stopped.output;
+    EXPECT_EQ(files(), (std::vector<std::string>{"f_0.exr", "f_0.png"}));
 }
 
 TEST_F(SequenceCli, TemporalGptRefusesWhatItCannotDo) {

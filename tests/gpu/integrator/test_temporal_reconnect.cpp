@@ -239,7 +239,7 @@ TEST_F(TemporalReconnect, AStillSceneHasAlmostNoDifference) {
                 unpaired += d.varBaseA.plane(c)[p] + d.varBaseB.plane(c)[q];
             }
         }
-        EXPECT_GT(d.counters.shiftPairs, 0u);
+        EXPECT_GT(d.pairs, 0u);
         return dt / unpaired;
     };
     const double still = varianceRatio(animated("moving_box.gltf", 0.0, 0.0));
