@@ -141,7 +141,9 @@ vec3 offsetLight(Offset o, LightSample ls, vec3 ul, float pBase, float areaBase,
         cosLight = abs(cosLight);
         Le = m.emissive;
         if (kHasTextures) Le *= sampleTexture(m.emissiveTex, hitUv(ls.triangle, bary.y, bary.z)).xyz;
-        pOff = lightTriangleSelectProb() * lightTriangle(sh.lightIndex).pmf / sh.area;
+        // (A triangle that is no light in this frame, e.g. of zero area here: no density.)
+        pOff = sh.lightIndex == kInvalidIndex ? 0.0
+                                              : lightTriangleSelectProb() * lightTriangle(sh.lightIndex).pmf / sh.area;
         jacobian = sh.area / areaBase;
     } else {
         PunctualLight l = punctualLight(ls.punctual);
