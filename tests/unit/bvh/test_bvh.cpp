@@ -496,5 +496,45 @@ TEST(BvhTraversal, WatertightThroughSharedEdges) {
     EXPECT_EQ(misses, 0u);
 }
 
+// growBvhBoxes: a tree built over one set of positions and grown to hold the same triangles at
+// other positions (another frame) finds, for rays of either set, exactly the brute-force hits
+// of that set; without growing, the moved set's rays miss hits (the test can fail).
+TEST(BvhBuilder, GrownBoxesHoldBothFrames) {
+    const Mesh a = test::randomSoup(600, 0.15f, 31);
+    Mesh b = a;
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> shift(-0.3f, 0.3f);
+    for (std::size_t t = 0; t < b.triangles.size(); ++t) {
+        const glm::vec3 d(shift(rng), shift(rng), shift(rng));  // each triangle moves by its own amount
+        for (int k = 0; k < 3; ++k) b.positions[b.triangles[t][k]] += d;
+    }
+    const Bvh built = buildBvh(a.positions, a.triangles);
+    Bvh grown = built;
+    growBvhBoxes(grown, b.positions, b.triangles);
+    const auto missed = [](const Bvh& bvh, const Mesh& m) {
+        const auto leafGeoms = makeTriangleGeoms(m.positions, m.triangles, bvh.triangleOrder);
+        const auto origGeoms = makeTriangleGeoms(m.positions, m.triangles, identityOrder(m.triangles.size()));
+        const WideBvh wide = collapseToWide(bvh.nodes);
+        int wrong = 0;
+        for (const Ray& r : makeRays(m, 2000, 5)) {
+            const Hit f = traceClosestBruteForce(origGeoms, r.orig, r.dir, 0.0f, r.tMax);
+            const Hit w = traceClosestWideCpu(wide.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax);
+            const bool anyW = traceAnyWideCpu(wide.nodes, leafGeoms, r.orig, r.dir, 0.0f, r.tMax);
+            const bool same = (w.triangle == gpu::kInvalidIndex) == (f.triangle == gpu::kInvalidIndex) &&
+                              (f.triangle == gpu::kInvalidIndex || w.t == f.t) &&
+                              anyW == (f.triangle != gpu::kInvalidIndex);
+            wrong += same ? 0 : 1;
+        }
+        return wrong;
+    };
+    EXPECT_EQ(grown.triangleOrder, built.triangleOrder);
+    EXPECT_EQ(missed(grown, a), 0);
+    EXPECT_EQ(missed(grown, b), 0);
+    EXPECT_GT(missed(built, b), 20) << "the moved triangles fit the first frame's boxes anyway";
+    Mesh fewer = b;
+    fewer.triangles.pop_back();
+    EXPECT_THROW(growBvhBoxes(grown, fewer.positions, fewer.triangles), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace gdpt
