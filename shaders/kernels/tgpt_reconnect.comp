@@ -13,9 +13,12 @@
 //   - every later vertex is the base's, carried by the animation: the same barycentric point of
 //     the same triangle with the other frame's vertex positions (a miss keeps its direction, the
 //     environment being static), and a light point likewise (a punctual light: the same light);
-//   - the shift fails (no offset beyond) where x1 or y1 has only a Dirac lobe, where the base
-//     sampled a Dirac lobe, and where the offset is not a path the other frame samples: an
-//     occluded segment, a direction under a surface or a one-sided back face.
+//   - where x1 and y1 are both mirrors (Dirac-only), the offset reflects on its own with the
+//     base's numbers and traces its own ray, until both paths reach non-Dirac vertices: the
+//     reconnection is at the first rough vertex, as G-PT's;
+//   - the shift fails (no offset beyond) where one own vertex is a mirror and the other not, where
+//     the base sampled a Dirac lobe elsewhere, and where the offset is not a path the other frame
+//     samples: an occluded segment, a direction under a surface, a one-sided back face.
 // In area measure every carried vertex has the Jacobian |A'(t)| / |A(t)| of its triangle
 // (1 for rigid motion); y1 and x1 share the camera sample (Jacobian 1). Each contribution of the
 // base (strategy s) and its offset are combined by the balance heuristic over the shift's two
@@ -92,6 +95,7 @@ vec3 trianglePoint(uint tri, float u, float v) {
 // base's sampling density, its own strategy weights left out), and ratio = p'·J/p of the prefix.
 struct Offset {
     bool alive;
+    bool own;  // v is the offset's own vertex (its first hit, or one found through a mirror)
     Vertex v;
     vec3 throughput;
     float ratio;
@@ -207,6 +211,7 @@ vec3 offsetStep(inout Offset o, vec3 wi, Hit hit, float baseDensity, float areaB
     }
     vec3 f = bsdfEval(o.v.bsdf, o.v.woLocal, wiLocal);
     Vertex next = makeVertex(makeSurfaceHit(hit.triangle, hit.u, hit.v, wiOff), wiOff);
+    o.own = false;
     // Area measure: the offset frame's cosine over distance² at the carried vertex times the
     // triangle's area ratio, per unit of the base's density.
     float g = abs(dot(next.s.ng, wiOff)) / dist2 * (triangleShading(hit.triangle).area / areaBase) / baseDensity;
@@ -222,6 +227,37 @@ vec3 offsetStep(inout Offset o, vec3 wi, Hit hit, float baseDensity, float areaB
                                  lightTrianglePdf(hit.triangle, from, next.s.p, triangleUnitNormal(hit.triangle)));
     }
     return o.throughput * Le;
+}
+
+// Both own vertices Dirac-only (mirrors): the offset samples its own reflection with the base's
+// numbers and traces its own ray in its frame (selected) to its next own vertex, as G-PT's offsets
+// follow the base through a mirror until both reach rough vertices, where they reconnect. In the
+// camera sample's measure both steps are Dirac: their densities are the lobe choices' (pdfBase,
+// the offset's). Killed where the offset's reflection fails or only one of the two rays leaves the
+// scene (baseMissed: the base's did). Returns the emission it sees there (weight 1 after a Dirac
+// step, as the base's).
+vec3 offsetOwnStep(inout Offset o, vec3 uBsdf, float pdfBase, bool baseMissed, inout uint rays) {
+    BsdfSample os;
+    if (!bsdfSample(o.v.bsdf, o.v.woLocal, uBsdf, os) || os.lobe != kLobeSpecular) {
+        kill(o);
+        return vec3(0.0);
+    }
+    vec3 wi = toWorld(os.wi, o.v.t, o.v.b, o.v.s.ns);
+    if (!(dot(wi, o.v.s.ng) > 0.0)) {
+        kill(o);
+        return vec3(0.0);
+    }
+    o.throughput *= os.weight * (os.pdf / pdfBase);
+    o.ratio *= os.pdf / pdfBase;
+    Hit h = traceClosest(offsetRayOriginScaled(o.v.s.p, o.v.s.ng, scene.sceneRadius), wi, 0.0, 1.0 / 0.0);
+    rays++;
+    if ((h.triangle == kInvalidIndex) != baseMissed) {
+        kill(o);
+        return vec3(0.0);
+    }
+    if (h.triangle == kInvalidIndex) return kHasEnv ? o.throughput * scene.envRadiance : vec3(0.0);
+    o.v = makeVertex(makeSurfaceHit(h.triangle, h.u, h.v, wi), wi);
+    return kHasLightTris ? o.throughput * surfaceEmission(o.v.s) : vec3(0.0);
 }
 
 SampleResult temporalSample(uint x, uint y, TemporalPartner partner, uint sampleIndex) {
@@ -247,11 +283,12 @@ SampleResult temporalSample(uint x, uint y, TemporalPartner partner, uint sample
     Hit offHit = traceClosest(scene.camPosition, offDir, 0.0, 1.0 / 0.0);
     Offset o;
     o.alive = offHit.triangle != kInvalidIndex;
+    o.own = true;
     o.throughput = vec3(1.0);
     o.ratio = 1.0;
     if (o.alive) {
         o.v = makeVertex(makeSurfaceHit(offHit.triangle, offHit.u, offHit.v, offDir), offDir);
-        o.alive = !blackBackFace(o.v.s) && !bsdfIsDeltaOnly(o.v.bsdf);
+        o.alive = !blackBackFace(o.v.s);
     }
 
     selectFrame(baseFrame);
@@ -260,7 +297,7 @@ SampleResult temporalSample(uint x, uint y, TemporalPartner partner, uint sample
     if (hit.triangle == kInvalidIndex) return r;  // the environment seen directly: not shifted
     Vertex v = makeVertex(makeSurfaceHit(hit.triangle, hit.u, hit.v, dir), dir);
     r.paired = true;
-    if (bsdfIsDeltaOnly(v.bsdf)) o.alive = false;
+    if (o.alive && bsdfIsDeltaOnly(v.bsdf) != bsdfIsDeltaOnly(o.v.bsdf)) o.alive = false;
     r.failed = !o.alive;
     if (!o.alive) kill(o);
 
@@ -270,6 +307,8 @@ SampleResult temporalSample(uint x, uint y, TemporalPartner partner, uint sample
     for (uint depth = 0u;; ++depth) {
         if (blackBackFace(v.s)) break;
         if (depth >= scene.maxDepth || depth + 1u >= kMaxDepth) break;
+        // Own vertices pair up only if both are mirrors or neither is.
+        if (o.alive && o.own && bsdfIsDeltaOnly(v.bsdf) != bsdfIsDeltaOnly(o.v.bsdf)) kill(o);
         vec3 origin = offsetRayOriginScaled(v.s.p, v.s.ng, scene.sceneRadius);
 
         // Next-event estimation: the base's light sample, and the same light point carried.
@@ -304,7 +343,8 @@ SampleResult temporalSample(uint x, uint y, TemporalPartner partner, uint sample
         // BSDF sampling continues the base (Russian roulette before the ray, as pt_core.glsl);
         // the offset follows to the carried vertex.
         BsdfSample bs;
-        bool sampled = bsdfSample(v.bsdf, v.woLocal, ldBsdf(lds, depth), bs);
+        vec3 uBsdf = ldBsdf(lds, depth);
+        bool sampled = bsdfSample(v.bsdf, v.woLocal, uBsdf, bs);
         vec3 wi = sampled ? toWorld(bs.wi, v.t, v.b, v.s.ns) : vec3(0.0);
         if (!sampled || !(dot(wi, v.s.ng) > 0.0)) break;
         bool specular = bs.lobe == kLobeSpecular;
@@ -315,7 +355,10 @@ SampleResult temporalSample(uint x, uint y, TemporalPartner partner, uint sample
             beta /= survive;
             o.throughput /= survive;
         }
-        if (specular) kill(o);
+        // Both own vertices Dirac-only: the offset reflects on its own (below); a Dirac lobe sampled
+        // anywhere else ends the shift.
+        bool ownStep = o.alive && o.own && bsdfIsDeltaOnly(v.bsdf);
+        if (specular && !ownStep) kill(o);
         hit = traceClosest(origin, wi, 0.0, 1.0 / 0.0);
         r.rays++;
 
@@ -342,7 +385,8 @@ SampleResult temporalSample(uint x, uint y, TemporalPartner partner, uint sample
         vec3 offset = vec3(0.0);
         if (o.alive) {
             selectFrame(offFrame);
-            offset = offsetStep(o, wi, hit, baseDensity, areaBase, r.rays);
+            offset = ownStep ? offsetOwnStep(o, uBsdf, bs.pdf, hit.triangle == kInvalidIndex, r.rays)
+                             : offsetStep(o, wi, hit, baseDensity, areaBase, r.rays);
             selectFrame(baseFrame);
         }
         if (maxComponent(base) > 0.0 || maxComponent(offset) > 0.0) {
