@@ -16,21 +16,6 @@ namespace {
 // Camera samples per pixel (each direction) of one submission.
 constexpr std::uint32_t kTemporalBatchSpp = 4;
 
-// The mean and the variance of the mean of each pixel's statistics, as images.
-void toImages(const std::vector<gpu::PixelStats>& stats, int width, int height, Image& mean,
-              Image& variance) {
-    mean = Image(width, height);
-    variance = Image(width, height);
-    for (std::size_t i = 0; i < stats.size(); ++i) {
-        const gpu::PixelStats& s = stats[i];
-        const float n = float(s.count);
-        for (int c = 0; c < 3; ++c) {
-            mean.plane(c)[i] = s.mean[c];
-            variance.plane(c)[i] = s.count > 1 ? s.m2[c] / ((n - 1.0f) * n) : 0.0f;
-        }
-    }
-}
-
 }  // namespace
 
 TemporalDifferences reconnectDifferences(const vk::Context& ctx, const Scene& a, const Scene& b,
@@ -46,7 +31,6 @@ TemporalDifferences reconnectDifferences(const vk::Context& ctx, const Scene& a,
     SceneGpuOptions quiet = sceneOptions;
     quiet.quiet = true;
     const SceneGpu pair(ctx, a, b, quiet);
-    TemporalReconnectPass pass(ctx, pair);
 
     // Partners both ways: p of a goes to q of b with the motion's sub-pixel part δ, q back to p
     // with −δ (the inverse toroidal shift).
@@ -59,7 +43,7 @@ TemporalDifferences reconnectDifferences(const vk::Context& ctx, const Scene& a,
         partners[0][p] = {q, d.x, d.y, 0};
         partners[1][q] = {static_cast<std::uint32_t>(p), -d.x, -d.y, 0};
     }
-    pass.setPartners(partners);
+    TemporalReconnectPass pass(ctx, pair, partners);
 
     // Batches of a few samples per pixel: an interrupt stops the pass between them, and the
     // 32-bit counters are summed per batch.
@@ -83,19 +67,21 @@ TemporalDifferences reconnectDifferences(const vk::Context& ctx, const Scene& a,
         out.nanSamples += c.nanSamples;
     }
 
-    Image forward, varForward, reverse, varReverse;
-    toImages(pass.differences(0), width, height, forward, varForward);
-    toImages(pass.differences(1), width, height, reverse, varReverse);
-    toImages(pass.bases(0), width, height, out.baseA, out.varBaseA);
-    toImages(pass.bases(1), width, height, out.baseB, out.varBaseB);
+    std::array<TemporalDirectionImages, 2> images = pass.readback();
+    const TemporalDirectionImages& forward = images[0];
+    const TemporalDirectionImages& reverse = images[1];
+    out.baseA = std::move(images[0].base);
+    out.varBaseA = std::move(images[0].varBase);
+    out.baseB = std::move(images[1].base);
+    out.varBaseB = std::move(images[1].varBase);
     out.dt = Image(width, height);
     out.varDt = Image(width, height);
     for (std::size_t p = 0; p < pixels; ++p) {
         const std::uint32_t q = map.partner[p];
         if (q == kNoTemporalPartner) continue;
         for (int c = 0; c < 3; ++c) {
-            out.dt.plane(c)[p] = forward.plane(c)[p] - reverse.plane(c)[q];
-            out.varDt.plane(c)[p] = varForward.plane(c)[p] + varReverse.plane(c)[q];
+            out.dt.plane(c)[p] = forward.difference.plane(c)[p] - reverse.difference.plane(c)[q];
+            out.varDt.plane(c)[p] = forward.varDifference.plane(c)[p] + reverse.varDifference.plane(c)[q];
         }
     }
     out.seconds = timer.seconds();

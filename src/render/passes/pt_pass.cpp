@@ -128,11 +128,11 @@ void PtPass::uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats)
     emitterSupersampling_.uploadStats(stats[1]);
 }
 
-void PtPass::readback(Image& mean, Image& varianceOfMean) const {
-    const std::size_t pixels = std::size_t{width_} * height_;
-    const auto stats = accum_.read<gpu::PixelStats>(pixels);
-    mean = Image(static_cast<int>(width_), static_cast<int>(height_));
-    varianceOfMean = Image(static_cast<int>(width_), static_cast<int>(height_));
+void statsToImages(const gpu::PixelStats* stats, std::uint32_t width, std::uint32_t height, Image& mean,
+                   Image& varianceOfMean) {
+    const std::size_t pixels = std::size_t{width} * height;
+    mean = Image(static_cast<int>(width), static_cast<int>(height));
+    varianceOfMean = Image(static_cast<int>(width), static_cast<int>(height));
     parallelRanges(0, pixels, std::size_t{1} << 14, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) {
             const auto& s = stats[i];
@@ -144,6 +144,11 @@ void PtPass::readback(Image& mean, Image& varianceOfMean) const {
             }
         }
     });
+}
+
+void PtPass::readback(Image& mean, Image& varianceOfMean) const {
+    const auto stats = accum_.read<gpu::PixelStats>(std::size_t{width_} * height_);
+    statsToImages(stats.data(), width_, height_, mean, varianceOfMean);
     // Independent estimates of two parts of the pixel: their means and variances add.
     emitterSupersampling_.addTo(&mean, &varianceOfMean);
 }

@@ -59,6 +59,11 @@ void recordTiled(VkCommandBuffer cmd, const vk::DeviceInfo& device, std::uint32_
                  std::uint32_t sampleBase, std::uint32_t spp, std::uint64_t maxPixelSamples,
                  const std::function<void(const DispatchTile&)>& dispatch);
 
+// Each pixel's mean and the variance of that mean (the unbiased sample variance over n; 0 below
+// two samples) of `stats` (width·height entries), as images.
+void statsToImages(const gpu::PixelStats* stats, std::uint32_t width, std::uint32_t height, Image& mean,
+                   Image& varianceOfMean);
+
 class PtPass final : public SamplingPass {
 public:
     // emitterSupersampling: rays per camera sample of emitter supersampling

@@ -15,7 +15,9 @@ namespace {
 constexpr std::uint64_t kMaxPixelSamplesPerDispatch = 1u << 18;
 }  // namespace
 
-TemporalReconnectPass::TemporalReconnectPass(const vk::Context& ctx, const SceneGpu& pair, WorkgroupSize wg)
+TemporalReconnectPass::TemporalReconnectPass(const vk::Context& ctx, const SceneGpu& pair,
+                                             const std::array<std::vector<gpu::TemporalPartner>, 2>& partners,
+                                             WorkgroupSize wg)
     : ctx_(ctx),
       width_(pair.spec().width()),
       height_(pair.spec().height()),
@@ -38,13 +40,6 @@ TemporalReconnectPass::TemporalReconnectPass(const vk::Context& ctx, const Scene
     kernel_.bindAddress(gpu::kBindTemporalPartner, partners_);
     kernel_.bindAddress(gpu::kBindTemporalDifference, differences_);
     kernel_.bindAddress(gpu::kBindTemporalBase, bases_);
-    std::vector<gpu::TemporalPartner> none(2ull * width_ * height_,
-                                           gpu::TemporalPartner{gpu::kInvalidIndex, 0, 0, 0});
-    partners_.uploadVector(none);
-    reset();
-}
-
-void TemporalReconnectPass::setPartners(const std::array<std::vector<gpu::TemporalPartner>, 2>& partners) {
     const std::size_t pixels = std::size_t{width_} * height_;
     std::vector<gpu::TemporalPartner> both;
     both.reserve(2 * pixels);
@@ -58,6 +53,7 @@ void TemporalReconnectPass::setPartners(const std::array<std::vector<gpu::Tempor
         both.insert(both.end(), p.begin(), p.end());
     }
     partners_.uploadVector(both);
+    reset();
 }
 
 void TemporalReconnectPass::reset() {
@@ -87,21 +83,17 @@ gpu::Counters TemporalReconnectPass::takeCounters() {
     return c;
 }
 
-namespace {
-// Direction d's entries of a buffer of both directions' statistics.
-std::vector<gpu::PixelStats> directionStats(const vk::Buffer& buffer, std::size_t pixels, int direction) {
-    std::vector<gpu::PixelStats> all = buffer.downloadVector<gpu::PixelStats>(2 * pixels);
-    return {all.begin() + std::ptrdiff_t(direction) * std::ptrdiff_t(pixels),
-            all.begin() + std::ptrdiff_t(direction + 1) * std::ptrdiff_t(pixels)};
-}
-}  // namespace
-
-std::vector<gpu::PixelStats> TemporalReconnectPass::differences(int direction) const {
-    return directionStats(differences_, std::size_t{width_} * height_, direction);
-}
-
-std::vector<gpu::PixelStats> TemporalReconnectPass::bases(int direction) const {
-    return directionStats(bases_, std::size_t{width_} * height_, direction);
+std::array<TemporalDirectionImages, 2> TemporalReconnectPass::readback() const {
+    const std::size_t pixels = std::size_t{width_} * height_;
+    const auto differences = differences_.read<gpu::PixelStats>(2 * pixels);
+    const auto bases = bases_.read<gpu::PixelStats>(2 * pixels);
+    std::array<TemporalDirectionImages, 2> out;
+    for (std::size_t d = 0; d < 2; ++d) {
+        statsToImages(differences.data() + d * pixels, width_, height_, out[d].difference,
+                      out[d].varDifference);
+        statsToImages(bases.data() + d * pixels, width_, height_, out[d].base, out[d].varBase);
+    }
+    return out;
 }
 
 }  // namespace gdpt

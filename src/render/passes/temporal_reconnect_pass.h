@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "gdpt_shared.h"
+#include "image/image.h"
 #include "render/device_scene/scene_gpu.h"
 #include "render/passes/pixel_buffers.h"
 #include "temporal_shared.h"
@@ -24,25 +25,31 @@ class Context;
 class GpuTimer;
 }  // namespace vk
 
+// One direction's statistics as images: per pixel the mean and the variance of the mean of the
+// pair-weighted differences and of the base paths' radiance.
+struct TemporalDirectionImages {
+    Image difference, varDifference, base, varBase;
+};
+
 class TemporalReconnectPass {
 public:
     // `pair`: the two frames (SceneGpu(ctx, a, b, options)); it must outlive the pass.
-    TemporalReconnectPass(const vk::Context& ctx, const SceneGpu& pair, WorkgroupSize wg = {});
+    // `partners`: each pixel's partner in the other frame, per direction (width·height entries
+    // each; pixel kInvalidIndex: no difference at that pixel).
+    TemporalReconnectPass(const vk::Context& ctx, const SceneGpu& pair,
+                          const std::array<std::vector<gpu::TemporalPartner>, 2>& partners,
+                          WorkgroupSize wg = {});
 
-    // Each pixel's partner in the other frame, per direction (width·height entries each;
-    // pixel kInvalidIndex: no difference at that pixel).
-    void setPartners(const std::array<std::vector<gpu::TemporalPartner>, 2>& partners);
     // Clears the statistics and counters.
     void reset();
     // Records `spp` samples per pixel from sample index `sampleBase` in both directions, direction
     // d with seed seeds[d]; `flags`: gpu::kTemporalFlag* (tests).
     void record(VkCommandBuffer cmd, std::uint32_t sampleBase, std::uint32_t spp,
                 std::array<std::uint32_t, 2> seeds, std::uint32_t flags = 0, vk::GpuTimer* timer = nullptr);
-    // After the fence: the counters written since the last call (cleared), and direction d's
-    // statistics of the differences and of the base paths' radiance (width·height each).
+    // After the fence: the counters written since the last call (cleared), and each direction's
+    // statistics.
     gpu::Counters takeCounters();
-    [[nodiscard]] std::vector<gpu::PixelStats> differences(int direction) const;
-    [[nodiscard]] std::vector<gpu::PixelStats> bases(int direction) const;
+    [[nodiscard]] std::array<TemporalDirectionImages, 2> readback() const;
     double waitForPipeline() const { return kernel_.wait(); }
 
 private:
