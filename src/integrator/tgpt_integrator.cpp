@@ -65,7 +65,7 @@ constexpr double kReconnectRenderShare = 0.55;
 // secondsPerSample: what a sample of the pass took last (0: not known yet; the pass then takes
 // half the render's samples); updated.
 FrameSamples sampleReconnected(const vk::Context& ctx, const GptSamplingOptions& sampling,
-                               const Scene* before, const Scene& scene, const MotionMap& map,
+                               const Scene* before, const Scene& scene, MotionMap map,
                                const RenderOptions& options, double share, std::uint32_t seed,
                                double& secondsPerSample) {
     const bool timed = options.timeBudget > 0.0;
@@ -101,7 +101,7 @@ FrameSamples sampleReconnected(const vk::Context& ctx, const GptSamplingOptions&
     secondsPerSample = d.seconds / double(t.spp);
     f.dt = d.dt;
     f.varDt = d.varDt;
-    f.fromPrevious = map.partner;
+    f.fromPrevious = std::move(map.partner);
     f.stats.tgpt.temporalSpp = t.spp;
     f.stats.tgpt.temporalMs = d.seconds * 1e3;
     f.stats.tgpt.temporalPairs = d.pairs;
@@ -303,15 +303,14 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         // The motion shift: where the frame before's pixels moved, and the streams that
         // replay their paths there in this frame's first half.
         GptSamplingOptions firstSampling = options_.sampling;
-        std::vector<std::uint32_t> fromPrevious;
-        std::vector<glm::vec2> subpixel;
-        std::uint64_t partnered = 0;
+        // Empty without a frame before (and for the replay shift): the same pixel.
+        MotionMap map;
         Timer motionTimer;
         if (motion || reconnect) {
             std::vector<PrimaryHit> hits = primaryHits(*scene, options.scene.camera, width, height);
             if (previousScene) {
-                MotionMap map = motionBetween(*previousScene, previousHits, *scene, hits,
-                                              options.scene.camera, width, height);
+                map = motionBetween(*previousScene, previousHits, *scene, hits, options.scene.camera, width,
+                                    height);
                 if (!map.sameTopology && !options.quiet)
                     std::fprintf(stderr,
                                  "gdpt: warning: frames %d and %d have different triangle lists; their "
@@ -320,14 +319,12 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
                 if (motion)
                     firstSampling.streams =
                         std::make_shared<const std::vector<gpu::PixelStream>>(carriedStreams(map));
-                partnered = map.partnered;
-                fromPrevious = std::move(map.partner);
-                subpixel = std::move(map.subpixel);
             }
             previousScene = scene;
             previousHits = std::move(hits);
         }
         const double motionMs = motionTimer.ms();
+        const std::uint64_t partnered = map.partnered;
         // Timed: what is left of the window's budget (less the last window's solve time),
         // shared by the frames still to sample.
         const double frameStart = timer.seconds();
@@ -336,11 +333,8 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
                             lastSolveSeconds_ * double(window.count) / double(lastSolveFrames_)) /
                                double(window.count - k));
         if (reconnect) {
-            MotionMap map;
-            map.partner = fromPrevious;
-            map.subpixel = std::move(subpixel);
-            FrameSamples f = sampleReconnected(ctx, options_.sampling, before.get(), *scene, map, options,
-                                               share, window.seed(frame), secondsPerTemporalSample_);
+            FrameSamples f = sampleReconnected(ctx, options_.sampling, before.get(), *scene, std::move(map),
+                                               options, share, window.seed(frame), secondsPerTemporalSample_);
             if (f.stats.cancelled) {
                 outputs.push_back({{}, f.stats});
                 return outputs;
@@ -384,10 +378,10 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         if (paired) {
             const SampleGroups groups = firstGroups.take();
             dtGroups = int(groups.ends.size());
-            f.varDt = pairedDifferenceVariance(groups, previousGroups, 0, fromPrevious);
+            f.varDt = pairedDifferenceVariance(groups, previousGroups, 0, map.partner);
             if (groupGradients) {
-                f.varDxt = pairedDifferenceVariance(groups, previousGroups, 1, fromPrevious);
-                f.varDyt = pairedDifferenceVariance(groups, previousGroups, 2, fromPrevious);
+                f.varDxt = pairedDifferenceVariance(groups, previousGroups, 1, map.partner);
+                f.varDyt = pairedDifferenceVariance(groups, previousGroups, 2, map.partner);
             }
             previousGroups = {};
         }
@@ -435,7 +429,7 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
         f.stats.tgpt.motionPartnered = partnered;
         f.stats.tgpt.motionMs = motionMs;
         f.stats.tgpt.dtVarianceGroups = dtGroups;
-        f.fromPrevious = std::move(fromPrevious);
+        f.fromPrevious = std::move(map.partner);
         pairedSpp = second.stats.spp;
         frames.push_back(std::move(f));
     }
