@@ -5,7 +5,7 @@
 // dispatch, the structure of pt.comp.
 //
 // Both frames are bound at once (GDPT_TWO_FRAMES: FramePairGpu; selectFrame switches every
-// scene access). The base path x̄ = (x1, x2, ...) is the path tracer's (pt_core.glsl: next-event
+// scene access). The base path x̄ = (x1, x2, ...) is the path tracer's (pt_estimator.glsl: next-event
 // estimation and BSDF sampling at every vertex, power heuristic between them, Russian roulette),
 // with the same random numbers. Its offset ȳ in the other frame:
 //   - y1 is the first hit of the camera ray through p's partner q at the same sub-pixel position
@@ -57,6 +57,7 @@ layout(push_constant, scalar) uniform Push { TemporalParams params; };
 #include "lib/bvh_traverse.glsl"
 #include "lib/camera.glsl"
 #include "lib/sampler.glsl"
+#include "lib/pt_estimator.glsl"
 #include "lib/pixel_stats.glsl"
 
 // A vertex with what shading it needs: the surface, its BSDF and shading basis, and the unit
@@ -222,9 +223,7 @@ vec3 offsetStep(inout Offset o, vec3 wi, Hit hit, float baseDensity, float areaB
     vec3 Le = vec3(0.0);
     if (kHasLightTris) {
         Le = surfaceEmission(next.s);
-        if (maxComponent(Le) > 0.0)
-            Le *= powerHeuristic(1.0, pdf, 1.0,
-                                 lightTrianglePdf(hit.triangle, from, next.s.p, triangleUnitNormal(hit.triangle)));
+        if (maxComponent(Le) > 0.0) Le *= ptEmissionWeight(false, pdf, from, hit.triangle, next.s.p);
     }
     return o.throughput * Le;
 }
@@ -315,17 +314,8 @@ SampleResult temporalSample(uint x, uint y, TemporalPartner partner, uint sample
         vec3 ul = ldLight(lds, depth);
         LightSample ls;
         if (!bsdfIsDeltaOnly(v.bsdf) && sampleLight(v.s.p, ul, ls) && dot(ls.wi, v.s.ng) > 0.0) {
-            vec3 wiLocal = local(v, ls.wi);
-            vec3 f = bsdfEval(v.bsdf, v.woLocal, wiLocal);
             vec3 base = vec3(0.0);
-            if (maxComponent(f) > 0.0) {
-                r.rays++;
-                if (!occludedTowards(origin, ls.pLight)) {
-                    float w = ls.isDelta == 0u ? powerHeuristic(1.0, ls.pdf, 1.0, bsdfPdf(v.bsdf, v.woLocal, wiLocal))
-                                               : 1.0;
-                    base = beta * f * ls.Li * (w / ls.pdf);
-                }
-            }
+            ptAddNee(ls, v.bsdf, v.woLocal, local(v, ls.wi), origin, beta, base, r.rays);
             vec3 offset = vec3(0.0);
             float ratio = 0.0;
             if (o.alive) {
@@ -340,7 +330,7 @@ SampleResult temporalSample(uint x, uint y, TemporalPartner partner, uint sample
             r.base += base;
         }
 
-        // BSDF sampling continues the base (Russian roulette before the ray, as pt_core.glsl);
+        // BSDF sampling continues the base (Russian roulette before the ray, as the path tracer);
         // the offset follows to the carried vertex.
         BsdfSample bs;
         vec3 uBsdf = ldBsdf(lds, depth);
@@ -349,12 +339,9 @@ SampleResult temporalSample(uint x, uint y, TemporalPartner partner, uint sample
         if (!sampled || !(dot(wi, v.s.ng) > 0.0)) break;
         bool specular = bs.lobe == kLobeSpecular;
         beta *= bs.weight;
-        if (depth + 1u >= scene.rrDepth) {
-            float survive = min(maxComponent(beta), 0.95);
-            if (!(ldRoulette(depth, rng) < survive)) break;
-            beta /= survive;
-            o.throughput /= survive;
-        }
+        float q;
+        if (!ptRoulette(depth, beta, rng, q)) break;
+        o.throughput /= q;
         // Both own vertices Dirac-only: the offset reflects on its own (below); a Dirac lobe sampled
         // anywhere else ends the shift.
         bool ownStep = o.alive && o.own && bsdfIsDeltaOnly(v.bsdf);
@@ -374,13 +361,7 @@ SampleResult temporalSample(uint x, uint y, TemporalPartner partner, uint sample
             baseDensity = bs.pdf * abs(dot(next.s.ng, wi)) / dot(d, d);
             areaBase = triangleShading(hit.triangle).area;
             vec3 Le = kHasLightTris ? surfaceEmission(next.s) : vec3(0.0);
-            if (maxComponent(Le) > 0.0) {
-                float w = 1.0;
-                if (!specular)
-                    w = powerHeuristic(1.0, bs.pdf, 1.0,
-                                       lightTrianglePdf(hit.triangle, v.s.p, next.s.p, triangleUnitNormal(hit.triangle)));
-                base = beta * Le * w;
-            }
+            if (maxComponent(Le) > 0.0) base = beta * Le * ptEmissionWeight(specular, bs.pdf, v.s.p, hit.triangle, next.s.p);
         }
         vec3 offset = vec3(0.0);
         if (o.alive) {

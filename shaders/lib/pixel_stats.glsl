@@ -1,5 +1,5 @@
-// pixel_stats.glsl — the per-pixel sample statistics of every estimator kernel (pt.comp,
-// wf_shade.comp, gpt.comp, emitter_supersampling.comp) and their readers (gpt_resolve.comp), in the
+// pixel_stats.glsl — the per-pixel sample statistics of every estimator kernel (pt.comp, gpt.comp,
+// mlt.comp, tgpt_reconnect.comp, emitter_supersampling.comp) and their readers (gpt_resolve.comp), in the
 // GLSL/C++ common subset so the CPU unit tests run this very code.
 //
 // An invocation folds its batch of n samples into a Welford accumulator (Welford 1962: running

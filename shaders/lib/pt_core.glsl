@@ -1,6 +1,6 @@
-// pt_core.glsl — one vertex of the unidirectional path tracer, shared by the megakernel
-// (pt.comp) and the wavefront schedule (wf_shade.comp) so that both compute the same
-// estimator. GLSL only; the including kernel has declared the scene buffers and included
+// pt_core.glsl — one vertex of the unidirectional path tracer, shared by pt.comp and mlt.comp
+// (PSSMLT's paths), built from the rules of pt_estimator.glsl, which tgpt_reconnect.comp's base
+// path uses too. GLSL only; the including kernel has declared the scene buffers and included
 // scene_access.glsl and bvh_traverse.glsl.
 //
 // Estimator (Veach 1997 ch. 9; pbrt-v4 PathIntegrator): at every non-Dirac vertex one light
@@ -16,6 +16,7 @@
 #include "lib/camera.glsl"
 #include "lib/pixel_stats.glsl"
 #include "lib/sampler.glsl"
+#include "lib/pt_estimator.glsl"
 #include "lib/visible_emission.glsl"
 
 // Starts a camera path through the continuous pixel position `pixelPos` of pixel `pixel`,
@@ -66,15 +67,10 @@ void ptProcessHit(inout PathState s, Hit hit) {
     vec3 d = s.dir;
     SurfaceHit sh = makeSurfaceHit(hit.triangle, hit.u, hit.v, d);
     vec3 Le = surfaceEmission(sh);
-    if (kHasLightTris && countEmission && maxComponent(Le) > 0.0) {
-        float w = 1.0;
-        if ((s.flags & kPathFlagPrevSpecular) == 0u) {
-            vec3 nl = triangleUnitNormal(sh.triangle);
-            float lightPdf = lightTrianglePdf(sh.triangle, s.prevP, sh.p, nl);
-            w = powerHeuristic(1.0, s.prevPdf, 1.0, lightPdf);
-        }
-        s.radiance += s.beta * Le * w;
-    }
+    if (kHasLightTris && countEmission && maxComponent(Le) > 0.0)
+        s.radiance +=
+            s.beta * Le *
+            ptEmissionWeight((s.flags & kPathFlagPrevSpecular) != 0u, s.prevPdf, s.prevP, sh.triangle, sh.p);
     Material mat = material(sh.material);
     // One-sided materials: the back face is an opaque black absorber.
     if (!sh.frontFace && (mat.flags & kMatFlagDoubleSided) == 0u) return;
@@ -91,18 +87,8 @@ void ptProcessHit(inout PathState s, Hit hit) {
     vec3 ul = ldLight(lds, s.depth);
     if (!bsdfIsDeltaOnly(bsdf)) {
         LightSample ls;
-        if (sampleLight(sh.p, ul, ls) && dot(ls.wi, sh.ng) > 0.0) {
-            vec3 wiLocal = toLocal(ls.wi, t, b, sh.ns);
-            vec3 f = bsdfEval(bsdf, woLocal, wiLocal);
-            if (maxComponent(f) > 0.0) {
-                s.rays++;
-                if (!occludedTowards(origin, ls.pLight)) {
-                    float w = 1.0;
-                    if (ls.isDelta == 0u) w = powerHeuristic(1.0, ls.pdf, 1.0, bsdfPdf(bsdf, woLocal, wiLocal));
-                    s.radiance += s.beta * f * ls.Li * (w / ls.pdf);
-                }
-            }
-        }
+        if (sampleLight(sh.p, ul, ls) && dot(ls.wi, sh.ng) > 0.0)
+            ptAddNee(ls, bsdf, woLocal, toLocal(ls.wi, t, b, sh.ns), origin, s.beta, s.radiance, s.rays);
     }
 
     // BSDF sampling continues the path.
@@ -117,14 +103,9 @@ void ptProcessHit(inout PathState s, Hit hit) {
         s.prevP = sh.p;
         s.origin = origin;
         s.dir = wi;
+        float q;
+        if (ptRoulette(s.depth, s.beta, rng, q)) s.flags |= kPathFlagAlive;
         s.depth++;
-        bool survive = true;
-        if (s.depth >= scene.rrDepth) {
-            float q = min(maxComponent(s.beta), 0.95);
-            survive = ldRoulette(s.depth - 1u, rng) < q;  // the decision of the bounce just sampled
-            s.beta /= q;
-        }
-        if (survive) s.flags |= kPathFlagAlive;
     }
     s.rng = rng.state;
 }

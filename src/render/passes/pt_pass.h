@@ -96,9 +96,6 @@ public:
     // continue a checkpointed render (two buffers of width*height entries).
     [[nodiscard]] std::vector<std::vector<gpu::PixelStats>> downloadStats() const override;
     void uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats) override;
-    // The statistics and counters, shared with the wavefront schedule.
-    [[nodiscard]] const vk::Buffer& accum() const { return accum_; }
-    [[nodiscard]] const vk::Buffer& counters() const { return counters_; }
     [[nodiscard]] EmitterSupersamplingPass& emitterSupersampling() { return emitterSupersampling_; }
     [[nodiscard]] const EmitterSupersamplingPass& emitterSupersampling() const override {
         return emitterSupersampling_;
