@@ -480,7 +480,8 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->check(CLI::IsMember({"auto", "on", "off"}))
         ->group(gpt);
     r->add_option("--split-bounce", a.splitBounce,
-                  "Split bounce loop (same image): auto = on for lavapipe before Mesa 23, on, off")
+                  "Split bounce loop of the G-PT sample, gpt and gmlt (same image): auto = on for lavapipe "
+                  "before Mesa 23, on, off")
         ->capture_default_str()
         ->check(CLI::IsMember({"auto", "on", "off"}))
         ->group(gpt);

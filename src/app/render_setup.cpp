@@ -92,6 +92,7 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
     g.sampling.splitBounce = args.splitBounce == "on"    ? GptPassOptions::SplitBounce::On
                              : args.splitBounce == "off" ? GptPassOptions::SplitBounce::Off
                                                          : GptPassOptions::SplitBounce::Auto;
+    m.mlt.splitBounce = g.sampling.splitBounce;
     g.sampling.edgeSamples = parseEdgeSamples(args.edgeSamples, "--edge-samples");
     g.sampling.demodulate = parseDemodulation(args.demodulate);
     g.reconstructions = {parseReconstruction(args.recon)};

@@ -126,6 +126,8 @@ struct MltOptions {
     float targetAlpha = 0.25f;            // gmlt: weight of the radiance in the target (mlt.glsl gmltTarget)
     std::uint32_t bootstrapPerPixel = 1;  // bootstrap samples per pixel (at least 16 per chain)
     std::uint32_t directSamples = 16;     // camera samples per pixel of the very-direct image
+    // gmlt: the split bounce loop of G-PT's sample (the same values; MltPassOptions::splitBounce).
+    GptPassOptions::SplitBounce splitBounce = GptPassOptions::SplitBounce::Auto;
     // gmlt: the reconstructions (L1, L2; the variance-weighted ones need per-pixel variances,
     // which a chain's correlated samples do not give), the first gives the final image.
     std::vector<Reconstruction> reconstructions = {Reconstruction::L1};

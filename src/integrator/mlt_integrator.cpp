@@ -78,6 +78,7 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     po.stepsPerBatch = kStepsPerBatch;
     po.largeStep = options_.largeStep;
     po.targetAlpha = options_.targetAlpha;
+    po.splitBounce = options_.splitBounce;
     SceneSpec spec(scene, options.scene);
     MltPass pass(ctx, spec, options.workgroup, po, vk::PipelineCreation::Background);
     SceneGpu sceneGpu(ctx, scene, options.scene, std::move(spec));
@@ -86,6 +87,7 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     stats.sceneDeviceBytes = sceneGpu.deviceBytes();
     stats.bvhRegisterStack = sceneGpu.spec().bvhRegisterStack();
     stats.bvhUnitSteps = sceneGpu.spec().bvhUnitSteps(ctx.info());
+    stats.gptSplitBounce = pass.splitBounceCompiled();
     stats.lightShares = sceneGpu.lightShares();
     stats.lightProbed = sceneGpu.lightProbed();
     stats.features = sceneGpu.features();
@@ -266,7 +268,10 @@ void MltIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
                 {"normalisation_stderr", m.normalisationStdErr},
                 {"normalisation_samples", m.normalisationSamples},
                 {"splat_s", m.splatMs * 1e-3}};
-    if (gradients()) j["mlt"]["target_alpha"] = options_.targetAlpha;
+    if (gradients()) {
+        j["mlt"]["target_alpha"] = options_.targetAlpha;
+        j["mlt"]["split_bounce"] = s.gptSplitBounce;
+    }
     j["reconstructions"] = reconstructionsJson(s);
 }
 

@@ -190,7 +190,7 @@ struct RenderStats {
     std::uint64_t nanSamples = 0;
     std::uint64_t shiftPairs = 0;                 // G-PT: shifts attempted (offsets in the image, base hit)
     std::uint64_t shiftFailures = 0;              // G-PT: shifts that failed (pair fell back to the base)
-    bool gptSplitBounce = false;                  // G-PT: the kernel ran the split bounce loop
+    bool gptSplitBounce = false;                  // G-PT, gmlt: the kernel ran the split bounce loop
     bool gptOcclusionBeams = false;               // G-PT: ... and traced the offsets' rays as beams
     std::uint32_t emitterSupersampling = 0;       // emitter supersampling factor (0 = off)
     std::uint32_t emitterRaysPerSample = 0;       // rays per camera sample it took (after its ray budget)

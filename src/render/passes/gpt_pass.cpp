@@ -27,11 +27,6 @@ const char* const kStatNames[kNumStats] = {
     "gpt central",        "gpt neighbor right", "gpt neighbor down", "gpt neighbor left", "gpt neighbor up",
     "gpt gradient right", "gpt gradient down",  "gpt gradient left", "gpt gradient up",   "gpt direct"};
 
-bool splitBounceFor(const vk::DeviceInfo& device, GptPassOptions::SplitBounce s) {
-    if (s == GptPassOptions::SplitBounce::Auto) return splitBounceDefault(device);
-    return s == GptPassOptions::SplitBounce::On;
-}
-
 vk::KernelDesc gptDesc(const SceneSpec& scene, const vk::DeviceInfo& device, WorkgroupSize wg,
                        bool halfVector, bool splitBounce, bool demodulate,
                        const EmitterSupersamplingPass& visible) {
@@ -99,6 +94,11 @@ bool gptNeedsHalfVector(const SceneSpec& scene) {
 
 bool splitBounceDefault(const vk::DeviceInfo& device) {
     return device.lavapipeBeforeMesa23;
+}
+
+bool splitBounceFor(const vk::DeviceInfo& device, GptPassOptions::SplitBounce s) {
+    if (s == GptPassOptions::SplitBounce::Auto) return splitBounceDefault(device);
+    return s == GptPassOptions::SplitBounce::On;
 }
 
 bool demodulationApplies(const Scene& scene) {

@@ -80,6 +80,8 @@ bool gptNeedsHalfVector(const SceneSpec& scene);
 // as on Mesa 25's lavapipe, where the split measured no faster and only costs pipeline
 // creation time (bench/RESULTS.md, split bounce loop).
 bool splitBounceDefault(const vk::DeviceInfo& device);
+// The choice `s` on `device` (Auto: splitBounceDefault).
+bool splitBounceFor(const vk::DeviceInfo& device, GptPassOptions::SplitBounce s);
 
 // The resolved images (see gpt_resolve.comp for the estimators). With demodulation, primal,
 // dx, dy and their variances are of J = I / m̄, `modulation` is m̄ (the final image is

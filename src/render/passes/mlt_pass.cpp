@@ -4,8 +4,9 @@
 #include <string>
 
 #include "mlt.spv.h"
+#include "mlt_split.spv.h"
+#include "mlt_split_units.spv.h"
 #include "mlt_units.spv.h"
-#include "render/passes/gpt_pass.h"
 #include "util/error.h"
 #include "vk/commands.h"
 #include "vk/context.h"
@@ -16,12 +17,13 @@ namespace {
 constexpr std::uint32_t kItemsPerRow = 256;
 
 vk::KernelDesc mltDesc(const SceneSpec& scene, const vk::DeviceInfo& device, WorkgroupSize wg,
-                       bool baseOnly) {
+                       bool baseOnly, bool splitBounce) {
     const std::vector<std::uint32_t> extra = {
         gpu::kBindCounters,     gpu::kBindMltChains, gpu::kBindMltPss,   gpu::kBindMltRecords,
         gpu::kBindMltBootstrap, gpu::kBindMltStarts, gpu::kBindMltDirect};
-    vk::KernelDesc d =
-        scene.kernelDesc(GDPT_TRACING_KERNEL("mlt", mlt), device, wg, extra, sizeof(gpu::MltParams));
+    vk::KernelDesc d = scene.kernelDesc(
+        splitBounce ? GDPT_TRACING_KERNEL("mlt", mlt_split) : GDPT_TRACING_KERNEL("mlt", mlt), device, wg, extra,
+        sizeof(gpu::MltParams));
     for (auto& [id, value] : d.specConstants)
         if (id == gpu::kSpecHasGlossy) value = gptNeedsHalfVector(scene) ? 1u : 0u;
     d.specConstants.push_back({gpu::kSpecMltBaseOnly, baseOnly ? 1u : 0u});
@@ -47,7 +49,8 @@ MltPass::MltPass(const vk::Context& ctx, const SceneSpec& spec, WorkgroupSize wg
       starts_(ctx, std::uint64_t{options.chains} * sizeof(std::uint32_t), "mlt chain starts"),
       direct_(ctx, std::uint64_t{width_} * height_ * 4 * sizeof(float), "mlt direct"),
       bootstrap_(ctx, 0, "mlt bootstrap"),
-      kernel_(ctx, mltDesc(spec, ctx.info(), wg, options.baseOnly), creation) {
+      splitBounce_(!options.baseOnly && splitBounceFor(ctx.info(), options.splitBounce)),
+      kernel_(ctx, mltDesc(spec, ctx.info(), wg, options.baseOnly, splitBounce_), creation) {
     GDPT_CHECK(options.chains > 0 && options.stepsPerBatch > 0);
     kernel_.bind(gpu::kBindCounters, counters_);
     kernel_.bind(gpu::kBindMltChains, chains_);

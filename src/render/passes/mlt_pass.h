@@ -9,6 +9,7 @@
 #include "image/image.h"
 #include "mlt_shared.h"
 #include "render/device_scene/scene_gpu.h"
+#include "render/passes/gpt_pass.h"
 #include "vk/buffer.h"
 #include "vk/kernel.h"
 
@@ -26,6 +27,9 @@ struct MltPassOptions {
     std::uint32_t stepsPerBatch = 8;  // mutation steps a batch records (records buffer size)
     float largeStep = 0.5f;           // probability of a large step
     float targetAlpha = 0.25f;        // G-MLT: weight of the primal term of the target
+    // G-MLT: the sample's split bounce loop (mlt.comp's mlt_split build, as gpt_split; the same
+    // values either way). PSSMLT traces the path tracer's path and has no such loop.
+    GptPassOptions::SplitBounce splitBounce = GptPassOptions::SplitBounce::Auto;
 };
 
 // Counters of the chains (summed over chains, from their MltChain).
@@ -65,6 +69,8 @@ public:
     // Reads the counters written since the last call and clears them (after the fence).
     gpu::Counters takeCounters();
     [[nodiscard]] const MltPassOptions& options() const { return options_; }
+    // Whether the kernel is the split bounce loop build (mlt_split; G-MLT only).
+    [[nodiscard]] bool splitBounceCompiled() const { return splitBounce_; }
 
 private:
     [[nodiscard]] gpu::MltParams params(std::uint32_t phase, std::uint32_t count, std::uint32_t seed) const;
@@ -78,6 +84,7 @@ private:
     vk::Buffer counters_, chains_, pss_, records_, starts_, direct_;
     vk::Buffer bootstrap_;
     std::vector<gpu::MltRecord> host_;
+    bool splitBounce_;
     vk::Kernel kernel_;
 };
 

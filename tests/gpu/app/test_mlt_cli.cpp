@@ -25,7 +25,8 @@ class MltCli : public test::TempDirTest {};
 TEST_F(MltCli, JsonReportsChainsAcceptanceAndNormalisation) {
     for (const std::string method : {"pssmlt", "gmlt"}) {
         const RunResult r = runGdpt("render " + kScene + " --method " + method +
-                                    " --width 24 --height 16 --spp 8 --chains 512 --large-step 0.25 -o " +
+                                    " --width 24 --height 16 --spp 8 --chains 512 --large-step 0.25 "
+                                    "--split-bounce on -o " +
                                     path(method + ".exr") + " --json " + path(method + ".json"));
         ASSERT_EQ(r.code, 0) << r.output;
         EXPECT_NE(r.output.find("512 chains, acceptance"), std::string::npos) << r.output;
@@ -52,6 +53,11 @@ TEST_F(MltCli, JsonReportsChainsAcceptanceAndNormalisation) {
         EXPECT_GE(m["splat_s"].get<double>(), 0.0);
         EXPECT_LT(m["splat_s"].get<double>(), j["time_s"]["sampling"].get<double>());
         EXPECT_EQ(j["reconstructions"].size(), method == "gmlt" ? 1u : 0u);
+        // --split-bounce reaches gmlt's kernel (G-PT's sample); pssmlt traces the path tracer's.
+        if (method == "gmlt")
+            EXPECT_TRUE(m.at("split_bounce").get<bool>());
+        else
+            EXPECT_FALSE(m.contains("split_bounce"));
     }
 }
 
