@@ -16,14 +16,14 @@ namespace {
 // Chains (or samples) per row of a dispatch: mlt.comp numbers its items row by row.
 constexpr std::uint32_t kItemsPerRow = 256;
 
-vk::KernelDesc mltDesc(const SceneSpec& scene, const vk::DeviceInfo& device, WorkgroupSize wg,
-                       bool baseOnly, bool splitBounce) {
+vk::KernelDesc mltDesc(const SceneSpec& scene, const vk::DeviceInfo& device, WorkgroupSize wg, bool baseOnly,
+                       bool splitBounce) {
     const std::vector<std::uint32_t> extra = {
         gpu::kBindCounters,     gpu::kBindMltChains, gpu::kBindMltPss,   gpu::kBindMltRecords,
         gpu::kBindMltBootstrap, gpu::kBindMltStarts, gpu::kBindMltDirect};
     vk::KernelDesc d = scene.kernelDesc(
-        splitBounce ? GDPT_TRACING_KERNEL("mlt", mlt_split) : GDPT_TRACING_KERNEL("mlt", mlt), device, wg, extra,
-        sizeof(gpu::MltParams));
+        splitBounce ? GDPT_TRACING_KERNEL("mlt", mlt_split) : GDPT_TRACING_KERNEL("mlt", mlt), device, wg,
+        extra, sizeof(gpu::MltParams));
     for (auto& [id, value] : d.specConstants)
         if (id == gpu::kSpecHasGlossy) value = gptNeedsHalfVector(scene) ? 1u : 0u;
     d.specConstants.push_back({gpu::kSpecMltBaseOnly, baseOnly ? 1u : 0u});
