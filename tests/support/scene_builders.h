@@ -4,8 +4,10 @@
 
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <string>
 
 #include "gdpt_shared.h"
+#include "scene/gltf_loader.h"
 #include "scene/procedural.h"
 #include "scene/scene.h"
 
@@ -67,6 +69,18 @@ inline Scene cornellBoxWithHiddenEmitter(std::uint32_t& hidden) {
     hidden = addEmitterQuad(s, {-0.5f, 0.5f, -1.5f}, {0.5f, 0.5f, -1.5f}, {0.5f, 1.5f, -1.5f},
                             {-0.5f, 1.5f, -1.5f}, glm::vec3(50.0f));
     return s;
+}
+
+// scenes/glossy_cornell.gltf (rough metal box, mirror sphere, area light) with a point light
+// beside the area light: the G-PT and MLT tests' glossy scene with both kinds of light.
+inline Scene glossyCornellWithPointLight() {
+    Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/glossy_cornell.gltf");
+    gpu::PunctualLight light{};
+    light.position = glm::vec3(0.3f, 1.5f, 0.2f);
+    light.type = gpu::kPunctualPoint;
+    light.intensity = glm::vec3(2.0f, 1.5f, 1.0f);
+    scene.punctualLights.push_back(light);
+    return scene;
 }
 
 }  // namespace gdpt::test

@@ -32,6 +32,7 @@
 #include "integrator/render_options.h"
 #include "scene/gltf_loader.h"
 #include "scene/procedural.h"
+#include "scene_builders.h"
 #include "stats_normal.h"
 
 namespace gdpt {
@@ -250,12 +251,7 @@ TEST_F(GptRender, MirrorCoatedDiffuseMatchesPathTracer) {
 // the offset vertex), environment/surface mismatch failures, and NEE to a punctual light
 // (same light point, J = 1, no BSDF strategy).
 TEST_F(GptRender, EnvironmentAndPointLightMatchPathTracer) {
-    Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/glossy_cornell.gltf");
-    gpu::PunctualLight light{};
-    light.position = glm::vec3(0.3f, 1.5f, 0.2f);
-    light.type = gpu::kPunctualPoint;
-    light.intensity = glm::vec3(2.0f, 1.5f, 1.0f);
-    scene.punctualLights.push_back(light);
+    Scene scene = test::glossyCornellWithPointLight();
     RenderOptions o = renderOptions(24, 24, 256, 107);
     o.scene.envRadiance = glm::vec3(0.4f, 0.5f, 0.6f);
     const RenderResultGpt g = renderGpt(ctx(), scene, o);
@@ -287,17 +283,12 @@ TEST_F(GptRender, DirectlySeenEmitterHasExactlyZeroGradients) {
 // environment and a point light, and where they reconnect (the diffuse walls). Two scenes,
 // because every render compiles its own pipeline (seconds each on a cold shader cache).
 TEST_F(GptRender, SplitBounceLoopGivesTheSameBitsAsTheSingleLoop) {
-    Scene glossy = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/glossy_cornell.gltf");
+    Scene glossy = test::glossyCornellWithPointLight();
     Scene coated = makeCornellBox();
     coated.materials[0].specular = 1.0f;
     coated.materials[0].roughness = 0.0f;
     coated.materials[0].ior = 1.5f;
     coated.materials[0].specularColor = glm::vec3(1.0f);
-    gpu::PunctualLight light{};
-    light.position = glm::vec3(0.3f, 1.5f, 0.2f);
-    light.type = gpu::kPunctualPoint;
-    light.intensity = glm::vec3(2.0f, 1.5f, 1.0f);
-    glossy.punctualLights.push_back(light);
     struct Case {
         const char* name;
         const Scene* scene;

@@ -20,6 +20,7 @@
 #include "integrator/integrator.h"
 #include "integrator/mlt_integrator.h"
 #include "scene/gltf_loader.h"
+#include "scene_builders.h"
 #include "stats_normal.h"
 
 namespace gdpt {
@@ -119,12 +120,7 @@ TEST_F(MltRender, CornellBoxQuadrantsMatchThePathTracer) {
 // threshold raised (offsets keep their own vertices through the rough metal too), an environment
 // and a point light.
 TEST_F(MltRender, SplitBounceLoopGivesTheSameBitsAsTheSingleLoop) {
-    Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/glossy_cornell.gltf");
-    gpu::PunctualLight light{};
-    light.position = glm::vec3(0.3f, 1.5f, 0.2f);
-    light.type = gpu::kPunctualPoint;
-    light.intensity = glm::vec3(2.0f, 1.5f, 1.0f);
-    scene.punctualLights.push_back(light);
+    Scene scene = test::glossyCornellWithPointLight();
     RenderOptions o = renderOptions(20, 16, 6, 11);
     o.scene.shiftThreshold = 0.5f;
     o.scene.envRadiance = glm::vec3(0.4f, 0.5f, 0.6f);
