@@ -39,7 +39,7 @@ struct RenderArgs {
     std::string edgeSamples = "auto";  // G-PT: "auto" or 0-64 (render/passes/edge_options.h)
     std::string demodulate = "auto";   // G-PT: auto, on, off (Demodulation, render/passes/gpt_pass.h)
     std::string recon = "auto";        // the final image's reconstruction; auto: resolvedRecon
-    double alpha = 0.2;
+    double alpha = -1.0;               // < 0: the method's own (GptOptions, MltOptions, TgptOptions::alpha)
     double tolerance = 1e-4;
     int debiasCells = kDefaultDebiasCells;  // poisson/debias.h
     std::string solver = "auto";            // the reconstructions' linear solver (parseSolverChoice)

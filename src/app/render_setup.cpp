@@ -99,7 +99,7 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
     if (args.allRecon)
         for (const char* other : {"l1", "l2", "wl2", "wl1"})
             if (args.recon != other) g.reconstructions.push_back(parseReconstruction(other));
-    g.alpha = args.alpha;
+    if (args.alpha >= 0.0) g.alpha = args.alpha;
     g.tolerance = args.tolerance;
     g.debiasCells = args.debiasCells;
     g.solver = parseSolverChoice(args.solver);
@@ -110,7 +110,7 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
     mlt.reconstructions = {parseReconstruction(args.recon)};
     if (args.allRecon && args.recon != "l2") mlt.reconstructions.push_back(Reconstruction::L2);
     if (args.allRecon && args.recon != "l1") mlt.reconstructions.push_back(Reconstruction::L1);
-    mlt.alpha = args.alpha;
+    if (args.alpha >= 0.0) mlt.alpha = args.alpha;
     mlt.tolerance = args.tolerance;
     mlt.solver = parseSolverChoice(args.solver);
     TgptOptions& t = m.tgpt;
@@ -118,7 +118,7 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
     t.window = args.window;
     t.l1 = args.recon == "l1" || args.recon == "wl1";
     t.weighted = args.recon == "wl1" || args.recon == "wl2";
-    t.alpha = args.alpha;
+    if (args.alpha >= 0.0) t.alpha = args.alpha;
     t.beta = args.beta;
     t.shift = parseTemporalShift(args.temporalShift);
     t.gamma = args.gamma >= 0.0 ? args.gamma : t.shift == TemporalShift::Reconnect ? 0.0 : 1.0;
@@ -273,7 +273,7 @@ void checkArgs(const RenderArgs& args) {
                 "--method tgpt does not demodulate (a frame's texture modulation differs from the next one's "
                 "where something moves)");
     }
-    if ((args.method == "gpt" || args.method == "gmlt" || args.method == "tgpt") && l1 && !(args.alpha > 0.0))
+    if ((args.method == "gpt" || args.method == "gmlt" || args.method == "tgpt") && l1 && args.alpha == 0.0)
         throw UsageError("--alpha " + std::to_string(args.alpha) +
                          ": the L1 reconstructions (--recon l1 or wl1, or --all-recon) need --alpha > 0 (the "
                          "primal term anchors each reweighted solve); use --recon l2 for alpha 0");

@@ -131,7 +131,11 @@ struct MltOptions {
     // gmlt: the reconstructions (L1, L2; the variance-weighted ones need per-pixel variances,
     // which a chain's correlated samples do not give), the first gives the final image.
     std::vector<Reconstruction> reconstructions = {Reconstruction::L1};
-    double alpha = 0.2;               // weight of the primal term of the screened Poisson energy
+    // Weight of the primal term of the screened Poisson energy. Lower than G-PT's 0.2: the chains'
+    // splatted primal is blotchy where its gradients are not; on the door scene at 256² 0.05
+    // gave 10-24 % lower relMSE at 16 s and 7-9 % at 64 s than 0.2, on the Cornell box 1-5 %
+    // higher at 16 s (bench/RESULTS.md, "G-MLT's primal weight").
+    double alpha = 0.05;
     double tolerance = 1e-4;          // relative residual at which each solve stops
     std::optional<GpuSolver> solver;  // as GptOptions::solver
 };

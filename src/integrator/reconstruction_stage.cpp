@@ -88,6 +88,7 @@ std::vector<NamedLayer> ReconstructionStage::run(const PoissonInput& input, cons
             report.converged,    report.ms};
         rs.stoppedAtDeadline = report.stoppedAtDeadline;
         rs.solver = toString(so.solver);
+        rs.alpha = so.alpha;
         std::string debiased;
         if (debiases(so.method, debiasCells_)) {
             // The coarse scales from the primal (poisson/debias.h): a few ms on the host.
@@ -135,6 +136,7 @@ nlohmann::json reconstructionsJson(const RenderStats& s) {
                           {"irls_iterations", r.irlsIterations},
                           {"residual", r.residual},
                           {"tolerance", r.tolerance},
+                          {"alpha", r.alpha},
                           {"converged", r.converged},
                           {"debias_scale_px", r.debiasScale},
                           {"debias_mean_change", r.debiasMeanChange},

@@ -115,6 +115,7 @@ struct ReconstructionStats {
     double debiasMs = 0.0;           // of ms: the debiasing (host)
     bool stoppedAtDeadline = false;  // IRLS rounds left out to end within a timed render's budget
     std::string solver;              // the linear solver: "mg-pcg", "host-pcg", ... (poisson_gpu.h)
+    double alpha = 0.0;              // the primal term's weight
 };
 
 // A render split across processes (sample_share.h): how its parts were merged.

@@ -54,10 +54,13 @@ TEST_F(MltCli, JsonReportsChainsAcceptanceAndNormalisation) {
         EXPECT_LT(m["splat_s"].get<double>(), j["time_s"]["sampling"].get<double>());
         EXPECT_EQ(j["reconstructions"].size(), method == "gmlt" ? 1u : 0u);
         // --split-bounce reaches gmlt's kernel (G-PT's sample); pssmlt traces the path tracer's.
-        if (method == "gmlt")
+        // gmlt's primal weight is its own default (0.05, not G-PT's 0.2).
+        if (method == "gmlt") {
             EXPECT_TRUE(m.at("split_bounce").get<bool>());
-        else
+            EXPECT_DOUBLE_EQ(j["reconstructions"][0].at("alpha").get<double>(), 0.05);
+        } else {
             EXPECT_FALSE(m.contains("split_bounce"));
+        }
     }
 }
 

@@ -58,6 +58,7 @@ TEST_F(ReconReportCli, RenderReportsAReconstructionThatDidNotConverge) {
     ASSERT_TRUE(normal.is_array() && normal.size() == 1u) << normal.dump();
     EXPECT_TRUE(normal[0]["converged"].get<bool>()) << normal.dump();
     EXPECT_EQ(normal[0]["method"].get<std::string>(), "wl1");  // G-PT's default (--recon auto)
+    EXPECT_DOUBLE_EQ(normal[0]["alpha"].get<double>(), 0.2);   // G-PT's default primal weight
     // auto: host-pcg on a CPU device, mg-pcg on a GPU.
     const std::string solver = normal[0]["solver"].get<std::string>();
     EXPECT_TRUE(solver == "host-pcg" || solver == "mg-pcg") << solver;
