@@ -49,7 +49,7 @@ struct RenderArgs {
     std::string resume;            // continue from this checkpoint
     std::string shard;          // "I/N": render part I of N and write its statistics (distributed/shards.h)
     std::uint32_t chains = 0;   // pssmlt, gmlt: Markov chains (0 = per image size)
-    float largeStep = 0.5f;     // pssmlt, gmlt: probability of a large step
+    float largeStep = -1.0f;    // pssmlt, gmlt: probability of a large step (< 0: the method's own)
     float targetAlpha = 0.25f;  // gmlt: weight of the radiance in the target
     std::string frames;         // "A:B": render frames A..B of an animation (sequence_command.cpp)
     double fps = 24.0;          // frames per second: frame k is the scene at time k / fps

@@ -492,8 +492,8 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(0u, 65536u))
         ->group(mlt);
-    r->add_option("--large-step", a.largeStep, "Probability of a large step (a fresh path) per mutation")
-        ->capture_default_str()
+    r->add_option("--large-step", a.largeStep,
+                  "Probability of a large step (a fresh path) per mutation (default: pssmlt 0.5, gmlt 0.7)")
         ->check(CLI::Range(0.0f, 1.0f))
         ->group(mlt);
     r->add_option("--target-alpha", a.targetAlpha,

@@ -120,9 +120,17 @@ struct GptOptions {
 };
 
 // The settings of Metropolis light transport (pssmlt, gmlt; mlt_integrator.h).
+// The methods' large-step probabilities (MltOptions::largeStep). gmlt's is higher: with the
+// large steps' MIS its chains gained from more fresh samples on the door scene and the Cornell
+// box (bench/RESULTS.md, "G-MLT's large-step probability").
+inline constexpr float kPssmltLargeStep = 0.5f;
+inline constexpr float kGmltLargeStep = 0.7f;
+
 struct MltOptions {
-    std::uint32_t chains = 0;             // Markov chains at once; 0 = per image size (defaultMltChains)
-    float largeStep = 0.5f;               // probability of a large step (a fresh state) per mutation
+    std::uint32_t chains = 0;  // Markov chains at once; 0 = per image size (defaultMltChains)
+    // Probability of a large step (a fresh state) per mutation; < 0: the method's own
+    // (kPssmltLargeStep, kGmltLargeStep).
+    float largeStep = -1.0f;
     float targetAlpha = 0.25f;            // gmlt: weight of the radiance in the target (mlt.glsl gmltTarget)
     std::uint32_t bootstrapPerPixel = 1;  // bootstrap samples per pixel (at least 16 per chain)
     std::uint32_t directSamples = 16;     // camera samples per pixel of the very-direct image

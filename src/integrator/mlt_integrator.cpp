@@ -26,6 +26,11 @@ constexpr std::uint32_t kStepsPerBatch = 8;
 constexpr std::uint32_t kBootstrapPerDispatch = 1u << 16;
 // Bootstrap samples per chain at least, so that the starts are drawn from many more states.
 constexpr std::uint32_t kBootstrapPerChain = 16;
+// The options with the method's own defaults where they are left to it.
+MltOptions withMethodDefaults(const std::string& method, MltOptions o) {
+    if (o.largeStep < 0.0f) o.largeStep = method == "gmlt" ? kGmltLargeStep : kPssmltLargeStep;
+    return o;
+}
 }  // namespace
 
 std::uint32_t defaultMltChains(int width, int height) {
@@ -35,7 +40,7 @@ std::uint32_t defaultMltChains(int width, int height) {
 
 MltIntegrator::MltIntegrator(std::string name, MltOptions options)
     : name_(std::move(name)),
-      options_(std::move(options)),
+      options_(withMethodDefaults(name_, std::move(options))),
       // pssmlt has no gradients to reconstruct: its image is the splatted primal.
       stage_(name_ == "gmlt" ? options_.reconstructions : std::vector<Reconstruction>{}, options_.alpha,
              options_.tolerance, 0, options_.solver) {}

@@ -64,6 +64,24 @@ TEST_F(MltCli, JsonReportsChainsAcceptanceAndNormalisation) {
     }
 }
 
+// Left unset, --large-step and --alpha are each method's own: pssmlt 0.5; gmlt 0.7 and a primal
+// weight of 0.05 (bench/RESULTS.md, "G-MLT's large-step probability", "G-MLT's primal weight").
+TEST_F(MltCli, DefaultsAreEachMethodsOwn) {
+    for (const std::string method : {"pssmlt", "gmlt"}) {
+        const RunResult r =
+            runGdpt("render " + kScene + " --method " + method + " --width 8 --height 8 --spp 2 -o " +
+                    path(method + ".exr") + " --json " + path(method + ".json"));
+        ASSERT_EQ(r.code, 0) << r.output;
+        std::ifstream in(path(method + ".json"));
+        const nlohmann::json j = nlohmann::json::parse(in);
+        EXPECT_FLOAT_EQ(j.at("mlt").at("large_step_probability").get<float>(),
+                        method == "gmlt" ? 0.7f : 0.5f);
+        if (method == "gmlt") {
+            EXPECT_DOUBLE_EQ(j["reconstructions"][0].at("alpha").get<double>(), 0.05);
+        }
+    }
+}
+
 TEST_F(MltCli, OptionsThatNeedPerPixelStatisticsAreUsageErrors) {
     const std::string base = "render " + kScene + " --width 8 --height 8 --spp 2 -o " + path("x.exr") + " ";
     const struct {
