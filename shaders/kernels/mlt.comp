@@ -158,7 +158,9 @@ Evaluated evaluate(uint stream, uint fresh, inout uint rays, inout uint nan) {
     }
     gPssActive = false;
     e.value[kMltCentral] = central;
-    e.target = kBaseOnly ? luminance(central) : gmltTarget(gradientAbs, central, neighborSum, frame.targetAlpha);
+    e.target = mltTemperedTarget(
+        kBaseOnly ? luminance(central) : gmltTarget(gradientAbs, central, neighborSum, frame.targetAlpha),
+        frame.targetExponent);
     // pixel_stats.glsl's policy: a non-finite sample counts as zero, in every quantity.
     if (!finite || !isFinite(e.target)) {
         nan++;

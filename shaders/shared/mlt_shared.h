@@ -37,7 +37,7 @@ GDPT_CONST uint kMltPhaseStart = 1u;      // chain c: the state of bootstrap sam
 GDPT_CONST uint kMltPhaseMutate = 2u;     // chain c: one proposal, two records, accept or not
 GDPT_CONST uint kMltPhaseDirect = 3u;     // pixel: the emission the camera sees directly
 
-// Push constants of mlt.comp (<= 128 bytes). 52 bytes.
+// Push constants of mlt.comp (<= 128 bytes). 56 bytes.
 struct MltParams {
     uint phase;              // kMltPhase*
     uint count;              // invocations that work (samples, chains or image rows x width)
@@ -52,6 +52,7 @@ struct MltParams {
     uint directSamples;      // direct: camera samples per pixel
     uint rowOffset;          // direct: first image row of this dispatch
     float misNormalisation;  // mutate: b' of the splat weights' multiple importance sampling (mlt.glsl)
+    float targetExponent;    // the chains' target is the method's raised to this power (mltTemperedTarget)
 };
 
 // A chain's current state besides its decisions (kBindMltPss). 144 bytes.
@@ -96,7 +97,7 @@ kSpecMltBaseOnly = 20u  // 1: trace the base path alone (PSSMLT), 0: base + offs
     GDPT_ENUM_END();
 
 #ifdef __cplusplus
-static_assert(sizeof(MltParams) == 52, "MltParams layout");
+static_assert(sizeof(MltParams) == 56, "MltParams layout");
 static_assert(sizeof(MltChain) == 144, "MltChain layout (scalar)");
 static_assert(sizeof(MltRecord) == 120, "MltRecord layout (scalar)");
 static_assert(std::uint32_t{kBindMltChains} > std::uint32_t{kBindGptEdgeProbe},

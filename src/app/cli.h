@@ -47,17 +47,18 @@ struct RenderArgs {
     std::string checkpoint;        // write the sampler state here on interrupt / periodically / at the end
     double checkpointEvery = 0.0;  // seconds between periodic checkpoints (0 = only at the end)
     std::string resume;            // continue from this checkpoint
-    std::string shard;          // "I/N": render part I of N and write its statistics (distributed/shards.h)
-    std::uint32_t chains = 0;   // pssmlt, gmlt: Markov chains (0 = per image size)
-    float largeStep = -1.0f;    // pssmlt, gmlt: probability of a large step (< 0: the method's own)
-    float targetAlpha = 0.25f;  // gmlt: weight of the radiance in the target
-    std::string frames;         // "A:B": render frames A..B of an animation (sequence_command.cpp)
-    double fps = 24.0;          // frames per second: frame k is the scene at time k / fps
-    std::string animation;      // the animation's name or index ("" = the first)
-    bool noVideo = false;       // no MP4 of the sequence even when ffmpeg is installed
-    int window = 10;            // tgpt: frames reconstructed together
-    double beta = 1.0;          // tgpt: weight of the temporal rows
-    double gamma = -1.0;        // tgpt: weight of the mixed rows (< 0: 1, or 0 with the reconnection shift)
+    std::string shard;         // "I/N": render part I of N and write its statistics (distributed/shards.h)
+    std::uint32_t chains = 0;  // pssmlt, gmlt: Markov chains (0 = per image size)
+    float largeStep = -1.0f;   // pssmlt, gmlt: probability of a large step (< 0: the method's own)
+    float targetExponent = -1.0f;  // pssmlt, gmlt: the target's exponent (< 0: the method's own)
+    float targetAlpha = 0.25f;     // gmlt: weight of the radiance in the target
+    std::string frames;            // "A:B": render frames A..B of an animation (sequence_command.cpp)
+    double fps = 24.0;             // frames per second: frame k is the scene at time k / fps
+    std::string animation;         // the animation's name or index ("" = the first)
+    bool noVideo = false;          // no MP4 of the sequence even when ffmpeg is installed
+    int window = 10;               // tgpt: frames reconstructed together
+    double beta = 1.0;             // tgpt: weight of the temporal rows
+    double gamma = -1.0;  // tgpt: weight of the mixed rows (< 0: 1, or 0 with the reconnection shift)
     std::string temporalShift = "motion";  // tgpt: motion | replay | reconnect
 };
 

@@ -496,6 +496,11 @@ Subcommand addRenderCommand(CLI::App& app) {
                   "Probability of a large step (a fresh path) per mutation (default: pssmlt 0.5, gmlt 0.7)")
         ->check(CLI::Range(0.0f, 1.0f))
         ->group(mlt);
+    r->add_option("--target-exponent", a.targetExponent,
+                  "The chains walk the method's target to this power: below 1 they mix faster, splat fewer "
+                  "blotches and importance-sample less (default: pssmlt 1, gmlt 0.25)")
+        ->check(CLI::Range(0.01f, 4.0f))
+        ->group(mlt);
     r->add_option("--target-alpha", a.targetAlpha,
                   "gmlt: weight of the path's radiance beside its gradients in the chains' target")
         ->capture_default_str()

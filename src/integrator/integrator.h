@@ -125,13 +125,20 @@ struct GptOptions {
 // box (bench/RESULTS.md, "G-MLT's large-step probability").
 inline constexpr float kPssmltLargeStep = 0.5f;
 inline constexpr float kGmltLargeStep = 0.7f;
+// gmlt's chains walk its gradient target to this power (mlt.glsl mltTemperedTarget); pssmlt
+// keeps Kelemen's target (1). On the door scene at 256² and 16 s the tempered target's chains
+// splat fewer blotches (bench/RESULTS.md, "A tempered target for G-MLT's chains").
+inline constexpr float kGmltTargetExponent = 0.25f;
 
 struct MltOptions {
     std::uint32_t chains = 0;  // Markov chains at once; 0 = per image size (defaultMltChains)
     // Probability of a large step (a fresh state) per mutation; < 0: the method's own
     // (kPssmltLargeStep, kGmltLargeStep).
     float largeStep = -1.0f;
-    float targetAlpha = 0.25f;            // gmlt: weight of the radiance in the target (mlt.glsl gmltTarget)
+    float targetAlpha = 0.25f;  // gmlt: weight of the radiance in the target (mlt.glsl gmltTarget)
+    // The chains walk the method's target to this power (mlt.glsl mltTemperedTarget); < 0: the
+    // method's own (pssmlt 1, gmlt kGmltTargetExponent).
+    float targetExponent = -1.0f;
     std::uint32_t bootstrapPerPixel = 1;  // bootstrap samples per pixel (at least 16 per chain)
     std::uint32_t directSamples = 16;     // camera samples per pixel of the very-direct image
     // gmlt: the split bounce loop of G-PT's sample (the same values; MltPassOptions::splitBounce).

@@ -29,6 +29,7 @@ constexpr std::uint32_t kBootstrapPerChain = 16;
 // The options with the method's own defaults where they are left to it.
 MltOptions withMethodDefaults(const std::string& method, MltOptions o) {
     if (o.largeStep < 0.0f) o.largeStep = method == "gmlt" ? kGmltLargeStep : kPssmltLargeStep;
+    if (o.targetExponent < 0.0f) o.targetExponent = method == "gmlt" ? kGmltTargetExponent : 1.0f;
     return o;
 }
 }  // namespace
@@ -57,6 +58,7 @@ ExrAttributes MltIntegrator::identity(const Scene&, const RenderOptions& options
                                             : defaultMltChains(options.scene.width, options.scene.height))},
             {"large_step", exactFloat(options_.largeStep)},
             {"target_alpha", exactFloat(options_.targetAlpha)},
+            {"target_exponent", exactFloat(options_.targetExponent)},
             {"shift_threshold", exactFloat(options.scene.shiftThreshold)}};
 }
 
@@ -83,6 +85,7 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     po.stepsPerBatch = kStepsPerBatch;
     po.largeStep = options_.largeStep;
     po.targetAlpha = options_.targetAlpha;
+    po.targetExponent = options_.targetExponent;
     po.splitBounce = options_.splitBounce;
     SceneSpec spec(scene, options.scene);
     MltPass pass(ctx, spec, options.workgroup, po, vk::PipelineCreation::Background);
@@ -263,6 +266,7 @@ void MltIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
     j["mlt"] = {{"chains", m.chains},
                 {"mutations", m.mutations},
                 {"large_step_probability", options_.largeStep},
+                {"target_exponent", options_.targetExponent},
                 {"acceptance_small", rate(m.acceptedSmall, m.proposedSmall)},
                 {"acceptance_large", rate(m.acceptedLarge, m.proposedLarge)},
                 {"proposed_small", m.proposedSmall},

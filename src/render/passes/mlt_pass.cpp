@@ -81,6 +81,7 @@ gpu::MltParams MltPass::params(std::uint32_t phase, std::uint32_t count, std::ui
     p.shiftThreshold = shiftThreshold_;
     p.largeStep = options_.largeStep;
     p.targetAlpha = options_.targetAlpha;
+    p.targetExponent = options_.targetExponent;
     p.misNormalisation = misNormalisation_;
     return p;
 }

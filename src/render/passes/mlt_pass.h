@@ -27,6 +27,7 @@ struct MltPassOptions {
     std::uint32_t stepsPerBatch = 8;  // mutation steps a batch records (records buffer size)
     float largeStep = 0.5f;           // probability of a large step
     float targetAlpha = 0.25f;        // G-MLT: weight of the primal term of the target
+    float targetExponent = 1.0f;      // the target walked is the method's to this power
     // G-MLT: the sample's split bounce loop (mlt.comp's mlt_split build, as gpt_split; the same
     // values either way). PSSMLT traces the path tracer's path and has no such loop.
     GptPassOptions::SplitBounce splitBounce = GptPassOptions::SplitBounce::Auto;

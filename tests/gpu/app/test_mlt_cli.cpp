@@ -64,8 +64,10 @@ TEST_F(MltCli, JsonReportsChainsAcceptanceAndNormalisation) {
     }
 }
 
-// Left unset, --large-step and --alpha are each method's own: pssmlt 0.5; gmlt 0.7 and a primal
-// weight of 0.05 (bench/RESULTS.md, "G-MLT's large-step probability", "G-MLT's primal weight").
+// Left unset, --large-step, --target-exponent and --alpha are each method's own: pssmlt 0.5
+// and Kelemen's target (exponent 1); gmlt 0.7, its target to the power 0.25 and a primal weight
+// of 0.05 (bench/RESULTS.md, "G-MLT's large-step probability", "A tempered target for G-MLT's
+// chains", "G-MLT's primal weight"). Given, --target-exponent reaches the chains of both.
 TEST_F(MltCli, DefaultsAreEachMethodsOwn) {
     for (const std::string method : {"pssmlt", "gmlt"}) {
         const RunResult r =
@@ -76,9 +78,21 @@ TEST_F(MltCli, DefaultsAreEachMethodsOwn) {
         const nlohmann::json j = nlohmann::json::parse(in);
         EXPECT_FLOAT_EQ(j.at("mlt").at("large_step_probability").get<float>(),
                         method == "gmlt" ? 0.7f : 0.5f);
+        EXPECT_FLOAT_EQ(j.at("mlt").at("target_exponent").get<float>(), method == "gmlt" ? 0.25f : 1.0f);
         if (method == "gmlt") {
             EXPECT_DOUBLE_EQ(j["reconstructions"][0].at("alpha").get<double>(), 0.05);
         }
+        // The exponent given: reported, and the chains walk another target (other acceptances).
+        const RunResult given = runGdpt("render " + kScene + " --method " + method +
+                                        " --width 8 --height 8 --spp 2 --target-exponent 0.5 -o " +
+                                        path(method + "_g.exr") + " --json " + path(method + "_g.json"));
+        ASSERT_EQ(given.code, 0) << given.output;
+        std::ifstream inGiven(path(method + "_g.json"));
+        const nlohmann::json g = nlohmann::json::parse(inGiven);
+        EXPECT_FLOAT_EQ(g.at("mlt").at("target_exponent").get<float>(), 0.5f);
+        EXPECT_NE(g.at("mlt").at("acceptance_small").get<double>(),
+                  j.at("mlt").at("acceptance_small").get<double>())
+            << method;
     }
 }
 

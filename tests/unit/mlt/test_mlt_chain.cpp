@@ -35,6 +35,12 @@ double target(double u, double v) {
     return 0.1 + std::exp(-((u - 0.3) * (u - 0.3) + (v - 0.6) * (v - 0.6)) / 0.02);
 }
 
+// The target a chain walks: `target` to the power `exponent` (mlt.glsl mltTemperedTarget; at
+// most 1.1 for every exponent in (0, 1], the rejection sampler's bound).
+double walked(double u, double v, float exponent) {
+    return gpu::mltTemperedTarget(static_cast<float>(target(u, v)), exponent);
+}
+
 constexpr int kCells = 10;      // 10 x 10 histogram
 constexpr int kSteps = 64;      // mutations per chain
 constexpr int kChains = 40000;  // independent chains (final states)
@@ -47,13 +53,13 @@ using Acceptance = std::function<float(float, float)>;
 // kLargeStep, else a small step of both coordinates).
 class AnalyticChains {
 public:
-    explicit AnalyticChains(std::uint32_t seed) : gen_(seed) {}
+    explicit AnalyticChains(std::uint32_t seed, float exponent) : gen_(seed), exponent_(exponent) {}
     float uniform() { return uni_(gen_); }
     void start(float& u, float& v) {
         do {
             u = uniform();
             v = uniform();
-        } while (uniform() * 1.1f >= target(u, v));
+        } while (uniform() * 1.1f >= walked(u, v, exponent_));
     }
     // The proposal from (u, v) into (pu, pv); true for a large step.
     bool propose(float u, float v, float& pu, float& pv) {
@@ -69,6 +75,7 @@ public:
 
 private:
     std::mt19937 gen_;
+    float exponent_;
     std::uniform_real_distribution<float> uni_{0.0f, 1.0f};
 };
 
@@ -79,18 +86,19 @@ struct Mutation {
     bool large;
 };
 
-// Walks `count` chains of `steps` mutations from exact starts: `step(m)` returns the
-// acceptance probability of mutation m (and may splat it); `end(u, v)` sees each final state.
+// Walks `count` chains of `steps` mutations from exact starts on the target to the power
+// `exponent`: `step(m)` returns the acceptance probability of mutation m (and may splat it);
+// `end(u, v)` sees each final state.
 template <class Step, class End>
-void walkChains(std::uint32_t seed, int count, int steps, Step step, End end) {
-    AnalyticChains chains(seed);
+void walkChains(std::uint32_t seed, int count, int steps, float exponent, Step step, End end) {
+    AnalyticChains chains(seed, exponent);
     for (int c = 0; c < count; ++c) {
         Mutation m{};
         chains.start(m.u, m.v);
-        m.t = static_cast<float>(target(m.u, m.v));
+        m.t = static_cast<float>(walked(m.u, m.v, exponent));
         for (int s = 0; s < steps; ++s) {
             m.large = chains.propose(m.u, m.v, m.pu, m.pv);
-            m.tp = static_cast<float>(target(m.pu, m.pv));
+            m.tp = static_cast<float>(walked(m.pu, m.pv, exponent));
             if (chains.uniform() < step(m)) m.u = m.pu, m.v = m.pv, m.t = m.tp;
         }
         end(m.u, m.v);
@@ -100,7 +108,7 @@ void walkChains(std::uint32_t seed, int count, int steps, Step step, End end) {
 std::vector<double> finalStateHistogram(const Acceptance& accept, std::uint32_t seed) {
     std::vector<double> counts(kCells * kCells, 0.0);
     walkChains(
-        seed, kChains, kSteps, [&](const Mutation& m) { return accept(m.t, m.tp); },
+        seed, kChains, kSteps, 1.0f, [&](const Mutation& m) { return accept(m.t, m.tp); },
         [&](float u, float v) {
             counts[std::size_t(std::min(int(v * kCells), kCells - 1) * kCells +
                                std::min(int(u * kCells), kCells - 1))] += 1.0;
@@ -181,38 +189,50 @@ int quadrant(double u, double v) {
     return (v < 0.5 ? 0 : 2) + (u < 0.5 ? 0 : 1);
 }
 
-// ∫ target and the quadrants' ∫ carried, by a 400 x 400 midpoint rule (the hole's and the
-// band's edges lie on its cell boundaries).
-void exactIntegrals(double& b, std::array<double, 4>& q) {
+// ∫ target^exponent and the quadrants' ∫ carried, by a 400 x 400 midpoint rule (the hole's
+// and the band's edges lie on its cell boundaries).
+void exactIntegrals(double& b, std::array<double, 4>& q, float exponent = 1.0f) {
     constexpr int kN = 400;
     b = 0.0;
     q = {};
     for (int j = 0; j < kN; ++j)
         for (int i = 0; i < kN; ++i) {
             const double u = (i + 0.5) / kN, v = (j + 0.5) / kN;
-            b += target(u, v) / (kN * kN);
+            b += walked(u, v, exponent) / (kN * kN);
             q[std::size_t(quadrant(u, v))] += carried(u, v) / (kN * kN);
         }
 }
 
+// How a render's chains walk and weigh: the exponent of the target they walk, and that of the
+// target their splat weights divide by (the same, unless a test breaks it on purpose).
+struct Tempering {
+    float walk = 1.0f, weigh = 1.0f;
+};
+
 // One render of the quadrants: chains started from exact samples of the target, each
 // mutating as mlt.comp does and splatting both records with mlt.glsl's weights (b' = bWeights),
 // the Metropolis sum scaled by the true b (mlt_estimate.h), the large steps' share kept or not.
-std::array<double, 4> misRender(std::uint32_t seed, double b, float bWeights, bool largeShare) {
+std::array<double, 4> misRender(std::uint32_t seed, double b, float bWeights, bool largeShare,
+                                Tempering tempering) {
     constexpr int kMisChains = 400, kMisSteps = 100;
     std::array<double, 4> metropolis{}, large{};
     const float bLarge = bWeights * kLargeStep;
     walkChains(
-        seed, kMisChains, kMisSteps,
+        seed, kMisChains, kMisSteps, tempering.walk,
         [&](const Mutation& m) {
             const float a = gpu::mltAcceptance(m.t, m.tp);
+            const auto weighed = [&](float walkedTarget, double u, double v) {
+                return tempering.weigh == tempering.walk ? walkedTarget
+                                                         : static_cast<float>(walked(u, v, tempering.weigh));
+            };
+            const float t = weighed(m.t, m.u, m.v), tp = weighed(m.tp, m.pu, m.pv);
             metropolis[std::size_t(quadrant(m.u, m.v))] +=
-                gpu::mltSplatWeight(1.0f - a, m.t, bLarge) * carried(m.u, m.v);
+                gpu::mltSplatWeight(1.0f - a, t, bLarge) * carried(m.u, m.v);
             metropolis[std::size_t(quadrant(m.pu, m.pv))] +=
-                gpu::mltSplatWeight(a, m.tp, bLarge) * carried(m.pu, m.pv);
+                gpu::mltSplatWeight(a, tp, bLarge) * carried(m.pu, m.pv);
             if (m.large)
                 large[std::size_t(quadrant(m.pu, m.pv))] +=
-                    gpu::mltLargeStepWeight(m.tp, bWeights, kLargeStep) * carried(m.pu, m.pv);
+                    gpu::mltLargeStepWeight(tp, bWeights, kLargeStep) * carried(m.pu, m.pv);
             return a;
         },
         [](float, float) {});
@@ -224,11 +244,13 @@ std::array<double, 4> misRender(std::uint32_t seed, double b, float bWeights, bo
 
 // The largest |t| over the quadrants of kRuns renders' means against the exact integrals;
 // b scales the Metropolis sum.
-double worstQuadrantT(double b, float bWeights, bool largeShare, const std::array<double, 4>& exact) {
+double worstQuadrantT(double b, float bWeights, bool largeShare, const std::array<double, 4>& exact,
+                      Tempering tempering = {}) {
     constexpr int kRuns = 30;
     std::array<double, 4> sum{}, sumSquares{};
     for (int r = 0; r < kRuns; ++r) {
-        const std::array<double, 4> q = misRender(1000u + std::uint32_t(r), b, bWeights, largeShare);
+        const std::array<double, 4> q =
+            misRender(1000u + std::uint32_t(r), b, bWeights, largeShare, tempering);
         for (std::size_t k = 0; k < 4; ++k) sum[k] += q[k], sumSquares[k] += q[k] * q[k];
     }
     double worst = 0.0;
@@ -254,6 +276,33 @@ TEST(MltEstimate, LargeStepMultipleImportanceSamplingIsUnbiased) {
     // Nor with the Metropolis sum scaled by the weights' b' = 1.5 b instead of b.
     EXPECT_GT(worstQuadrantT(1.5 * b, static_cast<float>(1.5 * b), true, exact), threshold)
         << "the test has no power";
+}
+
+// gmlt's chains walk a tempered target (T^γ, mltTemperedTarget): the same estimate, unbiased,
+// as long as the splat weights and b divide by the target walked. Power: weights that divide by
+// T while the chains walk T^0.5 miss the quadrants by many standard errors.
+TEST(MltEstimate, TemperedTargetIsUnbiased) {
+    constexpr float kExponent = 0.5f;
+    double b = 0.0, bUntempered = 0.0;
+    std::array<double, 4> exact{}, unused{};
+    exactIntegrals(b, exact, kExponent);
+    exactIntegrals(bUntempered, unused, 1.0f);
+    const double threshold = test::twoSidedT(test::sidakAlpha(1e-3, 8), 29);
+    const Tempering tempered{kExponent, kExponent};
+    EXPECT_LT(worstQuadrantT(b, static_cast<float>(b), true, exact, tempered), threshold) << "b' = b";
+    EXPECT_LT(worstQuadrantT(b, static_cast<float>(1.5 * b), true, exact, tempered), threshold)
+        << "b' = 1.5 b";
+    EXPECT_GT(worstQuadrantT(bUntempered, static_cast<float>(bUntempered), true, exact, {kExponent, 1.0f}),
+              threshold)
+        << "the test has no power";
+}
+
+TEST(MltChain, TemperedTargetIsTheIdentityAtOneAndKeepsZero) {
+    for (const float t : {0.0f, 1e-30f, 0.37f, 1.0f, 3.5e6f}) EXPECT_EQ(gpu::mltTemperedTarget(t, 1.0f), t);
+    EXPECT_EQ(gpu::mltTemperedTarget(0.0f, 0.25f), 0.0f);
+    EXPECT_EQ(gpu::mltTemperedTarget(-1.0f, 0.5f), 0.0f);
+    EXPECT_FLOAT_EQ(gpu::mltTemperedTarget(16.0f, 0.25f), 2.0f);
+    EXPECT_FLOAT_EQ(gpu::mltTemperedTarget(0.25f, 0.5f), 0.5f);
 }
 
 TEST(MltEstimate, NormalisationIsTheMeanTargetWithItsStandardError) {
