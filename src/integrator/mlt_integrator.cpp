@@ -121,6 +121,11 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
         stats.nanSamples += c.nanSamples;
     };
     const auto cancelled = [&] { return options.cancel && options.cancel->load(); };
+    // The kernel's compile at its first dispatch: a fixed cost (time_s.kernel_compile), not
+    // the very-direct light's (PixelSampling::run does the same for PT and G-PT).
+    Timer compile;
+    submit(name_ + " kernel's first dispatch", [&](VkCommandBuffer cmd) { pass.recordWarmUp(cmd); });
+    stats.compileMs = compile.ms();
     Timer sampling;
 
     // Stage 1: the very-direct light, and the bootstrap: b and the chains' starts.

@@ -71,6 +71,12 @@ double MltPass::waitForPipelines() const {
     return kernel_.wait();
 }
 
+void MltPass::recordWarmUp(VkCommandBuffer cmd) const {
+    const gpu::MltParams p = params(gpu::kMltPhaseDirect, 0, 0);  // no rows: every invocation returns
+    kernel_.dispatch(cmd, 1, 1, 1, &p, nullptr);
+    vk::computeBarrier(cmd);
+}
+
 gpu::MltParams MltPass::params(std::uint32_t phase, std::uint32_t count, std::uint32_t seed) const {
     gpu::MltParams p{};
     p.phase = phase;

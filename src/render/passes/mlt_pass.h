@@ -46,6 +46,11 @@ public:
             vk::PipelineCreation creation);
     void attach(const SceneGpu& scene);
     double waitForPipelines() const;
+    // Records one dispatch that does no work (the direct phase with no rows): lavapipe compiles
+    // the kernel to machine code at its first dispatch (seconds with a cold shader cache), so
+    // that compile is timed here and not as the bootstrap's or the very-direct light's
+    // (SamplingPass::recordWarmUp for PT and G-PT).
+    void recordWarmUp(VkCommandBuffer cmd) const;
 
     // Records `count` bootstrap samples from sample index `first` into the bootstrap buffer
     // (capacity: the count of the first call, which allocates it).
