@@ -81,6 +81,12 @@ Vertex makeVertex(SurfaceHit s, vec3 incoming) {
 
 vec3 local(Vertex v, vec3 w) { return toLocal(w, v.t, v.b, v.s.ns); }
 
+// Own vertices of a base and its offset pair up only if both are mirrors (Dirac-only) or
+// neither is: a mirror's offset cannot reconnect to a rough vertex, nor the reverse.
+bool mirrorMismatch(Vertex base, Vertex offset) {
+    return bsdfIsDeltaOnly(base.bsdf) != bsdfIsDeltaOnly(offset.bsdf);
+}
+
 // Whether a one-sided material's back face was hit (an opaque black absorber: the path ends).
 bool blackBackFace(SurfaceHit s) {
     return !s.frontFace && (material(s.material).flags & kMatFlagDoubleSided) == 0u;
@@ -296,7 +302,7 @@ SampleResult temporalSample(uint x, uint y, TemporalPartner partner, uint sample
     if (hit.triangle == kInvalidIndex) return r;  // the environment seen directly: not shifted
     Vertex v = makeVertex(makeSurfaceHit(hit.triangle, hit.u, hit.v, dir), dir);
     r.paired = true;
-    if (o.alive && bsdfIsDeltaOnly(v.bsdf) != bsdfIsDeltaOnly(o.v.bsdf)) o.alive = false;
+    if (o.alive && mirrorMismatch(v, o.v)) o.alive = false;
     r.failed = !o.alive;
     if (!o.alive) kill(o);
 
@@ -306,8 +312,7 @@ SampleResult temporalSample(uint x, uint y, TemporalPartner partner, uint sample
     for (uint depth = 0u;; ++depth) {
         if (blackBackFace(v.s)) break;
         if (depth >= scene.maxDepth || depth + 1u >= kMaxDepth) break;
-        // Own vertices pair up only if both are mirrors or neither is.
-        if (o.alive && o.own && bsdfIsDeltaOnly(v.bsdf) != bsdfIsDeltaOnly(o.v.bsdf)) kill(o);
+        if (o.alive && o.own && mirrorMismatch(v, o.v)) kill(o);
         vec3 origin = offsetRayOriginScaled(v.s.p, v.s.ng, scene.sceneRadius);
 
         // Next-event estimation: the base's light sample, and the same light point carried.
