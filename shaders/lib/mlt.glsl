@@ -76,24 +76,24 @@ GDPT_INLINE float mltLargeStepWeight(float t, float bWeights, float largeStep) {
 // sees is the path's own contribution (the pair weights of each pixel pair sum to one).
 // Every quantity the sample carries is non-zero only where this is (radiance is non-negative
 // and alpha > 0), so the chain misses nothing that it splats.
-// The tempered target T^γ that the chains walk, for the method's target T and γ =
-// `exponent` (`--target-exponent`; 1 leaves T as it is, to the bit). Any function that is
-// positive wherever a sample carries something is a valid target: the splat weights above
-// divide by the target the chains walk, so the estimate stays unbiased whatever γ > 0, and
-// only its variance changes. With γ < 1 the chains care less about how much brighter a state
-// is than another: the heavy tail of the gradient target (paths whose offsets fail, whose
-// gradients are their whole contribution) holds a chain less long, the chains move between
-// regions more often and splat fewer blotches, and the large steps' proposals are accepted
-// more often (a tempered target, as tempered Markov chain Monte Carlo uses: here the chains
-// walk it alone and the splat weights reweight their samples). T = 0 stays 0: a chain never enters a
-// state that carries nothing.
+GDPT_INLINE float gmltTarget(float gradientAbsLuminance, vec3 central, vec3 neighborSum, float alpha) {
+    return gradientAbsLuminance + alpha * 0.25f * luminance(central + neighborSum);
+}
+
+// The tempered target T^γ that the chains walk, for the method's target T and γ = `exponent`
+// (`--target-exponent`; 1 leaves T as it is, to the bit). Any function that is positive
+// wherever a sample carries something is a valid target: the splat weights above divide by the
+// target the chains walk, so the estimate stays unbiased whatever γ > 0, and only its variance
+// changes. With γ < 1 the chains care less about how much brighter a state is than another:
+// the heavy tail of the gradient target (paths whose offsets fail, whose gradients are their
+// whole contribution) holds a chain less long, the chains move between regions more often and
+// splat fewer blotches, and the large steps' proposals are accepted more often (a tempered
+// target, as tempered Markov chain Monte Carlo uses: here the chains walk it alone and the
+// splat weights reweight their samples). T = 0 stays 0: a chain never enters a state that
+// carries nothing.
 GDPT_INLINE float mltTemperedTarget(float t, float exponent) {
     if (exponent == 1.0f) return t;
     return t > 0.0f ? pow(t, exponent) : 0.0f;
-}
-
-GDPT_INLINE float gmltTarget(float gradientAbsLuminance, vec3 central, vec3 neighborSum, float alpha) {
-    return gradientAbsLuminance + alpha * 0.25f * luminance(central + neighborSum);
 }
 
 GDPT_NAMESPACE_END
