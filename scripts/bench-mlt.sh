@@ -4,7 +4,7 @@
 #      reference of REFSPP samples per pixel (rendered once into OUT/, seed 99, in --reference-shards
 #      parts that are kept as they finish, so an interrupted run resumes where it stopped, then
 #      merged (docs/distributed.md); or given with --reference, then of --reference-spp samples);
-#      its noise floor is printed (about 0.08 in relMSE at the default 65,536 spp, 0.3 at 16,384);
+#      its noise floor is printed (about 0.065 in relMSE at the default 65,536 spp, 0.26 at 16,384);
 #   2. the Cornell box of ../shared/scenes/cbox against its independent reference;
 #   3. the throughput: mutations per second of gmlt and pssmlt against camera samples per
 #      second of G-PT and PT (the same scene and size, --json samples_per_s, 3 interleaved rounds,
