@@ -221,11 +221,8 @@ std::array<double, 4> misRender(std::uint32_t seed, double b, float bWeights, bo
         seed, kMisChains, kMisSteps, tempering.walk,
         [&](const Mutation& m) {
             const float a = gpu::mltAcceptance(m.t, m.tp);
-            const auto weighed = [&](float walkedTarget, double u, double v) {
-                return tempering.weigh == tempering.walk ? walkedTarget
-                                                         : static_cast<float>(walked(u, v, tempering.weigh));
-            };
-            const float t = weighed(m.t, m.u, m.v), tp = weighed(m.tp, m.pu, m.pv);
+            const float t = static_cast<float>(walked(m.u, m.v, tempering.weigh));
+            const float tp = static_cast<float>(walked(m.pu, m.pv, tempering.weigh));
             metropolis[std::size_t(quadrant(m.u, m.v))] +=
                 gpu::mltSplatWeight(1.0f - a, t, bLarge) * carried(m.u, m.v);
             metropolis[std::size_t(quadrant(m.pu, m.pv))] +=
