@@ -74,9 +74,10 @@ layout(set = 0, binding = kBindCounters, scalar) buffer CounterBuf { Counters co
 layout(set = 0, binding = kBindMltChains, scalar) buffer ChainBuf { MltChain chains[]; };
 layout(set = 0, binding = kBindMltPss, scalar) buffer PssBuf { float pss[]; };
 layout(set = 0, binding = kBindMltRecords, scalar) writeonly buffer RecordBuf { MltRecord records[]; };
-layout(set = 0, binding = kBindMltBootstrap, scalar) writeonly buffer BootstrapBuf { float bootstrapTarget[]; };
+layout(set = 0, binding = kBindMltBootstrap, scalar) writeonly buffer BootstrapBuf { MltBootstrapSample bootstrap[]; };
 layout(set = 0, binding = kBindMltStarts, scalar) readonly buffer StartBuf { uint starts[]; };
 layout(set = 0, binding = kBindMltDirect, scalar) writeonly buffer DirectBuf { vec4 directOut[]; };
+layout(set = 0, binding = kBindMltNormalise, scalar) readonly buffer NormaliseBuf { float normaliser[]; };
 layout(push_constant, scalar) uniform Push { MltParams frame; };
 
 #include "lib/scene_access.glsl"
@@ -161,6 +162,8 @@ Evaluated evaluate(uint stream, uint fresh, inout uint rays, inout uint nan) {
     e.target = mltTemperedTarget(
         kBaseOnly ? luminance(central) : gmltTarget(gradientAbs, central, neighborSum, frame.targetAlpha),
         frame.targetExponent);
+    if (frame.normaliseBlock > 0u && frame.phase != kMltPhaseBootstrap)
+        e.target /= normaliser[(py / frame.normaliseBlock) * frame.normaliseColumns + px / frame.normaliseBlock];
     // pixel_stats.glsl's policy: a non-finite sample counts as zero, in every quantity.
     if (!finite || !isFinite(e.target)) {
         nan++;
@@ -278,7 +281,8 @@ void main() {
         }
         Evaluated e = evaluate(stream, fresh, rays, nan);
         if (frame.phase == kMltPhaseBootstrap) {
-            bootstrapTarget[item] = e.target;
+            bootstrap[item].target = e.target;
+            bootstrap[item].pixel = e.pixel;
         } else if (frame.phase == kMltPhaseStart) {
             storeChain(item, e);
             chains[item].proposedSmall = 0u;

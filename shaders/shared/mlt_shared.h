@@ -37,7 +37,7 @@ GDPT_CONST uint kMltPhaseStart = 1u;      // chain c: the state of bootstrap sam
 GDPT_CONST uint kMltPhaseMutate = 2u;     // chain c: one proposal, two records, accept or not
 GDPT_CONST uint kMltPhaseDirect = 3u;     // pixel: the emission the camera sees directly
 
-// Push constants of mlt.comp (<= 128 bytes). 56 bytes.
+// Push constants of mlt.comp (<= 128 bytes). 64 bytes.
 struct MltParams {
     uint phase;              // kMltPhase*
     uint count;              // invocations that work (samples, chains or image rows x width)
@@ -53,6 +53,16 @@ struct MltParams {
     uint rowOffset;          // direct: first image row of this dispatch
     float misNormalisation;  // mutate: b' of the splat weights' multiple importance sampling (mlt.glsl)
     float targetExponent;    // the chains' target is the method's raised to this power (mltTemperedTarget)
+    uint normaliseBlock;     // start, mutate: the target is divided by its image block's entry of
+                             // kBindMltNormalise, blocks of this many pixels square; 0: not
+    uint normaliseColumns;   // blocks per image row
+};
+
+// A bootstrap sample (kBindMltBootstrap): its target, not divided by its block's normaliser,
+// and the pixel its film position lies in. 8 bytes.
+struct MltBootstrapSample {
+    float target;
+    uint pixel;
 };
 
 // A chain's current state besides its decisions (kBindMltPss). 144 bytes.
@@ -87,9 +97,10 @@ GDPT_ENUM_BEGIN(MltBinding)
 kBindMltChains = 60u,         // MltChain per chain
     kBindMltPss = 61u,        // float per chain and decision: chain c's decision k at c·kMltPssDims + k
     kBindMltRecords = 62u,    // MltRecord, 2 per chain and mutation step of a batch
-    kBindMltBootstrap = 63u,  // float per bootstrap sample: its target value
+    kBindMltBootstrap = 63u,  // MltBootstrapSample per bootstrap sample
     kBindMltStarts = 64u,     // uint per chain: the bootstrap sample it starts from
-    kBindMltDirect = 65u      // vec4 per pixel: mean very-direct emission (rgb)
+    kBindMltDirect = 65u,     // vec4 per pixel: mean very-direct emission (rgb)
+    kBindMltNormalise = 66u   // float per image block (MltParams::normaliseBlock): the target's divisor
     GDPT_ENUM_END();
 
 GDPT_ENUM_BEGIN(MltSpecId)
@@ -97,7 +108,8 @@ kSpecMltBaseOnly = 20u  // 1: trace the base path alone (PSSMLT), 0: base + offs
     GDPT_ENUM_END();
 
 #ifdef __cplusplus
-static_assert(sizeof(MltParams) == 56, "MltParams layout");
+static_assert(sizeof(MltParams) == 64, "MltParams layout");
+static_assert(sizeof(MltBootstrapSample) == 8, "MltBootstrapSample layout");
 static_assert(sizeof(MltChain) == 144, "MltChain layout (scalar)");
 static_assert(sizeof(MltRecord) == 120, "MltRecord layout (scalar)");
 static_assert(std::uint32_t{kBindMltChains} > std::uint32_t{kBindGptEdgeProbe},

@@ -51,6 +51,7 @@ struct RenderArgs {
     std::uint32_t chains = 0;  // pssmlt, gmlt: Markov chains (0 = per image size)
     float largeStep = -1.0f;   // pssmlt, gmlt: probability of a large step (< 0: the method's own)
     float targetExponent = -1.0f;  // pssmlt, gmlt: the target's exponent (< 0: the method's own)
+    int targetBlock = -1;          // pssmlt, gmlt: the target's divisor blocks (< 0: the method's own)
     float targetAlpha = 0.25f;     // gmlt: weight of the radiance in the target
     std::string frames;            // "A:B": render frames A..B of an animation (sequence_command.cpp)
     double fps = 24.0;             // frames per second: frame k is the scene at time k / fps

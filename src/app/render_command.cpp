@@ -501,6 +501,12 @@ Subcommand addRenderCommand(CLI::App& app) {
                   "blotches and importance-sample less (default: pssmlt 1, gmlt 0.25)")
         ->check(CLI::Range(0.01f, 4.0f))
         ->group(mlt);
+    r->add_option("--target-block", a.targetBlock,
+                  "The chains walk the target divided by its image block's mean (from the bootstrap), blocks "
+                  "of this many pixels square: their samples go where the relative error is; 0 = undivided "
+                  "(default: pssmlt 0, gmlt 16)")
+        ->check(CLI::Range(0, 4096))
+        ->group(mlt);
     r->add_option("--target-alpha", a.targetAlpha,
                   "gmlt: weight of the path's radiance beside its gradients in the chains' target")
         ->capture_default_str()

@@ -107,6 +107,7 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
     mlt.chains = args.chains;
     mlt.largeStep = args.largeStep;
     mlt.targetExponent = args.targetExponent;
+    mlt.targetBlock = args.targetBlock;
     mlt.targetAlpha = args.targetAlpha;
     mlt.reconstructions = {parseReconstruction(args.recon)};
     if (args.allRecon && args.recon != "l2") mlt.reconstructions.push_back(Reconstruction::L2);

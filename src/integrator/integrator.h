@@ -129,6 +129,11 @@ inline constexpr float kGmltLargeStep = 0.7f;
 // keeps Kelemen's target (1). On the door scene at 256² and 16 s the tempered target's chains
 // splat fewer blotches (bench/RESULTS.md, "A tempered target for G-MLT's chains").
 inline constexpr float kGmltTargetExponent = 0.25f;
+// gmlt's chains walk its target divided by its image block's mean, blocks of this many pixels
+// square (mlt_estimate.h MltBlockNormaliser); pssmlt walks Kelemen's target undivided (0).
+// On the door scene at 256² the chains' samples then go where the relative error is
+// (bench/RESULTS.md, "G-MLT's target per image block").
+inline constexpr int kGmltTargetBlock = 16;
 
 struct MltOptions {
     std::uint32_t chains = 0;  // Markov chains at once; 0 = per image size (defaultMltChains)
@@ -139,6 +144,10 @@ struct MltOptions {
     // The chains walk the method's target to this power (mlt.glsl mltTemperedTarget); < 0: the
     // method's own (pssmlt 1, gmlt kGmltTargetExponent).
     float targetExponent = -1.0f;
+    // The chains' target is divided by its image block's mean target, blocks of this many pixels
+    // square (mlt_estimate.h MltBlockNormaliser); 0: not; < 0: the method's own (pssmlt 0,
+    // gmlt kGmltTargetBlock).
+    int targetBlock = -1;
     std::uint32_t bootstrapPerPixel = 1;  // bootstrap samples per pixel (at least 16 per chain)
     std::uint32_t directSamples = 16;     // camera samples per pixel of the very-direct image
     // gmlt: the split bounce loop of G-PT's sample (the same values; MltPassOptions::splitBounce).

@@ -5,6 +5,7 @@
 
 #include "lib/mlt.glsl"
 #include "lib/rng.glsl"
+#include "util/error.h"
 
 namespace gdpt {
 
@@ -68,6 +69,48 @@ std::vector<std::uint32_t> mltChainStarts(const std::vector<float>& targets, std
         starts.push_back(static_cast<std::uint32_t>(j));
     }
     return starts;
+}
+
+float MltBlockNormaliser::divisor(std::uint32_t pixel, std::uint32_t width) const {
+    if (block == 0) return 1.0f;
+    const std::uint32_t x = pixel % width, y = pixel / width;
+    return divisors[std::size_t(y / block) * columns + x / block];
+}
+
+MltBlockNormaliser mltBlockNormaliser(const std::vector<gpu::MltBootstrapSample>& samples,
+                                      std::uint32_t width, std::uint32_t height, std::uint32_t block,
+                                      float exponent) {
+    MltBlockNormaliser n;
+    if (block == 0) return n;
+    GDPT_CHECK(width > 0 && height > 0 && exponent > 0.0f);
+    n.block = block;
+    n.columns = (width + block - 1) / block;
+    n.rows = (height + block - 1) / block;
+    const std::size_t blocks = std::size_t(n.columns) * n.rows;
+    std::vector<double> sum(blocks, 0.0), count(blocks, 0.0);
+    double total = 0.0, samplesUsed = 0.0;
+    for (std::size_t i = 0; i < samples.size(); i += 2) {
+        const gpu::MltBootstrapSample& s = samples[i];
+        if (std::uint64_t{s.pixel} >= std::uint64_t{width} * height) continue;
+        // T from T^γ: the block means are of the untempered target.
+        const double t =
+            std::isfinite(s.target) && s.target > 0.0f
+                ? (exponent == 1.0f ? double(s.target) : std::pow(double(s.target), 1.0 / exponent))
+                : 0.0;
+        const std::size_t k = std::size_t((s.pixel / width) / block) * n.columns + (s.pixel % width) / block;
+        sum[k] += t;
+        count[k] += 1.0;
+        total += t;
+        samplesUsed += 1.0;
+    }
+    n.divisors.assign(blocks, 1.0f);
+    if (!(total > 0.0)) return n;
+    const double floor = kMltBlockFloor * total / samplesUsed;
+    for (std::size_t k = 0; k < blocks; ++k) {
+        const double mean = count[k] > 0.0 ? sum[k] / count[k] : 0.0;
+        n.divisors[k] = static_cast<float>(std::pow(mean + floor, double(exponent)));
+    }
+    return n;
 }
 
 MltAccumulator::MltAccumulator(int width, int height, float misNormalisation, float largeStep)

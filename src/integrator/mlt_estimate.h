@@ -49,6 +49,35 @@ MltNormalisation mltNormalisation(const std::vector<float>& targets);
 std::vector<std::uint32_t> mltChainStarts(const std::vector<float>& targets, std::uint32_t chains,
                                           std::uint32_t seed);
 
+// A target divided by its image block's brightness: any positive function is a valid target
+// (Hoberock and Hart 2010, "Arbitrary Importance Functions for Metropolis Light Transport",
+// Computer Graphics Forum 29(6), whose multi-stage MLT divides by a first estimate of the image
+// so that the chains go where the relative error is): the chains walk
+//     T'(x) = T(x)^γ / D_k,   D_k = (B_k + kMltBlockFloor · B̄)^γ
+// for a state x whose film position lies in block k (blocks of `block` pixels square, row
+// major), where B_k is the mean untempered target T of the bootstrap samples in block k and B̄
+// their mean over the image. With γ = 1 each block then holds about the same share of the
+// chains' samples whatever its brightness, and within a block they follow T; the floor keeps a
+// block whose bootstrap found nothing from drawing every chain that finds a path in it. D is
+// fixed before the chains start, so it is a target like any other (the estimate stays
+// unbiased); it is built from the bootstrap samples of even index only, and b̂ pools the odd
+// ones, which D does not depend on.
+inline constexpr double kMltBlockFloor = 0.1;
+
+struct MltBlockNormaliser {
+    std::uint32_t block = 0;  // pixels per block side; 0: no division
+    std::uint32_t columns = 0, rows = 0;
+    std::vector<float> divisors;  // D_k, columns × rows, row major
+    // D of the block that holds `pixel` (y·width + x); 1 without blocks.
+    [[nodiscard]] float divisor(std::uint32_t pixel, std::uint32_t width) const;
+};
+
+// D from bootstrap samples whose targets are T^exponent (mlt.comp's bootstrap phase); every
+// divisor 1 if no even-indexed sample has a positive target. block 0: no division.
+MltBlockNormaliser mltBlockNormaliser(const std::vector<gpu::MltBootstrapSample>& samples,
+                                      std::uint32_t width, std::uint32_t height, std::uint32_t block,
+                                      float exponent);
+
 // The factors of the two sums: metropolis = W·H·b̂/N, large = W·H/N.
 struct MltScale {
     double metropolis = 0.0, large = 0.0;

@@ -30,6 +30,7 @@ constexpr std::uint32_t kBootstrapPerChain = 16;
 MltOptions withMethodDefaults(const std::string& method, MltOptions o) {
     if (o.largeStep < 0.0f) o.largeStep = method == "gmlt" ? kGmltLargeStep : kPssmltLargeStep;
     if (o.targetExponent < 0.0f) o.targetExponent = method == "gmlt" ? kGmltTargetExponent : 1.0f;
+    if (o.targetBlock < 0) o.targetBlock = method == "gmlt" ? kGmltTargetBlock : 0;
     return o;
 }
 }  // namespace
@@ -59,6 +60,7 @@ ExrAttributes MltIntegrator::identity(const Scene&, const RenderOptions& options
             {"large_step", exactFloat(options_.largeStep)},
             {"target_alpha", exactFloat(options_.targetAlpha)},
             {"target_exponent", exactFloat(options_.targetExponent)},
+            {"target_block", std::to_string(options_.targetBlock)},
             {"shift_threshold", exactFloat(options.scene.shiftThreshold)}};
 }
 
@@ -136,22 +138,36 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     if (bootstrapCount > std::uint64_t{1} << 31)
         throw UsageError("--method " + name_ + ": " + std::to_string(bootstrapCount) +
                          " bootstrap samples are more than this renderer counts; use a smaller image");
-    std::vector<float> targets;
-    targets.reserve(bootstrapCount);
+    std::vector<gpu::MltBootstrapSample> bootstrap;
+    bootstrap.reserve(bootstrapCount);
     for (std::uint64_t first = 0; first < bootstrapCount && !cancelled(); first += kBootstrapPerDispatch) {
         const auto n = static_cast<std::uint32_t>(
             std::min<std::uint64_t>(kBootstrapPerDispatch, bootstrapCount - first));
         submit(name_ + " bootstrap from sample " + std::to_string(first), [&](VkCommandBuffer cmd) {
             pass.recordBootstrap(cmd, static_cast<std::uint32_t>(first), n, options.seed, timer);
         });
-        const std::vector<float> part = pass.bootstrapTargets(n);
-        targets.insert(targets.end(), part.begin(), part.end());
+        const std::vector<gpu::MltBootstrapSample> part = pass.bootstrapSamples(n);
+        bootstrap.insert(bootstrap.end(), part.begin(), part.end());
     }
-    TargetSums fresh;  // the targets of fresh states: the bootstrap's, then the large steps'
-    for (float t : targets) fresh.add(t);
-    stats.mlt.bootstrapEss = fresh.effectiveSampleSize();
+    // The target's divisors per image block (mlt_estimate.h), from the even bootstrap samples;
+    // the chains walk the divided target, which the bootstrap's targets are then divided by too.
+    const MltBlockNormaliser normaliser =
+        mltBlockNormaliser(bootstrap, std::uint32_t(width), std::uint32_t(height),
+                           static_cast<std::uint32_t>(options_.targetBlock), options_.targetExponent);
+    pass.setNormaliser(normaliser.block, normaliser.divisors);
+    std::vector<float> targets(bootstrap.size());
+    TargetSums bootstrapSums;  // every bootstrap sample's target: b' and the starts' ESS
+    TargetSums fresh;          // the fresh states that b̂ pools: the bootstrap's, then the large steps'
+    for (std::size_t i = 0; i < bootstrap.size(); ++i) {
+        targets[i] = bootstrap[i].target / normaliser.divisor(bootstrap[i].pixel, std::uint32_t(width));
+        bootstrapSums.add(targets[i]);
+        // With blocks, the samples the divisors were built from are left out of b̂.
+        if (normaliser.block == 0 || i % 2 == 1) fresh.add(targets[i]);
+    }
+    bootstrap = {};
+    stats.mlt.bootstrapEss = bootstrapSums.effectiveSampleSize();
     // b' of the splat weights (mlt.glsl): the bootstrap's b̂.
-    const auto misNormalisation = static_cast<float>(fresh.normalisation().b);
+    const auto misNormalisation = static_cast<float>(bootstrapSums.normalisation().b);
     pass.setMisNormalisation(misNormalisation);
     stats.mlt.chains = po.chains;
     stats.mlt.bootstrapSamples = targets.size();
@@ -272,6 +288,7 @@ void MltIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
                 {"mutations", m.mutations},
                 {"large_step_probability", options_.largeStep},
                 {"target_exponent", options_.targetExponent},
+                {"target_block", options_.targetBlock},
                 {"acceptance_small", rate(m.acceptedSmall, m.proposedSmall)},
                 {"acceptance_large", rate(m.acceptedLarge, m.proposedLarge)},
                 {"proposed_small", m.proposedSmall},

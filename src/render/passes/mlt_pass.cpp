@@ -19,8 +19,8 @@ constexpr std::uint32_t kItemsPerRow = 256;
 vk::KernelDesc mltDesc(const SceneSpec& scene, const vk::DeviceInfo& device, WorkgroupSize wg, bool baseOnly,
                        bool splitBounce) {
     const std::vector<std::uint32_t> extra = {
-        gpu::kBindCounters,     gpu::kBindMltChains, gpu::kBindMltPss,   gpu::kBindMltRecords,
-        gpu::kBindMltBootstrap, gpu::kBindMltStarts, gpu::kBindMltDirect};
+        gpu::kBindCounters,     gpu::kBindMltChains, gpu::kBindMltPss,    gpu::kBindMltRecords,
+        gpu::kBindMltBootstrap, gpu::kBindMltStarts, gpu::kBindMltDirect, gpu::kBindMltNormalise};
     vk::KernelDesc d = scene.kernelDesc(
         splitBounce ? GDPT_TRACING_KERNEL("mlt", mlt_split) : GDPT_TRACING_KERNEL("mlt", mlt), device, wg,
         extra, sizeof(gpu::MltParams));
@@ -49,6 +49,7 @@ MltPass::MltPass(const vk::Context& ctx, const SceneSpec& spec, WorkgroupSize wg
       starts_(ctx, std::uint64_t{options.chains} * sizeof(std::uint32_t), "mlt chain starts"),
       direct_(ctx, std::uint64_t{width_} * height_ * 4 * sizeof(float), "mlt direct"),
       bootstrap_(ctx, 0, "mlt bootstrap"),
+      normaliser_(ctx, 0, "mlt normaliser"),
       splitBounce_(!options.baseOnly && splitBounceFor(ctx.info(), options.splitBounce)),
       kernel_(ctx, mltDesc(spec, ctx.info(), wg, options.baseOnly, splitBounce_), creation) {
     GDPT_CHECK(options.chains > 0 && options.stepsPerBatch > 0);
@@ -59,6 +60,7 @@ MltPass::MltPass(const vk::Context& ctx, const SceneSpec& spec, WorkgroupSize wg
     kernel_.bind(gpu::kBindMltStarts, starts_);
     kernel_.bind(gpu::kBindMltDirect, direct_);
     kernel_.bind(gpu::kBindMltBootstrap, bootstrap_);
+    kernel_.bind(gpu::kBindMltNormalise, normaliser_);
     counters_.zero();
     chains_.zero();
 }
@@ -89,6 +91,8 @@ gpu::MltParams MltPass::params(std::uint32_t phase, std::uint32_t count, std::ui
     p.targetAlpha = options_.targetAlpha;
     p.targetExponent = options_.targetExponent;
     p.misNormalisation = misNormalisation_;
+    p.normaliseBlock = normaliseBlock_;
+    p.normaliseColumns = normaliseBlock_ ? (width_ + normaliseBlock_ - 1) / normaliseBlock_ : 0;
     return p;
 }
 
@@ -100,8 +104,9 @@ void MltPass::dispatchChains(VkCommandBuffer cmd, const gpu::MltParams& p, vk::G
 
 void MltPass::recordBootstrap(VkCommandBuffer cmd, std::uint32_t first, std::uint32_t count,
                               std::uint32_t seed, vk::GpuTimer* timer) {
-    if (bootstrap_.size() < std::uint64_t{count} * sizeof(float)) {
-        bootstrap_ = vk::Buffer(ctx_, std::uint64_t{count} * sizeof(float), "mlt bootstrap");
+    if (bootstrap_.size() < std::uint64_t{count} * sizeof(gpu::MltBootstrapSample)) {
+        bootstrap_ =
+            vk::Buffer(ctx_, std::uint64_t{count} * sizeof(gpu::MltBootstrapSample), "mlt bootstrap");
         kernel_.bind(gpu::kBindMltBootstrap, bootstrap_);
     }
     gpu::MltParams p = params(gpu::kMltPhaseBootstrap, count, seed);
@@ -109,8 +114,18 @@ void MltPass::recordBootstrap(VkCommandBuffer cmd, std::uint32_t first, std::uin
     dispatchChains(cmd, p, timer);
 }
 
-std::vector<float> MltPass::bootstrapTargets(std::uint32_t count) const {
-    return bootstrap_.downloadVector<float>(count);
+std::vector<gpu::MltBootstrapSample> MltPass::bootstrapSamples(std::uint32_t count) const {
+    return bootstrap_.downloadVector<gpu::MltBootstrapSample>(count);
+}
+
+void MltPass::setNormaliser(std::uint32_t block, const std::vector<float>& divisors) {
+    normaliseBlock_ = block;
+    if (block == 0) return;
+    const std::uint64_t columns = (width_ + block - 1) / block, rows = (height_ + block - 1) / block;
+    GDPT_CHECK(divisors.size() == columns * rows);
+    normaliser_ = vk::Buffer(ctx_, divisors.size() * sizeof(float), "mlt normaliser");
+    normaliser_.uploadVector(divisors);
+    kernel_.bind(gpu::kBindMltNormalise, normaliser_);
 }
 
 void MltPass::recordStart(VkCommandBuffer cmd, const std::vector<std::uint32_t>& starts, std::uint32_t seed,

@@ -56,8 +56,11 @@ public:
     // (capacity: the count of the first call, which allocates it).
     void recordBootstrap(VkCommandBuffer cmd, std::uint32_t first, std::uint32_t count, std::uint32_t seed,
                          vk::GpuTimer* timer);
-    // Their targets (after the fence).
-    [[nodiscard]] std::vector<float> bootstrapTargets(std::uint32_t count) const;
+    // Their targets and pixels (after the fence).
+    [[nodiscard]] std::vector<gpu::MltBootstrapSample> bootstrapSamples(std::uint32_t count) const;
+    // The divisors of the target per image block of `block` pixels square (row-major,
+    // ceil(width / block) per row), for the chains recorded after; block 0: none.
+    void setNormaliser(std::uint32_t block, const std::vector<float>& divisors);
     // Starts chain c at bootstrap sample starts[c] (starts.size() == chains).
     void recordStart(VkCommandBuffer cmd, const std::vector<std::uint32_t>& starts, std::uint32_t seed,
                      vk::GpuTimer* timer);
@@ -88,7 +91,8 @@ private:
     float misNormalisation_ = 0.0f;
     MltPassOptions options_;
     vk::Buffer counters_, chains_, pss_, records_, starts_, direct_;
-    vk::Buffer bootstrap_;
+    vk::Buffer bootstrap_, normaliser_;
+    std::uint32_t normaliseBlock_ = 0;
     std::vector<gpu::MltRecord> host_;
     bool splitBounce_;
     vk::Kernel kernel_;

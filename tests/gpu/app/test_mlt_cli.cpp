@@ -64,33 +64,42 @@ TEST_F(MltCli, JsonReportsChainsAcceptanceAndNormalisation) {
     }
 }
 
-// Left unset, --large-step, --target-exponent and --alpha are each method's own: pssmlt 0.5
-// and Kelemen's target (exponent 1); gmlt 0.7, its target to the power 0.25 and a primal weight
-// of 0.05 (bench/RESULTS.md, "G-MLT's large-step probability", "A tempered target for G-MLT's
-// chains", "G-MLT's primal weight"). Given, --target-exponent reaches the chains of both.
+// Left unset, --large-step, --target-exponent, --target-block and --alpha are each method's
+// own: pssmlt 0.5 and Kelemen's target (exponent 1, undivided); gmlt 0.7, its target to the
+// power 0.25 divided per block of 16 pixels, and a primal weight of 0.05 (bench/RESULTS.md,
+// "G-MLT's large-step probability", "A tempered target for G-MLT's chains", "G-MLT's target per
+// image block", "G-MLT's primal weight"). Given, --target-exponent and --target-block reach the
+// chains of both.
 TEST_F(MltCli, DefaultsAreEachMethodsOwn) {
-    for (const std::string method : {"pssmlt", "gmlt"}) {
+    // An 8 x 8 render of `method` with `flags`; its --json report.
+    const auto render = [&](const std::string& method, const std::string& flags, const std::string& tag) {
         const RunResult r =
-            runGdpt("render " + kScene + " --method " + method + " --width 8 --height 8 --spp 2 -o " +
-                    path(method + ".exr") + " --json " + path(method + ".json"));
-        ASSERT_EQ(r.code, 0) << r.output;
-        std::ifstream in(path(method + ".json"));
-        const nlohmann::json j = nlohmann::json::parse(in);
+            runGdpt("render " + kScene + " --method " + method + " --width 8 --height 8 --spp 2 " + flags +
+                    " -o " + path(method + tag + ".exr") + " --json " + path(method + tag + ".json"));
+        EXPECT_EQ(r.code, 0) << r.output;
+        std::ifstream in(path(method + tag + ".json"));
+        return nlohmann::json::parse(in);
+    };
+    for (const std::string method : {"pssmlt", "gmlt"}) {
+        const nlohmann::json j = render(method, "", "");
         EXPECT_FLOAT_EQ(j.at("mlt").at("large_step_probability").get<float>(),
                         method == "gmlt" ? 0.7f : 0.5f);
         EXPECT_FLOAT_EQ(j.at("mlt").at("target_exponent").get<float>(), method == "gmlt" ? 0.25f : 1.0f);
+        EXPECT_EQ(j.at("mlt").at("target_block").get<int>(), method == "gmlt" ? 16 : 0);
         if (method == "gmlt") {
             EXPECT_DOUBLE_EQ(j["reconstructions"][0].at("alpha").get<double>(), 0.05);
         }
         // The exponent given: reported, and the chains walk another target (other acceptances).
-        const RunResult given = runGdpt("render " + kScene + " --method " + method +
-                                        " --width 8 --height 8 --spp 2 --target-exponent 0.5 -o " +
-                                        path(method + "_g.exr") + " --json " + path(method + "_g.json"));
-        ASSERT_EQ(given.code, 0) << given.output;
-        std::ifstream inGiven(path(method + "_g.json"));
-        const nlohmann::json g = nlohmann::json::parse(inGiven);
+        const nlohmann::json g = render(method, "--target-exponent 0.5", "_g");
         EXPECT_FLOAT_EQ(g.at("mlt").at("target_exponent").get<float>(), 0.5f);
         EXPECT_NE(g.at("mlt").at("acceptance_small").get<double>(),
+                  j.at("mlt").at("acceptance_small").get<double>())
+            << method;
+        // Blocks of 4 pixels: four divisors on the 8 x 8 image (gmlt's 16 is one, a constant
+        // that changes no acceptance), so the chains walk another target.
+        const nlohmann::json b = render(method, "--target-block 4", "_b");
+        EXPECT_EQ(b.at("mlt").at("target_block").get<int>(), 4);
+        EXPECT_NE(b.at("mlt").at("acceptance_small").get<double>(),
                   j.at("mlt").at("acceptance_small").get<double>())
             << method;
     }

@@ -35,10 +35,20 @@ double target(double u, double v) {
     return 0.1 + std::exp(-((u - 0.3) * (u - 0.3) + (v - 0.6) * (v - 0.6)) / 0.02);
 }
 
-// The target a chain walks: `target` to the power `exponent` (mlt.glsl mltTemperedTarget; at
-// most 1.1 for every exponent in (0, 1], the rejection sampler's bound).
-double walked(double u, double v, float exponent) {
-    return gpu::mltTemperedTarget(static_cast<float>(target(u, v)), exponent);
+// The target a chain walks: `target` to the power `exponent` (mlt.glsl mltTemperedTarget),
+// divided, with `blocks`, by the divisor of the cell of a 3 x 3 grid that (u, v) lies in (as
+// mlt.comp divides by its image block's, mlt_estimate.h MltBlockNormaliser).
+struct Walk {
+    float exponent = 1.0f;
+    bool blocks = false;
+};
+constexpr std::array<double, 9> kBlockDivisors = {1.0, 2.5, 0.5, 1.5, 0.8, 3.0, 0.6, 1.2, 2.0};
+constexpr double kWalkedBound = 1.1 / 0.5;  // the largest walked target: the rejection sampler's bound
+
+double walked(double u, double v, Walk walk) {
+    const double t = gpu::mltTemperedTarget(static_cast<float>(target(u, v)), walk.exponent);
+    if (!walk.blocks) return t;
+    return t / kBlockDivisors[std::size_t(std::min(int(v * 3), 2) * 3 + std::min(int(u * 3), 2))];
 }
 
 constexpr int kCells = 10;      // 10 x 10 histogram
@@ -53,13 +63,13 @@ using Acceptance = std::function<float(float, float)>;
 // kLargeStep, else a small step of both coordinates).
 class AnalyticChains {
 public:
-    explicit AnalyticChains(std::uint32_t seed, float exponent) : gen_(seed), exponent_(exponent) {}
+    explicit AnalyticChains(std::uint32_t seed, Walk walk) : gen_(seed), walk_(walk) {}
     float uniform() { return uni_(gen_); }
     void start(float& u, float& v) {
         do {
             u = uniform();
             v = uniform();
-        } while (uniform() * 1.1f >= walked(u, v, exponent_));
+        } while (uniform() * kWalkedBound >= walked(u, v, walk_));
     }
     // The proposal from (u, v) into (pu, pv); true for a large step.
     bool propose(float u, float v, float& pu, float& pv) {
@@ -75,7 +85,7 @@ public:
 
 private:
     std::mt19937 gen_;
-    float exponent_;
+    Walk walk_;
     std::uniform_real_distribution<float> uni_{0.0f, 1.0f};
 };
 
@@ -86,19 +96,19 @@ struct Mutation {
     bool large;
 };
 
-// Walks `count` chains of `steps` mutations from exact starts on the target to the power
-// `exponent`: `step(m)` returns the acceptance probability of mutation m (and may splat it);
-// `end(u, v)` sees each final state.
+// Walks `count` chains of `steps` mutations from exact starts on the target `walk`:
+// `step(m)` returns the acceptance probability of mutation m (and may splat it); `end(u, v)`
+// sees each final state.
 template <class Step, class End>
-void walkChains(std::uint32_t seed, int count, int steps, float exponent, Step step, End end) {
-    AnalyticChains chains(seed, exponent);
+void walkChains(std::uint32_t seed, int count, int steps, Walk walk, Step step, End end) {
+    AnalyticChains chains(seed, walk);
     for (int c = 0; c < count; ++c) {
         Mutation m{};
         chains.start(m.u, m.v);
-        m.t = static_cast<float>(walked(m.u, m.v, exponent));
+        m.t = static_cast<float>(walked(m.u, m.v, walk));
         for (int s = 0; s < steps; ++s) {
             m.large = chains.propose(m.u, m.v, m.pu, m.pv);
-            m.tp = static_cast<float>(walked(m.pu, m.pv, exponent));
+            m.tp = static_cast<float>(walked(m.pu, m.pv, walk));
             if (chains.uniform() < step(m)) m.u = m.pu, m.v = m.pv, m.t = m.tp;
         }
         end(m.u, m.v);
@@ -108,7 +118,7 @@ void walkChains(std::uint32_t seed, int count, int steps, float exponent, Step s
 std::vector<double> finalStateHistogram(const Acceptance& accept, std::uint32_t seed) {
     std::vector<double> counts(kCells * kCells, 0.0);
     walkChains(
-        seed, kChains, kSteps, 1.0f, [&](const Mutation& m) { return accept(m.t, m.tp); },
+        seed, kChains, kSteps, Walk{}, [&](const Mutation& m) { return accept(m.t, m.tp); },
         [&](float u, float v) {
             counts[std::size_t(std::min(int(v * kCells), kCells - 1) * kCells +
                                std::min(int(u * kCells), kCells - 1))] += 1.0;
@@ -189,24 +199,24 @@ int quadrant(double u, double v) {
     return (v < 0.5 ? 0 : 2) + (u < 0.5 ? 0 : 1);
 }
 
-// ∫ target^exponent and the quadrants' ∫ carried, by a 400 x 400 midpoint rule (the hole's
-// and the band's edges lie on its cell boundaries).
-void exactIntegrals(double& b, std::array<double, 4>& q, float exponent = 1.0f) {
-    constexpr int kN = 400;
+// ∫ of the walked target and the quadrants' ∫ carried, by a 600 x 600 midpoint rule (the hole's,
+// the band's and the 3 x 3 grid's edges lie on its cell boundaries).
+void exactIntegrals(double& b, std::array<double, 4>& q, Walk walk = {}) {
+    constexpr int kN = 600;
     b = 0.0;
     q = {};
     for (int j = 0; j < kN; ++j)
         for (int i = 0; i < kN; ++i) {
             const double u = (i + 0.5) / kN, v = (j + 0.5) / kN;
-            b += walked(u, v, exponent) / (kN * kN);
+            b += walked(u, v, walk) / (kN * kN);
             q[std::size_t(quadrant(u, v))] += carried(u, v) / (kN * kN);
         }
 }
 
-// How a render's chains walk and weigh: the exponent of the target they walk, and that of the
-// target their splat weights divide by (the same, unless a test breaks it on purpose).
+// How a render's chains walk and weigh: the target they walk, and the target their splat
+// weights divide by (the same, unless a test breaks it on purpose).
 struct Tempering {
-    float walk = 1.0f, weigh = 1.0f;
+    Walk walk, weigh;
 };
 
 // One render of the quadrants: chains started from exact samples of the target, each
@@ -282,16 +292,72 @@ TEST(MltEstimate, TemperedTargetIsUnbiased) {
     constexpr float kExponent = 0.5f;
     double b = 0.0, bUntempered = 0.0;
     std::array<double, 4> exact{}, unused{};
-    exactIntegrals(b, exact, kExponent);
-    exactIntegrals(bUntempered, unused, 1.0f);
+    exactIntegrals(b, exact, Walk{kExponent});
+    exactIntegrals(bUntempered, unused, Walk{1.0f});
     const double threshold = test::twoSidedT(test::sidakAlpha(1e-3, 8), 29);
-    const Tempering tempered{kExponent, kExponent};
+    const Tempering tempered{{kExponent}, {kExponent}};
     EXPECT_LT(worstQuadrantT(b, static_cast<float>(b), true, exact, tempered), threshold) << "b' = b";
     EXPECT_LT(worstQuadrantT(b, static_cast<float>(1.5 * b), true, exact, tempered), threshold)
         << "b' = 1.5 b";
-    EXPECT_GT(worstQuadrantT(bUntempered, static_cast<float>(bUntempered), true, exact, {kExponent, 1.0f}),
+    EXPECT_GT(
+        worstQuadrantT(bUntempered, static_cast<float>(bUntempered), true, exact, {{kExponent}, {1.0f}}),
+        threshold)
+        << "the test has no power";
+}
+
+// gmlt's chains walk their tempered target divided by its image block's divisor
+// (MltBlockNormaliser): unbiased as long as the weights and b divide by the same. Power:
+// weights that leave the divisors out while the chains walk with them miss the quadrants.
+TEST(MltEstimate, BlockDividedTargetIsUnbiased) {
+    const Walk divided{0.25f, true}, undivided{0.25f, false};
+    double b = 0.0, bUndivided = 0.0;
+    std::array<double, 4> exact{}, unused{};
+    exactIntegrals(b, exact, divided);
+    exactIntegrals(bUndivided, unused, undivided);
+    const double threshold = test::twoSidedT(test::sidakAlpha(1e-3, 8), 29);
+    EXPECT_LT(worstQuadrantT(b, static_cast<float>(b), true, exact, {divided, divided}), threshold)
+        << "b' = b";
+    EXPECT_LT(worstQuadrantT(b, static_cast<float>(1.5 * b), true, exact, {divided, divided}), threshold)
+        << "b' = 1.5 b";
+    EXPECT_GT(worstQuadrantT(bUndivided, static_cast<float>(bUndivided), true, exact, {divided, undivided}),
               threshold)
         << "the test has no power";
+}
+
+// The divisors: per block the mean untempered target of the even-indexed samples in it plus
+// kMltBlockFloor times their mean over the image, to the power γ; odd samples left out.
+TEST(MltEstimate, BlockNormaliserIsTheBlocksMeanWithAFloor) {
+    // A 5 x 2 image in blocks of 2: 3 x 1 blocks (the last one column wide). Targets are T^0.5.
+    auto sample = [](float t, std::uint32_t x, std::uint32_t y) {
+        return gpu::MltBootstrapSample{std::sqrt(t), y * 5 + x};
+    };
+    const std::vector<gpu::MltBootstrapSample> samples = {
+        sample(4.0f, 0, 0), sample(1e6f, 0, 0),  // block 0; the odd one is not used
+        sample(2.0f, 1, 1), sample(1e6f, 4, 1),  // block 0
+        sample(0.0f, 2, 0), sample(1e6f, 4, 0),  // block 1: nothing found
+        sample(9.0f, 4, 1),                      // block 2
+    };
+    const MltBlockNormaliser n = mltBlockNormaliser(samples, 5, 2, 2, 0.5f);
+    ASSERT_EQ(n.block, 2u);
+    EXPECT_EQ(n.columns, 3u);
+    EXPECT_EQ(n.rows, 1u);
+    ASSERT_EQ(n.divisors.size(), 3u);
+    const double floor = kMltBlockFloor * (4.0 + 2.0 + 0.0 + 9.0) / 4.0;
+    EXPECT_NEAR(n.divisors[0], std::sqrt(3.0 + floor), 1e-5);
+    EXPECT_NEAR(n.divisors[1], std::sqrt(0.0 + floor), 1e-5);
+    EXPECT_NEAR(n.divisors[2], std::sqrt(9.0 + floor), 1e-5);
+    EXPECT_EQ(n.divisor(1 * 5 + 4, 5), n.divisors[2]);
+    EXPECT_EQ(n.divisor(0 * 5 + 3, 5), n.divisors[1]);
+    // Exponent 1: the means themselves (targets read as T).
+    const MltBlockNormaliser one = mltBlockNormaliser({{3.0f, 0}, {5.0f, 0}, {1.0f, 2}}, 4, 1, 2, 1.0f);
+    EXPECT_NEAR(one.divisors[0], 3.0 + kMltBlockFloor * 2.0, 1e-6);
+    EXPECT_NEAR(one.divisors[1], 1.0 + kMltBlockFloor * 2.0, 1e-6);
+    // Nothing found: every divisor 1. No blocks: no division.
+    const MltBlockNormaliser dark = mltBlockNormaliser({{0.0f, 0}, {7.0f, 1}}, 4, 1, 2, 0.25f);
+    EXPECT_EQ(dark.divisors, (std::vector<float>{1.0f, 1.0f}));
+    const MltBlockNormaliser none = mltBlockNormaliser(samples, 5, 2, 0, 0.5f);
+    EXPECT_EQ(none.block, 0u);
+    EXPECT_EQ(none.divisor(3, 5), 1.0f);
 }
 
 TEST(MltChain, TemperedTargetIsTheIdentityAtOneAndKeepsZero) {
