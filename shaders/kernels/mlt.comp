@@ -163,7 +163,7 @@ Evaluated evaluate(uint stream, uint fresh, inout uint rays, inout uint nan) {
         kBaseOnly ? luminance(central) : gmltTarget(gradientAbs, central, neighborSum, frame.targetAlpha),
         frame.targetExponent);
     if (frame.normaliseBlock > 0u && frame.phase != kMltPhaseBootstrap)
-        e.target /= normaliser[(py / frame.normaliseBlock) * frame.normaliseColumns + px / frame.normaliseBlock];
+        e.target /= normaliser[mltBlockIndex(px, py, frame.normaliseBlock, frame.normaliseColumns)];
     // pixel_stats.glsl's policy: a non-finite sample counts as zero, in every quantity.
     if (!finite || !isFinite(e.target)) {
         nan++;

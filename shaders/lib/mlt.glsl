@@ -96,6 +96,13 @@ GDPT_INLINE float mltTemperedTarget(float t, float exponent) {
     return t > 0.0f ? pow(t, exponent) : 0.0f;
 }
 
+// Index of the image block (`block` pixels square, `columns` per row, row major) that pixel
+// (x, y) lies in: the entry of the target's divisor (mlt.comp, mlt_estimate.h
+// MltBlockNormaliser).
+GDPT_INLINE uint mltBlockIndex(uint x, uint y, uint block, uint columns) {
+    return (y / block) * columns + x / block;
+}
+
 GDPT_NAMESPACE_END
 
 #endif  // GDPT_LIB_MLT

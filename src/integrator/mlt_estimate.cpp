@@ -73,8 +73,7 @@ std::vector<std::uint32_t> mltChainStarts(const std::vector<float>& targets, std
 
 float MltBlockNormaliser::divisor(std::uint32_t pixel, std::uint32_t width) const {
     if (block == 0) return 1.0f;
-    const std::uint32_t x = pixel % width, y = pixel / width;
-    return divisors[std::size_t(y / block) * columns + x / block];
+    return divisors[gpu::mltBlockIndex(pixel % width, pixel / width, block, columns)];
 }
 
 MltBlockNormaliser mltBlockNormaliser(const std::vector<gpu::MltBootstrapSample>& samples,
@@ -97,7 +96,7 @@ MltBlockNormaliser mltBlockNormaliser(const std::vector<gpu::MltBootstrapSample>
             std::isfinite(s.target) && s.target > 0.0f
                 ? (exponent == 1.0f ? double(s.target) : std::pow(double(s.target), 1.0 / exponent))
                 : 0.0;
-        const std::size_t k = std::size_t((s.pixel / width) / block) * n.columns + (s.pixel % width) / block;
+        const std::uint32_t k = gpu::mltBlockIndex(s.pixel % width, s.pixel / width, block, n.columns);
         sum[k] += t;
         count[k] += 1.0;
         total += t;

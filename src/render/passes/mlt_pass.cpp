@@ -92,7 +92,7 @@ gpu::MltParams MltPass::params(std::uint32_t phase, std::uint32_t count, std::ui
     p.targetExponent = options_.targetExponent;
     p.misNormalisation = misNormalisation_;
     p.normaliseBlock = normaliseBlock_;
-    p.normaliseColumns = normaliseBlock_ ? (width_ + normaliseBlock_ - 1) / normaliseBlock_ : 0;
+    p.normaliseColumns = normaliseColumns_;
     return p;
 }
 
@@ -120,9 +120,10 @@ std::vector<gpu::MltBootstrapSample> MltPass::bootstrapSamples(std::uint32_t cou
 
 void MltPass::setNormaliser(std::uint32_t block, const std::vector<float>& divisors) {
     normaliseBlock_ = block;
+    normaliseColumns_ = block ? (width_ + block - 1) / block : 0;
     if (block == 0) return;
-    const std::uint64_t columns = (width_ + block - 1) / block, rows = (height_ + block - 1) / block;
-    GDPT_CHECK(divisors.size() == columns * rows);
+    const std::uint64_t rows = (height_ + block - 1) / block;
+    GDPT_CHECK(divisors.size() == normaliseColumns_ * rows);
     normaliser_ = vk::Buffer(ctx_, divisors.size() * sizeof(float), "mlt normaliser");
     normaliser_.uploadVector(divisors);
     kernel_.bind(gpu::kBindMltNormalise, normaliser_);

@@ -92,7 +92,7 @@ private:
     MltPassOptions options_;
     vk::Buffer counters_, chains_, pss_, records_, starts_, direct_;
     vk::Buffer bootstrap_, normaliser_;
-    std::uint32_t normaliseBlock_ = 0;
+    std::uint32_t normaliseBlock_ = 0, normaliseColumns_ = 0;  // setNormaliser's blocks
     std::vector<gpu::MltRecord> host_;
     bool splitBounce_;
     vk::Kernel kernel_;
