@@ -423,7 +423,8 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->check(CLI::Range(0u, 1023u))
         ->group(sampling);
     r->add_option("--emitter-supersampling", a.emitterSupersampling,
-                  "Rays per camera sample for directly seen emission at the edges of lights (0 = off)")
+                  "Rays per camera sample for directly seen emission at the edges of lights (pt, gpt; pssmlt "
+                  "and gmlt per camera sample of their very-direct image; 0 = off)")
         ->capture_default_str()
         ->check(CLI::Range(0u, kMaxEmitterSupersampling))
         ->group(sampling);

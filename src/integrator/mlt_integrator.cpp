@@ -88,6 +88,7 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     po.largeStep = options_.largeStep;
     po.targetAlpha = options_.targetAlpha;
     po.targetExponent = options_.targetExponent;
+    po.emitterSupersampling = options.emitterSupersampling;
     po.splitBounce = options_.splitBounce;
     SceneSpec spec(scene, options.scene);
     MltPass pass(ctx, spec, options.workgroup, po, vk::PipelineCreation::Background);
@@ -255,6 +256,10 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     }
     Image direct = pass.directImage();
     stats.readbackMs = readback.ms();
+    const gpu::VisibleCounter visible = pass.emitterSupersampling().report();
+    stats.emitterSupersampling = pass.emitterSupersampling().samplesPerSpp();
+    stats.emitterRaysPerSample = visible.raysPerSample;
+    stats.emitterSupersampledPixels = visible.refinedPixels;
     if (!gradients()) {
         Image primal = acc.quantity(gpu::kMltCentral, scale);
         out.layers.push_back({"", gptFinal(primal, nullptr, &direct)});

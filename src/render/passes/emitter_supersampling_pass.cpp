@@ -142,6 +142,14 @@ void EmitterSupersamplingPass::addTo(Image* mean, Image* varianceOfMean) const {
     }
 }
 
+void EmitterSupersamplingPass::replaceIn(Image& image) const {
+    if (!enabled()) return;
+    const auto stats = downloadStats();
+    for (std::size_t i = 0; i < stats.size(); ++i)
+        if (stats[i].count > 0)
+            for (int c = 0; c < 3; ++c) image.plane(c)[i] = stats[i].mean[c];
+}
+
 gpu::VisibleCounter EmitterSupersamplingPass::report() const {
     gpu::VisibleCounter c{};
     if (enabled() && probed_) counter_.download(&c, sizeof c);

@@ -60,6 +60,9 @@ public:
     // Adds the supersampled estimate's mean to `mean` and its variance of the mean to
     // `varianceOfMean` (either may be null) in the refined pixels (after the fence).
     void addTo(Image* mean, Image* varianceOfMean) const;
+    // Sets `image` to the supersampled estimate's mean in the refined pixels (after the fence):
+    // for a caller whose own estimate of the term covers every pixel (mlt_pass.h).
+    void replaceIn(Image& image) const;
     // Refined pixels of the current probe and the rays per camera sample they get (the
     // factor, less where the ray budget cut it), after the fence of a record(); 0 before.
     [[nodiscard]] gpu::VisibleCounter report() const;

@@ -51,7 +51,8 @@ MltPass::MltPass(const vk::Context& ctx, const SceneSpec& spec, WorkgroupSize wg
       bootstrap_(ctx, 0, "mlt bootstrap"),
       normaliser_(ctx, 0, "mlt normaliser"),
       splitBounce_(!options.baseOnly && splitBounceFor(ctx.info(), options.splitBounce)),
-      kernel_(ctx, mltDesc(spec, ctx.info(), wg, options.baseOnly, splitBounce_), creation) {
+      kernel_(ctx, mltDesc(spec, ctx.info(), wg, options.baseOnly, splitBounce_), creation),
+      visible_(ctx, spec, wg, options.emitterSupersampling, counters_, creation) {
     GDPT_CHECK(options.chains > 0 && options.stepsPerBatch > 0);
     kernel_.bind(gpu::kBindCounters, counters_);
     kernel_.bind(gpu::kBindMltChains, chains_);
@@ -67,10 +68,11 @@ MltPass::MltPass(const vk::Context& ctx, const SceneSpec& spec, WorkgroupSize wg
 
 void MltPass::attach(const SceneGpu& scene) {
     scene.bindTo(kernel_);
+    visible_.attach(scene);
 }
 
 double MltPass::waitForPipelines() const {
-    return kernel_.wait();
+    return kernel_.wait() + visible_.waitForPipeline();
 }
 
 void MltPass::recordWarmUp(VkCommandBuffer cmd) const {
@@ -156,6 +158,7 @@ const gpu::MltRecord* MltPass::records(std::uint32_t steps) {
 
 void MltPass::recordDirect(VkCommandBuffer cmd, std::uint32_t samples, std::uint32_t seed,
                            vk::GpuTimer* timer) {
+    visible_.record(cmd, 0, samples, seed, timer);
     // Rows per dispatch: about 2^18 pixel-samples each (no dispatch long enough for a watchdog).
     const std::uint64_t perRow = std::uint64_t{width_} * std::max(samples, 1u);
     const auto rowsPer =
@@ -175,6 +178,9 @@ Image MltPass::directImage() const {
     Image out(static_cast<int>(width_), static_cast<int>(height_));
     for (std::size_t i = 0; i < n; ++i)
         for (int c = 0; c < 3; ++c) out.plane(c)[i] = v[4 * i + static_cast<std::size_t>(c)];
+    // The rim pixels' estimate from their own, independent rays (chosen by the probe's rays only,
+    // so unbiased; emitter_supersampling.comp) replaces the direct phase's there.
+    visible_.replaceIn(out);
     return out;
 }
 

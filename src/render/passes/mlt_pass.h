@@ -9,6 +9,7 @@
 #include "image/image.h"
 #include "mlt_shared.h"
 #include "render/device_scene/scene_gpu.h"
+#include "render/passes/emitter_supersampling_pass.h"
 #include "render/passes/gpt_pass.h"
 #include "vk/buffer.h"
 #include "vk/kernel.h"
@@ -28,6 +29,9 @@ struct MltPassOptions {
     float largeStep = 0.5f;           // probability of a large step
     float targetAlpha = 0.25f;        // G-MLT: weight of the primal term of the target
     float targetExponent = 1.0f;      // the target walked is the method's to this power
+    // Rays per camera sample of the very-direct image in the pixels where the emission the camera
+    // sees changes (emitter supersampling, emitter_supersampling_pass.h); 0: off.
+    std::uint32_t emitterSupersampling = kDefaultEmitterSupersampling;
     // G-MLT: the sample's split bounce loop (mlt.comp's mlt_split build, as gpt_split; the same
     // values either way). PSSMLT traces the path tracer's path and has no such loop.
     GptPassOptions::SplitBounce splitBounce = GptPassOptions::SplitBounce::Auto;
@@ -71,9 +75,14 @@ public:
                          vk::GpuTimer* timer);
     // The records of the last batch of `steps` steps, in step then chain order (after the fence).
     [[nodiscard]] const gpu::MltRecord* records(std::uint32_t steps);
-    // The very-direct image, `samples` stratified camera samples per pixel.
+    // The very-direct image, `samples` stratified camera samples per pixel; in the pixels
+    // where the emission changes within their neighbourhood (an emitter's rim), `samples`
+    // camera samples of emitterSupersampling rays each instead (PT's and G-PT's emitter
+    // supersampling).
     void recordDirect(VkCommandBuffer cmd, std::uint32_t samples, std::uint32_t seed, vk::GpuTimer* timer);
     [[nodiscard]] Image directImage() const;
+    // The emitter supersampling of the very-direct image (its report, after recordDirect's fence).
+    [[nodiscard]] const EmitterSupersamplingPass& emitterSupersampling() const { return visible_; }
     [[nodiscard]] MltAcceptance acceptance() const;
     // Reads the counters written since the last call and clears them (after the fence).
     gpu::Counters takeCounters();
@@ -96,6 +105,7 @@ private:
     std::vector<gpu::MltRecord> host_;
     bool splitBounce_;
     vk::Kernel kernel_;
+    EmitterSupersamplingPass visible_;
 };
 
 }  // namespace gdpt

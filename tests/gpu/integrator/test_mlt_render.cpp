@@ -113,6 +113,69 @@ TEST_F(MltRender, CornellBoxQuadrantsMatchThePathTracer) {
     }
 }
 
+// The very-direct image (the emission the camera sees, which the chains leave out) takes PT's
+// and G-PT's emitter supersampling at the light's rim: there the pixels get their direct
+// phase's 16 camera samples of k rays each from the supersampling pass instead of 16 rays
+// (k = 16 at 64², fewer on smaller images, where the pass's ray budget cuts it). Over 10 seeds each (pssmlt:
+// the same direct phase as gmlt's, cheaper chains), in the rim pixels (those whose direct value
+// varies between the renders without it): the mean with the supersampling matches the mean
+// without (Welch's t, both unbiased), its seed-to-seed variance is far below (k times the rays:
+// about 1/k of it; the test asks for less than 1/4, which with 9 degrees of freedom per rim
+// pixel and a few dozen pixels an F statistic misses by chance with a probability far below
+// 1e-3), and the power check: a mean 5 % off is rejected.
+TEST_F(MltRender, VeryDirectLightIsSupersampledAtTheLightsRim) {
+    const Scene scene = loadGltf(std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.gltf");
+    constexpr int kSize = 64;
+    std::unique_ptr<Integrator> pssmlt = makeIntegrator("pssmlt");
+    std::vector<Image> on, off;
+    for (int s = 0; s < kSeeds; ++s) {
+        RenderOptions o = renderOptions(kSize, kSize, 1, 300 + s);
+        const RenderOutput a = pssmlt->render(ctx(), scene, o);
+        EXPECT_GT(a.stats.emitterSupersampledPixels, 0u);
+        // The pass's ray budget (a quarter ray per pixel and camera sample) may cut the 16.
+        EXPECT_GE(a.stats.emitterRaysPerSample, 8u);
+        on.push_back(a.layer("direct"));
+        o.emitterSupersampling = 0;
+        const RenderOutput b = pssmlt->render(ctx(), scene, o);
+        EXPECT_EQ(b.stats.emitterSupersampledPixels, 0u);
+        off.push_back(b.layer("direct"));
+    }
+    std::vector<std::size_t> rim;
+    for (std::size_t p = 0; p < std::size_t(kSize * kSize); ++p)
+        for (int s = 1; s < kSeeds; ++s)
+            if (off[std::size_t(s)].plane(1)[p] != off[0].plane(1)[p]) {
+                rim.push_back(p);
+                break;
+            }
+    ASSERT_GE(rim.size(), 12u) << "the light's rim";
+    // Per seed the rim's mean; per pixel the variance over seeds, summed.
+    std::vector<double> meanOn, meanOff;
+    double varOn = 0.0, varOff = 0.0;
+    for (int s = 0; s < kSeeds; ++s) {
+        double a = 0.0, b = 0.0;
+        for (std::size_t p : rim) a += on[std::size_t(s)].plane(1)[p], b += off[std::size_t(s)].plane(1)[p];
+        meanOn.push_back(a / double(rim.size()));
+        meanOff.push_back(b / double(rim.size()));
+    }
+    for (std::size_t p : rim) {
+        double a = 0.0, a2 = 0.0, b = 0.0, b2 = 0.0;
+        for (int s = 0; s < kSeeds; ++s) {
+            const double x = on[std::size_t(s)].plane(1)[p], y = off[std::size_t(s)].plane(1)[p];
+            a += x, a2 += x * x, b += y, b2 += y * y;
+        }
+        varOn += (a2 - a * a / kSeeds) / (kSeeds - 1);
+        varOff += (b2 - b * b / kSeeds) / (kSeeds - 1);
+    }
+    EXPECT_LT(4.0 * varOn, varOff) << rim.size() << " rim pixels";
+    double mOff = 0.0, vOff = 0.0;
+    for (double m : meanOff) mOff += m / kSeeds;
+    for (double m : meanOff) vOff += (m - mOff) * (m - mOff) / (kSeeds - 1);
+    const double seOff = std::sqrt(vOff / kSeeds);
+    const double threshold = test::twoSidedT(test::sidakAlpha(1e-3, 1), kSeeds - 1);
+    EXPECT_LT(std::abs(tStatistic(meanOn, mOff, seOff)), threshold) << "rim mean " << mOff;
+    EXPECT_GT(std::abs(tStatistic(meanOn, 1.05 * mOff, seOff)), threshold) << "the test has no power";
+}
+
 // gmlt's kernel in the split bounce loop build (mlt_split: G-PT's sample with its bounces after
 // every offset reconnected run without the code for offsets with vertices of their own, and the
 // fan, beams and bundles of gpt_split) is a schedule of the same sample: the same bits as the
