@@ -38,15 +38,24 @@ double regionMean(const Image& im, int c, int x0, int y0, int x1, int y1) {
     return s / double((x1 - x0) * (y1 - y0));
 }
 
+// The mean of `samples` (one per seed), their sample variance and the mean's standard error.
+struct SampleMean {
+    double mean = 0.0, variance = 0.0, standardError = 0.0;
+};
+SampleMean sampleMean(const std::vector<double>& samples) {
+    SampleMean m;
+    for (double s : samples) m.mean += s;
+    m.mean /= double(samples.size());
+    for (double s : samples) m.variance += (s - m.mean) * (s - m.mean);
+    m.variance /= double(samples.size() - 1);
+    m.standardError = std::sqrt(m.variance / double(samples.size()));
+    return m;
+}
+
 // The t statistic of `samples` (one per seed) against `expected` ± expectedSe.
 double tStatistic(const std::vector<double>& samples, double expected, double expectedSe) {
-    double mean = 0.0;
-    for (double s : samples) mean += s;
-    mean /= double(samples.size());
-    double var = 0.0;
-    for (double s : samples) var += (s - mean) * (s - mean);
-    var /= double(samples.size() - 1);
-    return (mean - expected) / std::sqrt(var / double(samples.size()) + expectedSe * expectedSe);
+    const SampleMean m = sampleMean(samples);
+    return (m.mean - expected) / std::sqrt(m.standardError * m.standardError + expectedSe * expectedSe);
 }
 
 // The layer that holds the method's splatted estimate: pssmlt's final image, gmlt's primal
@@ -158,22 +167,21 @@ TEST_F(MltRender, VeryDirectLightIsSupersampledAtTheLightsRim) {
         meanOff.push_back(b / double(rim.size()));
     }
     for (std::size_t p : rim) {
-        double a = 0.0, a2 = 0.0, b = 0.0, b2 = 0.0;
+        std::vector<double> a, b;
         for (int s = 0; s < kSeeds; ++s) {
-            const double x = on[std::size_t(s)].plane(1)[p], y = off[std::size_t(s)].plane(1)[p];
-            a += x, a2 += x * x, b += y, b2 += y * y;
+            a.push_back(on[std::size_t(s)].plane(1)[p]);
+            b.push_back(off[std::size_t(s)].plane(1)[p]);
         }
-        varOn += (a2 - a * a / kSeeds) / (kSeeds - 1);
-        varOff += (b2 - b * b / kSeeds) / (kSeeds - 1);
+        varOn += sampleMean(a).variance;
+        varOff += sampleMean(b).variance;
     }
     EXPECT_LT(4.0 * varOn, varOff) << rim.size() << " rim pixels";
-    double mOff = 0.0, vOff = 0.0;
-    for (double m : meanOff) mOff += m / kSeeds;
-    for (double m : meanOff) vOff += (m - mOff) * (m - mOff) / (kSeeds - 1);
-    const double seOff = std::sqrt(vOff / kSeeds);
+    const SampleMean without = sampleMean(meanOff);
     const double threshold = test::twoSidedT(test::sidakAlpha(1e-3, 1), kSeeds - 1);
-    EXPECT_LT(std::abs(tStatistic(meanOn, mOff, seOff)), threshold) << "rim mean " << mOff;
-    EXPECT_GT(std::abs(tStatistic(meanOn, 1.05 * mOff, seOff)), threshold) << "the test has no power";
+    EXPECT_LT(std::abs(tStatistic(meanOn, without.mean, without.standardError)), threshold)
+        << "rim mean " << without.mean;
+    EXPECT_GT(std::abs(tStatistic(meanOn, 1.05 * without.mean, without.standardError)), threshold)
+        << "the test has no power";
 }
 
 // gmlt's kernel in the split bounce loop build (mlt_split: G-PT's sample with its bounces after
