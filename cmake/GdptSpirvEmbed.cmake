@@ -7,8 +7,11 @@
 #    lavapipe's vkCreateComputePipelines spends its time lowering that in NIR, on one core, and
 #    at a 4 s budget that time is the render's (bench/RESULTS.md, spirv-opt: gpt_split
 #    0.75 s -> 0.40 s, the kernel runs as fast; Mesa 25 runs it ~12 % slower, hence both
-#    variants). Specialisation constants stay constants. No -O: its extra passes made the
-#    G-PT kernel run 4 % slower on lavapipe 22.3.
+#    variants). Then the loops marked [[unroll]] (those over the four offsets) are unrolled and
+#    their arrays split into scalars, which lavapipe 22.3 would otherwise do itself, one nesting
+#    level per round of its optimisation loop over the whole kernel (bench/RESULTS.md, "Offset
+#    loops unrolled before the driver"). Specialisation constants stay constants. No -O: its
+#    extra passes made the G-PT kernel run 4 % slower on lavapipe 22.3.
 # 3. Embed the words as `const uint32_t NAME[]` (glslang's) and `NAME_opt[]` (spirv-opt's; the
 #    same words without SPIRV_OPT) in OUT; vk::useOptimizedSpirv picks one per device.
 string(REPLACE "|" ";" FLAGS "${FLAGS}")
@@ -33,6 +36,9 @@ if(SPIRV_OPT)
             --scalar-replacement=100 --eliminate-local-single-block --eliminate-local-single-store
             --ssa-rewrite --copy-propagate-arrays --eliminate-dead-code-aggressive
             --simplify-instructions --eliminate-dead-inserts
+            --eliminate-dead-branches --merge-blocks --loop-unroll
+            --scalar-replacement=100 --ssa-rewrite --copy-propagate-arrays
+            --eliminate-dead-code-aggressive --simplify-instructions --eliminate-dead-inserts
             ${raw} -o ${opt}
     RESULT_VARIABLE rc OUTPUT_VARIABLE log ERROR_VARIABLE log)
   # spirv-opt warns about every call it leaves (functions with an early return); lavapipe

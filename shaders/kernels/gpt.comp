@@ -41,6 +41,7 @@
 #version 460
 #extension GL_EXT_scalar_block_layout : require
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 
 #include "gpt_shared.h"
 #include "lib/common.glsl"
@@ -146,7 +147,7 @@ void main() {
     uint pixel = y * scene.width + x;
 
     Welford acc[kAccCount];
-    for (uint k = 0u; k < kAccCount; ++k) acc[k] = welfordInit();
+    [[unroll]] for (uint k = 0u; k < kAccCount; ++k) acc[k] = welfordInit();
     Welford accModulation = welfordInit();  // kDemodulate only
     uint n = 0u;
     uint rays = 0u;
@@ -171,7 +172,7 @@ void main() {
     vec4 countRatio = vec4(1.0);
     if (frame.sampleRates != 0u) {
         float own = float(sampleRate[pixel]);
-        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+        [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) {
             if (gptPairExists(x, y, i)) countRatio[i] = float(sampleRate[gptPairPixel(x, y, i)]) / own;
         }
     }
@@ -184,18 +185,18 @@ void main() {
         traceSample(lds, rng, vec2(x, y) + jitter, x, y, countDirect, countRatio, rays, direct, baseModulation,
                     offs);
         if (kDemodulate) {
-            for (uint i = 0u; i < kGptNumOffsets; ++i) {
+            [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) {
                 offs[i].baseSum /= baseModulation;
                 offs[i].offSum /= offs[i].modulation;
             }
         }
-        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+        [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) {
             shiftPairs += offs[i].shifted ? 1u : 0u;
             shiftFailures += offs[i].shifted && !offs[i].alive ? 1u : 0u;
         }
         vec3 central = vec3(0.0);
         bool finite = isFinite(direct);
-        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+        [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) {
             central += offs[i].baseSum;
             finite = finite && isFinite(offs[i].baseSum) && isFinite(offs[i].offSum);
         }
@@ -205,7 +206,7 @@ void main() {
         // quantity makes every quantity of it zero, so the pairs stay consistent.
         if (!finite) nan++;
         welfordAdd(acc[kAccCentral], statsSample(central, finite), n);
-        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+        [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) {
             welfordAdd(acc[kAccNeighbor + i], statsSample(offs[i].offSum, finite), n);
             welfordAdd(acc[kAccGradient + i], statsSample(offs[i].offSum - offs[i].baseSum, finite), n);
         }

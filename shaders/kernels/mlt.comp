@@ -25,6 +25,7 @@
 #version 460
 #extension GL_EXT_scalar_block_layout : require
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 
 #include "mlt_shared.h"
 #include "lib/common.glsl"
@@ -134,7 +135,7 @@ Evaluated evaluate(uint stream, uint fresh, inout uint rays, inout uint nan) {
     vec3 central = vec3(0.0), neighborSum = vec3(0.0);
     float gradientAbs = 0.0;
     bool finite = true;
-    for (uint k = 0u; k < kMltValues; ++k) e.value[k] = vec3(0.0);
+    [[unroll]] for (uint k = 0u; k < kMltValues; ++k) e.value[k] = vec3(0.0);
     gPssActive = true;
     if (kBaseOnly) {
         PathState path = ptBeginAt(e.pixel, e.film, rng, lds);
@@ -148,7 +149,7 @@ Evaluated evaluate(uint stream, uint fresh, inout uint rays, inout uint nan) {
         // Every film position is one chain's: no pixel counts differ, the pairs weigh both ends
         // alike.
         traceSample(lds, rng, e.film, px, py, false, vec4(1.0), rays, direct, baseModulation, offs);
-        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+        [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) {
             central += offs[i].baseSum;
             neighborSum += offs[i].offSum;
             e.value[kMltNeighbor + i] = offs[i].offSum;
@@ -168,7 +169,7 @@ Evaluated evaluate(uint stream, uint fresh, inout uint rays, inout uint nan) {
     if (!finite || !isFinite(e.target)) {
         nan++;
         e.target = 0.0;
-        for (uint k = 0u; k < kMltValues; ++k) e.value[k] = vec3(0.0);
+        [[unroll]] for (uint k = 0u; k < kMltValues; ++k) e.value[k] = vec3(0.0);
     }
     return e;
 }
@@ -184,7 +185,7 @@ void storeChain(uint c, Evaluated e) {
     chains[c].film = e.film;
     chains[c].pixel = e.pixel;
     chains[c].target = e.target;
-    for (uint k = 0u; k < kMltValues; ++k) chains[c].value[k] = e.value[k];
+    [[unroll]] for (uint k = 0u; k < kMltValues; ++k) chains[c].value[k] = e.value[k];
     for (uint k = 0u; k < kMltPssDims; ++k) pss[c * kMltPssDims + k] = gPss[k];
 }
 
@@ -194,7 +195,7 @@ void writeRecord(uint at, uint pixel, float weight, float largeTarget, vec3 valu
     records[at].largeTarget = largeTarget;
     // A large step's proposal is splatted by the host even with no Metropolis share.
     bool splatted = weight > 0.0 || largeTarget > 0.0;
-    for (uint k = 0u; k < kMltValues; ++k) records[at].value[k] = splatted ? value[k] : vec3(0.0);
+    [[unroll]] for (uint k = 0u; k < kMltValues; ++k) records[at].value[k] = splatted ? value[k] : vec3(0.0);
 }
 
 // Draws chain c's proposal into gPss: a large step (fresh decisions) or a small step of

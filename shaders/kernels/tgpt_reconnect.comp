@@ -30,6 +30,7 @@
 #version 460
 #extension GL_EXT_scalar_block_layout : require
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 
 #define GDPT_TWO_FRAMES
 #include "gdpt_shared.h"

@@ -352,12 +352,13 @@ layout(constant_id = kSpecBvhRegisterStack) const uint kBvhRegisterStack = 0u;
 // traceAny's order: the first inner child hit (slot order) becomes `next`, the others are
 // pushed (order does not change an occlusion answer).
 #define GDPT_BVH_ANY_ORDER(n, h, count, next)                     \
-    for (uint j = 0u; j < 4u; ++j) {                              \
-        if (!((h)[j] && (count)[j] == 0u)) continue;              \
-        if ((next) == kInvalidIndex) {                            \
-            (next) = (n).child[j];                                \
-        } else {                                                  \
-            GDPT_BVH_STACK_PUSH((n).child[j], 0.0f);              \
+    [[unroll]] for (uint j = 0u; j < 4u; ++j) {                   \
+        if ((h)[j] && (count)[j] == 0u) {                         \
+            if ((next) == kInvalidIndex) {                        \
+                (next) = (n).child[j];                            \
+            } else {                                              \
+                GDPT_BVH_STACK_PUSH((n).child[j], 0.0f);          \
+            }                                                     \
         }                                                         \
     }
 
@@ -805,10 +806,11 @@ void bvhRootBounds(out vec3 lo, out vec3 hi) {
     vec4 loZ = wideDecodeAxis(n.origin.z, n.qMin.z, sz), hiZ = wideDecodeAxis(n.origin.z, n.qMax.z, sz);
     lo = vec3(kBvhInfinity);
     hi = vec3(-kBvhInfinity);
-    for (uint j = 0u; j < 4u; ++j) {
-        if (n.child[j] == kInvalidIndex) continue;
-        lo = min(lo, vec3(loX[j], loY[j], loZ[j]));
-        hi = max(hi, vec3(hiX[j], hiY[j], hiZ[j]));
+    [[unroll]] for (uint j = 0u; j < 4u; ++j) {
+        if (n.child[j] != kInvalidIndex) {
+            lo = min(lo, vec3(loX[j], loY[j], loZ[j]));
+            hi = max(hi, vec3(hiX[j], hiY[j], hiZ[j]));
+        }
     }
 }
 

@@ -28,7 +28,7 @@
     // One-sided back faces absorb: the base path ends; an offset there cannot continue
     // (its reverse shift does not exist), so its pair falls back to the base alone.
     if (oneSidedBack(sh)) { pathEnded = true; break; }
-    for (uint i = 0u; i < kGptNumOffsets; ++i) {
+    [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) {
         if (offs[i].alive && ownVertex(offs[i], GDPT_GPT_GENERAL) && oneSidedBack(offs[i].hit))
             offs[i].alive = false;
     }
@@ -42,7 +42,7 @@
     bool baseCurRough = roughAll(bsdf);
     OffsetVertex offV[kGptNumOffsets];
     bool lightStrategy[kGptNumOffsets];
-    for (uint i = 0u; i < kGptNumOffsets; ++i) {
+    [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) {
         bool own = offs[i].alive && ownVertex(offs[i], GDPT_GPT_GENERAL);
         offV[i] = gptOffsetVertex(offs[i], own, bsdf, t, b, sh.ns);
         lightStrategy[i] = gptPairHasLightStrategy(own, offV[i].bsdf, baseCurRough);
@@ -57,7 +57,7 @@
         PairNee pairNee[kGptNumOffsets];
         vec3 neeOrigin[4];
         bvec4 neeTrace = bvec4(false);
-        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+        [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) {
             bool own = offs[i].alive && ownVertex(offs[i], GDPT_GPT_GENERAL);
             pairNee[i] = gptPairNeeBegin(offs[i], offV[i], own, lightStrategy[i], nee, bsdf, sh.p);
             neeOrigin[i] = pairNee[i].origin;
@@ -70,17 +70,18 @@
             neeOccluded =
                 traceAnyBeam(beamTowards(neeOrigin[0], neeOrigin[1], neeOrigin[2], neeOrigin[3], neeTrace, nee.ls.pLight));
 #endif
-        for (uint i = 0u; i < kGptNumOffsets; ++i) {
-            if (!gptPairCounted(px, py, i)) continue;
+        GDPT_UNROLL_UNLESS_TRACING for (uint i = 0u; i < kGptNumOffsets; ++i) {
+            if (gptPairCounted(px, py, i)) {
 #ifdef GDPT_GPT_BEAMS
-            OffsetNee on = gptPairNeeEnd(offs[i], pairNee[i], nee, neeOccluded[i], rays);
+                OffsetNee on = gptPairNeeEnd(offs[i], pairNee[i], nee, neeOccluded[i], rays);
 #else
-            bool own = offs[i].alive && ownVertex(offs[i], GDPT_GPT_GENERAL);
-            OffsetNee on = gptPairNee(offs[i], offV[i], own, lightStrategy[i], nee, bsdf, sh.p, rays);
+                bool own = offs[i].alive && ownVertex(offs[i], GDPT_GPT_GENERAL);
+                OffsetNee on = gptPairNee(offs[i], offV[i], own, lightStrategy[i], nee, bsdf, sh.p, rays);
 #endif
-            float c = offs[i].countRatio;
-            float w = gptMisWeight(ls.pdf, nee.pdfBsdf, c * on.qLight, c * on.qBsdf);
-            if (on.counts) addPair(offs[i], w, nee.fBase, on.f);
+                float c = offs[i].countRatio;
+                float w = gptMisWeight(ls.pdf, nee.pdfBsdf, c * on.qLight, c * on.qBsdf);
+                if (on.counts) addPair(offs[i], w, nee.fBase, on.f);
+            }
         }
     }
 
@@ -115,7 +116,7 @@
         bool reconnect[kGptNumOffsets];
         bool offCurRough[kGptNumOffsets];
         vec4 tMax = vec4(0.0);
-        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+        [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) {
             shiftRay[i] =
                 gptShiftOffsetOwnBegin(offs[i], offV[i], seg, conn[i], own[i], reconnect[i], offCurRough[i], rays);
             if (shiftRay[i].trace) tMax[i] = shiftRay[i].tMax;
@@ -124,7 +125,7 @@
         traceClosestFour(shiftRay[0].origin, shiftRay[0].dir, shiftRay[1].origin, shiftRay[1].dir, shiftRay[2].origin,
                          shiftRay[2].dir, shiftRay[3].origin, shiftRay[3].dir, tMax, 2.0 * scene.sceneRadius,
                          kGptBundleGrow * scene.sceneRadius, ho[0], ho[1], ho[2], ho[3]);
-        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+        [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) {
             if (own[i]) gptOwnVertexHit(offs[i], offV[i], seg, reconnect[i], offCurRough[i], conn[i], shiftRay[i], ho[i]);
         }
     } else if (GDPT_GPT_GENERAL) {
@@ -133,7 +134,7 @@
         ConnectionShift conn[kGptNumOffsets];
         ShiftRay shiftRay[kGptNumOffsets];
         bvec4 reconnecting;
-        for (uint i = 0u; i < kGptNumOffsets; ++i)
+        [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i)
             shiftRay[i] = gptShiftOffsetBegin(offs[i], offV[i], seg, conn[i], reconnecting[i], rays);
         // (Only a reconnection traces: trace implies reconnecting.)
         bvec4 trace = bvec4(shiftRay[0].trace, shiftRay[1].trace, shiftRay[2].trace, shiftRay[3].trace);
@@ -144,20 +145,20 @@
                 : beamTowards(shiftRay[0].origin, shiftRay[1].origin, shiftRay[2].origin, shiftRay[3].origin,
                               trace, seg.next.p);
         bvec4 shiftOccluded = traceAnyBeam(beam);
-        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+        [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) {
             if (reconnecting[i]) gptReconnectDone(offs[i], offV[i], seg, conn[i], shiftOccluded[i]);
         }
     } else
 #endif
     {
-        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+        GDPT_UNROLL_UNLESS_TRACING for (uint i = 0u; i < kGptNumOffsets; ++i) {
             if (offs[i].alive) gptShiftOffset(offs[i], offV[i], seg, GDPT_GPT_GENERAL, rays);
         }
     }
 
     // ---- 5. Emission reached by the BSDF sample: the environment or an emitter ----
     if (kHasEnv && seg.missed) {  // (kHasEnv: else the path ended above; lets the compiler drop this)
-        for (uint i = 0u; i < kGptNumOffsets; ++i) {
+        [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) {
             if (gptPairCounted(px, py, i)) gptPairEnvironment(offs[i], beta, scene.envRadiance);
         }
         { pathEnded = true; break; }
@@ -169,17 +170,17 @@
             vec3 nl = triangleUnitNormal(seg.next.triangle);
             pdfLight = lightTrianglePdf(seg.next.triangle, sh.p, seg.next.p, nl);
         }
-        for (uint i = 0u; i < kGptNumOffsets; ++i) {
-            if (!gptPairCounted(px, py, i)) continue;
+        [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) {
             // The light strategy competes only where NEE counted for this pair.
-            gptPairEmitter(offs[i], ownVertex(offs[i], GDPT_GPT_GENERAL), beta, le, seg.bs.pdf,
-                           lightStrategy[i] ? pdfLight : 0.0);
+            if (gptPairCounted(px, py, i))
+                gptPairEmitter(offs[i], ownVertex(offs[i], GDPT_GPT_GENERAL), beta, le, seg.bs.pdf,
+                               lightStrategy[i] ? pdfLight : 0.0);
         }
     }
     // Nothing left to carry (e.g. the base and all offsets sit on a black emitter): every
     // later contribution of every pair would be w·0, so stop tracing.
     bool carries = maxComponent(beta) > 0.0;
-    for (uint i = 0u; i < kGptNumOffsets; ++i)
+    [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i)
         carries = carries || (offs[i].alive && maxComponent(offs[i].beta) > 0.0);
     if (!carries) { pathEnded = true; break; }
     sh = seg.next;

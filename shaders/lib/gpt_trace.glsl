@@ -38,13 +38,27 @@
 #define GDPT_GPT_BEAMS
 #endif
 
+// The loops over the four offsets are unrolled before the driver ([[unroll]], which the build's
+// spirv-opt pass list carries out, cmake/GdptSpirvEmbed.cmake): lavapipe 22.3 unrolls them
+// itself, one nesting level per round of its optimisation loop, and each round walks the whole
+// kernel (17 rounds on the Cornell box's G-PT kernel, 7 once unrolled before; bench/RESULTS.md,
+// "Offset loops unrolled before the driver"). A loop that traces rays (an offset's primary,
+// shadow or shift ray, in the builds without beams) holds a traversal loop, which NIR does
+// not unroll around; so that it keeps the same form, such a loop unrolls only where it
+// traces nothing (GDPT_UNROLL_UNLESS_TRACING).
+#ifdef GDPT_GPT_BEAMS
+#define GDPT_UNROLL_UNLESS_TRACING [[unroll]]
+#else
+#define GDPT_UNROLL_UNLESS_TRACING
+#endif
+
 // Offset i has a vertex of its own (NOT_CONNECTED); never in the fast form (general false).
 bool ownVertex(OffsetPath o, bool general) { return general && o.state == kShiftNotConnected; }
 
 // Some live offset has a vertex of its own.
 bool anyOwnVertex(OffsetPath offs[kGptNumOffsets]) {
     bool own = false;
-    for (uint i = 0u; i < kGptNumOffsets; ++i) own = own || (offs[i].alive && ownVertex(offs[i], true));
+    [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) own = own || (offs[i].alive && ownVertex(offs[i], true));
     return own;
 }
 
@@ -59,7 +73,7 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
                  inout OffsetPath offs[kGptNumOffsets]) {
     direct = vec3(0.0);
     baseModulation = vec3(1.0);
-    for (uint i = 0u; i < kGptNumOffsets; ++i) {
+    [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) {
         offs[i].modulation = vec3(1.0);
         offs[i].alive = gptPairExists(px, py, i);
         offs[i].shifted = false;
@@ -78,7 +92,7 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
 #ifdef GDPT_GPT_BEAMS
     // The base's and the offsets' primary rays as one fan (bvh_traverse.glsl, traceClosestBundle).
     vec3 dOff[kGptNumOffsets];
-    for (uint i = 0u; i < kGptNumOffsets; ++i) dOff[i] = cameraRay(pixelPos + vec2(kOffsetDelta[i]));
+    [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) dOff[i] = cameraRay(pixelPos + vec2(kOffsetDelta[i]));
     Hit hit;
     Hit hOff[kGptNumOffsets];
     traceClosestBundle(fanFrom(o, d, dOff[0], dOff[1], dOff[2], dOff[3],
@@ -95,26 +109,27 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     SurfaceHit sh = makeSurfaceHit(hit.triangle, hit.u, hit.v, d);
     if (kHasLightTris && countDirect) direct += surfaceEmission(sh);
     if (kDemodulate) baseModulation = firstHitModulation(sh, py * scene.width + px);
-    for (uint i = 0u; i < kGptNumOffsets; ++i) {
+    GDPT_UNROLL_UNLESS_TRACING for (uint i = 0u; i < kGptNumOffsets; ++i) {
         offs[i].shifted = offs[i].alive;
-        if (!offs[i].alive) continue;
+        if (offs[i].alive) {
 #ifdef GDPT_GPT_BEAMS
-        vec3 di = dOff[i];
-        Hit hi = hOff[i];
+            vec3 di = dOff[i];
+            Hit hi = hOff[i];
 #else
-        vec3 di = cameraRay(pixelPos + vec2(kOffsetDelta[i]));
-        Hit hi = traceClosest(o, di, 0.0, kInf);
+            vec3 di = cameraRay(pixelPos + vec2(kOffsetDelta[i]));
+            Hit hi = traceClosest(o, di, 0.0, kInf);
 #endif
-        rays++;
-        if (hi.triangle == kInvalidIndex) {
-            offs[i].alive = false;  // base hit, offset missed: no shift
-            continue;
-        }
-        offs[i].hit = makeSurfaceHit(hi.triangle, hi.u, hi.v, di);
-        offs[i].woWorld = -di;
-        if (kDemodulate) {
-            // The offset is alive, so its pair exists and q is inside the image.
-            offs[i].modulation = firstHitModulation(offs[i].hit, gptPairPixel(px, py, i));
+            rays++;
+            if (hi.triangle == kInvalidIndex) {
+                offs[i].alive = false;  // base hit, offset missed: no shift
+            } else {
+                offs[i].hit = makeSurfaceHit(hi.triangle, hi.u, hi.v, di);
+                offs[i].woWorld = -di;
+                if (kDemodulate) {
+                    // The offset is alive, so its pair exists and q is inside the image.
+                    offs[i].modulation = firstHitModulation(offs[i].hit, gptPairPixel(px, py, i));
+                }
+            }
         }
     }
 
