@@ -94,22 +94,24 @@ GDPT_INLINE vec3 dielectricF0(BsdfParams m) {
 // GGX normal distribution for a unit local half vector (Walter et al. 2007, eq. 33), written
 // as alpha^2 / (pi (sin^2 + alpha^2 cos^2)^2) so small alpha does not cancel catastrophically.
 GDPT_INLINE float ggxD(float alpha, vec3 h) {
-    if (h.z <= 0.0f) {
-        return 0.0f;
+    float d = 0.0f;
+    if (!(h.z <= 0.0f)) {
+        float a2 = alpha * alpha;
+        float den = h.x * h.x + h.y * h.y + a2 * h.z * h.z;
+        d = a2 / max(kPi * den * den, 1e-30f);
     }
-    float a2 = alpha * alpha;
-    float den = h.x * h.x + h.y * h.y + a2 * h.z * h.z;
-    return a2 / max(kPi * den * den, 1e-30f);
+    return d;
 }
 
 // Smith Lambda for GGX (Heitz 2014, eq. 72): (-1 + sqrt(1 + alpha^2 tan^2)) / 2.
 GDPT_INLINE float ggxLambda(float alpha, vec3 w) {
     float cos2 = w.z * w.z;
-    if (cos2 <= 0.0f) {
-        return 1e30f;
+    float lambda = 1e30f;
+    if (!(cos2 <= 0.0f)) {
+        float a2tan2 = alpha * alpha * (w.x * w.x + w.y * w.y) / cos2;
+        lambda = 0.5f * (sqrt(1.0f + a2tan2) - 1.0f);
     }
-    float a2tan2 = alpha * alpha * (w.x * w.x + w.y * w.y) / cos2;
-    return 0.5f * (sqrt(1.0f + a2tan2) - 1.0f);
+    return lambda;
 }
 
 GDPT_INLINE float ggxG1(float alpha, vec3 w) {
@@ -156,13 +158,14 @@ GDPT_INLINE vec3 glossyFresnel(BsdfParams m, float cosVh) {
 // F(cos_o) + (1 - F(cos_o)) = 1 for the mirror case (Ashikhmin & Shirley 2000 use the same
 // kind of coupling).
 GDPT_INLINE float diffuseWeight(BsdfParams m, float cosO, float cosI) {
-    if (!GDPT_BSDF_SPECULAR) {
-        return 1.0f - m.metallic;  // s = 0: T_o = T_i = 1
+    float w = 1.0f - m.metallic;  // s = 0: T_o = T_i = 1
+    if (GDPT_BSDF_SPECULAR) {
+        vec3 f0 = dielectricF0(m);
+        float to = 1.0f - m.specular * maxComponent(schlickFresnel(f0, cosO));
+        float ti = 1.0f - m.specular * maxComponent(schlickFresnel(f0, cosI));
+        w = (1.0f - m.metallic) * to * ti;
     }
-    vec3 f0 = dielectricF0(m);
-    float to = 1.0f - m.specular * maxComponent(schlickFresnel(f0, cosO));
-    float ti = 1.0f - m.specular * maxComponent(schlickFresnel(f0, cosI));
-    return (1.0f - m.metallic) * to * ti;
+    return w;
 }
 
 // Structural presence of each lobe (independent of wo).
@@ -190,21 +193,18 @@ GDPT_INLINE bool bsdfIsDeltaOnly(BsdfParams m) {
 GDPT_INLINE float glossySelectProb(BsdfParams m, vec3 wo) {
     bool hasDiffuse = bsdfHasDiffuse(m);
     bool hasGlossy = bsdfHasGlossyOrMirror(m);
-    if (!hasGlossy) {
-        return 0.0f;
+    float p = hasGlossy ? 1.0f : 0.0f;
+    if (hasGlossy && hasDiffuse) {
+        float cosO = clamp(wo.z, 0.0f, 1.0f);
+        // The (1 - s max F(cos_i)) factor of the diffuse weight averages to about 0.9 for
+        // F0 = 0.04; it is left out (overestimating diffuse slightly is harmless).
+        float wDiffuse = (1.0f - m.metallic) * (1.0f - m.specular * maxComponent(
+                         schlickFresnel(dielectricF0(m), cosO))) * luminance(m.baseColor);
+        float wGlossy = luminance(glossyFresnel(m, cosO));
+        float sum = wDiffuse + wGlossy;
+        p = clamp(sum > 0.0f ? wGlossy / sum : 0.5f, kMinLobeProb, 1.0f - kMinLobeProb);
     }
-    if (!hasDiffuse) {
-        return 1.0f;
-    }
-    float cosO = clamp(wo.z, 0.0f, 1.0f);
-    // The (1 - s max F(cos_i)) factor of the diffuse weight averages to about 0.9 for
-    // F0 = 0.04; it is left out (overestimating diffuse slightly is harmless).
-    float wDiffuse = (1.0f - m.metallic) * (1.0f - m.specular * maxComponent(
-                     schlickFresnel(dielectricF0(m), cosO))) * luminance(m.baseColor);
-    float wGlossy = luminance(glossyFresnel(m, cosO));
-    float sum = wDiffuse + wGlossy;
-    float p = sum > 0.0f ? wGlossy / sum : 0.5f;
-    return clamp(p, kMinLobeProb, 1.0f - kMinLobeProb);
+    return p;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -213,44 +213,45 @@ GDPT_INLINE float glossySelectProb(BsdfParams m, vec3 wo) {
 
 // f(wo, wi) |cos_i| of the non-Dirac lobes; zero unless both directions are in the upper
 // hemisphere. The diffuse weight uses v.h of the actual half vector, which keeps f reciprocal.
+// (Both functions have a single exit, so that spirv-opt inlines their many call sites before
+// the driver instead of lavapipe: bench/RESULTS.md, "Offset loops unrolled before the driver".)
 GDPT_INLINE vec3 bsdfEval(BsdfParams m, vec3 wo, vec3 wi) {
-    if (!(wo.z > 0.0f) || !(wi.z > 0.0f) || !isFinite(wo) || !isFinite(wi)) {
-        return vec3(0.0f);
-    }
+    vec3 result = vec3(0.0f);
     vec3 h = wo + wi;
     float hLen2 = dot(h, h);
-    if (!(hLen2 > 1e-20f)) {
-        return vec3(0.0f);
+    if (wo.z > 0.0f && wi.z > 0.0f && isFinite(wo) && isFinite(wi) && hLen2 > 1e-20f) {
+        h = h * inversesqrt(hLen2);
+        float cosVh = max(dot(wo, h), 0.0f);
+        result = diffuseWeight(m, wo.z, wi.z) * m.baseColor * (kInvPi * wi.z);
+        if (m.alpha >= kDeltaAlpha && bsdfHasGlossyOrMirror(m)) {
+            // F D G2 / (4 cos_o cos_i) * cos_i
+            float dg = ggxD(m.alpha, h) * ggxG2(m.alpha, wo, wi) / (4.0f * wo.z);
+            result += glossyFresnel(m, cosVh) * dg;
+        }
+        if (!isFinite(result)) result = vec3(0.0f);
     }
-    h = h * inversesqrt(hLen2);
-    float cosVh = max(dot(wo, h), 0.0f);
-    vec3 result = diffuseWeight(m, wo.z, wi.z) * m.baseColor * (kInvPi * wi.z);
-    if (m.alpha >= kDeltaAlpha && bsdfHasGlossyOrMirror(m)) {
-        // F D G2 / (4 cos_o cos_i) * cos_i
-        float dg = ggxD(m.alpha, h) * ggxG2(m.alpha, wo, wi) / (4.0f * wo.z);
-        result += glossyFresnel(m, cosVh) * dg;
-    }
-    return isFinite(result) ? result : vec3(0.0f);
+    return result;
 }
 
 // Solid-angle pdf with which bsdfSample returns wi through a non-Dirac lobe, including the
 // lobe-selection probabilities: (1-pG) cos_i/pi + pG G1(wo) D(h) / (4 cos_o)  (VNDF pdf of
 // wi = D_wo(h) / (4 wo.h), Heitz 2018 eq. 17). Zero for wi below the surface.
 GDPT_INLINE float bsdfPdf(BsdfParams m, vec3 wo, vec3 wi) {
-    if (!(wo.z > 0.0f) || !(wi.z > 0.0f) || !isFinite(wo) || !isFinite(wi)) {
-        return 0.0f;
-    }
-    float pGlossy = glossySelectProb(m, wo);
-    float pdf = (1.0f - pGlossy) * wi.z * kInvPi;
-    if (m.alpha >= kDeltaAlpha && pGlossy > 0.0f) {
-        vec3 h = wo + wi;
-        float hLen2 = dot(h, h);
-        if (hLen2 > 1e-20f) {
-            h = h * inversesqrt(hLen2);
-            pdf += pGlossy * ggxG1(m.alpha, wo) * ggxD(m.alpha, h) / (4.0f * wo.z);
+    float pdf = 0.0f;
+    if (wo.z > 0.0f && wi.z > 0.0f && isFinite(wo) && isFinite(wi)) {
+        float pGlossy = glossySelectProb(m, wo);
+        pdf = (1.0f - pGlossy) * wi.z * kInvPi;
+        if (m.alpha >= kDeltaAlpha && pGlossy > 0.0f) {
+            vec3 h = wo + wi;
+            float hLen2 = dot(h, h);
+            if (hLen2 > 1e-20f) {
+                h = h * inversesqrt(hLen2);
+                pdf += pGlossy * ggxG1(m.alpha, wo) * ggxD(m.alpha, h) / (4.0f * wo.z);
+            }
         }
+        if (!isFinite(pdf)) pdf = 0.0f;
     }
-    return isFinite(pdf) ? pdf : 0.0f;
+    return pdf;
 }
 
 // Samples wi given wo and three uniform numbers: u.x selects the lobe, u.y/u.z drive the

@@ -21,17 +21,20 @@ vec4 fetchTexel(TextureInfo info, int x, int y) {
 }
 
 vec4 sampleTexture(int tex, vec2 uv) {
-    if (!kHasTextures || tex < 0) return vec4(1.0);
-    TextureInfo info = textureInfo(tex);
-    // glTF uv (0,0) is the top-left of the image (row 0).
-    vec2 st = uv * vec2(info.width, info.height) - 0.5;
-    vec2 f = floor(st);
-    vec2 t = st - f;
-    int x0 = int(f.x);
-    int y0 = int(f.y);
-    vec4 a = mix(fetchTexel(info, x0, y0), fetchTexel(info, x0 + 1, y0), t.x);
-    vec4 b = mix(fetchTexel(info, x0, y0 + 1), fetchTexel(info, x0 + 1, y0 + 1), t.x);
-    return mix(a, b, t.y);
+    vec4 texel = vec4(1.0);
+    if (kHasTextures && tex >= 0) {
+        TextureInfo info = textureInfo(tex);
+        // glTF uv (0,0) is the top-left of the image (row 0).
+        vec2 st = uv * vec2(info.width, info.height) - 0.5;
+        vec2 f = floor(st);
+        vec2 t = st - f;
+        int x0 = int(f.x);
+        int y0 = int(f.y);
+        vec4 a = mix(fetchTexel(info, x0, y0), fetchTexel(info, x0 + 1, y0), t.x);
+        vec4 b = mix(fetchTexel(info, x0, y0 + 1), fetchTexel(info, x0 + 1, y0 + 1), t.x);
+        texel = mix(a, b, t.y);
+    }
+    return texel;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -81,11 +84,13 @@ SurfaceHit makeSurfaceHit(uint tri, float u, float v, vec3 rayDir) {
 
 // Cutout test used during traversal (GDPT_ANYHIT_FILTER): false = ignore this hit.
 bool alphaPasses(uint tri, float u, float v) {
-    if (!kHasAlphaMask) return true;
-    Material m = material(triangleShading(tri).material);
-    if ((m.flags & kMatFlagAlphaMask) == 0u) return true;
-    float alpha = m.baseColor.w * sampleTexture(m.baseColorTex, hitUv(tri, u, v)).w;
-    return alpha >= m.alphaCutoff;
+    bool passes = true;
+    if (kHasAlphaMask) {
+        Material m = material(triangleShading(tri).material);
+        if ((m.flags & kMatFlagAlphaMask) != 0u)
+            passes = m.baseColor.w * sampleTexture(m.baseColorTex, hitUv(tri, u, v)).w >= m.alphaCutoff;
+    }
+    return passes;
 }
 
 BsdfParams materialBsdf(uint matIndex, vec2 uv) {

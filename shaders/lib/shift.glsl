@@ -38,10 +38,9 @@ GDPT_CONST uint kShiftConnected = 2u;          // offset shares every later vert
 // component's). A Dirac layer counts as 0. A BSDF with
 // no lobe at all (a black emitter) is rough: nothing can be half-vector shifted through it.
 GDPT_INLINE float shiftRoughnessAll(BsdfParams m) {
-    if (bsdfHasGlossyOrMirror(m)) {
-        return m.alpha < kDeltaAlpha ? 0.0f : sqrt(m.alpha);
-    }
-    return 1.0f;
+    float roughness = 1.0f;
+    if (bsdfHasGlossyOrMirror(m)) roughness = m.alpha < kDeltaAlpha ? 0.0f : sqrt(m.alpha);
+    return roughness;
 }
 
 // "Diffuse" (reconnectable) iff roughness > threshold (threshold: GptFrameParams::shiftThreshold).
