@@ -43,9 +43,10 @@
 // itself, one nesting level per round of its optimisation loop, and each round walks the whole
 // kernel (17 rounds on the Cornell box's G-PT kernel, 7 once unrolled before; bench/RESULTS.md,
 // "Offset loops unrolled before the driver"). A loop that traces rays (an offset's primary,
-// shadow or shift ray, in the builds without beams) holds a traversal loop, which NIR does
-// not unroll around; so that it keeps the same form, such a loop unrolls only where it
-// traces nothing (GDPT_UNROLL_UNLESS_TRACING).
+// shadow or shift ray, in the builds without beams) holds a traversal loop, and NIR leaves a
+// loop around another loop rolled; so that it keeps that form, it carries the mark only in
+// the builds where it traces nothing (GDPT_UNROLL_UNLESS_TRACING). The marked loops have no
+// `continue`: spirv-opt unrolls single-exit loops only (tests/gpu/vk/test_spirv_unroll.cpp).
 #ifdef GDPT_GPT_BEAMS
 #define GDPT_UNROLL_UNLESS_TRACING [[unroll]]
 #else
