@@ -21,6 +21,7 @@
 #include "pt.spv.h"
 #include "same_bits.h"
 #include "scene/gltf_loader.h"
+#include "spirv_words.h"
 #include "temp_dir.h"
 #include "util/error.h"
 #include "vk/context.h"
@@ -37,12 +38,9 @@ constexpr std::uint32_t kDecorationSpecId = 1;
 // The SpecId decorations of a module, in order.
 std::vector<std::uint32_t> specIds(const std::vector<std::uint32_t>& words) {
     std::vector<std::uint32_t> ids;
-    for (std::size_t i = 5; i < words.size();) {
-        const std::uint32_t count = words[i] >> 16, op = words[i] & 0xFFFFu;
-        if (count == 0) break;
-        if (op == kOpDecorate && count >= 4 && words[i + 2] == kDecorationSpecId) ids.push_back(words[i + 3]);
-        i += count;
-    }
+    test::forEachSpirvInstruction(words, [&](std::uint32_t op, const std::uint32_t* in, std::uint32_t count) {
+        if (op == kOpDecorate && count >= 4 && in[2] == kDecorationSpecId) ids.push_back(in[3]);
+    });
     return ids;
 }
 
