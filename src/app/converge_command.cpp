@@ -9,6 +9,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -17,6 +18,7 @@
 #include <sstream>
 
 #include "app/bench_util.h"
+#include "app/cli.h"
 #include "app/edge_samples_option.h"
 #include "app/subcommand.h"
 #include "image/atomic_write.h"
@@ -57,16 +59,25 @@ struct ConvergeArgs {
     std::string edgeSamples = "auto";
     std::string demodulate = "auto";
     int debiasCells = kDefaultDebiasCells;
+    std::string env = "0,0,0";    // --env as given
+    glm::vec3 envRadiance{0.0f};  // ... parsed (runConverge)
 };
 
 // FNV-1a of the scene file's bytes and the render settings: the cache key of a made reference.
-std::string referenceKey(const std::string& scenePath, int w, int h, std::uint32_t spp) {
+// A black environment leaves the key of the references made before --env existed.
+std::string referenceKey(const std::string& scenePath, int w, int h, std::uint32_t spp, glm::vec3 env) {
     std::ifstream in(scenePath, std::ios::binary);
     std::uint64_t hash = 1469598103934665603ull;
     char c = 0;
     while (in.get(c)) hash = (hash ^ static_cast<unsigned char>(c)) * 1099511628211ull;
     for (std::uint64_t v : {std::uint64_t(w), std::uint64_t(h), std::uint64_t(spp)})
         hash = (hash ^ v) * 1099511628211ull;
+    if (env != glm::vec3(0.0f))
+        for (int k = 0; k < 3; ++k) {
+            std::uint32_t bits = 0;
+            std::memcpy(&bits, &env[k], sizeof bits);
+            hash = (hash ^ bits) * 1099511628211ull;
+        }
     char buf[32];
     std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(hash));
     return buf;
@@ -133,6 +144,7 @@ private:
         RenderOptions o;
         o.scene.width = a_.width;
         o.scene.height = a_.height;
+        o.scene.envRadiance = a_.envRadiance;
         o.quiet = true;
         o.emitterSupersampling = a_.emitterSupersampling;
         o.cancel = &interruptFlag();
@@ -277,7 +289,7 @@ int runConverge(const ConvergeArgs& a) {
 
     const Scene scene = loadGltf(a.scene);
     throwIfInterrupted("loading");
-    if (const auto black = blackImageWarning(scene, glm::vec3(0.0f), /*envOption=*/false))
+    if (const auto black = blackImageWarning(scene, a.envRadiance))
         std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
     vk::ContextOptions co;
     co.device = a.device;
@@ -290,7 +302,8 @@ int runConverge(const ConvergeArgs& a) {
         reference = readExrLayer(a.reference);
     } else {
         const fs::path cached =
-            dir / ("reference_" + referenceKey(a.scene, a.width, a.height, a.makeReference) + ".exr");
+            dir / ("reference_" + referenceKey(a.scene, a.width, a.height, a.makeReference, a.envRadiance) +
+                   ".exr");
         referenceName = cached.string();
         if (fs::exists(cached)) {
             reference = readExrLayer(cached.string());
@@ -300,6 +313,7 @@ int runConverge(const ConvergeArgs& a) {
             RenderOptions o;
             o.scene.width = a.width;
             o.scene.height = a.height;
+            o.scene.envRadiance = a.envRadiance;
             o.spp = a.makeReference;
             o.seed = 0xC0FFEEu;
             o.cancel = &interruptFlag();
@@ -397,6 +411,7 @@ int runConverge(const ConvergeArgs& a) {
                           {"reference", a.reference.empty() ? "(made)" : a.reference},
                           {"width", a.width},
                           {"height", a.height},
+                          {"env", {a.envRadiance.x, a.envRadiance.y, a.envRadiance.z}},
                           {"repeats", a.repeats},
                           {"device", ctx.info().name},
                           {"methods", methods},
@@ -470,6 +485,10 @@ Subcommand addConvergeCommand(CLI::App& app) {
                   std::string("G-PT methods (as gdpt render): ") + kDebiasCellsHelp)
         ->capture_default_str()
         ->check(CLI::Range(0, kMaxDebiasCells));
+    c->add_option("--env", a->env,
+                  "(as gdpt render) Constant environment radiance R,G,B (or one value for grey), in the "
+                  "runs and in the --make-reference render")
+        ->capture_default_str();
     c->add_option("--width", a->width, "Image width")->capture_default_str()->check(CLI::Range(1, 16384));
     c->add_option("--height", a->height, "Image height")->capture_default_str()->check(CLI::Range(1, 16384));
     c->add_option("--target", a->target,
@@ -478,7 +497,10 @@ Subcommand addConvergeCommand(CLI::App& app) {
     c->add_option("-o,--output", a->output, "Output directory")->capture_default_str();
     c->add_option("--device", a->device, "Vulkan device index or name substring");
     c->add_flag("--validate", a->validate, "Enable Vulkan validation layers (errors make the run fail)");
-    return {c, [a] { return runConverge(*a); }};
+    return {c, [a] {
+                a->envRadiance = parseColor(a->env, "--env");
+                return runConverge(*a);
+            }};
 }
 
 }  // namespace gdpt

@@ -226,5 +226,51 @@ TEST_F(ConvergeCli, ErrorFallsWithTimeForEveryMethod) {
     }
 }
 
+// --env lights the runs and the made reference alike, as gdpt render's --env lights a render.
+// The Cornell box's open side lets the environment in: with --env 0.5 its 16x16 image's mean is
+// about 0.227 against 0.120 without. Against a reference rendered with --env 0.5, every run with
+// the same --env has a mean bias within its noise (measured: the mean of a 1-spp 16x16 render
+// spreads by a standard deviation of about 0.014 over seeds, for PT and G-PT alike, and the runs
+// here take at least 1 spp), so |bias| < 0.05 is more than 3.5 standard deviations; runs without
+// it miss the environment's light (bias about -0.107, 7.6 standard deviations below 0), so
+// bias < -0.05 separates the two with the same margin. A reference that converge makes is
+// cached under a key that includes the environment: the two made here are two files.
+TEST_F(ConvergeCli, EnvironmentLightsTheRunsAndTheMadeReference) {
+    const std::string size = " --width 16 --height 16";
+    const std::string ref = path("ref.exr");
+    const test::RunResult made =
+        test::runGdpt("render " + kScene + " --env 0.5 --spp 1024" + size + " --quiet -o " + ref);
+    ASSERT_EQ(made.code, 0) << made.output;
+    const auto biases = [&](const std::string& env, double envValue, const std::string& out) {
+        const test::RunResult r =
+            test::runGdpt("converge " + kScene + env + " --reference " + ref + size +
+                          " --methods pt,gpt --times 0.5 --repeats 1 --validate -o " + path(out));
+        EXPECT_EQ(r.code, 0) << r.output;
+        std::map<std::string, double> bias;
+        std::ifstream in(fs::path(path(out)) / "results.json");
+        if (!in) return bias;
+        const json j = json::parse(in);
+        EXPECT_EQ(j.value("env", json()), json::array({envValue, envValue, envValue})) << env;
+        for (const json& run : j["runs"])
+            bias[run["method"].get<std::string>()] = run["mean_bias"].get<double>();
+        return bias;
+    };
+    const std::map<std::string, double> lit = biases(" --env 0.5", 0.5, "lit");
+    ASSERT_EQ(lit.size(), 2u);
+    for (const auto& [method, bias] : lit) EXPECT_LT(std::abs(bias), 0.05) << method << " with --env";
+    const std::map<std::string, double> unlit = biases("", 0.0, "unlit");
+    ASSERT_EQ(unlit.size(), 2u);
+    for (const auto& [method, bias] : unlit) EXPECT_LT(bias, -0.05) << method << " without --env";
+
+    for (const std::string env : {" --env 0.5", ""}) {
+        const test::RunResult r = test::runGdpt("converge " + kScene + env + " --make-reference 16" + size +
+                                                " --methods pt --times 0.05 --repeats 1 -o " + path("made"));
+        ASSERT_EQ(r.code, 0) << r.output;
+    }
+    int references = 0;
+    for (const std::string& name : listing("made")) references += name.rfind("reference_", 0) == 0 ? 1 : 0;
+    EXPECT_EQ(references, 2);
+}
+
 }  // namespace
 }  // namespace gdpt
