@@ -7,6 +7,10 @@
 # equal-time table with each method's gain over PT and bias. Not a test: a long benchmark (hours with
 # the defaults on 2 cores).
 #
+# Scene `engine_sky` (not in the default list): a real asset, the Khronos sample model
+# 2CylinderEngine (110,342 triangles, no lights) from Debian's assimp-testmodels
+# (scripts/install-deps.sh installs it), under a constant sky of radiance 1 (`--env 1,1,1`).
+#
 #   scripts/converge-set.sh [-o OUT] [--times 4,8,16,32] [--repeats 3] [--reference-spp 4096]
 #                           [--methods pt,gpt-wl1,gpt-l1,gpt-l2] [--size 256] [--scenes a,b,...]
 set -euo pipefail
@@ -22,7 +26,7 @@ while (($#)); do
     --methods) methods=$2; shift 2 ;;
     --size) size=$2; shift 2 ;;
     --scenes) scenes=$2; shift 2 ;;
-    -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
     *) echo "converge-set.sh: unknown option '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -34,6 +38,10 @@ for s in "${list[@]}"; do
     ref=../shared/scenes/cbox/reference.exr
     [ "$size" = 256 ] || { echo "converge-set.sh: cbox's reference is 256x256; skipping it at --size $size" >&2; continue; }
     build/gdpt converge ../shared/scenes/cbox/cbox.gltf --reference "$ref" "${common[@]}" -o "$out/$s"
+  elif [ "$s" = engine_sky ]; then
+    engine=/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb
+    [ -f "$engine" ] || { echo "converge-set.sh: $engine missing (apt-get install assimp-testmodels); skipping engine_sky" >&2; continue; }
+    build/gdpt converge "$engine" --env 1,1,1 --make-reference "$refspp" "${common[@]}" -o "$out/$s"
   else
     build/gdpt converge "scenes/$s.gltf" --make-reference "$refspp" "${common[@]}" -o "$out/$s"
   fi
