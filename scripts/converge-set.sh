@@ -7,7 +7,7 @@
 # equal-time table with each method's gain over PT and bias. Not a test: a long benchmark (hours with
 # the defaults on 2 cores).
 #
-# Scene `engine_sky` (not in the default list): a real asset, the Khronos sample model
+# Scene `engine_sky` (skipped when the file is missing): a real asset, the Khronos sample model
 # 2CylinderEngine (110,342 triangles, no lights) from Debian's assimp-testmodels
 # (scripts/install-deps.sh installs it), under a constant sky of radiance 1 (`--env 1,1,1`).
 #
@@ -16,7 +16,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=converge-set times=4,8,16,32 repeats=3 refspp=4096 methods=pt,gpt-wl1,gpt-l1,gpt-l2 size=256
-scenes=cbox,cornell_box,glossy_cornell,small_light,indirect_gap,textured,furnace,open_scene
+scenes=cbox,cornell_box,glossy_cornell,small_light,indirect_gap,textured,furnace,open_scene,engine_sky
 while (($#)); do
   case "$1" in
     -o) out=$2; shift 2 ;;
