@@ -37,7 +37,7 @@ PixelSampling::PixelSampling(const vk::Context& ctx, const Scene& scene, const R
     stats_.bvhBuildMs = scene_->bvhInfo().buildMs;
     stats_.sceneDeviceBytes = scene_->deviceBytes();
     stats_.bvhRegisterStack = scene_->spec().bvhRegisterStack();
-    stats_.bvhUnitSteps = scene_->spec().bvhUnitSteps(ctx.info());
+    stats_.bvhUnitSteps = scene_->spec().bvhUnitSteps(ctx.info(), pass_->tracesBundles());
     stats_.lightShares = scene_->lightShares();
     stats_.lightProbed = scene_->lightProbed();
     stats_.features = scene_->features();

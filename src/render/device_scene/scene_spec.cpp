@@ -95,15 +95,16 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> SceneSpec::specConstants() 
     return spec;
 }
 
-bool SceneSpec::bvhUnitSteps(const vk::DeviceInfo& device) const {
-    return envChoice("GDPT_BVH_STEPS", "nodes", "units", device.lavapipeBeforeMesa23) &&
+bool SceneSpec::bvhUnitSteps(const vk::DeviceInfo& device, bool bundles) const {
+    const bool bundleTree = bundles && features_.triangles <= kBundleNodeStepsTriangles;
+    return envChoice("GDPT_BVH_STEPS", "nodes", "units", device.lavapipeBeforeMesa23 && !bundleTree) &&
            bvhRegisterStack() == 0;
 }
 
 vk::KernelDesc SceneSpec::kernelDesc(const TracingKernel& kernel, const vk::DeviceInfo& device,
                                      WorkgroupSize wg, const std::vector<std::uint32_t>& extraBindings,
-                                     std::uint32_t pushBytes) const {
-    vk::KernelDesc base = bvhUnitSteps(device) ? kernel.unitSteps : kernel.nodeSteps;
+                                     std::uint32_t pushBytes, bool bundles) const {
+    vk::KernelDesc base = bvhUnitSteps(device, bundles) ? kernel.unitSteps : kernel.nodeSteps;
     base.bindings = sceneBindings();
     base.texelBindings = sceneTexelBindings();
     base.bindings.insert(base.bindings.end(), extraBindings.begin(), extraBindings.end());

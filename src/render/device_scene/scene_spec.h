@@ -65,6 +65,13 @@ SceneBvh buildSceneBvh(const Scene& scene);
 // kBvhRegisterStackMax stack entries anyway (a 5k-triangle soup of spheres needs 20).
 inline constexpr std::size_t kSpecBvhTriangles = 4096;
 
+// G-PT's split build on lavapipe before Mesa 23 traverses trees of up to this many triangles in
+// node steps, with its fan, bundles and beams, although their stack is in memory: 12-20 % less
+// time per sample than the unit-step build on a 110k-triangle asset under a sky and on 50k- and
+// 100k-triangle terrains, 21 % more on a 200k-triangle terrain and twice as much on 1M
+// (bench/RESULTS.md, "Node steps for G-PT's bundles up to 2^17 triangles").
+inline constexpr std::size_t kBundleNodeStepsTriangles = std::size_t{1} << 17;
+
 // The two builds of a kernel that traces rays (shaders/lib/bvh_traverse.glsl): its traversal
 // loop in node steps (the stack in registers or memory) and in unit steps (GDPT_BVH_UNIT_STEPS,
 // the stack in memory). GDPT_TRACING_KERNEL(label, name) names the embedded SPIR-V of both
@@ -111,16 +118,21 @@ public:
     // (bvh_traverse.glsl): unit steps where the stack is in memory (a tree that the register
     // stack does not hold, or not known before the pipelines) on lavapipe before Mesa 23, the
     // driver they were measured to pay on (bench/RESULTS.md, "Unit steps for large trees"), and
-    // node steps everywhere else. GDPT_BVH_STEPS=nodes|units in the environment overrides the
-    // device's choice (units still only with the stack in memory); throws for another value.
-    [[nodiscard]] bool bvhUnitSteps(const vk::DeviceInfo& device) const;
+    // node steps everywhere else. `bundles`: the kernel is G-PT's split build, whose node-step
+    // form traces the camera fan, the ray bundles and the occlusion beams (gpt_trace.glsl,
+    // GDPT_GPT_BEAMS) and whose unit-step form does not; it keeps node steps up to
+    // kBundleNodeStepsTriangles triangles. GDPT_BVH_STEPS=nodes|units in the environment
+    // overrides the device's choice (units still only with the stack in memory); throws for
+    // another value.
+    [[nodiscard]] bool bvhUnitSteps(const vk::DeviceInfo& device, bool bundles = false) const;
     // Completes the build of `kernel` that the scene's tree takes on `device` (bvhUnitSteps)
     // into the descriptor of a kernel that reads the scene: the scene bindings plus
     // `extraBindings`, `pushBytes` of push constants, the scene's feature specialisation
     // constants and the workgroup size.
     [[nodiscard]] vk::KernelDesc kernelDesc(const TracingKernel& kernel, const vk::DeviceInfo& device,
                                             WorkgroupSize wg, const std::vector<std::uint32_t>& extraBindings,
-                                            std::uint32_t pushBytes = sizeof(gpu::FrameParams)) const;
+                                            std::uint32_t pushBytes = sizeof(gpu::FrameParams),
+                                            bool bundles = false) const;
 
 private:
     SceneFeatures features_;

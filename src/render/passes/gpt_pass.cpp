@@ -35,7 +35,7 @@ vk::KernelDesc gptDesc(const SceneSpec& scene, const vk::DeviceInfo& device, Wor
     for (std::uint32_t i = 0; i < kNumStats; ++i) extra.push_back(gpu::kBindGptCentral + i);
     vk::KernelDesc d = scene.kernelDesc(
         splitBounce ? GDPT_TRACING_KERNEL("gpt", gpt_split) : GDPT_TRACING_KERNEL("gpt", gpt), device, wg,
-        extra, sizeof(gpu::GptFrameParams));
+        extra, sizeof(gpu::GptFrameParams), /*bundles=*/splitBounce);
     for (auto& [id, value] : d.specConstants)
         if (id == gpu::kSpecHasGlossy) value = halfVector ? 1u : 0u;
     d.specConstants.push_back({gpu::kSpecGptDemodulate, demodulate ? 1u : 0u});
@@ -148,7 +148,7 @@ GptPass::GptPass(const vk::Context& ctx, const SceneSpec& scene, WorkgroupSize w
       options_(options),
       halfVector_(options.forceHalfVector || gptNeedsHalfVector(scene)),
       splitBounce_(splitBounceFor(ctx.info(), options.splitBounce)),
-      occlusionBeams_(splitBounce_ && !scene.bvhUnitSteps(ctx.info())),
+      occlusionBeams_(splitBounce_ && !scene.bvhUnitSteps(ctx.info(), /*bundles=*/true)),
       checked_(ctx, width_, height_, pixelBuffers(options)),
       counters_(ctx, sizeof(gpu::Counters), "gpt counters"),
       emitterSupersampling_(ctx, scene, wg, options.emitterSupersampling, counters_, creation),

@@ -134,6 +134,8 @@ public:
     void uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats) override;
     // Whether the kernel is the split bounce loop build (gpt_split, see gpt.comp).
     [[nodiscard]] bool splitBounceCompiled() const { return splitBounce_; }
+    // The split build (its node-step form traces bundles).
+    [[nodiscard]] bool tracesBundles() const override { return splitBounce_; }
     // Whether the kernel traces the offsets' occlusion rays as beams and the five primary rays as
     // one fan (GDPT_GPT_BEAMS, shaders/lib/gpt_trace.glsl: the split build in node steps).
     [[nodiscard]] bool occlusionBeamsCompiled() const { return occlusionBeams_; }

@@ -47,6 +47,9 @@ public:
     [[nodiscard]] virtual std::vector<std::vector<gpu::PixelStats>> downloadStats() const = 0;
     virtual void uploadStats(const std::vector<std::vector<gpu::PixelStats>>& stats) = 0;
     [[nodiscard]] virtual const EmitterSupersamplingPass& emitterSupersampling() const = 0;
+    // Whether the main kernel is a build that traces ray bundles in node steps, which picks its
+    // traversal form by SceneSpec::bvhUnitSteps(device, bundles = true). Default: no.
+    [[nodiscard]] virtual bool tracesBundles() const { return false; }
 };
 
 }  // namespace gdpt

@@ -120,11 +120,25 @@ TEST(BvhRegisterStack, SpecPicksTheSmallestStackThatHoldsTheTree) {
     EXPECT_EQ(registerStack(large), 0u);
     EXPECT_TRUE(large.bvhUnitSteps(lavapipe22));
     EXPECT_FALSE(large.bvhUnitSteps(otherDevice)) << "node steps on drivers not measured to gain";
+    // G-PT's split build (bundles) keeps node steps up to kBundleNodeStepsTriangles triangles.
+    EXPECT_FALSE(large.bvhUnitSteps(lavapipe22, /*bundles=*/true));
+    const std::uint32_t limit = static_cast<std::uint32_t>(kBundleNodeStepsTriangles);
+    // (makeTriangleScene's count is a target, met within a few per cent.)
+    const SceneSpec below(makeTriangleScene(limit - limit / 8, 1), o);
+    ASSERT_LE(below.features().triangles, limit);
+    const SceneSpec beyond(makeTriangleScene(limit + limit / 8, 1), o);
+    ASSERT_GT(beyond.features().triangles, limit);
+    EXPECT_FALSE(below.bvhUnitSteps(lavapipe22, true)) << below.features().triangles << " triangles";
+    EXPECT_TRUE(beyond.bvhUnitSteps(lavapipe22, true)) << beyond.features().triangles << " triangles";
+    EXPECT_TRUE(beyond.bvhUnitSteps(lavapipe22));
+    EXPECT_FALSE(beyond.bvhUnitSteps(otherDevice, true));
     // GDPT_BVH_STEPS overrides the device's choice, units only with the stack in memory.
     ::setenv("GDPT_BVH_STEPS", "nodes", 1);
     EXPECT_FALSE(large.bvhUnitSteps(lavapipe22));
+    EXPECT_FALSE(beyond.bvhUnitSteps(lavapipe22, true));
     ::setenv("GDPT_BVH_STEPS", "units", 1);
     EXPECT_TRUE(large.bvhUnitSteps(otherDevice));
+    EXPECT_TRUE(large.bvhUnitSteps(lavapipe22, true));
     EXPECT_FALSE(SceneSpec(makeCornellBox(), o).bvhUnitSteps(otherDevice)) << "its stack is in registers";
     ::setenv("GDPT_BVH_STEPS", "fast", 1);
     EXPECT_THROW((void)large.bvhUnitSteps(lavapipe22), Error);
