@@ -21,7 +21,9 @@
 // Occlusion beams (GDPT_GPT_BEAMS; bvh_traverse.glsl, traceAnyBeam): the offsets' own shadow
 // rays, and without glossy vertices their reconnections' visibility rays, traced as one beam
 // per bounce instead of one ray each, in the build for lavapipe before Mesa 23 (the split
-// build) on trees small enough for node steps. Measured (bench/RESULTS.md, "Occlusion beams
+// build) in node steps, which it takes on trees of up to 2^17 triangles (SceneSpec::
+// bvhUnitSteps with bundles; bench/RESULTS.md, "Node steps for G-PT's bundles up to 2^17
+// triangles"). Measured (bench/RESULTS.md, "Occlusion beams
 // for the offsets' rays"): 11-18 % less time per G-PT sample there on the scene set (4 % on the
 // glossy box, whose shift rays are bundles instead, below), for about 0.1 s more pipeline creation; in
 // unit steps (trees of 10^5 triangles) level or slower, and on Mesa 25, which skips the
