@@ -6,6 +6,7 @@
 #include <string>
 #include <utility>
 
+#include "integrator/gpt_alpha.h"
 #include "integrator/render_identity.h"
 #include "util/interrupt.h"
 #include "util/timer.h"
@@ -16,8 +17,8 @@ namespace gdpt {
 GptIntegrator::GptIntegrator(std::string name, GptOptions options)
     : name_(std::move(name)),
       options_(std::move(options)),
-      stage_(options_.reconstructions, options_.alpha, options_.tolerance, options_.debiasCells,
-             options_.solver) {}
+      stage_(options_.reconstructions, options_.alpha.value_or(kGptAlphaEmitters), options_.tolerance,
+             options_.debiasCells, options_.solver) {}
 
 GptIntegrator::~GptIntegrator() = default;
 
@@ -55,7 +56,9 @@ RenderOutput GptIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     out.stats = g.stats;
     if (g.stats.cancelled || g.stats.handedOff) return out;
 
-    // Stage 2, the screened Poisson reconstructions of the primal and gradients.
+    // Stage 2, the screened Poisson reconstructions of the primal and gradients, with the
+    // primal weight given or chosen by the scene's light (gpt_alpha.h).
+    stage_.setAlpha(options_.alpha.value_or(gptDefaultAlpha(gptLighting(g.stats.features))));
     PoissonInput input;
     input.primal = &g.primal;
     input.dx = &g.dx;

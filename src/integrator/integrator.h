@@ -106,7 +106,9 @@ struct GptOptions {
     // median's), had 4-14 % lower relMSE than L1 on every scene of the set at equal samples and
     // lower at equal time (bench/RESULTS.md, "Weighted L1 with bounded weights").
     std::vector<Reconstruction> reconstructions = {Reconstruction::WeightedL1};
-    double alpha = 0.2;       // weight of the primal term
+    // Weight of the primal term; nullopt: by the scene's light (gpt_alpha.h), 0.2 without an
+    // environment.
+    std::optional<double> alpha;
     double tolerance = 1e-4;  // relative residual at which each solve stops
     // Cells across the image's shorter side of the coarse grid whose scales the biased
     // reconstructions take from the primal (poisson/debias.h); 0 = the published reconstruction.

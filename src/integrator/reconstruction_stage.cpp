@@ -30,6 +30,10 @@ ReconstructionStage::ReconstructionStage(std::vector<Reconstruction> reconstruct
 
 ReconstructionStage::~ReconstructionStage() = default;
 
+void ReconstructionStage::setAlpha(double alpha) {
+    for (SolveOptions& so : solves_) so.alpha = alpha;
+}
+
 PoissonSolverGpu& ReconstructionStage::solver(const vk::Context& ctx, int width, int height) {
     if (!solver_ || solverCtx_ != &ctx || solverWidth_ != width || solverHeight_ != height) {
         solver_ = std::make_unique<PoissonSolverGpu>(ctx, width, height);
@@ -109,12 +113,12 @@ std::vector<NamedLayer> ReconstructionStage::run(const PoissonInput& input, cons
                 report.stoppedAtDeadline
                     ? " of " + std::to_string(so.irlsIterations) + ", stopped for the budget"
                     : "";
-            std::fprintf(
-                stderr,
-                "gdpt: %s reconstruction (%s): %d iterations (%d IRLS%s), residual %.2g%s%s, %.1f ms%s\n",
-                toString(so.method), toString(so.solver), report.iterations, report.irlsIterations,
-                stopped.c_str(), report.residual, report.converged ? "" : " NOT converged", scaled.c_str(),
-                rs.ms, debiased.c_str());
+            std::fprintf(stderr,
+                         "gdpt: %s reconstruction (%s, alpha %g): %d iterations (%d IRLS%s), residual "
+                         "%.2g%s%s, %.1f ms%s\n",
+                         toString(so.method), toString(so.solver), so.alpha, report.iterations,
+                         report.irlsIterations, stopped.c_str(), report.residual,
+                         report.converged ? "" : " NOT converged", scaled.c_str(), rs.ms, debiased.c_str());
         }
         cut = cut || rs.stoppedAtDeadline;
         stats.reconstructions.push_back(rs);

@@ -33,6 +33,9 @@ public:
     ~ReconstructionStage();
 
     [[nodiscard]] const std::vector<SolveOptions>& solves() const { return solves_; }
+    // The primal weight of every solve from now on (the time reserved stays the one measured
+    // for the constructor's: the solve's time hardly depends on it).
+    void setAlpha(double alpha);
     [[nodiscard]] bool empty() const { return solves_.empty(); }
     // The solver for this device and size (made on first use, kept for later renders so that
     // its pipelines are compiled once).

@@ -123,3 +123,34 @@ TEST_F(ReconReportCli, RenderReportsTheDebiasing) {
 
 }  // namespace
 }  // namespace gdpt
+
+namespace gdpt {
+namespace {
+
+// G-PT's α without --alpha is chosen by the scene's light (integrator/gpt_alpha.h), and the
+// JSON and the summary line say which: the Cornell box alone 0.2, under a sky beside its lamp
+// 0.4, and --alpha wins over the rule (here under the same sky). Every reconstruction of
+// --all-recon uses the same α. Fails if the rule is not applied (0.2 under the sky), applied
+// to the wrong case, or applied over --alpha.
+TEST_F(ReconReportCli, GptAlphaFollowsTheScenesLightUnlessGiven) {
+    RunResult r;
+    const nlohmann::json lamp = render("", r);
+    ASSERT_EQ(r.code, 0) << r.output;
+    ASSERT_TRUE(lamp.is_array() && !lamp.empty()) << lamp.dump();
+    EXPECT_DOUBLE_EQ(lamp[0]["alpha"].get<double>(), 0.2);
+    EXPECT_NE(r.output.find("alpha 0.2)"), std::string::npos) << r.output;
+
+    const nlohmann::json sky = render("--env 0.2,0.3,0.4 --all-recon", r);
+    ASSERT_EQ(r.code, 0) << r.output;
+    ASSERT_TRUE(sky.is_array() && sky.size() == 4u) << sky.dump();
+    for (const auto& recon : sky) EXPECT_DOUBLE_EQ(recon["alpha"].get<double>(), 0.4) << recon.dump();
+    EXPECT_NE(r.output.find("alpha 0.4)"), std::string::npos) << r.output;
+
+    const nlohmann::json given = render("--env 0.2,0.3,0.4 --alpha 0.3", r);
+    ASSERT_EQ(r.code, 0) << r.output;
+    ASSERT_TRUE(given.is_array() && !given.empty()) << given.dump();
+    EXPECT_DOUBLE_EQ(given[0]["alpha"].get<double>(), 0.3);
+}
+
+}  // namespace
+}  // namespace gdpt
