@@ -10,18 +10,24 @@ GptLighting gptLighting(const SceneFeatures& features) {
 
 double gptDefaultAlpha(GptLighting lighting) {
     switch (lighting) {
-        case GptLighting::Environment: return kGptAlphaEnvironment;
-        case GptLighting::EnvironmentAndEmitters: return kGptAlphaEnvironmentAndEmitters;
-        case GptLighting::Emitters: break;
+        case GptLighting::Environment:
+            return kGptAlphaEnvironment;
+        case GptLighting::EnvironmentAndEmitters:
+            return kGptAlphaEnvironmentAndEmitters;
+        case GptLighting::Emitters:
+            break;
     }
     return kGptAlphaEmitters;
 }
 
 const char* toString(GptLighting lighting) {
     switch (lighting) {
-        case GptLighting::Environment: return "environment";
-        case GptLighting::EnvironmentAndEmitters: return "environment and emitters";
-        case GptLighting::Emitters: break;
+        case GptLighting::Environment:
+            return "environment";
+        case GptLighting::EnvironmentAndEmitters:
+            return "environment and emitters";
+        case GptLighting::Emitters:
+            break;
     }
     return "emitters";
 }
