@@ -5,7 +5,7 @@
 // et al. 2015, §4, eq. 2, α = 0.2). That value is the best or within 2 % of it on the scenes lit
 // by emissive surfaces alone (the Cornell box, its small-light, textured and glossy variants),
 // but every scene measured with a constant environment (`--env`) gave its lowest relMSE at a
-// larger α, at equal samples and so at equal time (the solve costs the same): lit by the
+// larger α, at equal samples and so at equal time (the solve costs no more): lit by the
 // environment alone (a 110,000-triangle engine) α = 0.8, 16–18 % below α = 0.2; by the
 // environment and emissive surfaces (the Cornell box open to a sky, a terrain with a small
 // sun, the small-light box under a dim sky) α = 0.4, 4–15 % below, where α = 0.8 was 1–5 %

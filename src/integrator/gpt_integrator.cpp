@@ -93,6 +93,9 @@ void GptIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
     j["edge_samples"] = edgeSamplesJson(s);
     j["demodulation"] = {{"on", s.demodulated}, {"pixels", s.demodulatedPixels}};
     j["reconstructions"] = reconstructionsJson(s);
+    // Where the reconstructions' α came from: --alpha, or the scene's light (gpt_alpha.h).
+    j["alpha_choice"] = options_.alpha ? std::string("--alpha")
+                                       : std::string("scene light: ") + toString(gptLighting(s.features));
 }
 
 std::string GptIntegrator::summary(const RenderStats& s) const {

@@ -28,13 +28,16 @@ const std::string kScene = std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.g
 
 class ReconReportCli : public test::TempDirTest {
 protected:
-    // Renders with `flags`; returns the output and the JSON's "reconstructions".
-    nlohmann::json render(const std::string& flags, RunResult& r) {
+    // Renders with `flags`; returns the output and the JSON's "reconstructions" (and its
+    // "alpha_choice" in `choice`, if given).
+    nlohmann::json render(const std::string& flags, RunResult& r, std::string* choice = nullptr) {
         r = runGdpt("render " + kScene + " --width 16 --height 16 --spp 4 --seed 3 -o " + path("r.exr") +
                     " --json " + path("r.json") + " " + flags);
         std::ifstream in(path("r.json"));
         if (r.code != 0 || !in) return nlohmann::json();
-        return nlohmann::json::parse(in)["reconstructions"];
+        const nlohmann::json j = nlohmann::json::parse(in);
+        if (choice) *choice = j.value("alpha_choice", std::string());
+        return j["reconstructions"];
     }
 };
 
@@ -128,28 +131,33 @@ namespace gdpt {
 namespace {
 
 // G-PT's α without --alpha is chosen by the scene's light (integrator/gpt_alpha.h), and the
-// JSON and the summary line say which: the Cornell box alone 0.2, under a sky beside its lamp
-// 0.4, and --alpha wins over the rule (here under the same sky). Every reconstruction of
+// JSON (`alpha_choice`, each reconstruction's `alpha`) and the summary line say which: the Cornell box alone
+// 0.2, under a sky beside its lamp 0.4, and --alpha wins over the rule (here under the same sky). Every
+// reconstruction of
 // --all-recon uses the same α. Fails if the rule is not applied (0.2 under the sky), applied
 // to the wrong case, or applied over --alpha.
 TEST_F(ReconReportCli, GptAlphaFollowsTheScenesLightUnlessGiven) {
     RunResult r;
-    const nlohmann::json lamp = render("", r);
+    std::string choice;
+    const nlohmann::json lamp = render("", r, &choice);
     ASSERT_EQ(r.code, 0) << r.output;
     ASSERT_TRUE(lamp.is_array() && !lamp.empty()) << lamp.dump();
     EXPECT_DOUBLE_EQ(lamp[0]["alpha"].get<double>(), 0.2);
     EXPECT_NE(r.output.find("alpha 0.2)"), std::string::npos) << r.output;
+    EXPECT_EQ(choice, "scene light: emitters");
 
-    const nlohmann::json sky = render("--env 0.2,0.3,0.4 --all-recon", r);
+    const nlohmann::json sky = render("--env 0.2,0.3,0.4 --all-recon", r, &choice);
     ASSERT_EQ(r.code, 0) << r.output;
     ASSERT_TRUE(sky.is_array() && sky.size() == 4u) << sky.dump();
     for (const auto& recon : sky) EXPECT_DOUBLE_EQ(recon["alpha"].get<double>(), 0.4) << recon.dump();
     EXPECT_NE(r.output.find("alpha 0.4)"), std::string::npos) << r.output;
+    EXPECT_EQ(choice, "scene light: environment and emitters");
 
-    const nlohmann::json given = render("--env 0.2,0.3,0.4 --alpha 0.3", r);
+    const nlohmann::json given = render("--env 0.2,0.3,0.4 --alpha 0.3", r, &choice);
     ASSERT_EQ(r.code, 0) << r.output;
     ASSERT_TRUE(given.is_array() && !given.empty()) << given.dump();
     EXPECT_DOUBLE_EQ(given[0]["alpha"].get<double>(), 0.3);
+    EXPECT_EQ(choice, "--alpha");
 }
 
 }  // namespace

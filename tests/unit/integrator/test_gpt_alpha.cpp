@@ -17,7 +17,8 @@ SceneFeatures featuresOf(const char* scene, glm::vec3 env) {
 }
 
 TEST(GptAlpha, EmissiveSurfacesAloneKeepThePublishedWeight) {
-    for (const char* scene : {"cornell_box.gltf", "small_light.gltf", "glossy_cornell.gltf", "open_scene.gltf"}) {
+    for (const char* scene :
+         {"cornell_box.gltf", "small_light.gltf", "glossy_cornell.gltf", "open_scene.gltf"}) {
         EXPECT_EQ(gptLighting(featuresOf(scene, glm::vec3(0.0f))), GptLighting::Emitters) << scene;
     }
     EXPECT_EQ(gptDefaultAlpha(GptLighting::Emitters), 0.2);
