@@ -2,8 +2,8 @@
 // chosen from how the scene is lit.
 //
 // The screened Poisson energy weighs the primal rows by α against the gradient rows (Kettunen
-// et al. 2015, §4, eq. 2, α = 0.2). That value is the best or within 2 % of it on the scenes lit
-// by emissive surfaces alone (the Cornell box, its small-light, textured and glossy variants),
+// et al. 2015, §4, eq. 2, α = 0.2). That value is the best or within 2 % of it on the rooms lit
+// by emissive surfaces (the Cornell box, its small-light, textured and glossy variants),
 // but every scene measured with a constant environment (`--env`) gave its lowest relMSE at a
 // larger α, at equal samples and so at equal time (the solve costs no more): lit by the
 // environment alone (a 110,000-triangle engine) α = 0.8, 16–18 % below α = 0.2; by the
@@ -11,7 +11,9 @@
 // sun, the small-light box under a dim sky) α = 0.4, 4–15 % below, where α = 0.8 was 1–5 %
 // better or up to 12 % worse (bench/RESULTS.md, "The primal weight α by the scene's light").
 // The scene's light is what the choice reads: deterministic, before any sample, and the same
-// on every run. `--alpha` overrides it; the other methods keep their own defaults.
+// on every run. A sky of emissive triangles is not told apart from other emitters (the open
+// scene's dome gained at 0.4-0.8, the furnace's enclosing sphere lost). `--alpha` overrides
+// the choice; the other methods keep their own defaults (T-GPT's flicker rose at 0.4).
 #pragma once
 
 #include "render/device_scene/features.h"
