@@ -124,18 +124,11 @@ TEST_F(ReconReportCli, RenderReportsTheDebiasing) {
     }
 }
 
-}  // namespace
-}  // namespace gdpt
-
-namespace gdpt {
-namespace {
-
 // G-PT's α without --alpha is chosen by the scene's light (integrator/gpt_alpha.h), and the
-// JSON (`alpha_choice`, each reconstruction's `alpha`) and the summary line say which: the Cornell box alone
-// 0.2, under a sky beside its lamp 0.4, and --alpha wins over the rule (here under the same sky). Every
-// reconstruction of
-// --all-recon uses the same α. Fails if the rule is not applied (0.2 under the sky), applied
-// to the wrong case, or applied over --alpha.
+// JSON (`alpha_choice`, each reconstruction's `alpha`) and the summary line say which: the
+// Cornell box alone 0.2, under a sky beside its lamp 0.4, and --alpha wins over the rule (here
+// under the same sky). Every reconstruction of --all-recon uses the same α. Fails if the rule
+// is not applied (0.2 under the sky), applied to the wrong case, or applied over --alpha.
 TEST_F(ReconReportCli, GptAlphaFollowsTheScenesLightUnlessGiven) {
     RunResult r;
     std::string choice;
