@@ -1,6 +1,6 @@
 // mlt_estimate.h — the host's share of Metropolis light transport (mlt_integrator.h): the
 // bootstrap's normalisation, the chains' starting states, and the splat of the kernel's
-// records into images. Plain CPU code, tested on its own (tests/unit/sampling/test_mlt_chain.cpp).
+// records into images. Plain CPU code, tested on its own (tests/unit/mlt/test_mlt_chain.cpp).
 //
 // Estimator (Veach 1997 §11.3; Kelemen et al. 2002 §4, whose multiple importance sampling of
 // the Metropolis samples and the large steps' uniform ones mlt.glsl derives): with T the
