@@ -4,27 +4,21 @@
 // allocation beyond scripts/fuzz.sh's -malloc_limit_mb, or memory beyond -rss_limit_mb,
 // means something was materialised before it was checked (also a bug).
 // Build: configure with clang and -DGDPT_FUZZ=ON (see tests/fuzz/README.md).
-#include <unistd.h>
-
 #include <cstdint>
-#include <cstdio>
-#include <string>
 
+#include "fuzz_input_file.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     // The loader reads files (relative URIs resolve next to it); give it a private one.
-    static const std::string path = "/tmp/gdpt_fuzz_gltf_" + std::to_string(getpid()) + ".gltf";
-    FILE* f = std::fopen(path.c_str(), "wb");
-    if (!f) return 0;
-    std::fwrite(data, 1, size, f);
-    std::fclose(f);
+    static const gdpt::fuzz::InputFile file("gdpt_fuzz_gltf", ".gltf");
+    if (!file.write(data, size)) return 0;
     gdpt::LoadOptions options;
     options.memoryBudget = 64ull << 20;
     options.quiet = true;
     try {
-        (void)gdpt::loadGltf(path, options);
+        (void)gdpt::loadGltf(file.path(), options);
     } catch (const gdpt::Error&) {
         // The expected way to reject malformed input.
     }

@@ -22,13 +22,22 @@ inline std::string readText(const std::string& path) {
     return s.str();
 }
 
+// One path component from a test's suite and name: a parameterised test's names hold '/'
+// ("Phases/SignalsCli", "Stops/0"), which would make nested directories that TearDown's
+// removal of the innermost one leaves behind.
+inline std::string testDirName(const ::testing::TestInfo& info) {
+    std::string name = std::string(info.test_suite_name()) + "_" + info.name();
+    std::replace(name.begin(), name.end(), '/', '_');
+    return name;
+}
+
 // Each test gets an empty directory named after the process, suite and test.
 class TempDirTest : public ::testing::Test {
 protected:
     void SetUp() override {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
         dir_ = std::filesystem::temp_directory_path() /
-               ("gdpt_" + std::to_string(::getpid()) + "_" + info->test_suite_name() + "_" + info->name());
+               ("gdpt_" + std::to_string(::getpid()) + "_" + testDirName(*info));
         std::filesystem::remove_all(dir_);
         std::filesystem::create_directories(dir_);
     }
