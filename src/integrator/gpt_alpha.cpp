@@ -3,7 +3,8 @@
 namespace gdpt {
 
 GptLighting gptLighting(const SceneFeatures& features) {
-    if (!features.hasEnv) return GptLighting::Emitters;
+    if (!features.hasEnv)
+        return features.hasEmissiveEnclosure ? GptLighting::EmissiveSky : GptLighting::Emitters;
     return features.hasLightTris || features.hasPunctual ? GptLighting::EnvironmentAndEmitters
                                                          : GptLighting::Environment;
 }
@@ -14,6 +15,8 @@ double gptDefaultAlpha(GptLighting lighting) {
             return kGptAlphaEnvironment;
         case GptLighting::EnvironmentAndEmitters:
             return kGptAlphaEnvironmentAndEmitters;
+        case GptLighting::EmissiveSky:
+            return kGptAlphaEmissiveSky;
         case GptLighting::Emitters:
             break;
     }
@@ -26,6 +29,8 @@ const char* toString(GptLighting lighting) {
             return "environment";
         case GptLighting::EnvironmentAndEmitters:
             return "environment and emitters";
+        case GptLighting::EmissiveSky:
+            return "emissive sky";
         case GptLighting::Emitters:
             break;
     }

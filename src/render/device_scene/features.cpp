@@ -51,6 +51,35 @@ double emitterPower(const Scene& scene, std::size_t tri, float area) {
     return p > 0.0 ? p : 0.0;
 }
 
+bool hasEmissiveEnclosure(const Scene& scene) {
+    std::vector<Bounds> bounds(scene.materials.size());
+    Bounds all;
+    for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
+        const std::uint32_t m = scene.triangleMaterial[t];
+        if (m >= bounds.size()) continue;
+        for (int k = 0; k < 3; ++k) {
+            bounds[m].extend(scene.positions[scene.triangles[t][k]]);
+            all.extend(scene.positions[scene.triangles[t][k]]);
+        }
+    }
+    if (all.empty()) return false;
+    const float tolerance = 1e-4f * glm::length(all.max - all.min);
+    for (std::size_t e = 0; e < bounds.size(); ++e) {
+        const Bounds& sky = bounds[e];
+        if (sky.empty() || !(scene.materials[e].flags & gpu::kMatFlagEmissive)) continue;
+        const glm::vec3 extent = sky.max - sky.min;
+        if (!(std::min({extent.x, extent.y, extent.z}) > tolerance)) continue;
+        bool encloses = true;
+        for (std::size_t m = 0; m < bounds.size() && encloses; ++m) {
+            if (m == e || bounds[m].empty()) continue;
+            encloses = glm::all(glm::lessThanEqual(sky.min, bounds[m].min + tolerance)) &&
+                       glm::all(glm::greaterThanEqual(sky.max, bounds[m].max - tolerance));
+        }
+        if (encloses) return true;
+    }
+    return false;
+}
+
 SceneFeatures analyzeScene(const Scene& scene, glm::vec3 envRadiance, float shiftThreshold) {
     SceneFeatures f;
     f.triangles = static_cast<std::uint32_t>(scene.triangles.size());
@@ -67,6 +96,7 @@ SceneFeatures analyzeScene(const Scene& scene, glm::vec3 envRadiance, float shif
             ++f.emissiveTriangles;
     }
     f.hasLightTris = f.emissiveTriangles > 0;
+    f.hasEmissiveEnclosure = f.hasLightTris && hasEmissiveEnclosure(scene);
     for (std::size_t t = 0; t < scene.triangles.size() && !f.hasShadingNormals; ++t)
         f.hasShadingNormals = triangleHasShadingNormals(scene, t);
     for (std::size_t i = 0; i < scene.materials.size(); ++i) {
@@ -105,6 +135,7 @@ std::vector<std::pair<std::string, std::string>> describeFeatures(const SceneFea
         {"roughness range", std::to_string(f.minRoughness) + " .. " + std::to_string(f.maxRoughness)},
         {"glossy/specular vertices", yn(f.hasGlossy)},
         {"environment", yn(f.hasEnv)},
+        {"emissive enclosure (a sky of triangles)", yn(f.hasEmissiveEnclosure)},
         {"transmission", "no (not supported)"},
     };
 }

@@ -23,6 +23,9 @@ struct SceneFeatures {
     bool hasPunctual = false;
     bool hasLightTris = false;
     bool hasEnv = false;
+    // Some emissive material's triangles bound all the others: a sky made of triangles (a dome,
+    // sphere or box of emissive surface around the scene; glTF has no environment light).
+    bool hasEmissiveEnclosure = false;
     bool hasGlossy = false;         // some vertex can be classified glossy (roughness <= threshold)
     bool hasSpecularLayer = false;  // some material has a non-Lambertian (metal/dielectric) lobe
     bool hasAlphaMask = false;
@@ -44,6 +47,12 @@ float triangleArea(const Scene& scene, std::size_t tri);
 double emitterPower(const Scene& scene, std::size_t tri, float area);
 // Whether triangle `tri`'s material emits (a cheap test that emitterPower > 0 requires).
 bool materialIsEmissive(const Scene& scene, std::size_t tri);
+
+// Whether the triangles of one emissive material enclose the rest of `scene` as far as their
+// bounding boxes tell: that material's box has a positive extent on every axis and contains
+// the box of every other material's triangles (within 1e-4 of the scene's diagonal). A scene
+// of that material alone (the white furnace's sphere) counts.
+bool hasEmissiveEnclosure(const Scene& scene);
 
 // shiftThreshold: roughness at or below which a vertex is "glossy" for gradient-domain
 // shifts (Kettunen et al. 2015 reference default 0.001).
