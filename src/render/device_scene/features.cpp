@@ -135,7 +135,7 @@ std::vector<std::pair<std::string, std::string>> describeFeatures(const SceneFea
         {"roughness range", std::to_string(f.minRoughness) + " .. " + std::to_string(f.maxRoughness)},
         {"glossy/specular vertices", yn(f.hasGlossy)},
         {"environment", yn(f.hasEnv)},
-        {"emissive enclosure (a sky of triangles)", yn(f.hasEmissiveEnclosure)},
+        {"emissive sky (enclosure)", yn(f.hasEmissiveEnclosure)},
         {"transmission", "no (not supported)"},
     };
 }
