@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -31,11 +32,29 @@ inline std::string loadError(const std::string& path) {
 
 constexpr int kFloat = 5126, kUInt = 5125, kUShort = 5123, kUByte = 5121;
 
-// A fresh directory per test: <gtest temp dir>/gdpt_scene_<suite>_<test>.
+// <gtest temp dir>/gdpt_scene_<suite>_<test> (one path component, as temp_dir.h's).
+inline std::filesystem::path testDirPath(const ::testing::TestInfo& info) {
+    std::string name = "gdpt_scene_" + std::string(info.test_suite_name()) + "_" + info.name();
+    std::replace(name.begin(), name.end(), '/', '_');
+    return std::filesystem::path(::testing::TempDir()) / name;
+}
+
+// Removes each test's directory when the test ends (registered once per test program).
+class TestDirCleaner : public ::testing::EmptyTestEventListener {
+    void OnTestEnd(const ::testing::TestInfo& info) override {
+        std::error_code ignored;
+        std::filesystem::remove_all(testDirPath(info), ignored);
+    }
+};
+inline const bool kTestDirCleanerRegistered = [] {
+    ::testing::UnitTest::GetInstance()->listeners().Append(new TestDirCleaner);
+    return true;
+}();
+
+// A fresh directory per test, removed when the test ends.
 inline std::string testDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) /
-                                ("gdpt_scene_" + std::string(info->test_suite_name()) + "_" + info->name());
+    (void)kTestDirCleanerRegistered;  // an odr-use: registered before the first directory
+    const std::filesystem::path dir = testDirPath(*::testing::UnitTest::GetInstance()->current_test_info());
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     return dir.string();
