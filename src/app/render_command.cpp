@@ -454,9 +454,8 @@ Subcommand addRenderCommand(CLI::App& app) {
          "--alpha", a.alpha,
          "Weight of the primal term of the screened Poisson energy (default: gpt by the scene's light, "
          "0.2 without --env, 0.4 with --env and emissive surfaces or punctual lights, 0.8 with --env "
-         "alone, 0.4 under a sky of emissive triangles around the scene (docs/reconstruction.md); tgpt 0.2; "
-         "gmlt 0.05, whose splatted primal is blotchier "
-         "than its gradients)")
+         "alone, 0.4 under a sky of emissive triangles around the scene (docs/reconstruction.md); "
+         "tgpt 0.2; gmlt 0.05, whose splatted primal is blotchier than its gradients)")
         ->check(CLI::Range(0.0, 1e3))
         ->group(gpt);
     r->add_option("--tolerance", a.tolerance, "Relative residual at which the solver stops")
