@@ -127,9 +127,9 @@ TEST_F(ReconReportCli, RenderReportsTheDebiasing) {
 // G-PT's α without --alpha is chosen by the scene's light (integrator/gpt_alpha.h), and the
 // JSON (`alpha_choice`, each reconstruction's `alpha`) and the summary line say which: the
 // Cornell box alone 0.2, under a sky beside its lamp 0.4, the open scene under its dome of
-// emissive triangles 0.4, and --alpha wins over the rule (here under the same sky). Every reconstruction of
-// --all-recon uses the same α. Fails if the rule is not applied (0.2 under the sky), applied to the wrong
-// case, or applied over --alpha.
+// emissive triangles 0.4, and --alpha wins over the rule (here under the same sky). Every
+// reconstruction of --all-recon uses the same α. Fails if the rule is not applied (0.2 under
+// the sky), applied to the wrong case, or applied over --alpha.
 TEST_F(ReconReportCli, GptAlphaFollowsTheScenesLightUnlessGiven) {
     RunResult r;
     std::string choice;
@@ -148,10 +148,9 @@ TEST_F(ReconReportCli, GptAlphaFollowsTheScenesLightUnlessGiven) {
     EXPECT_EQ(choice, "scene light: environment and emitters");
 
     // A sky of emissive triangles (the open scene's dome) counts as a sky: 0.4.
-    r = runGdpt("render " + std::string(GDPT_SOURCE_DIR) +
-                "/scenes/open_scene.gltf --width 16 --height 16 "
-                "--spp 2 -o " +
-                path("o.exr") + " --json " + path("o.json"));
+    const std::string openScene = std::string(GDPT_SOURCE_DIR) + "/scenes/open_scene.gltf";
+    r = runGdpt("render " + openScene + " --width 16 --height 16 --spp 2 -o " + path("o.exr") + " --json " +
+                path("o.json"));
     ASSERT_EQ(r.code, 0) << r.output;
     std::ifstream dome(path("o.json"));
     const nlohmann::json d = nlohmann::json::parse(dome);
