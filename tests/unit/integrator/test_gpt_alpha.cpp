@@ -8,6 +8,8 @@
 #include "integrator/gpt_alpha.h"
 #include "render/device_scene/features.h"
 #include "scene/gltf_loader.h"
+#include "scene/procedural.h"
+#include "scene_builders.h"
 
 namespace gdpt {
 namespace {
@@ -45,28 +47,19 @@ TEST(GptAlpha, AnEnvironmentAloneWeighsThePrimalMost) {
     EXPECT_EQ(gptLighting(withPoint), GptLighting::EnvironmentAndEmitters);
 }
 
-// A box from lo to hi of material m (12 triangles), appended to `scene`.
-void addBox(Scene& scene, glm::vec3 lo, glm::vec3 hi, std::uint32_t m) {
-    const auto base = static_cast<std::uint32_t>(scene.positions.size());
-    for (int i = 0; i < 8; ++i)
-        scene.positions.emplace_back(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
-    const int faces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
-                             {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
-    for (const auto& f : faces) {
-        scene.triangles.emplace_back(base + f[0], base + f[1], base + f[2]);
-        scene.triangles.emplace_back(base + f[0], base + f[2], base + f[3]);
-        scene.triangleMaterial.insert(scene.triangleMaterial.end(), 2, m);
-    }
-}
-
-// The Cornell box (lamp included) with a box of a new material around it, emissive or not.
+// The Cornell box (lamp included) with a box of a new material around it, emissive or not: six
+// quads from lo to hi (procedural.h's addQuad, which keeps the scene's normals beside its
+// positions).
 Scene cornellBoxInside(glm::vec3 lo, glm::vec3 hi, bool emissive) {
     Scene scene = loadGltf(GDPT_SOURCE_DIR "/scenes/cornell_box.gltf");
-    gpu::Material sky{};
-    sky.emissive = glm::vec3(1.0f);
-    sky.flags = emissive ? gpu::kMatFlagEmissive : 0u;
-    scene.materials.push_back(sky);
-    addBox(scene, lo, hi, static_cast<std::uint32_t>(scene.materials.size() - 1));
+    scene.materials.push_back(test::lambert(glm::vec3(0.0f), glm::vec3(emissive ? 1.0f : 0.0f)));
+    const auto m = static_cast<std::uint32_t>(scene.materials.size() - 1);
+    glm::vec3 c[8];
+    for (int i = 0; i < 8; ++i)
+        c[i] = glm::vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+    const int faces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
+                             {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+    for (const auto& f : faces) addQuad(scene, c[f[0]], c[f[1]], c[f[2]], c[f[3]], m);
     return scene;
 }
 
