@@ -53,15 +53,17 @@ double emitterPower(const Scene& scene, std::size_t tri, float area) {
 
 bool hasEmissiveEnclosure(const Scene& scene) {
     std::vector<Bounds> bounds(scene.materials.size());
-    Bounds all;
     for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
         const std::uint32_t m = scene.triangleMaterial[t];
         if (m >= bounds.size()) continue;
-        for (int k = 0; k < 3; ++k) {
-            bounds[m].extend(scene.positions[scene.triangles[t][k]]);
-            all.extend(scene.positions[scene.triangles[t][k]]);
-        }
+        for (int k = 0; k < 3; ++k) bounds[m].extend(scene.positions[scene.triangles[t][k]]);
     }
+    Bounds all;  // the union of the materials' boxes
+    for (const Bounds& b : bounds)
+        if (!b.empty()) {
+            all.extend(b.min);
+            all.extend(b.max);
+        }
     if (all.empty()) return false;
     const float tolerance = 1e-4f * glm::length(all.max - all.min);
     for (std::size_t e = 0; e < bounds.size(); ++e) {
