@@ -5,7 +5,6 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -16,6 +15,7 @@
 #include <vector>
 
 #include "scene/gltf_loader.h"
+#include "temp_dir.h"
 #include "util/error.h"
 
 namespace gdpt::test {
@@ -32,11 +32,9 @@ inline std::string loadError(const std::string& path) {
 
 constexpr int kFloat = 5126, kUInt = 5125, kUShort = 5123, kUByte = 5121;
 
-// <gtest temp dir>/gdpt_scene_<suite>_<test> (one path component, as temp_dir.h's).
+// <gtest temp dir>/gdpt_scene_<suite>_<test>, one path component (temp_dir.h's testDirName).
 inline std::filesystem::path testDirPath(const ::testing::TestInfo& info) {
-    std::string name = "gdpt_scene_" + std::string(info.test_suite_name()) + "_" + info.name();
-    std::replace(name.begin(), name.end(), '/', '_');
-    return std::filesystem::path(::testing::TempDir()) / name;
+    return std::filesystem::path(::testing::TempDir()) / ("gdpt_scene_" + testDirName(info));
 }
 
 // Removes each test's directory when the test ends (registered once per test program).
