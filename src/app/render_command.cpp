@@ -309,7 +309,9 @@ int runRender(const RenderArgs& args, const MergedShards* merged) {
     if (shard) {
         ExrAttributes shardInfo = info;
         shardInfo["render_spp"] = std::to_string(timed ? 0u : args.spp);
-        shardInfo["render_args"] = renderArgsJson(args);
+        RenderArgs recorded = args;  // naming the reconstruction that gpt's auto chose
+        recorded.recon = recordedRecon(args, s.features);
+        shardInfo["render_args"] = renderArgsJson(recorded);
         shardInfo["scene_path"] = absolutePath(args.scene);
         writeCheckpoint(*exrFile, identity, shardInfo, *shardState);
     } else {
@@ -442,7 +444,8 @@ Subcommand addRenderCommand(CLI::App& app) {
     const char* gpt = "G-PT";
     r->add_option(
          "--recon", a.recon,
-         "Reconstruction of the final image: auto (wl1 for gpt, l1 for gmlt and tgpt), l1, l2, wl2 or "
+         "Reconstruction of the final image: auto (gpt by the scene's surfaces: wl1, or wl2 where some "
+         "vertex is glossy, e.g. a mirror; l1 for gmlt and tgpt), l1, l2, wl2 or "
          "wl1 (docs/reconstruction.md; for tgpt the space-time solve's, its wl* weighting dt by the "
          "paired samples' variance: docs/animation.md)")
         ->capture_default_str()

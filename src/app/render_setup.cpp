@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "app/bench_util.h"
+#include "integrator/gpt_reconstruction.h"
 #include "integrator/recon_reserve.h"
 #include "render/passes/edge_options.h"
 #include "render/passes/pixel_buffers.h"
@@ -95,10 +96,14 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
     m.mlt.splitBounce = g.sampling.splitBounce;
     g.sampling.edgeSamples = parseEdgeSamples(args.edgeSamples, "--edge-samples");
     g.sampling.demodulate = parseDemodulation(args.demodulate);
-    g.reconstructions = {parseReconstruction(args.recon)};
+    // --recon auto (resolvedRecon keeps it for gpt): the scene's choice, made at render time
+    // (gpt_reconstruction.h); GptOptions' first reconstruction holds its place until then.
+    g.reconstructionByScene = args.recon == "auto";
+    if (!g.reconstructionByScene) g.reconstructions = {parseReconstruction(args.recon)};
     if (args.allRecon)
         for (const char* other : {"l1", "l2", "wl2", "wl1"})
-            if (args.recon != other) g.reconstructions.push_back(parseReconstruction(other));
+            if (g.reconstructions.front() != parseReconstruction(other))
+                g.reconstructions.push_back(parseReconstruction(other));
     if (args.alpha >= 0.0) g.alpha = args.alpha;
     g.tolerance = args.tolerance;
     g.debiasCells = args.debiasCells;
@@ -109,9 +114,10 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
     mlt.targetExponent = args.targetExponent;
     mlt.targetBlock = args.targetBlock;
     mlt.targetAlpha = args.targetAlpha;
-    mlt.reconstructions = {parseReconstruction(args.recon)};
-    if (args.allRecon && args.recon != "l2") mlt.reconstructions.push_back(Reconstruction::L2);
-    if (args.allRecon && args.recon != "l1") mlt.reconstructions.push_back(Reconstruction::L1);
+    const std::string mltRecon = resolvedRecon("gmlt", args.recon);
+    mlt.reconstructions = {parseReconstruction(mltRecon)};
+    if (args.allRecon && mltRecon != "l2") mlt.reconstructions.push_back(Reconstruction::L2);
+    if (args.allRecon && mltRecon != "l1") mlt.reconstructions.push_back(Reconstruction::L1);
     if (args.alpha >= 0.0) mlt.alpha = args.alpha;
     mlt.tolerance = args.tolerance;
     mlt.solver = parseSolverChoice(args.solver);
@@ -244,13 +250,20 @@ int validationExitStatus(const vk::Context& ctx) {
 }
 
 std::string resolvedRecon(const std::string& method, const std::string& recon) {
+    if (recon != "auto" || method == "gpt") return recon;
+    return "l1";
+}
+
+std::string recordedRecon(const RenderArgs& args, const SceneFeatures& features) {
+    const std::string recon = resolvedRecon(args.method, args.recon);
     if (recon != "auto") return recon;
-    return method == "gpt" ? toString(GptOptions{}.reconstructions.front()) : "l1";
+    return toString(gptDefaultReconstruction(gptSurfaces(features)));
 }
 
 // Usage errors that the option checks alone cannot see (exit 2 before any work).
 void checkArgs(const RenderArgs& args) {
-    const bool l1 = args.recon == "l1" || args.recon == "wl1" || args.allRecon;
+    // (auto for gpt: wl1 on most scenes.)
+    const bool l1 = args.recon == "l1" || args.recon == "wl1" || args.recon == "auto" || args.allRecon;
     const bool mlt = args.method == "pssmlt" || args.method == "gmlt";
     if (mlt && (!args.checkpoint.empty() || !args.resume.empty() || !args.shard.empty()))
         throw UsageError(
@@ -276,9 +289,10 @@ void checkArgs(const RenderArgs& args) {
                 "where something moves)");
     }
     if ((args.method == "gpt" || args.method == "gmlt" || args.method == "tgpt") && l1 && args.alpha == 0.0)
-        throw UsageError("--alpha " + std::to_string(args.alpha) +
-                         ": the L1 reconstructions (--recon l1 or wl1, or --all-recon) need --alpha > 0 (the "
-                         "primal term anchors each reweighted solve); use --recon l2 for alpha 0");
+        throw UsageError(
+            "--alpha " + std::to_string(args.alpha) +
+            ": the L1 reconstructions (--recon l1 or wl1, G-PT's auto, or --all-recon) need --alpha > 0 (the "
+            "primal term anchors each reweighted solve); use --recon l2 for alpha 0");
 }
 
 }  // namespace gdpt

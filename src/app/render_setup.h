@@ -58,9 +58,13 @@ int validationExitStatus(const vk::Context& ctx);
 // Usage errors that the option checks alone cannot see (throws gdpt::UsageError, exit 2,
 // before any work).
 void checkArgs(const RenderArgs& args);
-// --recon auto: the method's default reconstruction, wl1 for gpt (GptOptions), l1 for gmlt
-// (its chains give no per-pixel variances) and tgpt (its space-time solve's default); any
-// other value as it is.
+// --recon auto: the method's default reconstruction, l1 for gmlt (its chains give no per-pixel
+// variances) and tgpt (its space-time solve's default); for gpt `auto` stays, the scene's choice
+// at render time (gpt_reconstruction.h: wl1, or wl2 where some vertex is glossy); any other value
+// as it is.
 std::string resolvedRecon(const std::string& method, const std::string& recon);
+// The reconstruction a render's recorded settings name (a shard's, which gdpt merge
+// reconstructs with): resolvedRecon's, with gpt's auto as the scene chose it.
+std::string recordedRecon(const RenderArgs& args, const SceneFeatures& features);
 
 }  // namespace gdpt

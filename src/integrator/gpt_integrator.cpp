@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "integrator/gpt_alpha.h"
+#include "integrator/gpt_reconstruction.h"
 #include "integrator/render_identity.h"
 #include "util/interrupt.h"
 #include "util/timer.h"
@@ -56,8 +57,11 @@ RenderOutput GptIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     out.stats = g.stats;
     if (g.stats.cancelled || g.stats.handedOff) return out;
 
-    // Stage 2, the screened Poisson reconstructions of the primal and gradients, with the
-    // primal weight given or chosen by the scene's light (gpt_alpha.h).
+    // Stage 2, the screened Poisson reconstructions of the primal and gradients, the final one
+    // given or chosen by the scene's surfaces (gpt_reconstruction.h), with the primal weight
+    // given or chosen by the scene's light (gpt_alpha.h).
+    if (options_.reconstructionByScene)
+        stage_.setFinal(gptDefaultReconstruction(gptSurfaces(g.stats.features)));
     stage_.setAlpha(options_.alpha.value_or(gptDefaultAlpha(gptLighting(g.stats.features))));
     PoissonInput input;
     input.primal = &g.primal;
@@ -96,6 +100,12 @@ void GptIntegrator::describe(nlohmann::json& j, const RenderStats& s) const {
     // Where the reconstructions' α came from: --alpha, or the scene's light (gpt_alpha.h).
     j["alpha_choice"] = options_.alpha ? std::string("--alpha")
                                        : std::string("scene light: ") + toString(gptLighting(s.features));
+    // Where the final reconstruction came from: --recon, or the scene's surfaces
+    // (gpt_reconstruction.h).
+    if (!options_.reconstructions.empty())
+        j["recon_choice"] = options_.reconstructionByScene
+                                ? std::string("scene surfaces: ") + toString(gptSurfaces(s.features))
+                                : std::string("--recon");
 }
 
 std::string GptIntegrator::summary(const RenderStats& s) const {

@@ -106,6 +106,10 @@ struct GptOptions {
     // median's), had 4-14 % lower relMSE than L1 on every scene of the set at equal samples and
     // lower at equal time (bench/RESULTS.md, "Weighted L1 with bounded weights").
     std::vector<Reconstruction> reconstructions = {Reconstruction::WeightedL1};
+    // Whether the final reconstruction is the scene's choice (gpt_reconstruction.h: WL1, or WL2
+    // where some vertex is glossy), made at render time: it takes the first place of
+    // `reconstructions`. False: `reconstructions` as given (`--recon`, `gpt-<name>`).
+    bool reconstructionByScene = true;
     // Weight of the primal term; nullopt: by the scene's light (gpt_alpha.h), 0.2 without an
     // environment.
     std::optional<double> alpha;

@@ -29,6 +29,7 @@ std::unique_ptr<Integrator> makeIntegrator(const std::string& name, const Method
     const std::string prefix = "gpt-";
     if (name.compare(0, prefix.size(), prefix) == 0) {
         GptOptions gpt = options.gpt;
+        gpt.reconstructionByScene = false;
         try {
             gpt.reconstructions = {parseReconstruction(name.substr(prefix.size()))};
         } catch (const UsageError&) {

@@ -34,6 +34,17 @@ void ReconstructionStage::setAlpha(double alpha) {
     for (SolveOptions& so : solves_) so.alpha = alpha;
 }
 
+void ReconstructionStage::setFinal(Reconstruction r) {
+    if (solves_.empty() || solves_.front().method == r) return;
+    const auto it =
+        std::find_if(solves_.begin(), solves_.end(), [r](const SolveOptions& so) { return so.method == r; });
+    if (it == solves_.end()) {
+        solves_.front().method = r;
+        return;
+    }
+    std::rotate(solves_.begin(), it, it + 1);
+}
+
 PoissonSolverGpu& ReconstructionStage::solver(const vk::Context& ctx, int width, int height) {
     if (!solver_ || solverCtx_ != &ctx || solverWidth_ != width || solverHeight_ != height) {
         solver_ = std::make_unique<PoissonSolverGpu>(ctx, width, height);

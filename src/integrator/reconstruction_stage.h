@@ -39,6 +39,12 @@ public:
     // 0.2), so a reservation calibrated at 0.2 errs long; one remembered from a render at a
     // larger α errs short for a render at 0.2, whose IRLS the reconstruction deadline cuts.
     void setAlpha(double alpha);
+    // The reconstruction that gives the final image from now on: moved to the front if it is
+    // one of the stage's, else in place of the first. The time reserved stays the one for the
+    // constructor's reconstructions (G-PT: WL1, which gpt_reconstruction.h may turn into WL2,
+    // whose single solve takes about as long); a timed render remembers what the solves took,
+    // per scene, for the next one (ReconTimeCache).
+    void setFinal(Reconstruction r);
     [[nodiscard]] bool empty() const { return solves_.empty(); }
     // The solver for this device and size (made on first use, kept for later renders so that
     // its pipelines are compiled once).

@@ -6,7 +6,8 @@
 // on the same render (the test's power check: the flag is not always false). And the
 // debiasing (--debias-cells) is reported: its node spacing and mean change in the JSON and a
 // line, on the default WL1, not with --debias-cells 0 and not on L2; bad values are usage
-// errors. `--recon auto` (the default) is each method's own reconstruction: wl1 for gpt, l1 for
+// errors. `--recon auto` (the default) is each method's own reconstruction: for gpt the scene's
+// choice (wl1, or wl2 where some vertex is glossy: integrator/gpt_reconstruction.h), l1 for
 // gmlt (its chains give no per-pixel variances, which wl1 needs), and the render's recorded
 // settings name the resolved one.
 #include <gtest/gtest.h>
@@ -89,6 +90,14 @@ TEST_F(ReconReportCli, TheAutomaticReconstructionIsEachMethodsOwn) {
     const std::string bytes((std::istreambuf_iterator<char>(exr)), std::istreambuf_iterator<char>());
     EXPECT_NE(bytes.find("\"recon\":\"wl1\""), std::string::npos) << "render_args do not name wl1";
     EXPECT_EQ(bytes.find("\"recon\":\"auto\""), std::string::npos);
+    // The glossy box's shard names the scene's choice, wl2.
+    r = runGdpt("render " + std::string(GDPT_SOURCE_DIR) +
+                "/scenes/glossy_cornell.gltf --width 16 --height 16 " + "--spp 2 --shard 1/2 -o " +
+                path("g.exr"));
+    ASSERT_EQ(r.code, 0) << r.output;
+    std::ifstream glossy(path("g.exr"), std::ios::binary);
+    const std::string g((std::istreambuf_iterator<char>(glossy)), std::istreambuf_iterator<char>());
+    EXPECT_NE(g.find("\"recon\":\"wl2\""), std::string::npos) << "render_args do not name wl2";
 }
 
 TEST_F(ReconReportCli, RenderReportsTheDebiasing) {
@@ -162,6 +171,46 @@ TEST_F(ReconReportCli, GptAlphaFollowsTheScenesLightUnlessGiven) {
     ASSERT_TRUE(given.is_array() && !given.empty()) << given.dump();
     EXPECT_DOUBLE_EQ(given[0]["alpha"].get<double>(), 0.3);
     EXPECT_EQ(choice, "--alpha");
+}
+
+// G-PT's final reconstruction without --recon is chosen by the scene's surfaces
+// (integrator/gpt_reconstruction.h), and the JSON (`recon_choice`, the reconstructions' order)
+// and the summary line say which: the Cornell box wl1, the glossy box (a mirror sphere) wl2,
+// first of --all-recon's four; --recon wins over the rule. Fails if the rule is not applied,
+// applied to the wrong scene, or applied over --recon.
+TEST_F(ReconReportCli, GptReconstructionFollowsTheScenesSurfacesUnlessGiven) {
+    const std::string glossy = std::string(GDPT_SOURCE_DIR) + "/scenes/glossy_cornell.gltf";
+    const auto renderScene = [&](const std::string& scene, const std::string& flags, RunResult& r) {
+        r = runGdpt("render " + scene + " --width 16 --height 16 --spp 2 --seed 3 -o " + path("s.exr") +
+                    " --json " + path("s.json") + " " + flags);
+        std::ifstream in(path("s.json"));
+        return r.code == 0 && in ? nlohmann::json::parse(in) : nlohmann::json();
+    };
+    RunResult r;
+    const nlohmann::json rough = renderScene(kScene, "", r);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_EQ(rough.value("recon_choice", std::string()), "scene surfaces: rough");
+    EXPECT_EQ(rough.at("reconstructions").at(0).at("method"), "wl1") << rough.dump();
+
+    const nlohmann::json mirror = renderScene(glossy, "", r);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_EQ(mirror.value("recon_choice", std::string()), "scene surfaces: glossy vertices");
+    ASSERT_EQ(mirror.at("reconstructions").size(), 1u) << mirror.dump();
+    EXPECT_EQ(mirror.at("reconstructions").at(0).at("method"), "wl2") << mirror.dump();
+    EXPECT_NE(r.output.find("wl2 reconstruction ("), std::string::npos) << r.output;
+
+    const nlohmann::json all = renderScene(glossy, "--all-recon", r);
+    ASSERT_EQ(r.code, 0) << r.output;
+    ASSERT_EQ(all.at("reconstructions").size(), 4u) << all.dump();
+    EXPECT_EQ(all.at("reconstructions").at(0).at("method"), "wl2") << all.dump();
+    int wl1 = 0;
+    for (const auto& recon : all.at("reconstructions")) wl1 += recon.at("method") == "wl1" ? 1 : 0;
+    EXPECT_EQ(wl1, 1) << all.dump();
+
+    const nlohmann::json given = renderScene(glossy, "--recon wl1", r);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_EQ(given.value("recon_choice", std::string()), "--recon");
+    EXPECT_EQ(given.at("reconstructions").at(0).at("method"), "wl1") << given.dump();
 }
 
 }  // namespace
