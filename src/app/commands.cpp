@@ -16,6 +16,8 @@
 #include "image/finite_check.h"
 #include "image/metrics.h"
 #include "image/png_preview.h"
+#include "integrator/gpt_alpha.h"
+#include "integrator/gpt_reconstruction.h"
 #include "integrator/gpt_sampler.h"
 #include "render/device_scene/features.h"
 #include "render/device_scene/scene_gpu.h"
@@ -231,6 +233,11 @@ int runInfo(const InfoArgs& args) {
         spec ? spec->bvhRegisterStack() : 0u);
     // G-PT's first-hit texture demodulation as --demodulate auto chooses it (gpt_pass.h).
     std::printf("gpt variant: demodulate=%d\n", demodulationApplies(scene) ? 1 : 0);
+    // G-PT's reconstruction and primal weight as render chooses them without --recon and --alpha
+    // (gpt_reconstruction.h, gpt_alpha.h).
+    std::printf("gpt reconstruction: %s (scene surfaces: %s), alpha %g (scene light: %s)\n",
+                toString(gptDefaultReconstruction(gptSurfaces(f))), toString(gptSurfaces(f)),
+                gptDefaultAlpha(gptLighting(f)), toString(gptLighting(f)));
     for (const auto& u : scene.unsupported) std::printf("  unsupported: %s\n", u.c_str());
     if (const auto black = blackImageWarning(scene, so.envRadiance))
         std::printf("warning: %s\n", black->c_str());

@@ -350,7 +350,8 @@ TEST_F(Cli, GptRenderOfATexturedSceneDemodulatesAndSolveUsesItsModulation) {
 
 // `gdpt info` names the scene's features and the kernel variant it selects, including the
 // traversal stack: cornell_box's 36-triangle tree needs 4 entries (register stack of 8);
-// the procedural furnace sphere's 1280 triangles need 13 (register stack of 16).
+// the procedural furnace sphere's 1280 triangles need 13 (register stack of 16); and G-PT's
+// reconstruction and primal weight by the scene.
 TEST_F(Cli, InfoPrintsTheFeaturesAndTheKernelVariant) {
     const RunResult box = run("info " + kScene);
     ASSERT_EQ(box.code, 0) << box.output;
@@ -364,6 +365,19 @@ TEST_F(Cli, InfoPrintsTheFeaturesAndTheKernelVariant) {
     const RunResult textured = run("info " + std::string(GDPT_SOURCE_DIR) + "/scenes/textured.gltf");
     ASSERT_EQ(textured.code, 0) << textured.output;
     EXPECT_NE(textured.output.find("gpt variant: demodulate=1"), std::string::npos) << textured.output;
+    // G-PT's reconstruction and α as render chooses them: the box's, and the glossy box's (its
+    // mirror sphere) and the furnace's (a sky of emissive triangles).
+    EXPECT_NE(
+        box.output.find("gpt reconstruction: wl1 (scene surfaces: rough), alpha 0.2 (scene light: emitters)"),
+        std::string::npos)
+        << box.output;
+    const RunResult glossy = run("info " + std::string(GDPT_SOURCE_DIR) + "/scenes/glossy_cornell.gltf");
+    ASSERT_EQ(glossy.code, 0) << glossy.output;
+    EXPECT_NE(glossy.output.find("gpt reconstruction: wl2 (scene surfaces: glossy vertices)"),
+              std::string::npos)
+        << glossy.output;
+    EXPECT_NE(furnace.output.find("alpha 0.4 (scene light: emissive sky)"), std::string::npos)
+        << furnace.output;
     // The emitters' shares under the default rule: one light has them all; the open scene's
     // two are probed.
     EXPECT_NE(box.output.find("material 3 1.000 (probe)"), std::string::npos) << box.output;

@@ -12,7 +12,9 @@
 namespace gdpt {
 namespace {
 
-Scene sceneFile(const char* name) { return loadGltf(std::string(GDPT_SOURCE_DIR "/scenes/") + name); }
+Scene sceneFile(const char* name) {
+    return loadGltf(std::string(GDPT_SOURCE_DIR "/scenes/") + name);
+}
 
 TEST(GptReconstruction, RoughScenesKeepWeightedL1) {
     for (const char* scene : {"cornell_box.gltf", "small_light.gltf", "textured.gltf", "indirect_gap.gltf",
@@ -25,7 +27,8 @@ TEST(GptReconstruction, RoughScenesKeepWeightedL1) {
 
 TEST(GptReconstruction, AMirrorChoosesWeightedL2) {
     // The glossy box's mirror sphere (roughness 0).
-    EXPECT_EQ(gptSurfaces(analyzeScene(sceneFile("glossy_cornell.gltf"), glm::vec3(0.0f))), GptSurfaces::Glossy);
+    EXPECT_EQ(gptSurfaces(analyzeScene(sceneFile("glossy_cornell.gltf"), glm::vec3(0.0f))),
+              GptSurfaces::Glossy);
     EXPECT_EQ(gptDefaultReconstruction(GptSurfaces::Glossy), Reconstruction::WeightedL2);
     // The Cornell box with its red wall made a mirror; then that wall a GGX metal of roughness
     // 0.02, rough for the default --shift-threshold (0.001) and glossy for a threshold above it,
