@@ -9,7 +9,7 @@
 // samples met one, and its debiasing (debias.h) puts that pixel's energy back spread over a hat of
 // the coarse grid. Measured on the same samples, relMSE of WL2 against WL1 (bench/RESULTS.md,
 // "Reconstruction by the scene's surfaces"): the glossy box (a mirror sphere) −13 to −47 % on each
-// of fourteen renders of 8 to 128 spp, −50 to −55 % at 128²; a Cornell box with a mirror wall −14 %,
+// of thirteen renders of 8 to 128 spp, −50 to −55 % at 128²; a Cornell box with a mirror wall −14 %,
 // its small-light variant −76 to −79 %, the open scene with two mirror boxes −37 to −80 %. The
 // glossy box with its mirror made rough (no glossy vertex) +25 % (WL1 the better), the Cornell
 // box +11 to +20 %.
