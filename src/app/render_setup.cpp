@@ -101,9 +101,9 @@ std::unique_ptr<Integrator> integratorFor(const RenderArgs& args, const ReconTim
     g.reconstructionByScene = args.recon == "auto";
     if (!g.reconstructionByScene) g.reconstructions = {parseReconstruction(args.recon)};
     if (args.allRecon)
-        for (const char* other : {"l1", "l2", "wl2", "wl1"})
-            if (g.reconstructions.front() != parseReconstruction(other))
-                g.reconstructions.push_back(parseReconstruction(other));
+        for (const Reconstruction other :
+             {Reconstruction::L1, Reconstruction::L2, Reconstruction::WeightedL2, Reconstruction::WeightedL1})
+            if (other != g.reconstructions.front()) g.reconstructions.push_back(other);
     if (args.alpha >= 0.0) g.alpha = args.alpha;
     g.tolerance = args.tolerance;
     g.debiasCells = args.debiasCells;

@@ -29,14 +29,18 @@ const std::string kScene = std::string(GDPT_SOURCE_DIR) + "/scenes/cornell_box.g
 
 class ReconReportCli : public test::TempDirTest {
 protected:
-    // Renders with `flags`; returns the output and the JSON's "reconstructions" (and its
-    // "alpha_choice" in `choice`, if given).
-    nlohmann::json render(const std::string& flags, RunResult& r, std::string* choice = nullptr) {
-        r = runGdpt("render " + kScene + " --width 16 --height 16 --spp 4 --seed 3 -o " + path("r.exr") +
+    // Renders `scene` with `flags`; returns the output and the whole --json (null on failure).
+    nlohmann::json renderJson(const std::string& scene, const std::string& flags, RunResult& r) {
+        r = runGdpt("render " + scene + " --width 16 --height 16 --spp 4 --seed 3 -o " + path("r.exr") +
                     " --json " + path("r.json") + " " + flags);
         std::ifstream in(path("r.json"));
-        if (r.code != 0 || !in) return nlohmann::json();
-        const nlohmann::json j = nlohmann::json::parse(in);
+        return r.code == 0 && in ? nlohmann::json::parse(in) : nlohmann::json();
+    }
+    // Renders the Cornell box with `flags`; returns the output and the JSON's "reconstructions"
+    // (and its "alpha_choice" in `choice`, if given).
+    nlohmann::json render(const std::string& flags, RunResult& r, std::string* choice = nullptr) {
+        const nlohmann::json j = renderJson(kScene, flags, r);
+        if (j.is_null()) return j;
         if (choice) *choice = j.value("alpha_choice", std::string());
         return j["reconstructions"];
     }
@@ -92,8 +96,7 @@ TEST_F(ReconReportCli, TheAutomaticReconstructionIsEachMethodsOwn) {
     EXPECT_EQ(bytes.find("\"recon\":\"auto\""), std::string::npos);
     // The glossy box's shard names the scene's choice, wl2.
     r = runGdpt("render " + std::string(GDPT_SOURCE_DIR) +
-                "/scenes/glossy_cornell.gltf --width 16 --height 16 " + "--spp 2 --shard 1/2 -o " +
-                path("g.exr"));
+                "/scenes/glossy_cornell.gltf --width 16 --height 16 --spp 2 --shard 1/2 -o " + path("g.exr"));
     ASSERT_EQ(r.code, 0) << r.output;
     std::ifstream glossy(path("g.exr"), std::ios::binary);
     const std::string g((std::istreambuf_iterator<char>(glossy)), std::istreambuf_iterator<char>());
@@ -157,12 +160,8 @@ TEST_F(ReconReportCli, GptAlphaFollowsTheScenesLightUnlessGiven) {
     EXPECT_EQ(choice, "scene light: environment and emitters");
 
     // A sky of emissive triangles (the open scene's dome) counts as a sky: 0.4.
-    const std::string openScene = std::string(GDPT_SOURCE_DIR) + "/scenes/open_scene.gltf";
-    r = runGdpt("render " + openScene + " --width 16 --height 16 --spp 2 -o " + path("o.exr") + " --json " +
-                path("o.json"));
+    const nlohmann::json d = renderJson(std::string(GDPT_SOURCE_DIR) + "/scenes/open_scene.gltf", "", r);
     ASSERT_EQ(r.code, 0) << r.output;
-    std::ifstream dome(path("o.json"));
-    const nlohmann::json d = nlohmann::json::parse(dome);
     EXPECT_EQ(d.value("alpha_choice", std::string()), "scene light: emissive sky");
     EXPECT_DOUBLE_EQ(d.at("reconstructions").at(0).at("alpha").get<double>(), 0.4) << d.dump();
 
@@ -180,26 +179,20 @@ TEST_F(ReconReportCli, GptAlphaFollowsTheScenesLightUnlessGiven) {
 // applied to the wrong scene, or applied over --recon.
 TEST_F(ReconReportCli, GptReconstructionFollowsTheScenesSurfacesUnlessGiven) {
     const std::string glossy = std::string(GDPT_SOURCE_DIR) + "/scenes/glossy_cornell.gltf";
-    const auto renderScene = [&](const std::string& scene, const std::string& flags, RunResult& r) {
-        r = runGdpt("render " + scene + " --width 16 --height 16 --spp 2 --seed 3 -o " + path("s.exr") +
-                    " --json " + path("s.json") + " " + flags);
-        std::ifstream in(path("s.json"));
-        return r.code == 0 && in ? nlohmann::json::parse(in) : nlohmann::json();
-    };
     RunResult r;
-    const nlohmann::json rough = renderScene(kScene, "", r);
+    const nlohmann::json rough = renderJson(kScene, "", r);
     ASSERT_EQ(r.code, 0) << r.output;
     EXPECT_EQ(rough.value("recon_choice", std::string()), "scene surfaces: rough");
     EXPECT_EQ(rough.at("reconstructions").at(0).at("method"), "wl1") << rough.dump();
 
-    const nlohmann::json mirror = renderScene(glossy, "", r);
+    const nlohmann::json mirror = renderJson(glossy, "", r);
     ASSERT_EQ(r.code, 0) << r.output;
     EXPECT_EQ(mirror.value("recon_choice", std::string()), "scene surfaces: glossy vertices");
     ASSERT_EQ(mirror.at("reconstructions").size(), 1u) << mirror.dump();
     EXPECT_EQ(mirror.at("reconstructions").at(0).at("method"), "wl2") << mirror.dump();
     EXPECT_NE(r.output.find("wl2 reconstruction ("), std::string::npos) << r.output;
 
-    const nlohmann::json all = renderScene(glossy, "--all-recon", r);
+    const nlohmann::json all = renderJson(glossy, "--all-recon", r);
     ASSERT_EQ(r.code, 0) << r.output;
     ASSERT_EQ(all.at("reconstructions").size(), 4u) << all.dump();
     EXPECT_EQ(all.at("reconstructions").at(0).at("method"), "wl2") << all.dump();
@@ -207,7 +200,7 @@ TEST_F(ReconReportCli, GptReconstructionFollowsTheScenesSurfacesUnlessGiven) {
     for (const auto& recon : all.at("reconstructions")) wl1 += recon.at("method") == "wl1" ? 1 : 0;
     EXPECT_EQ(wl1, 1) << all.dump();
 
-    const nlohmann::json given = renderScene(glossy, "--recon wl1", r);
+    const nlohmann::json given = renderJson(glossy, "--recon wl1", r);
     ASSERT_EQ(r.code, 0) << r.output;
     EXPECT_EQ(given.value("recon_choice", std::string()), "--recon");
     EXPECT_EQ(given.at("reconstructions").at(0).at("method"), "wl1") << given.dump();
