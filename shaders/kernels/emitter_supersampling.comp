@@ -13,14 +13,21 @@
 // supersampling). Here each such pixel gets samplesPerSpp first-hit rays per camera sample,
 // at scrambled Sobol' positions (sobol.glsl), which stratify the pixel as they accumulate.
 //
-// Phases (push constant `phase`, one dispatch each over the whole image):
-//   probe   4 rays per pixel (the first four scrambled Sobol' points: one per quarter);
-//           probe[p] = a hash of the emission if the four agree, else 1 ("mixed").
-//   count   a pixel is refined if it is mixed or a neighbour's (3x3) signature differs
-//           from its own; counts them.
-//   refine  per camera sample of the batch, k rays per refined pixel, merged into
-//           visibleStats[p]; k = samplesPerSpp, reduced so that k × refined pixels stays
-//           within rayBudget when the edges are many.
+// Phases (push constant `phase`):
+//   probe   over the image: 4 rays per pixel (the first four scrambled Sobol' points: one
+//           per quarter); probe[p] = a hash of the emission if the four agree, else 1
+//           ("mixed").
+//   count   over the image: a pixel is refined if it is mixed or a neighbour's (3x3)
+//           signature differs from its own; counts them and lists them after the
+//           signatures (probe[pixels + i], in the order the atomic counter hands out).
+//   args    one invocation: k = samplesPerSpp, reduced so that k × refined pixels stays
+//           within rayBudget when the edges are many, and the refine dispatch's group counts.
+//   refine  over the list (dispatched indirectly): per camera sample of the batch, k rays
+//           per refined pixel, merged into visibleStats[p]. One invocation per listed pixel
+//           keeps every lane of a SIMD vector on a refined pixel: over the image, a vector
+//           of eight neighbours that an edge crosses in one or two of them ran their rays
+//           with the rest idle. A pixel's estimate depends on its own rays alone, so the
+//           list's order (which the atomic makes vary) changes no bit of it.
 // Unbiased: which pixels are refined depends only on the probe's rays; the refined estimate
 // uses other, independent rays, and each scrambled point is uniform over the pixel, so the
 // pixel's estimate is unbiased given the choice, hence unbiased. Both PT and G-PT use it.
@@ -87,23 +94,38 @@ bool refined(uint x, uint y) {
 
 void main() {
     loadScene();
-    uint x = gl_GlobalInvocationID.x;
-    uint y = gl_GlobalInvocationID.y;
-    if (x >= scene.width || y >= scene.height) return;
-    uint pixel = y * scene.width + x;
+    uint pixels = scene.width * scene.height;
+    uint pixel;
+    if (params.phase == kVisiblePhaseRefine) {
+        uint item = gl_WorkGroupID.x * (gl_WorkGroupSize.x * gl_WorkGroupSize.y) + gl_LocalInvocationIndex;
+        if (item >= visibleCounter.refinedPixels) return;
+        pixel = probe[pixels + item];
+    } else {
+        if (gl_GlobalInvocationID.x >= scene.width || gl_GlobalInvocationID.y >= scene.height) return;
+        pixel = gl_GlobalInvocationID.y * scene.width + gl_GlobalInvocationID.x;
+    }
+    uint x = pixel % scene.width;
+    uint y = pixel / scene.width;
 
     if (params.phase == kVisiblePhaseCount) {
-        if (refined(x, y)) atomicAdd(visibleCounter.refinedPixels, 1u);
+        if (refined(x, y)) probe[pixels + atomicAdd(visibleCounter.refinedPixels, 1u)] = pixel;
+        return;
+    }
+    if (params.phase == kVisiblePhaseArgs) {
+        if (pixel != 0u) return;
+        uint refinedPixels = visibleCounter.refinedPixels;
+        visibleCounter.raysPerSample = clamp(params.rayBudget / max(refinedPixels, 1u), 1u, params.samplesPerSpp);
+        uint groupSize = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
+        visibleCounter.groupsX = (refinedPixels + groupSize - 1u) / groupSize;
+        visibleCounter.groupsY = 1u;
+        visibleCounter.groupsZ = 1u;
         return;
     }
     // Probe: one "sample" of four rays; refine: the batch's camera samples of k rays each.
     uint samples = 1u, raysPerSample = 4u, sampleBase = 0u;
     uint salt = 0x70726f62u;  // "prob"
     if (params.phase == kVisiblePhaseRefine) {
-        uint k = clamp(params.rayBudget / max(visibleCounter.refinedPixels, 1u), 1u, params.samplesPerSpp);
-        if (pixel == 0u) visibleCounter.raysPerSample = k;  // for the host's report
-        if (!refined(x, y)) return;
-        raysPerSample = k;
+        raysPerSample = visibleCounter.raysPerSample;
         samples = params.samplesPerPixel;
         sampleBase = params.sampleBase;
         salt = 0x76697369u;  // "visi"

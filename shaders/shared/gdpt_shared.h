@@ -231,15 +231,20 @@ struct VisibleParams {
     uint pad1;
 };
 GDPT_CONST uint kVisiblePhaseProbe = 0u;   // 4 stratified rays per pixel -> signature
-GDPT_CONST uint kVisiblePhaseCount = 1u;   // count the pixels to supersample
-GDPT_CONST uint kVisiblePhaseRefine = 2u;  // supersample them (one batch)
+GDPT_CONST uint kVisiblePhaseCount = 1u;   // list the pixels to supersample
+GDPT_CONST uint kVisiblePhaseRefine = 2u;  // supersample them (one batch), one invocation per listed pixel
+GDPT_CONST uint kVisiblePhaseArgs = 3u;    // the refine dispatch's group counts and rays per sample
 
-// Written by emitter_supersampling.comp's count phase. 16 bytes.
+// Written by emitter_supersampling.comp's count and args phases. 32 bytes.
 struct VisibleCounter {
     uint refinedPixels;  // pixels whose neighbourhood sees an emission edge
     uint raysPerSample;  // refine rays per camera sample in them (after the ray budget)
     uint pad1;
     uint pad2;
+    uint groupsX;  // the refine phase's indirect dispatch (VkDispatchIndirectCommand): enough
+    uint groupsY;  // workgroups for one invocation per refined pixel, 1, 1
+    uint groupsZ;
+    uint pad3;
 };
 
 // Per-pixel running statistics of one estimator (Welford/Chan merge). 32 bytes.
@@ -273,7 +278,8 @@ kBindTriGeom = 0u,
     // emitter supersampling (emitter_supersampling.comp, render/passes/emitter_supersampling_pass.h): the
     // supersampled estimate of the emission seen at the camera's first hit (PixelStats; a
     // count > 0 tells the path kernels to leave that term to it), the probe signature
-    // per pixel (uint) and the pass's counter (VisibleCounter).
+    // per pixel (uint) followed by the list of refined pixels (uint each, as many as the
+    // image's pixels) and the pass's counter (VisibleCounter).
     kBindVisibleStats = 14u, kBindVisibleProbe = 15u, kBindVisibleCounter = 16u GDPT_ENUM_END();
 
 // Bindings used only by test kernels (tests/gpu/kernels), kept here so no number repeats.

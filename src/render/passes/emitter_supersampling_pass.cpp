@@ -1,6 +1,7 @@
 #include "render/passes/emitter_supersampling_pass.h"
 
 #include <algorithm>
+#include <cstddef>
 #include <string>
 
 #include "emitter_supersampling.spv.h"
@@ -45,8 +46,8 @@ EmitterSupersamplingPass::EmitterSupersamplingPass(const vk::Context& ctx, const
       // Disabled: 16-byte placeholders (the path kernels compile the read out).
       stats_(ctx, enabled() ? std::uint64_t{width_} * height_ * sizeof(gpu::PixelStats) : 0,
              "emitter-supersampling statistics"),
-      probe_(ctx, enabled() ? std::uint64_t{width_} * height_ * sizeof(std::uint32_t) : 0,
-             "emitter-supersampling probe"),
+      probe_(ctx, enabled() ? std::uint64_t{width_} * height_ * kEmitterProbeBytesPerPixel : 0,
+             "emitter-supersampling probe and list"),
       counter_(ctx, sizeof(gpu::VisibleCounter), "emitter-supersampling counter") {
     if (!enabled()) return;
     vk::KernelDesc d = scene.kernelDesc(
@@ -90,8 +91,8 @@ void EmitterSupersamplingPass::record(VkCommandBuffer cmd, std::uint32_t sampleB
     p.samplesPerSpp = samplesPerSpp_;
     p.rayBudget = rayBudget(width_, height_);
     if (!probed_ || probeSeed_ != seed) {
-        // The probe and the count: the same for every batch of a render with this seed, so a
-        // resumed render redoes them and refines the same pixels.
+        // The probe, the list and the refine dispatch's size: the same for every batch of a
+        // render with this seed, so a resumed render redoes them and refines the same pixels.
         counter_.zero();
         p.phase = gpu::kVisiblePhaseProbe;
         kernel_->dispatchItems(cmd, width_, height_, &p, timer);
@@ -99,11 +100,14 @@ void EmitterSupersamplingPass::record(VkCommandBuffer cmd, std::uint32_t sampleB
         p.phase = gpu::kVisiblePhaseCount;
         kernel_->dispatchItems(cmd, width_, height_, &p, timer);
         vk::computeBarrier(cmd);
+        p.phase = gpu::kVisiblePhaseArgs;
+        kernel_->dispatch(cmd, 1, 1, 1, &p, timer);
+        vk::computeBarrier(cmd);
         probed_ = true;
         probeSeed_ = seed;
     }
     p.phase = gpu::kVisiblePhaseRefine;
-    kernel_->dispatchItems(cmd, width_, height_, &p, timer);
+    kernel_->dispatchIndirect(cmd, counter_, offsetof(gpu::VisibleCounter, groupsX), &p, timer);
     vk::computeBarrier(cmd);
 }
 

@@ -22,6 +22,10 @@
 
 namespace gdpt {
 
+// Bytes per pixel of the pass's probe buffer: the probe's signature, then the list of the
+// refined pixels, which may hold every pixel (emitter_supersampling.comp).
+inline constexpr std::uint64_t kEmitterProbeBytesPerPixel = 2 * sizeof(std::uint32_t);
+
 namespace vk {
 class Context;
 class GpuTimer;

@@ -61,7 +61,7 @@ std::vector<PixelBuffer> pixelBuffers(const GptPassOptions& options) {
     std::vector<PixelBuffer> b = {{"each G-PT per-pixel statistics buffer", sizeof(gpu::PixelStats)},
                                   {"the resolved G-PT images", sizeof(gpu::GptResolved)},
                                   {"the emitter-supersampling statistics", sizeof(gpu::PixelStats)},
-                                  {"the emitter-supersampling probe", sizeof(std::uint32_t)},
+                                  {"the emitter-supersampling probe and list", kEmitterProbeBytesPerPixel},
                                   {"the edge mask", sizeof(std::uint32_t)},
                                   {"the edge sample rates", sizeof(std::uint32_t)},
                                   {"the edge probe", sizeof(gpu::EdgeProbe)}};

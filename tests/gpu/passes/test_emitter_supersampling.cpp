@@ -9,13 +9,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "gpu_fixture.h"
 #include "integrator/gpt_sampler.h"
 #include "integrator/pt_sampler.h"
 #include "integrator/render_options.h"
+#include "render/device_scene/scene_gpu.h"
+#include "render/passes/pt_pass.h"
 #include "scene_builders.h"
+#include "vk/commands.h"
 
 namespace gdpt {
 namespace {
@@ -136,6 +140,49 @@ TEST_F(VisibleEmission, RimPixelsAreUnbiasedAndFarBelowTheKernelsOwnEstimate) {
         const RimErrors off = rimErrors(render(method, s, options(spp, 0, 11), &stats), spp, method + " off");
         EXPECT_LT(r.sumSquared, 0.25 * off.sumSquared) << method;
     }
+}
+
+// The refine phase runs one invocation per pixel of the count phase's list, which its atomic
+// counter fills in whatever order the device's threads reach it: every refined pixel takes
+// each camera sample of every batch exactly once (a pixel listed twice would count 2 × 5, one
+// left out 0), no other pixel any, and the statistics are the same bits in a second pass over
+// the same batches, whatever its list's order.
+TEST_F(VisibleEmission, EveryRefinedPixelTakesEachCameraSampleOnce) {
+    const Scene s = squareScene();
+    SceneGpuOptions so;
+    so.width = so.height = kSize;
+    const SceneGpu scene(ctx(), s, so);
+    const auto statistics = [&](gpu::VisibleCounter* counter) {
+        PtPass pass(ctx(), scene, WorkgroupSize{}, 16);
+        vk::CommandStream stream(ctx(), "emitter supersampling");
+        pass.record(stream.begin(), 0, 2, 7, nullptr);
+        stream.submitAndWait();
+        pass.record(stream.begin(), 2, 3, 7, nullptr);
+        stream.submitAndWait();
+        *counter = pass.emitterSupersampling().report();
+        return pass.emitterSupersampling().downloadStats();
+    };
+    gpu::VisibleCounter counter{}, again{};
+    const std::vector<gpu::PixelStats> first = statistics(&counter), second = statistics(&again);
+    ASSERT_EQ(first.size(), std::size_t{kSize} * kSize);
+    std::uint32_t sampled = 0;
+    for (int y = 0; y < kSize; ++y)
+        for (int x = 0; x < kSize; ++x) {
+            const gpu::PixelStats& p = first[std::size_t(y) * kSize + x];
+            if (p.count == 0) continue;
+            ++sampled;
+            EXPECT_EQ(p.count, 5u) << "pixel " << x << "," << y;
+        }
+    for (int y = 0; y < kSize; ++y)
+        for (int x = 0; x < kSize; ++x) {
+            const double c = coverage(x, y);
+            if (c > 0.0 && c < 1.0) {
+                EXPECT_EQ(first[std::size_t(y) * kSize + x].count, 5u) << "rim pixel " << x << "," << y;
+            }
+        }
+    EXPECT_EQ(sampled, counter.refinedPixels);
+    EXPECT_EQ(again.refinedPixels, counter.refinedPixels);
+    EXPECT_EQ(0, std::memcmp(first.data(), second.data(), first.size() * sizeof(gpu::PixelStats)));
 }
 
 TEST_F(VisibleEmission, OffLeavesThePathKernelsOwnUnbiasedEstimate) {

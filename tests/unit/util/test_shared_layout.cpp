@@ -21,6 +21,8 @@ static_assert(offsetof(BvhNode, leftCount) == 28 && offsetof(BvhNode, rightCount
 static_assert(sizeof(BvhWideNode) == 64);
 static_assert(offsetof(BvhWideNode, exponents) == 12 && offsetof(BvhWideNode, qMin) == 16);
 static_assert(offsetof(BvhWideNode, qMax) == 32 && offsetof(BvhWideNode, child) == 48);
+static_assert(sizeof(VisibleCounter) == 32 &&
+              offsetof(VisibleCounter, groupsX) == 16);  // an indirect dispatch
 static_assert(sizeof(Material) == 80);
 static_assert(offsetof(Material, emissive) == 16 && offsetof(Material, specularColor) == 32);
 static_assert(offsetof(Material, flags) == 60 && offsetof(Material, normalTex) == 76);
