@@ -21,7 +21,8 @@
 //           signature differs from its own; counts them and lists them after the
 //           signatures (probe[pixels + i], in the order the atomic counter hands out).
 //   args    one invocation: k = samplesPerSpp, reduced so that k × refined pixels stays
-//           within rayBudget when the edges are many, and the refine dispatch's group counts.
+//           within rayBudget when the edges are many, and the refine dispatch's group counts
+//           (rows of groups; the last row's surplus invocations return at once).
 //   refine  over the list (dispatched indirectly): per camera sample of the batch, k rays
 //           per refined pixel, merged into visibleStats[p]. One invocation per listed pixel
 //           keeps every lane of a SIMD vector on a refined pixel: over the image, a vector
@@ -97,7 +98,8 @@ void main() {
     uint pixels = scene.width * scene.height;
     uint pixel;
     if (params.phase == kVisiblePhaseRefine) {
-        uint item = gl_WorkGroupID.x * (gl_WorkGroupSize.x * gl_WorkGroupSize.y) + gl_LocalInvocationIndex;
+        uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+        uint item = group * (gl_WorkGroupSize.x * gl_WorkGroupSize.y) + gl_LocalInvocationIndex;
         if (item >= visibleCounter.refinedPixels) return;
         pixel = probe[pixels + item];
     } else {
@@ -115,9 +117,12 @@ void main() {
         if (pixel != 0u) return;
         uint refinedPixels = visibleCounter.refinedPixels;
         visibleCounter.raysPerSample = clamp(params.rayBudget / max(refinedPixels, 1u), 1u, params.samplesPerSpp);
+        // Rows of at most 65,535 groups, the least maxComputeWorkGroupCount a device has (a
+        // 4K image whose every pixel is refined needs 130,000 groups of 64).
         uint groupSize = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
-        visibleCounter.groupsX = (refinedPixels + groupSize - 1u) / groupSize;
-        visibleCounter.groupsY = 1u;
+        uint groups = (refinedPixels + groupSize - 1u) / groupSize;
+        visibleCounter.groupsX = min(groups, 65535u);
+        visibleCounter.groupsY = (groups + 65534u) / 65535u;
         visibleCounter.groupsZ = 1u;
         return;
     }

@@ -242,8 +242,8 @@ struct VisibleCounter {
     uint pad1;
     uint pad2;
     uint groupsX;  // the refine phase's indirect dispatch (VkDispatchIndirectCommand): enough
-    uint groupsY;  // workgroups for one invocation per refined pixel, 1, 1
-    uint groupsZ;
+    uint groupsY;  // workgroups for one invocation per refined pixel, in rows of at most
+    uint groupsZ;  // 65,535 groups; 1
     uint pad3;
 };
 

@@ -185,6 +185,36 @@ TEST_F(VisibleEmission, EveryRefinedPixelTakesEachCameraSampleOnce) {
     EXPECT_EQ(0, std::memcmp(first.data(), second.data(), first.size() * sizeof(gpu::PixelStats)));
 }
 
+// More refined pixels than 65,535 workgroups hold (the least maxComputeWorkGroupCount of a
+// device): with one-invocation workgroups, a 256² image whose every pixel is refined needs
+// 65,536 groups, which the indirect dispatch lays out in two rows. An emissive bar over the
+// left half of every pixel column makes each pixel's probe mixed.
+TEST_F(VisibleEmission, AListLongerThanOneRowOfWorkgroupsIsRefinedWhole) {
+    constexpr int kBars = 256;
+    Scene s;
+    s.materials.push_back(test::lambert(glm::vec3(0.0f), kRadiance));
+    const float half =
+        kCameraHeight * std::tan(0.5f * glm::radians(kFovDeg));  // the view's half-width at z = 0
+    const auto worldX = [&](double pixel) { return float((2.0 * pixel / kBars - 1.0) * half); };
+    for (int i = 0; i < kBars; ++i) {
+        const float x0 = worldX(i), x1 = worldX(i + 0.5), y = 1.1f * half;
+        addQuad(s, {x0, -y, 0.0f}, {x1, -y, 0.0f}, {x1, y, 0.0f}, {x0, y, 0.0f}, 0);
+    }
+    s.cameras.push_back(test::lookDown(kCameraHeight, kFovDeg));
+    SceneGpuOptions so;
+    so.width = so.height = kBars;
+    const SceneGpu scene(ctx(), s, so);
+    PtPass pass(ctx(), scene, WorkgroupSize{1, 1}, 16);
+    vk::CommandStream stream(ctx(), "emitter supersampling");
+    pass.record(stream.begin(), 0, 2, 3, nullptr);
+    stream.submitAndWait();
+    EXPECT_EQ(pass.emitterSupersampling().report().refinedPixels, std::uint32_t(kBars * kBars));
+    const std::vector<gpu::PixelStats> stats = pass.emitterSupersampling().downloadStats();
+    std::size_t twice = 0;
+    for (const gpu::PixelStats& p : stats) twice += p.count == 2u ? 1u : 0u;
+    EXPECT_EQ(twice, stats.size()) << "pixels with both camera samples";
+}
+
 TEST_F(VisibleEmission, OffLeavesThePathKernelsOwnUnbiasedEstimate) {
     const Scene s = squareScene();
     const std::uint32_t spp = 16;
