@@ -55,10 +55,10 @@ namespace gdpt {
 // inverse-variance row weights taken from a box-filtered variance (weightedL1Weights).
 enum class Reconstruction { L2, WeightedL2, L1, WeightedL1 };
 // HostPcg: not on the device but on the host's threads, in double precision (the space-time
-// solver of poisson_spacetime.h with one frame: Jacobi-preconditioned CG, IRLS with the same
-// schedule and weights). On a CPU device (lavapipe) it is several times faster than the
-// device's solvers (bench/RESULTS.md, "The reconstruction on the host"); a singular problem
-// (α = 0 or no primal row) still goes to the device.
+// solver of poisson_spacetime.h with one frame: CG preconditioned by one multigrid V-cycle
+// (host_vcycle.h), IRLS with the same schedule and weights). On a CPU device (lavapipe) it
+// is several times faster than the device's solvers (bench/RESULTS.md, "The reconstruction
+// on the host"); a singular problem (α = 0 or no primal row) still goes to the device.
 enum class GpuSolver { MgPcg, Cg, Jacobi, Mg, HostPcg };
 
 // Parses "l1|l2|wl2|wl1" and "mg-pcg|cg|jacobi|mg|host-pcg"; throws gdpt::UsageError otherwise.
@@ -74,7 +74,8 @@ inline constexpr const char* kSolverChoices[] = {"auto", "mg-pcg", "cg", "jacobi
 inline constexpr const char* kSolverHelp =
     "Linear solver of the reconstruction: auto (host-pcg on a CPU Vulkan device such as lavapipe, where "
     "it is several times faster; mg-pcg on a GPU), mg-pcg (device, multigrid-preconditioned CG), cg, "
-    "jacobi, mg (device), host-pcg (the host's threads, Jacobi-preconditioned CG in double precision)";
+    "jacobi, mg (device), host-pcg (the host's threads, CG preconditioned by a multigrid V-cycle, in "
+    "double precision)";
 // "auto" (nullopt) or a solver's name (parseGpuSolver); throws gdpt::UsageError otherwise.
 std::optional<GpuSolver> parseSolverChoice(const std::string& text);
 // The solver of a choice on `ctx`: the chosen one, or for auto host-pcg on a CPU device
@@ -100,12 +101,13 @@ struct SolveOptions {
     // (Cornell box 4-32 spp, relMSE within 2 % from 0.001 to 0.1), but outlier rejection
     // does (a test image with corrupted gradients: rmse 0.0015 at 0.001, 0.014 at 0.01,
     // 0.015 at 0.02, 0.050 at 0.05). 0.02 instead of 0.01 keeps that and takes 20-30 % fewer
-    // iterations on low-spp renders (bench/RESULTS.md, IRLS schedule). The host's
-    // Jacobi-preconditioned CG leaves more low-frequency error at the same relative residual
-    // than multigrid: at 0.02 its L1 images were 0.6-1.3 % above the device's relMSE, at 0.005
-    // 0.0-1.1 % below it, still in under half the device's time on lavapipe (Cornell box, 8
-    // and 32 spp, bench/RESULTS.md, "The reconstruction on the host"). nullopt: the solver's
-    // default (kDeviceIrlsInnerTolerance, kHostIrlsInnerTolerance).
+    // iterations on low-spp renders (bench/RESULTS.md, IRLS schedule). The host's CG, when
+    // its preconditioner was the diagonal (before host_vcycle.h's V-cycle), left more
+    // low-frequency error at the same relative residual than multigrid: at 0.02 its L1
+    // images were 0.6-1.3 % above the device's relMSE, at 0.005 0.0-1.1 % below it, still in
+    // under half the device's time on lavapipe (Cornell box, 8 and 32 spp, bench/RESULTS.md,
+    // "The reconstruction on the host"). nullopt: the solver's default
+    // (kDeviceIrlsInnerTolerance, kHostIrlsInnerTolerance).
     std::optional<double> irlsInnerTolerance;
     double varianceEpsilon = 1e-4;  // WL2, WL1: w = 1/(var + ε)
     // WL1: the variances are averaged over a (2r+1)² box first, so that a row's weight is

@@ -936,7 +936,7 @@ struct ChannelSolve {
     bool stoppedAtDeadline = false;
 };
 
-// Jacobi-preconditioned CG from x until ‖b − A x‖ ≤ tolerance ‖b‖, the three channels in
+// Preconditioned CG from x until ‖b − A x‖ ≤ tolerance ‖b‖, the three channels in
 // lockstep (each stops where it converges), pixel ranges over `threads`. A is SPD (α > 0).
 // Jacobi: z = r / d is not stored (p ← r/d + β p). Multigrid (`mg`, one-frame windows): z =
 // M⁻¹ r by one V-cycle (host_vcycle.h), p ← z + β p.
