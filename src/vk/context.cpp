@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "util/error.h"
+#include "util/file_size_limit.h"
 #include "vk/pipeline_cache.h"
 #include "vk/vk_check.h"
 
@@ -208,6 +209,7 @@ Context::Context(const ContextOptions& options)
             "validation requested but VK_LAYER_KHRONOS_validation is not installed "
             "(apt-get install vulkan-validationlayers)");
     const bool debugUtils = instanceExtensionAvailable(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    const std::size_t memoryFilesBefore = memoryFileCount();
     instance_ = Handle<VkInstance>(createInstance(validation_, debugUtils),
                                    [](VkInstance i) { vkDestroyInstance(i, nullptr); });
     VkInstance inst = instance_.get();
@@ -277,6 +279,14 @@ Context::Context(const ContextOptions& options)
         vkDestroyDevice(d, nullptr);
     });
     vkGetDeviceQueue(device, queueFamily_, 0, &queue_);
+    // Before any allocation: a file-size limit would crash a driver that keeps device memory in
+    // a memory file (util/file_size_limit.h).
+    const std::size_t memoryFilesAfter = memoryFileCount();
+    if (auto problem = memoryFileLimitProblem(
+            info_.name, info_.isCpu,
+            memoryFilesAfter > memoryFilesBefore ? memoryFilesAfter - memoryFilesBefore : 0, fileSizeLimit(),
+            info_.deviceLocalHeapBytes))
+        throw Error(*problem);
     if (options.keepPipelines) pipelineCache_ = std::make_unique<PipelineCache>();
 }
 

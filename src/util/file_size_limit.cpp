@@ -1,0 +1,42 @@
+// file_size_limit.cpp — see file_size_limit.h.
+#include "util/file_size_limit.h"
+
+#include <sys/resource.h>
+
+#include <filesystem>
+#include <system_error>
+
+#include "util/memory.h"
+
+namespace gdpt {
+
+std::optional<std::uint64_t> fileSizeLimit() {
+    rlimit r{};
+    if (getrlimit(RLIMIT_FSIZE, &r) != 0 || r.rlim_cur == RLIM_INFINITY) return std::nullopt;
+    return std::uint64_t(r.rlim_cur);
+}
+
+std::size_t memoryFileCount() {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    std::size_t count = 0;
+    for (fs::directory_iterator it("/proc/self/fd", ec), end; !ec && it != end; it.increment(ec)) {
+        std::error_code linkError;
+        const fs::path target = fs::read_symlink(it->path(), linkError);
+        if (!linkError && target.native().rfind("/memfd:", 0) == 0) ++count;
+    }
+    return count;
+}
+
+std::optional<std::string> memoryFileLimitProblem(const std::string& device, bool cpuDevice,
+                                                  std::size_t memoryFilesAdded, std::optional<std::uint64_t> limit,
+                                                  std::uint64_t heapBytes) {
+    if (!cpuDevice || memoryFilesAdded == 0 || !limit || *limit >= heapBytes) return std::nullopt;
+    const std::string size = *limit >= (1ull << 20) ? memoryText(*limit) : std::to_string(*limit) + " bytes";
+    return "the file-size limit (ulimit -f) of " + size + " also caps the memory of device '" + device +
+           "', which keeps it in a memory file, and the driver would be killed (SIGBUS) past it; raise the "
+           "limit to at least the device's " +
+           memoryText(heapBytes) + " (ulimit -f unlimited)";
+}
+
+}  // namespace gdpt
