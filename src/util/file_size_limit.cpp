@@ -29,11 +29,12 @@ std::size_t memoryFileCount() {
 }
 
 std::optional<std::string> memoryFileLimitProblem(const std::string& device, bool cpuDevice,
-                                                  std::size_t memoryFilesAdded, std::optional<std::uint64_t> limit,
+                                                  std::size_t memoryFilesAdded,
+                                                  std::optional<std::uint64_t> limit,
                                                   std::uint64_t heapBytes) {
     if (!cpuDevice || memoryFilesAdded == 0 || !limit || *limit >= heapBytes) return std::nullopt;
-    const std::string size = *limit >= (1ull << 20) ? memoryText(*limit) : std::to_string(*limit) + " bytes";
-    return "the file-size limit (ulimit -f) of " + size + " also caps the memory of device '" + device +
+    return "the file-size limit (ulimit -f) of " + memoryText(*limit) + " also caps the memory of device '" +
+           device +
            "', which keeps it in a memory file, and the driver would be killed (SIGBUS) past it; raise the "
            "limit to at least the device's " +
            memoryText(heapBytes) + " (ulimit -f unlimited)";

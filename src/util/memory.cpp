@@ -24,7 +24,12 @@ std::string gibibytes(std::uint64_t bytes) {
 std::string memoryText(std::uint64_t bytes) {
     if (bytes >= (1ull << 30)) return gibibytes(bytes);
     char text[32];
-    std::snprintf(text, sizeof text, "%.0f MiB", double(bytes) / double(1ull << 20));
+    if (bytes >= (1ull << 20))
+        std::snprintf(text, sizeof text, "%.0f MiB", double(bytes) / double(1ull << 20));
+    else if (bytes >= (1ull << 10))
+        std::snprintf(text, sizeof text, "%.0f KiB", double(bytes) / double(1ull << 10));
+    else
+        std::snprintf(text, sizeof text, "%llu bytes", static_cast<unsigned long long>(bytes));
     return text;
 }
 

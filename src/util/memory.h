@@ -13,7 +13,7 @@ namespace gdpt {
 
 // "1.5 GiB": bytes in gibibytes with one decimal.
 [[nodiscard]] std::string gibibytes(std::uint64_t bytes);
-// gibibytes from 1 GiB up, "37 MiB" below.
+// gibibytes from 1 GiB up, "37 MiB" below, "12 KiB" below 1 MiB, "512 bytes" below 1 KiB.
 [[nodiscard]] std::string memoryText(std::uint64_t bytes);
 
 }  // namespace gdpt

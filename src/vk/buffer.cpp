@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "util/huge_pages.h"
+#include "util/memory.h"
 #include "vk/commands.h"
 #include "vk/context.h"
 #include "vk/vk_check.h"
@@ -66,7 +67,7 @@ VkMemoryPropertyFlags Buffer::allocate(VkBufferUsageFlags usage,
     VkDeviceMemory memory = VK_NULL_HANDLE;
     const VkResult r = vkAllocateMemory(device, &alloc, nullptr, &memory);
     if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY)
-        throw Error("out of " + what + " (" + std::to_string(size_ >> 20) + " MiB)");
+        throw Error("out of " + what + " (" + memoryText(size_) + ")");
     VK_CHECK(r);
     ctx_->noteAllocation(req.size);
     memory_ = Handle<VkDeviceMemory>(memory, [device, ctxp = ctx_, bytes = req.size](VkDeviceMemory m) {

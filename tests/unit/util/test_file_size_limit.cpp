@@ -43,14 +43,14 @@ TEST(FileSizeLimit, RefusesOnlyACpuDeviceWithMemoryFilesUnderALimitBelowItsHeap)
     // The case that crashed: every condition holds.
     const std::optional<std::string> problem = memoryFileLimitProblem("llvmpipe", true, 1, 2048, kHeap);
     ASSERT_TRUE(problem.has_value());
-    EXPECT_NE(problem->find("2048 bytes"), std::string::npos) << *problem;
+    EXPECT_NE(problem->find("2 KiB"), std::string::npos) << *problem;
     EXPECT_NE(problem->find("'llvmpipe'"), std::string::npos) << *problem;
     EXPECT_NE(problem->find("1.0 GiB"), std::string::npos) << *problem;
     EXPECT_NE(problem->find("ulimit -f unlimited"), std::string::npos) << *problem;
     EXPECT_NE(memoryFileLimitProblem("llvmpipe", true, 1, 3u << 20, kHeap)->find("3 MiB"), std::string::npos);
     // Any condition missing: no refusal.
-    EXPECT_FALSE(memoryFileLimitProblem("gpu", false, 1, 2048, kHeap));      // a GPU's memory
-    EXPECT_FALSE(memoryFileLimitProblem("llvmpipe", true, 0, 2048, kHeap));  // Mesa 22.3: no memfd
+    EXPECT_FALSE(memoryFileLimitProblem("gpu", false, 1, 2048, kHeap));              // a GPU's memory
+    EXPECT_FALSE(memoryFileLimitProblem("llvmpipe", true, 0, 2048, kHeap));          // Mesa 22.3: no memfd
     EXPECT_FALSE(memoryFileLimitProblem("llvmpipe", true, 1, std::nullopt, kHeap));  // unlimited
     EXPECT_FALSE(memoryFileLimitProblem("llvmpipe", true, 1, kHeap, kHeap));         // above the heap
 }
