@@ -98,7 +98,8 @@ TEST_F(OutputsCli, BadOutputPathsFailBeforeRenderingAndLeaveNothing) {
 // it (exit 135): gdpt refuses it before any work instead, naming the limit
 // (util/file_size_limit.h). Either way: exit 1, the reason, no output.
 TEST_F(OutputsCli, AFullDiskIsAnErrorAndLeavesNoOutput) {
-    // ulimit -f counts 1024-byte blocks. 2 KiB holds none of a G-PT EXR (13 layers).
+    // sh (dash) counts ulimit -f in 512-byte blocks, bash in 1024: 1 or 2 KiB holds none of a
+    // G-PT EXR (13 layers).
     const std::string cmd = "sh -c 'ulimit -f 2; exec " + test::gdptBinary() + " render " + kScene +
                             " --width 16 --height 16 --spp 2 --method gpt --quiet -o " + path("out.exr") +
                             "' 2>&1";
