@@ -4,11 +4,13 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <new>
 #include <string>
 #include <vector>
 
 #include "app/subcommand.h"
 #include "distributed/mpi_world.h"
+#include "util/address_space_limit.h"
 #include "util/error.h"
 #include "util/interrupt.h"
 
@@ -55,6 +57,9 @@ int run(int argc, char** argv) {
     } catch (const Interrupted& e) {  // SIGINT or SIGTERM (util/interrupt.h)
         std::fprintf(stderr, "gdpt: %s\n", e.what());
         return 130;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "gdpt: error: %s\n", hostAllocationFailure(addressSpaceLimit()).c_str());
+        return 1;
     } catch (const std::exception& e) {
         // A signal that ended a phase through a layer that re-wrapped the error.
         if (interruptRequested()) {
@@ -70,6 +75,8 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    // Before any thread: under `ulimit -v`, one malloc arena (util/address_space_limit.h).
+    gdpt::fitMallocToAddressSpaceLimit();
     // Under mpirun, every rank runs the same command (distributed/mpi_world.h).
     gdpt::MpiWorld::start(&argc, &argv);
     return gdpt::MpiWorld::finish(run(argc, argv));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "util/address_space_limit.h"
 #include "util/huge_pages.h"
 #include "util/memory.h"
 #include "vk/commands.h"
@@ -64,6 +65,11 @@ VkMemoryPropertyFlags Buffer::allocate(VkBufferUsageFlags usage,
     if (usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) alloc.pNext = &allocFlags;
     alloc.allocationSize = req.size;
     alloc.memoryTypeIndex = ctx_->findMemoryType(req.memoryTypeBits, flags);
+    // A CPU device's memory is the process's: under an address-space limit, keep what its
+    // driver needs to compile kernels (util/address_space_limit.h).
+    if (auto problem = addressSpaceLimitProblem(ctx_->info().name, ctx_->info().isCpu, addressSpaceLimit(),
+                                                addressSpaceInUse() + req.size, kCpuDeviceHeadroomBytes))
+        throw Error("out of " + what + " (" + memoryText(size_) + "): " + *problem);
     VkDeviceMemory memory = VK_NULL_HANDLE;
     const VkResult r = vkAllocateMemory(device, &alloc, nullptr, &memory);
     if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY)

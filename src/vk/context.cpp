@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "util/address_space_limit.h"
 #include "util/error.h"
 #include "util/file_size_limit.h"
 #include "vk/pipeline_cache.h"
@@ -61,8 +62,11 @@ VkInstance createInstance(bool validation, bool debugUtils) {
     if (r == VK_ERROR_INCOMPATIBLE_DRIVER || r == VK_ERROR_INITIALIZATION_FAILED)
         throw Error(std::string("no Vulkan driver found (") + vkResultName(r) +
                     "); install mesa-vulkan-drivers for the CPU device (lavapipe), or check "
-                    "VK_DRIVER_FILES / VK_ICD_FILENAMES");
-    VK_CHECK(r);
+                    "VK_DRIVER_FILES / VK_ICD_FILENAMES" +
+                    driverStartHint(addressSpaceLimit()));
+    if (r != VK_SUCCESS)
+        throw Error("vkCreateInstance failed with " + std::string(vkResultName(r)) +
+                    driverStartHint(addressSpaceLimit()));
     return instance;
 }
 
@@ -151,18 +155,24 @@ DeviceInfo queryDevice(VkPhysicalDevice pd, std::uint32_t index) {
 }
 
 std::vector<VkPhysicalDevice> physicalDevices(VkInstance instance) {
-    std::uint32_t count = 0;
-    VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, nullptr));
-    std::vector<VkPhysicalDevice> devices(count);
-    VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, devices.data()));
-    return devices;
+    try {
+        std::uint32_t count = 0;
+        VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, nullptr));
+        std::vector<VkPhysicalDevice> devices(count);
+        VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, devices.data()));
+        return devices;
+    } catch (const VulkanError& e) {  // a driver that could not start under `ulimit -v`
+        throw Error(e.what() + driverStartHint(addressSpaceLimit()));
+    }
 }
 
 // Default choice: lavapipe (a CPU device) first, as the product's first-class target; then
 // discrete, integrated, anything usable. An explicit --device is an index or a
 // case-sensitive substring of the device name.
 std::uint32_t chooseDevice(const std::vector<DeviceInfo>& infos, const std::string& wanted) {
-    if (infos.empty()) throw Error("no Vulkan devices found; install mesa-vulkan-drivers");
+    if (infos.empty())
+        throw Error("no Vulkan devices found; install mesa-vulkan-drivers" +
+                    driverStartHint(addressSpaceLimit()));
     if (!wanted.empty()) {
         const bool numeric = std::all_of(wanted.begin(), wanted.end(), ::isdigit);
         for (const auto& d : infos) {
@@ -273,6 +283,12 @@ Context::Context(const ContextOptions& options)
     deviceInfo.queueCreateInfoCount = 1;
     deviceInfo.pQueueCreateInfos = &queueInfo;
     VkDevice device = VK_NULL_HANDLE;
+    // Lavapipe crashes where it runs out of address space starting its threads or compiling a
+    // kernel (util/address_space_limit.h): before the device, room for both; after it, for a kernel.
+    if (auto problem = addressSpaceLimitProblem(info_.name, info_.isCpu, addressSpaceLimit(),
+                                                addressSpaceInUse() + cpuDeviceStartBytes(cpuDeviceThreads()),
+                                                kCpuDeviceHeadroomBytes))
+        throw Error(*problem);
     VK_CHECK(vkCreateDevice(physical_, &deviceInfo, nullptr, &device));
     device_ = Handle<VkDevice>(device, [](VkDevice d) {
         vkDeviceWaitIdle(d);
@@ -287,6 +303,10 @@ Context::Context(const ContextOptions& options)
             memoryFilesAfter > memoryFilesBefore ? memoryFilesAfter - memoryFilesBefore : 0, fileSizeLimit(),
             info_.deviceLocalHeapBytes))
         throw Error(*problem);
+    if (auto problem = addressSpaceLimitProblem(info_.name, info_.isCpu, addressSpaceLimit(),
+                                                addressSpaceInUse(), kCpuDeviceHeadroomBytes))
+        throw Error(*problem);
+    serialPipelines_ = info_.isCpu && addressSpaceLimit().has_value();
     if (options.keepPipelines) pipelineCache_ = std::make_unique<PipelineCache>();
 }
 

@@ -91,6 +91,10 @@ public:
     [[nodiscard]] VkMemoryPropertyFlags memoryTypeFlags(std::uint32_t index) const;
     // ContextOptions::stagedTransfers.
     [[nodiscard]] bool stagedTransfers() const { return stagedTransfers_; }
+    // Whether pipelines are created one at a time, never beside an allocation: a CPU device under
+    // an address-space limit, whose driver crashes where a compilation runs out of it, so every
+    // allocation keeps room for the next compilation (util/address_space_limit.h).
+    [[nodiscard]] bool serialPipelines() const { return serialPipelines_; }
     // Debug name shown by validation messages and tools (no-op without debug utils).
     void setName(VkObjectType type, std::uint64_t handle, const std::string& name) const;
 
@@ -122,6 +126,7 @@ private:
     bool validation_ = false;
     bool printValidation_ = true;
     bool stagedTransfers_ = false;
+    bool serialPipelines_ = false;
     std::atomic<std::uint32_t> validationErrors_{0};
     mutable std::atomic<std::uint64_t> deviceBytesNow_{0};
     mutable std::atomic<std::uint64_t> deviceBytesPeak_{0};

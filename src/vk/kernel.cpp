@@ -225,6 +225,7 @@ bool useOptimizedSpirv(const DeviceInfo& device) {
 
 Kernel::Kernel(const Context& ctx, const KernelDesc& desc, PipelineCreation creation)
     : ctx_(ctx), desc_(desc) {
+    if (ctx.serialPipelines()) creation = PipelineCreation::Now;
     VkDevice device = ctx.device();
     GDPT_CHECK(desc.spirv != nullptr && desc.spirvBytes > 0);
     if (desc.pushConstantBytes > ctx.info().maxPushConstantsSize)
