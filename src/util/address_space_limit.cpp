@@ -2,7 +2,6 @@
 #include "util/address_space_limit.h"
 
 #include <malloc.h>
-#include <sys/resource.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -11,13 +10,12 @@
 #include <thread>
 
 #include "util/memory.h"
+#include "util/resource_limit.h"
 
 namespace gdpt {
 
 std::optional<std::uint64_t> addressSpaceLimit() {
-    rlimit r{};
-    if (getrlimit(RLIMIT_AS, &r) != 0 || r.rlim_cur == RLIM_INFINITY) return std::nullopt;
-    return std::uint64_t(r.rlim_cur);
+    return softResourceLimit(RLIMIT_AS);
 }
 
 std::uint64_t addressSpaceInUse() {
@@ -52,16 +50,20 @@ unsigned cpuDeviceThreads() {
     return std::min(std::max(std::thread::hardware_concurrency(), 1u), kMaxThreads);
 }
 
-std::uint64_t cpuDeviceStartBytes(unsigned threads) { return (std::uint64_t(48) + 16 * std::uint64_t(threads)) << 20; }
+std::uint64_t cpuDeviceStartBytes(unsigned threads) {
+    return (std::uint64_t(48) + 16 * std::uint64_t(threads)) << 20;
+}
 
 std::optional<std::string> addressSpaceLimitProblem(const std::string& device, bool cpuDevice,
-                                                    std::optional<std::uint64_t> limit, std::uint64_t inUseBytes,
-                                                    std::uint64_t headroomBytes) {
-    if (!cpuDevice || !limit || (*limit > inUseBytes && *limit - inUseBytes >= headroomBytes)) return std::nullopt;
+                                                    std::optional<std::uint64_t> limit,
+                                                    std::uint64_t inUseBytes, std::uint64_t headroomBytes) {
+    if (!cpuDevice || !limit || (*limit > inUseBytes && *limit - inUseBytes >= headroomBytes))
+        return std::nullopt;
     return "the address-space limit (ulimit -v) of " + memoryText(*limit) + " would leave less than the " +
            memoryText(headroomBytes) + " that compiling a kernel takes beside the " + memoryText(inUseBytes) +
            " that gdpt and device '" + device +
-           "' hold or are about to take, and the device's driver crashes (SIGSEGV) where an allocation of its "
+           "' hold or are about to take, and the device's driver crashes (SIGSEGV) where an allocation of "
+           "its "
            "own fails; raise the limit above " +
            memoryText(inUseBytes + headroomBytes) + " (ulimit -v unlimited)";
 }

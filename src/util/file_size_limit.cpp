@@ -1,19 +1,16 @@
 // file_size_limit.cpp — see file_size_limit.h.
 #include "util/file_size_limit.h"
 
-#include <sys/resource.h>
-
 #include <filesystem>
 #include <system_error>
 
 #include "util/memory.h"
+#include "util/resource_limit.h"
 
 namespace gdpt {
 
 std::optional<std::uint64_t> fileSizeLimit() {
-    rlimit r{};
-    if (getrlimit(RLIMIT_FSIZE, &r) != 0 || r.rlim_cur == RLIM_INFINITY) return std::nullopt;
-    return std::uint64_t(r.rlim_cur);
+    return softResourceLimit(RLIMIT_FSIZE);
 }
 
 std::size_t memoryFileCount() {
