@@ -96,8 +96,10 @@ TEST(AddressSpaceLimit, RefusesOnlyACpuDeviceThatTheLimitLeavesTooLittle) {
     EXPECT_TRUE(addressSpaceLimitProblem("llvmpipe", true, limit, limit - headroom + 1, headroom));
     // Any condition missing: no refusal.
     EXPECT_FALSE(addressSpaceLimitProblem("gpu", false, limit, 400 * kMiB, headroom));  // a GPU's memory
-    EXPECT_FALSE(addressSpaceLimitProblem("llvmpipe", true, std::nullopt, 400 * kMiB, headroom));  // unlimited
-    EXPECT_FALSE(addressSpaceLimitProblem("llvmpipe", true, limit, limit - headroom, headroom));  // just enough
+    EXPECT_FALSE(
+        addressSpaceLimitProblem("llvmpipe", true, std::nullopt, 400 * kMiB, headroom));  // unlimited
+    EXPECT_FALSE(
+        addressSpaceLimitProblem("llvmpipe", true, limit, limit - headroom, headroom));  // just enough
 }
 
 TEST(AddressSpaceLimit, ADeviceStartCountsItsThreads) {
