@@ -59,13 +59,14 @@ std::optional<std::string> addressSpaceLimitProblem(const std::string& device, b
                                                     std::uint64_t inUseBytes, std::uint64_t headroomBytes) {
     if (!cpuDevice || !limit || (*limit > inUseBytes && *limit - inUseBytes >= headroomBytes))
         return std::nullopt;
+    // The figure to raise the limit above, in whole MiB rounded up (memoryText's "1.0 GiB" could
+    // read lower than it).
+    const std::string needed = std::to_string((inUseBytes + headroomBytes + (1u << 20) - 1) >> 20) + " MiB";
     return "the address-space limit (ulimit -v) of " + memoryText(*limit) + " would leave less than the " +
            memoryText(headroomBytes) + " that compiling a kernel takes beside the " + memoryText(inUseBytes) +
-           " that gdpt and device '" + device +
-           "' hold or are about to take, and the device's driver crashes (SIGSEGV) where an allocation of "
-           "its "
-           "own fails; raise the limit above " +
-           memoryText(inUseBytes + headroomBytes) + " (ulimit -v unlimited)";
+           " that gdpt and device '" + device + "' hold or are about to take, and the device's driver " +
+           "crashes (SIGSEGV) where an allocation of its own fails; raise the limit above " + needed +
+           " (ulimit -v unlimited)";
 }
 
 std::string driverStartHint(std::optional<std::uint64_t> limit) {

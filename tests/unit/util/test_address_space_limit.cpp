@@ -92,6 +92,11 @@ TEST(AddressSpaceLimit, RefusesOnlyACpuDeviceThatTheLimitLeavesTooLittle) {
     EXPECT_NE(problem->find("500 MiB"), std::string::npos) << *problem;
     EXPECT_NE(problem->find("'llvmpipe'"), std::string::npos) << *problem;
     EXPECT_NE(problem->find("above 528 MiB"), std::string::npos) << *problem;
+    // Past 1 GiB the figure stays in whole MiB, rounded up (not "1.1 GiB").
+    const std::optional<std::string> large =
+        addressSpaceLimitProblem("llvmpipe", true, 1024 * kMiB, 1000 * kMiB + 1, headroom);
+    ASSERT_TRUE(large.has_value());
+    EXPECT_NE(large->find("above 1129 MiB"), std::string::npos) << *large;
     EXPECT_TRUE(addressSpaceLimitProblem("llvmpipe", true, limit, 600 * kMiB, headroom));  // beyond the limit
     EXPECT_TRUE(addressSpaceLimitProblem("llvmpipe", true, limit, limit - headroom + 1, headroom));
     // Any condition missing: no refusal.
