@@ -213,7 +213,7 @@ void checkWindowMemory(int width, int height, int frames, bool mixed, bool weigh
     const std::uint64_t perFrame = windowBytes(width, height, 1, mixed, weighted);
     throw Error("a tgpt window of " + std::to_string(frames) + " frames of " + std::to_string(width) + "x" +
                 std::to_string(height) + " needs about " + gibibytes(need) +
-                " for its space-time reconstruction, more than this machine's " + gibibytes(memory) +
+                " for its space-time reconstruction, more than " + availableMemoryText(memory) +
                 "; the largest window that fits is " + std::to_string(memory / perFrame) +
                 " frames (--window), or render smaller frames");
 }

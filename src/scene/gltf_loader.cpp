@@ -373,7 +373,7 @@ void refuseBeyondLimits(const SceneEstimate& e, const LoadOptions& opts) {
         throw Error("loading the scene (" + std::to_string(e.triangles) + " triangles, " +
                     std::to_string(e.vertices) + " vertices after instancing) needs about " +
                     gibibytes(e.bytes) + ", more than the memory budget of " + gibibytes(budget) +
-                    (opts.memoryBudget != 0 ? "" : " (this machine's memory)"));
+                    (opts.memoryBudget != 0 ? "" : " (" + availableMemoryText(budget) + ")"));
     if (opts.checkEstimate) opts.checkEstimate(e);
 }
 

@@ -147,10 +147,9 @@ void checkRenderMemory(const SceneEstimate& estimate) {
         double(estimate.bytes) / double(estimate.triangles) + double(kRenderBytesPerTriangle);
     const auto fits = static_cast<std::uint64_t>(double(memory) / perTriangle);
     throw Error("rendering the scene (" + std::to_string(estimate.triangles) + " triangles) needs about " +
-                memoryText(needed) +
-                " of memory (the loaded scene, its BVH and its tables), more than this machine's " +
-                memoryText(memory) + ": a scene like it fits with up to about " + std::to_string(fits) +
-                " triangles");
+                memoryText(needed) + " of memory (the loaded scene, its BVH and its tables), more than " +
+                availableMemoryText(memory) + ": a scene like it fits with up to about " +
+                std::to_string(fits) + " triangles");
 }
 
 LoadOptions deviceLoadOptions(const std::string& device, bool quiet) {

@@ -66,7 +66,7 @@ std::string imageMemoryRefusal(const std::string& method, std::uint32_t width, s
     return "a " + std::to_string(width) + "x" + std::to_string(height) + " " +
            (method == "gpt" ? "G-PT" : "PT") + " render needs about " +
            memoryText(static_cast<std::uint64_t>(needed)) + " of memory (" + memoryText(perMegapixel) +
-           " per megapixel), more than this machine's " + memoryText(memory) +
+           " per megapixel), more than " + availableMemoryText(memory) +
            ": the largest image of this shape that fits is " + std::to_string(fit.width) + "x" +
            std::to_string(fit.height);
 }
