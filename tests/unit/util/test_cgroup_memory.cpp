@@ -41,9 +41,11 @@ TEST_F(CgroupMemory, Version2TakesTheLowestLimitOfTheGroupAndTheGroupsAboveIt) {
     write("batch/memory.max", "4294967296");
     write("batch/job7/memory.max", "8589934592");  // a child may not raise its parent's limit
     write("batch/job7/step0/memory.max", "max");
-    EXPECT_EQ(cgroupMemoryLimit("0::/batch/job7/step0\n", root()), std::optional<std::uint64_t>(4294967296ull));
+    EXPECT_EQ(cgroupMemoryLimit("0::/batch/job7/step0\n", root()),
+              std::optional<std::uint64_t>(4294967296ull));
     write("batch/job7/step0/memory.max", "1073741824");
-    EXPECT_EQ(cgroupMemoryLimit("0::/batch/job7/step0\n", root()), std::optional<std::uint64_t>(1073741824ull));
+    EXPECT_EQ(cgroupMemoryLimit("0::/batch/job7/step0\n", root()),
+              std::optional<std::uint64_t>(1073741824ull));
 }
 
 TEST_F(CgroupMemory, Version1ReadsTheMemoryControllersHierarchyOnly) {
@@ -54,7 +56,8 @@ TEST_F(CgroupMemory, Version1ReadsTheMemoryControllersHierarchyOnly) {
     write("pids/jobs/a/memory.limit_in_bytes", "1024");  // not the memory controller's
     EXPECT_EQ(cgroupMemoryLimit(self, root()), std::optional<std::uint64_t>(2147483648ull));
     // A controller list that names memory among others.
-    EXPECT_EQ(cgroupMemoryLimit("3:memory,hugetlb:/jobs/a\n", root()), std::optional<std::uint64_t>(2147483648ull));
+    EXPECT_EQ(cgroupMemoryLimit("3:memory,hugetlb:/jobs/a\n", root()),
+              std::optional<std::uint64_t>(2147483648ull));
 }
 
 // A container often sees its own group as the root of the tree, while /proc/self/cgroup names the
@@ -64,7 +67,8 @@ TEST_F(CgroupMemory, AContainersLimitAtTheRootIsFound) {
     EXPECT_EQ(cgroupMemoryLimit("0::/system.slice/docker-1234.scope\n", root()),
               std::optional<std::uint64_t>(536870912ull));
     write("memory/memory.limit_in_bytes", "268435456");
-    EXPECT_EQ(cgroupMemoryLimit("5:memory:/docker/1234\n", root()), std::optional<std::uint64_t>(268435456ull));
+    EXPECT_EQ(cgroupMemoryLimit("5:memory:/docker/1234\n", root()),
+              std::optional<std::uint64_t>(268435456ull));
 }
 
 TEST_F(CgroupMemory, NoLimitWhereNothingIsSetOrReadable) {
