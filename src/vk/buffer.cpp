@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cstring>
 
-#include "util/address_space_limit.h"
 #include "util/huge_pages.h"
 #include "util/memory.h"
 #include "vk/commands.h"
@@ -67,8 +66,7 @@ VkMemoryPropertyFlags Buffer::allocate(VkBufferUsageFlags usage,
     alloc.memoryTypeIndex = ctx_->findMemoryType(req.memoryTypeBits, flags);
     // A CPU device's memory is the process's: under an address-space limit, keep what its
     // driver needs to compile kernels (util/address_space_limit.h).
-    if (auto problem = addressSpaceLimitProblem(ctx_->info().name, ctx_->info().isCpu, addressSpaceLimit(),
-                                                addressSpaceInUse() + req.size, kCpuDeviceHeadroomBytes))
+    if (auto problem = ctx_->addressSpaceProblem(req.size))
         throw Error("out of " + what + " (" + memoryText(size_) + "): " + *problem);
     VkDeviceMemory memory = VK_NULL_HANDLE;
     const VkResult r = vkAllocateMemory(device, &alloc, nullptr, &memory);

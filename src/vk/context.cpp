@@ -285,10 +285,8 @@ Context::Context(const ContextOptions& options)
     VkDevice device = VK_NULL_HANDLE;
     // Lavapipe crashes where it runs out of address space starting its threads or compiling a
     // kernel (util/address_space_limit.h): before the device, room for both; after it, for a kernel.
-    if (auto problem = addressSpaceLimitProblem(info_.name, info_.isCpu, addressSpaceLimit(),
-                                                addressSpaceInUse() + cpuDeviceStartBytes(cpuDeviceThreads()),
-                                                kCpuDeviceHeadroomBytes))
-        throw Error(*problem);
+    if (info_.isCpu) addressSpaceLimit_ = addressSpaceLimit();
+    if (auto problem = addressSpaceProblem(cpuDeviceStartBytes(cpuDeviceThreads()))) throw Error(*problem);
     VK_CHECK(vkCreateDevice(physical_, &deviceInfo, nullptr, &device));
     device_ = Handle<VkDevice>(device, [](VkDevice d) {
         vkDeviceWaitIdle(d);
@@ -303,14 +301,17 @@ Context::Context(const ContextOptions& options)
             memoryFilesAfter > memoryFilesBefore ? memoryFilesAfter - memoryFilesBefore : 0, fileSizeLimit(),
             info_.deviceLocalHeapBytes))
         throw Error(*problem);
-    if (auto problem = addressSpaceLimitProblem(info_.name, info_.isCpu, addressSpaceLimit(),
-                                                addressSpaceInUse(), kCpuDeviceHeadroomBytes))
-        throw Error(*problem);
-    serialPipelines_ = info_.isCpu && addressSpaceLimit().has_value();
+    if (auto problem = addressSpaceProblem(0)) throw Error(*problem);
     if (options.keepPipelines) pipelineCache_ = std::make_unique<PipelineCache>();
 }
 
 Context::~Context() = default;  // pipelineCache_ before device_
+
+std::optional<std::string> Context::addressSpaceProblem(std::uint64_t aboutToTake) const {
+    if (!addressSpaceLimit_) return std::nullopt;
+    return addressSpaceLimitProblem(info_.name, true, addressSpaceLimit_, addressSpaceInUse() + aboutToTake,
+                                    kCpuDeviceHeadroomBytes);
+}
 
 VkBool32 Context::messengerCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                     VkDebugUtilsMessageTypeFlagsEXT /*types*/,

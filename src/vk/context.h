@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -94,7 +95,11 @@ public:
     // Whether pipelines are created one at a time, never beside an allocation: a CPU device under
     // an address-space limit, whose driver crashes where a compilation runs out of it, so every
     // allocation keeps room for the next compilation (util/address_space_limit.h).
-    [[nodiscard]] bool serialPipelines() const { return serialPipelines_; }
+    [[nodiscard]] bool serialPipelines() const { return addressSpaceLimit_.has_value(); }
+    // Why taking `aboutToTake` more bytes would leave such a device too little address space for
+    // the next compilation; nullopt when it would not, or when no limit applies (then without
+    // reading the process's address space).
+    [[nodiscard]] std::optional<std::string> addressSpaceProblem(std::uint64_t aboutToTake) const;
     // Debug name shown by validation messages and tools (no-op without debug utils).
     void setName(VkObjectType type, std::uint64_t handle, const std::string& name) const;
 
@@ -126,7 +131,7 @@ private:
     bool validation_ = false;
     bool printValidation_ = true;
     bool stagedTransfers_ = false;
-    bool serialPipelines_ = false;
+    std::optional<std::uint64_t> addressSpaceLimit_;  // a CPU device's address-space limit, if set
     std::atomic<std::uint32_t> validationErrors_{0};
     mutable std::atomic<std::uint64_t> deviceBytesNow_{0};
     mutable std::atomic<std::uint64_t> deviceBytesPeak_{0};
