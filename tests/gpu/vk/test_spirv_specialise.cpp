@@ -21,6 +21,7 @@
 #include "pt.spv.h"
 #include "same_bits.h"
 #include "scene/gltf_loader.h"
+#include "scoped_env.h"
 #include "spirv_words.h"
 #include "temp_dir.h"
 #include "util/error.h"
@@ -48,28 +49,9 @@ std::vector<std::uint32_t> ptWords() {
     return std::vector<std::uint32_t>(std::begin(kSpv_pt_opt), std::end(kSpv_pt_opt));
 }
 
-// Sets GDPT_SPECIALISE and GDPT_CACHE_DIR for a scope (renders read them when their kernels
+// GDPT_SPECIALISE and GDPT_CACHE_DIR are set for a scope (renders read them when their kernels
 // are made).
-class ScopedEnv {
-public:
-    ScopedEnv(const char* var, const std::string& value) : var_(var) {
-        if (const char* old = std::getenv(var)) old_ = old, had_ = true;
-        ::setenv(var, value.c_str(), 1);
-    }
-    ~ScopedEnv() {
-        if (had_)
-            ::setenv(var_, old_.c_str(), 1);
-        else
-            ::unsetenv(var_);
-    }
-    ScopedEnv(const ScopedEnv&) = delete;
-    ScopedEnv& operator=(const ScopedEnv&) = delete;
-
-private:
-    const char* var_;
-    std::string old_;
-    bool had_ = false;
-};
+using test::ScopedEnv;
 
 class SpirvSpecialise : public test::TempDirTest {};
 

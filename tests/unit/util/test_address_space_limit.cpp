@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "scoped_env.h"
 #include "util/address_space_limit.h"
 
 namespace gdpt {
@@ -110,40 +111,39 @@ TEST(AddressSpaceLimit, RefusesOnlyACpuDeviceThatTheLimitLeavesTooLittle) {
 TEST(AddressSpaceLimit, ADeviceStartCountsItsThreads) {
     EXPECT_EQ(cpuDeviceStartBytes(0), 48 * kMiB);
     EXPECT_EQ(cpuDeviceStartBytes(2), 80 * kMiB);
-    const char* original = std::getenv("LP_NUM_THREADS");
-    const std::string saved = original ? original : "";
-    setenv("LP_NUM_THREADS", "3", 1);
-    EXPECT_EQ(cpuDeviceThreads(), 3u);
-    setenv("LP_NUM_THREADS", "0", 1);  // lavapipe without threads
-    EXPECT_EQ(cpuDeviceThreads(), 0u);
-    setenv("LP_NUM_THREADS", "500", 1);  // lavapipe starts at most 32
-    EXPECT_EQ(cpuDeviceThreads(), 32u);
-    unsetenv("LP_NUM_THREADS");
+    {
+        test::ScopedEnv threads("LP_NUM_THREADS", "3");
+        EXPECT_EQ(cpuDeviceThreads(), 3u);
+    }
+    {
+        test::ScopedEnv threads("LP_NUM_THREADS", "0");  // lavapipe without threads
+        EXPECT_EQ(cpuDeviceThreads(), 0u);
+    }
+    {
+        test::ScopedEnv threads("LP_NUM_THREADS", "500");  // lavapipe starts at most 32
+        EXPECT_EQ(cpuDeviceThreads(), 32u);
+    }
+    test::ScopedEnv unset("LP_NUM_THREADS", nullptr);
     EXPECT_GE(cpuDeviceThreads(), 1u);
     EXPECT_LE(cpuDeviceThreads(), 32u);
-    if (original) setenv("LP_NUM_THREADS", saved.c_str(), 1);
 }
 
 TEST(AddressSpaceLimit, MallocGetsOneArenaOnlyUnderALimit) {
-    const char* original = std::getenv("MALLOC_ARENA_MAX");
-    const std::string saved = original ? original : "";
-    unsetenv("MALLOC_ARENA_MAX");
+    test::ScopedEnv unset("MALLOC_ARENA_MAX", nullptr);
     rlimit current{};
     ASSERT_EQ(getrlimit(RLIMIT_AS, &current), 0);
     if (current.rlim_cur == RLIM_INFINITY) {
         EXPECT_FALSE(fitMallocToAddressSpaceLimit());
     }
+    FiniteLimit finite;
+    ASSERT_TRUE(finite.ok());
     {
-        FiniteLimit finite;
-        ASSERT_TRUE(finite.ok());
-        setenv("MALLOC_ARENA_MAX", "4", 1);  // the user's choice stands
+        test::ScopedEnv user("MALLOC_ARENA_MAX", "4");  // the user's choice stands
         EXPECT_FALSE(fitMallocToAddressSpaceLimit());
-        unsetenv("MALLOC_ARENA_MAX");
-#if !defined(__SANITIZE_ADDRESS__)  // the sanitizer's allocator has no arenas: its mallopt does nothing
-        EXPECT_TRUE(fitMallocToAddressSpaceLimit());
-#endif
     }
-    if (original) setenv("MALLOC_ARENA_MAX", saved.c_str(), 1);
+#if !defined(__SANITIZE_ADDRESS__)  // the sanitizer's allocator has no arenas: its mallopt does nothing
+    EXPECT_TRUE(fitMallocToAddressSpaceLimit());
+#endif
 }
 
 TEST(AddressSpaceLimit, ErrorsNameTheLimitWhereOneIsSet) {

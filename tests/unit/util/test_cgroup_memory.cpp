@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "scoped_env.h"
 #include "util/memory.h"
 
 namespace gdpt {
@@ -81,10 +82,12 @@ TEST_F(CgroupMemory, NoLimitWhereNothingIsSetOrReadable) {
 
 TEST(AvailableMemoryText, NamesTheMachineUnlessTheGroupsLimitIsTheFigure) {
     // GDPT_TEST_MEMORY_BYTES stands in for the machine's memory: always "this machine's".
-    setenv("GDPT_TEST_MEMORY_BYTES", "2147483648", 1);
-    EXPECT_EQ(physicalMemory(), 2147483648ull);
-    EXPECT_EQ(availableMemoryText(2147483648ull), "this machine's 2.0 GiB");
-    unsetenv("GDPT_TEST_MEMORY_BYTES");
+    {
+        test::ScopedEnv memory("GDPT_TEST_MEMORY_BYTES", "2147483648");
+        EXPECT_EQ(physicalMemory(), 2147483648ull);
+        EXPECT_EQ(availableMemoryText(2147483648ull), "this machine's 2.0 GiB");
+    }
+    test::ScopedEnv unset("GDPT_TEST_MEMORY_BYTES", nullptr);
     EXPECT_GT(physicalMemory(), 0u);
 }
 

@@ -7,34 +7,13 @@
 #include <optional>
 #include <string>
 
+#include "scoped_env.h"
 #include "shared_data.h"
 
 namespace gdpt {
 namespace {
 
-// Sets an environment variable for one scope and restores the previous value after it.
-class ScopedEnv {
-public:
-    ScopedEnv(const char* name, const char* value) : name_(name) {
-        if (const char* old = std::getenv(name)) old_ = old;
-        if (value != nullptr)
-            setenv(name, value, 1);
-        else
-            unsetenv(name);
-    }
-    ~ScopedEnv() {
-        if (old_)
-            setenv(name_, old_->c_str(), 1);
-        else
-            unsetenv(name_);
-    }
-    ScopedEnv(const ScopedEnv&) = delete;
-    ScopedEnv& operator=(const ScopedEnv&) = delete;
-
-private:
-    const char* name_;
-    std::optional<std::string> old_;
-};
+using test::ScopedEnv;
 
 const char* const kMissing = "/nonexistent-gdpt-shared/scenes/none.gltf";
 
