@@ -78,18 +78,32 @@ std::optional<std::uint64_t> cgroupMemoryLimit(const std::string& procSelfCgroup
     return lowest;
 }
 
-std::uint64_t physicalMemory() {
+namespace {
+
+// physicalMemory()'s figure, and whether it is the control group's limit.
+struct MemoryFigure {
+    std::uint64_t bytes = 0;
+    bool groupLimit = false;
+};
+
+MemoryFigure processMemory() {
     if (const char* test = std::getenv("GDPT_TEST_MEMORY_BYTES"); test && *test)
-        return std::strtoull(test, nullptr, 10);
+        return {std::strtoull(test, nullptr, 10), false};
     const std::uint64_t machine = machineMemory();
     const std::optional<std::uint64_t> group = processCgroupLimit();
-    return group && (*group < machine || machine == 0) ? *group : machine;
+    if (group && (*group < machine || machine == 0)) return {*group, true};
+    return {machine, false};
+}
+
+}  // namespace
+
+std::uint64_t physicalMemory() {
+    return processMemory().bytes;
 }
 
 std::string availableMemoryText(std::uint64_t bytes) {
-    const char* test = std::getenv("GDPT_TEST_MEMORY_BYTES");
-    const std::optional<std::uint64_t> group = test && *test ? std::nullopt : processCgroupLimit();
-    if (group && *group == bytes)
+    const MemoryFigure memory = processMemory();
+    if (memory.groupLimit && memory.bytes == bytes)
         return "the " + memoryText(bytes) + " memory limit of this process's control group";
     return "this machine's " + memoryText(bytes);
 }
