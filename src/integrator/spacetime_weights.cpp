@@ -27,7 +27,7 @@ void appendWeights(Field& to, const std::vector<Image>& images, std::size_t pixe
     }
 }
 
-// Weight 0 for the rows the solve does not have (unitWeights in poisson_spacetime.cpp): dx of
+// Weight 0 for the rows the solve does not have (unitWeights in poisson/spacetime_irls.h): dx of
 // each frame's last column, dy of its last row, dt and the rows to the previous frame where a
 // pixel has no temporal partner. They then count neither in the bound's median nor in the
 // renormalisation, as in the 2D weights (poisson_gpu.cpp). The mixed rows' own conditions

@@ -1,5 +1,5 @@
 // host_vcycle.h — one multigrid V-cycle as the preconditioner of the host's conjugate
-// gradients (poisson_spacetime.cpp, one-frame windows: G-PT's reconstruction on a CPU device).
+// gradients (spacetime_pcg.h; one-frame windows: G-PT's reconstruction on a CPU device).
 // The hierarchy is poisson_multigrid.cpp's (piecewise-constant prolongation, restriction ¼Pᵀ,
 // Galerkin coarse operators, the coarsest ≤ 2×2 level solved by its pseudo-inverse); this is
 // its fast form: the three channels at once, rows over the host's threads, one red-black
