@@ -83,7 +83,7 @@ layout(push_constant, scalar) uniform Push { MltParams frame; };
 
 #include "lib/scene_access.glsl"
 #define GDPT_ANYHIT_FILTER(tri, u, v) alphaPasses(tri, u, v)
-#include "lib/bvh_traverse.glsl"
+#include "lib/bvh_coherent.glsl"
 #include "lib/shift.glsl"
 #include "lib/gpt_light.glsl"
 

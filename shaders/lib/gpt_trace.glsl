@@ -3,7 +3,8 @@
 // gpt.comp (see there), shared with mlt.comp, whose Markov chains evaluate the same sample at a
 // film position of their own. GLSL only: the including kernel has declared the scene buffers,
 // `frame` (with shiftThreshold), kOffsetDelta, kDemodulate and firstHitModulation, and
-// included gpt_path.glsl, gpt_light.glsl, shift.glsl, surface_rules.glsl and gpt_steps.glsl.
+// included bvh_coherent.glsl, gpt_path.glsl, gpt_light.glsl, shift.glsl, surface_rules.glsl and
+// gpt_steps.glsl.
 #ifndef GDPT_LIB_GPT_TRACE
 #define GDPT_LIB_GPT_TRACE
 
@@ -18,7 +19,7 @@
 // constant, because lavapipe spends that time on the dead loop too. The image is the same
 // bit for bit either way (bench/RESULTS.md).
 
-// Occlusion beams (GDPT_GPT_BEAMS; bvh_traverse.glsl, traceAnyBeam): the offsets' own shadow
+// Occlusion beams (GDPT_GPT_BEAMS; bvh_coherent.glsl, traceAnyBeam): the offsets' own shadow
 // rays, and without glossy vertices their reconnections' visibility rays, traced as one beam
 // per bounce instead of one ray each, in the build for lavapipe before Mesa 23 (the split
 // build) in node steps, which it takes on trees of up to 2^17 triangles (SceneSpec::
@@ -93,7 +94,7 @@ void traceSample(LdSample lds, inout Rng rng, vec2 pixelPos, uint px, uint py, b
     vec3 o = scene.camPosition;
     vec3 d = cameraRay(pixelPos);
 #ifdef GDPT_GPT_BEAMS
-    // The base's and the offsets' primary rays as one fan (bvh_traverse.glsl, traceClosestBundle).
+    // The base's and the offsets' primary rays as one fan (bvh_coherent.glsl, traceClosestBundle).
     vec3 dOff[kGptNumOffsets];
     [[unroll]] for (uint i = 0u; i < kGptNumOffsets; ++i) dOff[i] = cameraRay(pixelPos + vec2(kOffsetDelta[i]));
     Hit hit;

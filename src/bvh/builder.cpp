@@ -67,7 +67,7 @@ constexpr uint32_t kInterruptPollMinTriangles = 1024;
 // Applied twice: per triangle (its largest coordinate; covers the rounding of
 // e1 = p1 - p0, <= 1 ulp) and per scene (the largest scene coordinate; covers the rounding
 // error and edge widening of the ray/triangle test, ~2^-20 of the ray-to-triangle distance,
-// see kEdgeTolerance in bvh_traverse.glsl, for rays starting within a few scene radii).
+// see kEdgeTolerance in bvh_intersect.glsl, for rays starting within a few scene radii).
 constexpr float kBoundsPad = 1.0f / 262144.0f;
 // Centroid bins: scale by (1 - 2^-20) so the largest centroid stays in the last bin.
 constexpr float kBinScale = 1.0f - 1.0f / 1048576.0f;

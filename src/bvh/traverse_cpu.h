@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "gdpt_shared.h"
-#include "lib/bvh_traverse.glsl"
+#include "lib/bvh_intersect.glsl"
 
 namespace gdpt {
 

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "lib/bvh_traverse.glsl"
+#include "lib/bvh_intersect.glsl"
 #include "util/huge_pages.h"
 #include "util/parallel.h"
 

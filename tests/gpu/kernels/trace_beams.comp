@@ -1,4 +1,4 @@
-// trace_beams.comp — test kernel: occlusion beams (traceAnyBeam, shaders/lib/bvh_traverse.glsl)
+// trace_beams.comp — test kernel: occlusion beams (traceAnyBeam, shaders/lib/bvh_coherent.glsl)
 // against the same rays traced one by one (occludedTowards, traceAny). Beam i is rays 4i..4i+3:
 // their origins, and in tMin whether each is wanted (0) or not (1); ray 4i's dir is the shared
 // end, a target point where its tMax is finite, else the shared direction (rays to infinity).
@@ -21,7 +21,7 @@ layout(push_constant, scalar) uniform Push {
     uint noGrowth;
 };
 
-#include "lib/bvh_traverse.glsl"
+#include "lib/bvh_coherent.glsl"
 
 void main() {
     uint i = gl_GlobalInvocationID.x;

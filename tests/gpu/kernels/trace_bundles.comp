@@ -1,4 +1,4 @@
-// trace_bundles.comp — test kernel: ray bundles (traceClosestBundle, shaders/lib/bvh_traverse.glsl)
+// trace_bundles.comp — test kernel: ray bundles (traceClosestBundle, shaders/lib/bvh_coherent.glsl)
 // against the same rays traced one by one (traceClosest). Bundle i is rays 5i..5i+4, every ray's
 // dir its direction (normalised here, as G-PT's rays are unit), tMin whether it is wanted (0) or
 // not (1). Primary fans (flag 2 clear): ray 5i's origin is the fan's, ray 5i the centre ray,
@@ -24,7 +24,7 @@ layout(push_constant, scalar) uniform Push {
     uint flags;
 };
 
-#include "lib/bvh_traverse.glsl"
+#include "lib/bvh_coherent.glsl"
 
 vec4 packHit(Hit h) { return vec4(h.t, uintBitsToFloat(h.triangle), h.u, h.v); }
 

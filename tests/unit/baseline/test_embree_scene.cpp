@@ -32,7 +32,7 @@ struct GdptTracer {
 
 // Closest hits of random rays: the same triangle, or (at a tie or an edge shared by two
 // triangles) the same distance to 1e-5 relative. gdpt's triangle test widens edges by about
-// 2^-20 of the distance (kEdgeTolerance in bvh_traverse.glsl) and Embree's does not, so a ray
+// 2^-20 of the distance (kEdgeTolerance in bvh_intersect.glsl) and Embree's does not, so a ray
 // grazing an unshared edge may hit in gdpt and miss in Embree (3 in 10^5 on the soup, each at an
 // edge: a barycentric coordinate within 1e-4 of 0, found by brute force too); the test allows
 // 1 in 10^4.
