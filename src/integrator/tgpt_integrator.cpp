@@ -14,6 +14,7 @@
 #include "integrator/sample_groups.h"
 #include "integrator/spacetime_weights.h"
 #include "integrator/temporal_reconnect.h"
+#include "integrator/tgpt_window.h"
 #include "poisson/poisson_spacetime.h"
 #include "util/error.h"
 #include "util/memory.h"
@@ -21,25 +22,6 @@
 
 namespace gdpt {
 namespace {
-
-// One frame's two half renders, combined.
-struct FrameSamples {
-    Image primal, dx, dy, direct, varPrimal, varDx, varDy, varDirect;
-    Image firstHalfPrimal;   // seeded σ(f): pairs with the previous frame's second half
-    Image secondHalfPrimal;  // seeded σ(f+1): pairs with the next frame's first half
-    // The halves' spatial differences, for the mixed rows (γ > 0 only; else empty).
-    Image firstHalfDx, firstHalfDy, secondHalfDx, secondHalfDy;
-    // Where each pixel of the frame before moved to in this one (its first half's streams
-    // follow it); empty for the replay shift or without a frame before.
-    std::vector<std::uint32_t> fromPrevious;
-    // The variances of the paired differences from the frame before (at its pixels, as the
-    // solve's rows), from the sample groups of its second half and this first half; empty
-    // without a frame before (or with fewer than two groups); dxt, dyt for weighted mixed rows.
-    Image varDt, varDxt, varDyt;
-    // The reconnection shift: the differences from the frame before (at its pixels, as varDt).
-    Image dt;
-    RenderStats stats;
-};
 
 // Two estimates of n_a and n_b samples combined with the weights w = n / (n_a + n_b), each
 // value raised to `power`: 1 for the spp-weighted mean of the estimates, 2 for the variance of
@@ -111,43 +93,6 @@ FrameSamples sampleReconnected(const vk::Context& ctx, const GptSamplingOptions&
     return f;
 }
 
-// The temporal differences from `earlier` to `later`, at the earlier frame's pixels p:
-// later(π(p)) − earlier(p), 0 where p has no partner; π = the same pixel if `partner` is empty.
-Image differenceAlong(const Image& later, const Image& earlier, const std::vector<std::uint32_t>& partner) {
-    Image out(earlier.width(), earlier.height());
-    for (int c = 0; c < 3; ++c)
-        for (std::size_t p = 0; p < out.pixelCount(); ++p) {
-            const std::uint32_t q = partner.empty() ? std::uint32_t(p) : partner[p];
-            if (q != kNoTemporalPartner) out.plane(c)[p] = later.plane(c)[q] - earlier.plane(c)[p];
-        }
-    return out;
-}
-
-// The same differences moved to the later frame's pixels (the dt layer of the later frame).
-Image atLaterPixels(const Image& dt, const std::vector<std::uint32_t>& partner) {
-    if (partner.empty()) return dt;
-    Image out(dt.width(), dt.height());
-    for (int c = 0; c < 3; ++c)
-        for (std::size_t p = 0; p < out.pixelCount(); ++p)
-            if (partner[p] != kNoTemporalPartner) out.plane(c)[partner[p]] = dt.plane(c)[p];
-    return out;
-}
-
-// Per pixel q of a frame: the offset (x, y) to the pixel of the frame before that it came
-// from, and 1 in the third channel where it has one (the same pixel for the replay shift).
-Image motionLayer(const std::vector<std::uint32_t>& partner, bool hasPrevious, int width, int height) {
-    Image out(width, height);
-    if (!hasPrevious) return out;
-    for (std::size_t p = 0; p < out.pixelCount(); ++p) {
-        const std::uint32_t q = partner.empty() ? std::uint32_t(p) : partner[p];
-        if (q == kNoTemporalPartner) continue;
-        out.plane(0)[q] = float(int(p % std::size_t(width)) - int(q % std::uint32_t(width)));
-        out.plane(1)[q] = float(int(p / std::size_t(width)) - int(q / std::uint32_t(width)));
-        out.plane(2)[q] = 1.0f;
-    }
-    return out;
-}
-
 // The counters and times of two renders of one frame, added.
 RenderStats addStats(const RenderStats& a, const RenderStats& b) {
     RenderStats s = a;
@@ -171,19 +116,6 @@ RenderStats addStats(const RenderStats& a, const RenderStats& b) {
     }
     s.cancelled = a.cancelled || b.cancelled;
     return s;
-}
-
-// Appends an image (W·H per channel) to a frame-major field.
-void append(std::array<Field, 3>& to, const Image& image) {
-    for (int c = 0; c < 3; ++c) to[c].insert(to[c].end(), image.plane(c).begin(), image.plane(c).end());
-}
-
-Image frameOf(const std::array<Field, 3>& x, std::size_t frame, int width, int height) {
-    Image out(width, height);
-    const std::size_t np = out.pixelCount();
-    for (int c = 0; c < 3; ++c)
-        for (std::size_t i = 0; i < np; ++i) out.plane(c)[i] = float(x[c][frame * np + i]);
-    return out;
 }
 
 // Groups of paired samples kept per half render (sample_groups.h): at most 16, so that a pixel's
@@ -269,15 +201,108 @@ RenderOutput TgptIntegrator::render(const vk::Context& ctx, const Scene& scene,
         "--method tgpt renders a sequence of frames (temporal differences between them): add --frames A:B");
 }
 
+FrameSamples TgptIntegrator::sampleHalves(const vk::Context& ctx, const Scene& scene,
+                                          const RenderOptions& options, GptSamplingOptions firstSampling,
+                                          const std::vector<std::uint32_t>& partner,
+                                          const FrameWindow& window, int frame, double share,
+                                          HalfPairing& pairing) {
+    Timer frameTimer;
+    const bool mixed = options_.gamma > 0.0;
+    // The mixed rows' variances only weight them.
+    const bool groupGradients = options_.weighted && mixed;
+    const bool timed = options.timeBudget > 0.0;
+    RenderOptions half = options;
+    half.spp = std::max<std::uint32_t>(1, options.spp / 2);
+    half.whileCompiling = nullptr;
+    half.elapsedBefore = 0.0;
+    // Timed: each half takes half of the frame's share.
+    // The first half replays the frame before's second half: the same number of samples,
+    // so that every one of them is paired (timed: whatever that second half reached). A
+    // second half gets half the frame's share, in whole samples: the next first half will
+    // take as many, and what a frame over- or underspends moves the later frames' shares.
+    // (Giving it the rest of its frame's share instead made the halves alternate between
+    // about 1/3 and 2/3 of the frame's samples.)
+    const bool paired = pairing.spp > 0;
+    if (timed) half.timeBudget = paired ? 0.0 : 0.5 * share;
+    if (paired) half.spp = pairing.spp;
+    half.seed = window.seed(frame);
+    // Paired: the same groups of samples as the second half it repeats (batches end there).
+    SampleGroupRecorder firstGroups =
+        SampleGroupRecorder::atEnds(paired ? pairing.groups.ends : std::vector<std::uint32_t>{});
+    if (paired) {
+        firstSampling.groups = &firstGroups;
+        firstSampling.groupGradients = groupGradients;
+        half.batchStops = pairing.groups.ends;
+    }
+    RenderResultGpt first = renderGpt(ctx, scene, half, firstSampling);
+    if (first.stats.cancelled) {
+        FrameSamples cancelled;
+        cancelled.stats = first.stats;
+        return cancelled;
+    }
+    half.batchStops.clear();
+    FrameSamples f;
+    int dtGroups = 0;  // (stats are set below, from both halves)
+    if (paired) {
+        const SampleGroups groups = firstGroups.take();
+        dtGroups = int(groups.ends.size());
+        f.varDt = pairedDifferenceVariance(groups, pairing.groups, 0, partner);
+        if (groupGradients) {
+            f.varDxt = pairedDifferenceVariance(groups, pairing.groups, 1, partner);
+            f.varDyt = pairedDifferenceVariance(groups, pairing.groups, 2, partner);
+        }
+        pairing.groups = {};
+    }
+    if (timed) half.timeBudget = paired ? 0.5 * share : std::max(1e-3, share - frameTimer.seconds());
+    half.spp = std::max<std::uint32_t>(1, options.spp / 2);
+    half.partialPass = false;
+    half.seed = window.seed(frame + 1);
+    // Its sample groups, which the next frame's first half repeats: equal ones where its
+    // samples are known in advance, else its batch ends, merged in pairs past 16.
+    const bool secondTimed = half.timeBudget > 0.0;
+    if (!secondTimed) half.batchStops = equalGroupEnds(half.spp, kSampleGroups);
+    SampleGroupRecorder secondGroups = secondTimed ? SampleGroupRecorder::everyBatch(kSampleGroups)
+                                                   : SampleGroupRecorder::atEnds(half.batchStops);
+    GptSamplingOptions secondSampling = options_.sampling;
+    secondSampling.groups = &secondGroups;
+    secondSampling.groupGradients = groupGradients;
+    RenderResultGpt second = renderGpt(ctx, scene, half, secondSampling);
+    if (second.stats.cancelled) {
+        f.stats = addStats(first.stats, second.stats);
+        return f;
+    }
+    half.batchStops.clear();
+    pairing.groups = secondGroups.take();
+    const double na = first.stats.spp, nb = second.stats.spp;
+    f.primal = combineHalves(first.primal, na, second.primal, nb, 1);
+    f.dx = combineHalves(first.dx, na, second.dx, nb, 1);
+    f.dy = combineHalves(first.dy, na, second.dy, nb, 1);
+    f.direct = combineHalves(first.direct, na, second.direct, nb, 1);
+    f.varPrimal = combineHalves(first.varPrimal, na, second.varPrimal, nb, 2);
+    f.varDx = combineHalves(first.varDx, na, second.varDx, nb, 2);
+    f.varDy = combineHalves(first.varDy, na, second.varDy, nb, 2);
+    f.varDirect = combineHalves(first.varDirect, na, second.varDirect, nb, 2);
+    f.firstHalfPrimal = std::move(first.primal);
+    f.secondHalfPrimal = std::move(second.primal);
+    if (mixed) {
+        f.firstHalfDx = std::move(first.dx);
+        f.firstHalfDy = std::move(first.dy);
+        f.secondHalfDx = std::move(second.dx);
+        f.secondHalfDy = std::move(second.dy);
+    }
+    f.stats = addStats(first.stats, second.stats);
+    f.stats.tgpt.firstHalfSpp = first.stats.spp;
+    f.stats.tgpt.secondHalfSpp = second.stats.spp;
+    f.stats.tgpt.dtVarianceGroups = dtGroups;
+    pairing.spp = second.stats.spp;
+    return f;
+}
+
 std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, const FrameWindow& window,
                                                        const RenderOptions& options) {
     const int width = options.scene.width, height = options.scene.height;
     const bool mixed = options_.gamma > 0.0;
-    const bool weighted = options_.weighted;
-    // The mixed rows' variances only weight them.
-    const bool groupGradients = weighted && mixed;
-    checkWindowMemory(width, height, window.count, mixed, weighted);
-    const bool timed = options.timeBudget > 0.0;
+    checkWindowMemory(width, height, window.count, mixed, options_.weighted);
     Timer timer;
     std::vector<RenderOutput> outputs;
     std::vector<FrameSamples> frames;
@@ -288,11 +313,8 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
     // The frame before the one being sampled, for the motion between them.
     std::shared_ptr<const Scene> previousScene = joined ? carry_->scene : nullptr;
     std::vector<PrimaryHit> previousHits = joined ? carry_->hits : std::vector<PrimaryHit>{};
-    // Samples per pixel of the frame before's second half (0: no frame before).
-    std::uint32_t pairedSpp = joined ? carry_->secondHalfSpp : 0;
-    // The sample groups of the frame before's second half, which this frame's first half
-    // repeats (for the variance of dt).
-    SampleGroups previousGroups = joined ? std::move(carry_->secondHalfGroups) : SampleGroups{};
+    HalfPairing pairing;
+    if (joined) pairing = {carry_->secondHalfSpp, std::move(carry_->secondHalfGroups)};
 
     // 1. Sampling: two half renders per frame, seeded σ(f) and σ(f+1) (the reconnection shift:
     // one render per frame, and the differences from the frame before by the reconnection pass).
@@ -344,177 +366,26 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
             frames.push_back(std::move(f));
             continue;
         }
-        RenderOptions half = options;
-        half.spp = std::max<std::uint32_t>(1, options.spp / 2);
-        half.whileCompiling = nullptr;
-        half.elapsedBefore = 0.0;
-        // Timed: each half takes half of the frame's share.
-        // The first half replays the frame before's second half: the same number of samples,
-        // so that every one of them is paired (timed: whatever that second half reached). A
-        // second half gets half the frame's share, in whole samples: the next first half will
-        // take as many, and what a frame over- or underspends moves the later frames' shares.
-        // (Giving it the rest of its frame's share instead made the halves alternate between
-        // about 1/3 and 2/3 of the frame's samples.)
-        const bool paired = pairedSpp > 0;
-        if (timed) half.timeBudget = paired ? 0.0 : 0.5 * share;
-        if (paired) half.spp = pairedSpp;
-        half.seed = window.seed(frame);
-        // Paired: the same groups of samples as the second half it repeats (batches end there).
-        SampleGroupRecorder firstGroups =
-            SampleGroupRecorder::atEnds(paired ? previousGroups.ends : std::vector<std::uint32_t>{});
-        if (paired) {
-            firstSampling.groups = &firstGroups;
-            firstSampling.groupGradients = groupGradients;
-            half.batchStops = previousGroups.ends;
-        }
-        RenderResultGpt first = renderGpt(ctx, *scene, half, firstSampling);
-        if (first.stats.cancelled) {
-            outputs.push_back({{}, first.stats});
+        FrameSamples f = sampleHalves(ctx, *scene, options, std::move(firstSampling), map.partner, window,
+                                      frame, share, pairing);
+        if (f.stats.cancelled) {
+            outputs.push_back({{}, f.stats});
             return outputs;
         }
-        half.batchStops.clear();
-        FrameSamples f;
-        int dtGroups = 0;  // (stats are set below, from both halves)
-        if (paired) {
-            const SampleGroups groups = firstGroups.take();
-            dtGroups = int(groups.ends.size());
-            f.varDt = pairedDifferenceVariance(groups, previousGroups, 0, map.partner);
-            if (groupGradients) {
-                f.varDxt = pairedDifferenceVariance(groups, previousGroups, 1, map.partner);
-                f.varDyt = pairedDifferenceVariance(groups, previousGroups, 2, map.partner);
-            }
-            previousGroups = {};
-        }
-        if (timed)
-            half.timeBudget = paired ? 0.5 * share : std::max(1e-3, share - (timer.seconds() - frameStart));
-        half.spp = std::max<std::uint32_t>(1, options.spp / 2);
-        half.partialPass = false;
-        half.seed = window.seed(frame + 1);
-        // Its sample groups, which the next frame's first half repeats: equal ones where its
-        // samples are known in advance, else its batch ends, merged in pairs past 16.
-        const bool secondTimed = half.timeBudget > 0.0;
-        if (!secondTimed) half.batchStops = equalGroupEnds(half.spp, kSampleGroups);
-        SampleGroupRecorder secondGroups = secondTimed ? SampleGroupRecorder::everyBatch(kSampleGroups)
-                                                       : SampleGroupRecorder::atEnds(half.batchStops);
-        GptSamplingOptions secondSampling = options_.sampling;
-        secondSampling.groups = &secondGroups;
-        secondSampling.groupGradients = groupGradients;
-        RenderResultGpt second = renderGpt(ctx, *scene, half, secondSampling);
-        if (second.stats.cancelled) {
-            outputs.push_back({{}, addStats(first.stats, second.stats)});
-            return outputs;
-        }
-        half.batchStops.clear();
-        previousGroups = secondGroups.take();
-        const double na = first.stats.spp, nb = second.stats.spp;
-        f.primal = combineHalves(first.primal, na, second.primal, nb, 1);
-        f.dx = combineHalves(first.dx, na, second.dx, nb, 1);
-        f.dy = combineHalves(first.dy, na, second.dy, nb, 1);
-        f.direct = combineHalves(first.direct, na, second.direct, nb, 1);
-        f.varPrimal = combineHalves(first.varPrimal, na, second.varPrimal, nb, 2);
-        f.varDx = combineHalves(first.varDx, na, second.varDx, nb, 2);
-        f.varDy = combineHalves(first.varDy, na, second.varDy, nb, 2);
-        f.varDirect = combineHalves(first.varDirect, na, second.varDirect, nb, 2);
-        f.firstHalfPrimal = std::move(first.primal);
-        f.secondHalfPrimal = std::move(second.primal);
-        if (mixed) {
-            f.firstHalfDx = std::move(first.dx);
-            f.firstHalfDy = std::move(first.dy);
-            f.secondHalfDx = std::move(second.dx);
-            f.secondHalfDy = std::move(second.dy);
-        }
-        f.stats = addStats(first.stats, second.stats);
-        f.stats.tgpt.firstHalfSpp = first.stats.spp;
-        f.stats.tgpt.secondHalfSpp = second.stats.spp;
         f.stats.tgpt.motionPartnered = partnered;
         f.stats.tgpt.motionMs = motionMs;
-        f.stats.tgpt.dtVarianceGroups = dtGroups;
         f.fromPrevious = std::move(map.partner);
-        pairedSpp = second.stats.spp;
         frames.push_back(std::move(f));
     }
 
-    // 2. The space-time reconstruction of the window: dt_k = first half of k+1 − second
-    // half of k (the same random numbers in consecutive frames).
-    SpaceTimeProblem problem;
-    problem.width = width;
-    problem.height = height;
-    problem.frames = window.count;
-    problem.alpha = options_.alpha;
-    problem.beta = options_.beta;
-    problem.gamma = options_.gamma;
-    // dt at the earlier frame's pixels, as the solve takes it; the layers hold it at the
-    // later frame's pixels.
-    std::vector<Image> dtToPrevious(frames.size());
-    for (std::size_t k = 0; k < frames.size(); ++k) {
-        append(problem.primal, frames[k].primal);
-        append(problem.dx, frames[k].dx);
-        append(problem.dy, frames[k].dy);
-        if (k > 0) {
-            const Image dt = reconnect
-                                 ? frames[k].dt
-                                 : differenceAlong(frames[k].firstHalfPrimal, frames[k - 1].secondHalfPrimal,
-                                                   frames[k].fromPrevious);
-            append(problem.dt, dt);
-            if (mixed) {
-                // The change of each spatial difference along the motion, from the paired halves
-                // (the same random numbers): the mixed rows' targets.
-                append(problem.dxt, differenceAlong(frames[k].firstHalfDx, frames[k - 1].secondHalfDx,
-                                                    frames[k].fromPrevious));
-                append(problem.dyt, differenceAlong(frames[k].firstHalfDy, frames[k - 1].secondHalfDy,
-                                                    frames[k].fromPrevious));
-            }
-            if (motion || reconnect)
-                problem.temporalPartner.insert(problem.temporalPartner.end(), frames[k].fromPrevious.begin(),
-                                               frames[k].fromPrevious.end());
-            dtToPrevious[k] = atLaterPixels(dt, frames[k].fromPrevious);
-        }
-    }
-    if (joined) {
-        const Image dt = reconnect ? frames[0].dt
-                                   : differenceAlong(frames[0].firstHalfPrimal, carry_->secondHalfPrimal,
-                                                     frames[0].fromPrevious);
-        problem.previous = carry_->recon;
-        append(problem.dtPrevious, dt);
-        if (mixed && !carry_->secondHalfDx.empty()) {
-            // Mixed rows across the windows' boundary, with targets as inside a window.
-            append(problem.dxtPrevious,
-                   differenceAlong(frames[0].firstHalfDx, carry_->secondHalfDx, frames[0].fromPrevious));
-            append(problem.dytPrevious,
-                   differenceAlong(frames[0].firstHalfDy, carry_->secondHalfDy, frames[0].fromPrevious));
-        }
-        if (motion || reconnect) problem.previousPartner = frames[0].fromPrevious;
-        dtToPrevious[0] = atLaterPixels(dt, frames[0].fromPrevious);
-    }
-    if (weighted) {
-        // Rows weighted by their inverse variances; a pair without a variance of dt (fewer
-        // than two groups: one sample per half) has 0 there, as a one-sample half's own.
-        const auto orZero = [&](const Image& v) { return v.empty() ? Image(width, height) : v; };
-        RowVariances v;
-        for (std::size_t k = 0; k < frames.size(); ++k) {
-            v.primal.push_back(frames[k].varPrimal);
-            v.dx.push_back(frames[k].varDx);
-            v.dy.push_back(frames[k].varDy);
-            if (k == 0) continue;
-            v.dt.push_back(orZero(frames[k].varDt));
-            if (mixed) {
-                v.dxt.push_back(orZero(frames[k].varDxt));
-                v.dyt.push_back(orZero(frames[k].varDyt));
-            }
-        }
-        if (joined) v.dtPrevious = orZero(frames[0].varDt);
-        if (!problem.dxtPrevious[0].empty()) {
-            v.dxtPrevious = orZero(frames[0].varDxt);
-            v.dytPrevious = orZero(frames[0].varDyt);
-        }
-        const SolveOptions defaults;
-        setVarianceWeights(problem, v, options_.l1, defaults.varianceEpsilon, defaults.varianceFilterRadius);
-    }
+    // 2. The space-time reconstruction of the window.
+    WindowProblem w = windowProblem(frames, options_, joined ? &*carry_ : nullptr, width, height);
+
     SpaceTimeOptions solve;
     solve.l1 = options_.l1;
     solve.tolerance = options_.tolerance;
     SpaceTimeStats solved;
-    const std::array<Field, 3> x = solveSpaceTime(problem, solve, &solved, &workspace_);
+    const std::array<Field, 3> x = solveSpaceTime(w.problem, solve, &solved, &workspace_);
     lastSolveSeconds_ = solved.ms * 1e-3;
     lastSolveFrames_ = window.count;
     if (!options.quiet)
@@ -525,55 +396,19 @@ std::vector<RenderOutput> TgptIntegrator::renderWindow(const vk::Context& ctx, c
                      solved.iterations, solved.irlsIterations, solved.residual, solved.ms);
 
     // 3. Compose each frame: reconstruction + very-direct light.
-    const std::string solveName = "spacetime_" + reconstructionName();
-    for (std::size_t k = 0; k < frames.size(); ++k) {
-        FrameSamples& f = frames[k];
-        Image recon = frameOf(x, k, width, height);
-        RenderOutput out;
-        out.stats = f.stats;
-        ReconstructionStats r;
-        r.method = solveName;
-        r.iterations = solved.iterations;
-        r.irlsIterations = solved.irlsIterations;
-        r.residual = solved.residual;
-        r.tolerance = options_.tolerance;
-        r.converged = solved.converged;
-        r.ms = solved.ms / double(frames.size());  // the window's solve, shared by its frames
-        out.stats.reconstructions.push_back(r);
-        out.stats.reconstructionMs = r.ms;
-        out.stats.tgpt.windowFirst = window.first;
-        out.stats.tgpt.windowFrames = window.count;
-        out.stats.tgpt.temporalToPrevious = k > 0 || joined;
-        out.stats.tgpt.joinedPreviousWindow = joined;
-        const bool hasPrevious = k > 0 || joined;
-        if (dtToPrevious[k].empty()) dtToPrevious[k] = Image(width, height);
-        out.layers.push_back({"", gptFinal(recon, nullptr, &f.direct)});
-        Image primalPlusDirect = gptFinal(f.primal, nullptr, &f.direct);
-        out.layers.push_back({"recon_" + solveName, std::move(recon)});
-        out.layers.push_back({"primal", std::move(f.primal)});
-        out.layers.push_back({"dx", std::move(f.dx)});
-        out.layers.push_back({"dy", std::move(f.dy)});
-        out.layers.push_back({"dt", std::move(dtToPrevious[k])});
-        out.layers.push_back(
-            {"var_dt", f.varDt.empty() ? Image(width, height) : atLaterPixels(f.varDt, f.fromPrevious)});
-        out.layers.push_back({"motion", motionLayer(f.fromPrevious, hasPrevious, width, height)});
-        out.layers.push_back({"direct", std::move(f.direct)});
-        out.layers.push_back({"var_primal", std::move(f.varPrimal)});
-        out.layers.push_back({"var_dx", std::move(f.varDx)});
-        out.layers.push_back({"var_dy", std::move(f.varDy)});
-        out.layers.push_back({"var_direct", std::move(f.varDirect)});
-        out.layers.push_back({"primal_plus_direct", std::move(primalPlusDirect)});
-        outputs.push_back(std::move(out));
-    }
-    carry_ = Carry{window.first + window.count - 1,
-                   {},
-                   std::move(frames.back().secondHalfPrimal),
-                   pairedSpp,
-                   std::move(previousGroups),
-                   mixed ? std::move(frames.back().secondHalfDx) : Image(),
-                   mixed ? std::move(frames.back().secondHalfDy) : Image(),
-                   std::move(previousScene),
-                   std::move(previousHits)};
+    outputs = composeWindow(frames, w.dtToPrevious,
+                            WindowSolve{&x, solved, "spacetime_" + reconstructionName(), options_.tolerance},
+                            window, joined, width, height);
+
+    carry_ = WindowCarry{window.first + window.count - 1,
+                         {},
+                         std::move(frames.back().secondHalfPrimal),
+                         pairing.spp,
+                         std::move(pairing.groups),
+                         mixed ? std::move(frames.back().secondHalfDx) : Image(),
+                         mixed ? std::move(frames.back().secondHalfDy) : Image(),
+                         std::move(previousScene),
+                         std::move(previousHits)};
     const std::size_t last = std::size_t(window.count - 1) * std::size_t(width) * std::size_t(height);
     for (int c = 0; c < 3; ++c) carry_->recon[c].assign(x[c].begin() + std::ptrdiff_t(last), x[c].end());
     return outputs;

@@ -39,8 +39,7 @@
 #include <vector>
 
 #include "integrator/integrator.h"
-#include "integrator/motion_map.h"
-#include "integrator/sample_groups.h"
+#include "integrator/tgpt_window.h"
 #include "poisson/poisson_spacetime.h"
 
 namespace gdpt {
@@ -64,21 +63,24 @@ private:
     // "l1", "l2", "wl1", "wl2".
     [[nodiscard]] std::string reconstructionName() const;
 
-    TgptOptions options_;
-    // From the last window: its last frame's reconstruction and its second half's primal
-    // (seeded like the next window's first frame's first half).
-    struct Carry {
-        int frame = -1;
-        std::array<std::vector<double>, 3> recon;
-        Image secondHalfPrimal;
-        std::uint32_t secondHalfSpp = 0;
-        SampleGroups secondHalfGroups;     // its sample groups (the next first half repeats them)
-        Image secondHalfDx, secondHalfDy;  // with mixed rows: the targets of the rows across
-        // The motion shift: the last frame's scene and primary hits (motion_map.h).
-        std::shared_ptr<const Scene> scene;
-        std::vector<PrimaryHit> hits;
+    // A frame's first half repeats the frame before's second half: that half's samples per
+    // pixel (0: no frame before) and its sample groups (for the variance of dt).
+    struct HalfPairing {
+        std::uint32_t spp = 0;
+        SampleGroups groups;
     };
-    std::optional<Carry> carry_;
+    // The motion shift's and the replay's frame `frame` of `window`: two G-PT renders of half the
+    // samples each, seeded σ(f) (replaying the frame before's second half, with `firstSampling`'s
+    // streams; `partner`: where its pixels moved) and σ(f+1), combined. `share`: a timed frame's
+    // seconds. `pairing` becomes this frame's second half's. Cancelled: the stats so far, with
+    // `cancelled` set.
+    FrameSamples sampleHalves(const vk::Context& ctx, const Scene& scene, const RenderOptions& options,
+                              GptSamplingOptions firstSampling, const std::vector<std::uint32_t>& partner,
+                              const FrameWindow& window, int frame, double share, HalfPairing& pairing);
+
+    TgptOptions options_;
+    // What the last window leaves this one (tgpt_window.h).
+    std::optional<WindowCarry> carry_;
     // The space-time solver's buffers, kept from window to window (poisson_spacetime.h).
     SpaceTimeWorkspace workspace_;
     // The last window's solve, reserved (per frame) from the next window's budget.
