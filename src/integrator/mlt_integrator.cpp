@@ -68,6 +68,180 @@ ReservedTime MltIntegrator::reserveAfterSampling(const vk::Context& ctx, int wid
     return stage_.reserve(ctx, width, height, nullptr);
 }
 
+namespace {
+
+// One render's device work and its stages (Kelemen et al. 2002): the bootstrap, the chains and
+// the estimate. Each submission waits for the device and adds the pass's counters to the stats.
+class MltRun {
+public:
+    MltRun(const vk::Context& ctx, const std::string& name, MltPass& pass, const MltPassOptions& po,
+           const RenderOptions& options, RenderStats& stats, vk::GpuTimer* timer)
+        : name_(name),
+          pass_(pass),
+          po_(po),
+          options_(options),
+          stats_(stats),
+          timer_(timer),
+          stream_(ctx, name),
+          pixels_(std::uint64_t(options.scene.width) * std::uint64_t(options.scene.height)) {}
+
+    [[nodiscard]] bool cancelled() const { return options_.cancel && options_.cancel->load(); }
+
+    void submit(const std::string& what, const std::function<void(VkCommandBuffer)>& work) {
+        VkCommandBuffer cmd = stream_.begin();
+        if (timer_) timer_->reset(cmd);
+        work(cmd);
+        stream_.setWhat(what);
+        stream_.submit();
+        stream_.waitAll();
+        if (timer_) timer_->collect();
+        const gpu::Counters c = pass_.takeCounters();
+        stats_.raysTraced += c.raysTraced;
+        stats_.pathsCompleted += c.pathsCompleted;
+        stats_.nanSamples += c.nanSamples;
+    }
+
+    // What the bootstrap leaves the chains.
+    struct Starts {
+        std::vector<std::uint32_t> chains;  // the bootstrap sample each chain starts from
+        float misNormalisation = 0.0f;      // b' of the splat weights (mlt.glsl): the bootstrap's b̂
+        TargetSums fresh;                   // the fresh states b̂ pools: the bootstrap's so far
+    };
+
+    // The bootstrap: max(W·H · per pixel, 16 · chains) fresh states, the target's divisors per
+    // image block (mlt_estimate.h) from the even ones, b̂ from the others, and the chains'
+    // starts drawn in proportion to the divided target (mltChainStarts).
+    Starts bootstrap(const MltOptions& o) {
+        const int width = options_.scene.width, height = options_.scene.height;
+        const std::uint64_t count = std::max<std::uint64_t>(pixels_ * o.bootstrapPerPixel,
+                                                            std::uint64_t{po_.chains} * kBootstrapPerChain);
+        if (count > std::uint64_t{1} << 31)
+            throw UsageError("--method " + name_ + ": " + std::to_string(count) +
+                             " bootstrap samples are more than this renderer counts; use a smaller image");
+        std::vector<gpu::MltBootstrapSample> samples;
+        samples.reserve(count);
+        for (std::uint64_t first = 0; first < count && !cancelled(); first += kBootstrapPerDispatch) {
+            const auto n =
+                static_cast<std::uint32_t>(std::min<std::uint64_t>(kBootstrapPerDispatch, count - first));
+            submit(name_ + " bootstrap from sample " + std::to_string(first), [&](VkCommandBuffer cmd) {
+                pass_.recordBootstrap(cmd, static_cast<std::uint32_t>(first), n, options_.seed, timer_);
+            });
+            const std::vector<gpu::MltBootstrapSample> part = pass_.bootstrapSamples(n);
+            samples.insert(samples.end(), part.begin(), part.end());
+        }
+        // The chains walk the divided target, which the bootstrap's targets are then divided by too.
+        const MltBlockNormaliser normaliser =
+            mltBlockNormaliser(samples, std::uint32_t(width), std::uint32_t(height),
+                               static_cast<std::uint32_t>(o.targetBlock), o.targetExponent);
+        pass_.setNormaliser(normaliser.block, normaliser.divisors);
+        Starts out;
+        std::vector<float> targets(samples.size());
+        TargetSums all;  // every bootstrap sample's target: b' and the starts' ESS
+        for (std::size_t i = 0; i < samples.size(); ++i) {
+            targets[i] = samples[i].target / normaliser.divisor(samples[i].pixel, std::uint32_t(width));
+            all.add(targets[i]);
+            // With blocks, the samples the divisors were built from are left out of b̂.
+            if (normaliser.block == 0 || i % 2 == 1) out.fresh.add(targets[i]);
+        }
+        samples = {};
+        stats_.mlt.bootstrapEss = all.effectiveSampleSize();
+        out.misNormalisation = static_cast<float>(all.normalisation().b);
+        pass_.setMisNormalisation(out.misNormalisation);
+        stats_.mlt.chains = po_.chains;
+        stats_.mlt.bootstrapSamples = targets.size();
+        out.chains = mltChainStarts(targets, po_.chains, options_.seed);
+        return out;
+    }
+
+    // The chains from `starts`: mutation steps in batches, each batch's records splatted into
+    // `acc` by the host in record order while nothing else runs (the same order on every run),
+    // until --spp mutations per pixel or the budget (`total`: the render's clock). Returns the
+    // steps taken.
+    std::uint64_t chains(const std::vector<std::uint32_t>& starts, MltAccumulator& acc, const Timer& total) {
+        const bool timed = options_.timeBudget > 0.0;
+        const double budget = options_.timeBudget - options_.elapsedBefore;
+        const std::uint64_t wantedMutations = std::uint64_t{options_.spp} * pixels_;
+        const std::uint64_t wantedSteps = (wantedMutations + po_.chains - 1) / po_.chains;
+        std::uint64_t steps = 0;
+        if (starts.empty() || cancelled()) return steps;
+        submit(name_ + " chain start",
+               [&](VkCommandBuffer cmd) { pass_.recordStart(cmd, starts, options_.seed, timer_); });
+        Progress progress("render " + name_, timed ? budget : double(wantedSteps), options_.quiet);
+        double secondsPerStep = 0.0;
+        stats_.setupSeconds = options_.elapsedBefore + total.seconds();  // the bootstrap included
+        while (!cancelled()) {
+            std::uint32_t n = kStepsPerBatch;
+            if (!timed) {
+                if (steps >= wantedSteps) break;
+                n = static_cast<std::uint32_t>(std::min<std::uint64_t>(n, wantedSteps - steps));
+            } else if (steps == 0) {
+                n = 1;  // measures a step; the set-up may have used the budget already
+            } else {
+                const double left = budget - total.seconds();
+                const auto fits =
+                    static_cast<std::uint64_t>(std::max(0.0, left / std::max(secondsPerStep, 1e-9)));
+                if (fits == 0) break;
+                n = static_cast<std::uint32_t>(std::min<std::uint64_t>(n, fits));
+            }
+            if (steps + n > UINT32_MAX) break;  // step indices are 32-bit
+            Timer batch;
+            submit(name_ + " mutation steps " + std::to_string(steps) + ".." + std::to_string(steps + n - 1) +
+                       " (seed " + std::to_string(options_.seed) + ")",
+                   [&](VkCommandBuffer cmd) {
+                       pass_.recordMutations(cmd, static_cast<std::uint32_t>(steps), n, options_.seed,
+                                             timer_);
+                   });
+            Timer splat;
+            acc.add(pass_.records(n), std::size_t{2} * po_.chains * n);
+            stats_.mlt.splatMs += splat.ms();
+            steps += n;
+            ++stats_.batches;
+            secondsPerStep = batch.seconds() / n;
+            if (stats_.firstBatchSeconds == 0.0) stats_.firstBatchSeconds = batch.seconds();
+            char rate[64];
+            std::snprintf(rate, sizeof rate, "%.1f mutations/pixel",
+                          double(steps) * double(po_.chains) / double(pixels_));
+            progress.update(timed ? total.seconds() : double(steps), rate);
+        }
+        progress.finish();
+        const MltAcceptance a = pass_.acceptance();
+        stats_.mlt.proposedSmall = a.proposedSmall;
+        stats_.mlt.acceptedSmall = a.acceptedSmall;
+        stats_.mlt.proposedLarge = a.proposedLarge;
+        stats_.mlt.acceptedLarge = a.acceptedLarge;
+        return steps;
+    }
+
+    // The scales of the estimate X(p) = W·H/N Σ (b̂·weight + largeWeight)·X (mlt_estimate.h),
+    // with b̂ from every fresh state (Kelemen et al. 2002, §4): the bootstrap's and the large
+    // steps'.
+    MltScale scale(TargetSums fresh, const MltAccumulator& acc) {
+        fresh.add(acc.largeSteps());
+        const MltNormalisation norm = fresh.normalisation();
+        stats_.mlt.normalisation = norm.b;
+        stats_.mlt.normalisationStdErr = norm.standardError;
+        stats_.mlt.normalisationSamples = norm.samples;
+        MltScale scale;
+        if (stats_.mlt.mutations) {
+            scale.large = double(pixels_) / double(stats_.mlt.mutations);
+            scale.metropolis = scale.large * norm.b;
+        }
+        return scale;
+    }
+
+private:
+    const std::string& name_;
+    MltPass& pass_;
+    const MltPassOptions& po_;
+    const RenderOptions& options_;
+    RenderStats& stats_;
+    vk::GpuTimer* timer_;
+    vk::CommandStream stream_;
+    std::uint64_t pixels_;
+};
+
+}  // namespace
+
 RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, const RenderOptions& options) {
     if (options.resume || options.checkpoint || options.share.split() || options.combine)
         throw UsageError("--method " + name_ +
@@ -108,132 +282,29 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     stats.uploadMs = total.ms() - stats.bvhBuildMs;
 
     vk::GpuTimer gpuTimer(ctx);
-    vk::GpuTimer* timer = options.profile ? &gpuTimer : nullptr;
-    vk::CommandStream stream(ctx, name_);
-    const auto submit = [&](const std::string& what, const std::function<void(VkCommandBuffer)>& work) {
-        VkCommandBuffer cmd = stream.begin();
-        if (timer) timer->reset(cmd);
-        work(cmd);
-        stream.setWhat(what);
-        stream.submit();
-        stream.waitAll();
-        if (timer) timer->collect();
-        const gpu::Counters c = pass.takeCounters();
-        stats.raysTraced += c.raysTraced;
-        stats.pathsCompleted += c.pathsCompleted;
-        stats.nanSamples += c.nanSamples;
-    };
-    const auto cancelled = [&] { return options.cancel && options.cancel->load(); };
+    MltRun run(ctx, name_, pass, po, options, stats, options.profile ? &gpuTimer : nullptr);
     // The kernel's compile at its first dispatch: a fixed cost (time_s.kernel_compile), not
     // the very-direct light's (PixelSampling::run does the same for PT and G-PT).
     Timer compile;
-    submit(name_ + " kernel's first dispatch", [&](VkCommandBuffer cmd) { pass.recordWarmUp(cmd); });
+    run.submit(name_ + " kernel's first dispatch", [&](VkCommandBuffer cmd) { pass.recordWarmUp(cmd); });
     stats.compileMs = compile.ms();
     Timer sampling;
 
     // Stage 1: the very-direct light, and the bootstrap: b and the chains' starts.
-    submit(name_ + " direct light",
-           [&](VkCommandBuffer cmd) { pass.recordDirect(cmd, options_.directSamples, options.seed, timer); });
-    const std::uint64_t bootstrapCount = std::max<std::uint64_t>(
-        pixels * options_.bootstrapPerPixel, std::uint64_t{po.chains} * kBootstrapPerChain);
-    if (bootstrapCount > std::uint64_t{1} << 31)
-        throw UsageError("--method " + name_ + ": " + std::to_string(bootstrapCount) +
-                         " bootstrap samples are more than this renderer counts; use a smaller image");
-    std::vector<gpu::MltBootstrapSample> bootstrap;
-    bootstrap.reserve(bootstrapCount);
-    for (std::uint64_t first = 0; first < bootstrapCount && !cancelled(); first += kBootstrapPerDispatch) {
-        const auto n = static_cast<std::uint32_t>(
-            std::min<std::uint64_t>(kBootstrapPerDispatch, bootstrapCount - first));
-        submit(name_ + " bootstrap from sample " + std::to_string(first), [&](VkCommandBuffer cmd) {
-            pass.recordBootstrap(cmd, static_cast<std::uint32_t>(first), n, options.seed, timer);
-        });
-        const std::vector<gpu::MltBootstrapSample> part = pass.bootstrapSamples(n);
-        bootstrap.insert(bootstrap.end(), part.begin(), part.end());
-    }
-    // The target's divisors per image block (mlt_estimate.h), from the even bootstrap samples;
-    // the chains walk the divided target, which the bootstrap's targets are then divided by too.
-    const MltBlockNormaliser normaliser =
-        mltBlockNormaliser(bootstrap, std::uint32_t(width), std::uint32_t(height),
-                           static_cast<std::uint32_t>(options_.targetBlock), options_.targetExponent);
-    pass.setNormaliser(normaliser.block, normaliser.divisors);
-    std::vector<float> targets(bootstrap.size());
-    TargetSums bootstrapSums;  // every bootstrap sample's target: b' and the starts' ESS
-    TargetSums fresh;          // the fresh states that b̂ pools: the bootstrap's, then the large steps'
-    for (std::size_t i = 0; i < bootstrap.size(); ++i) {
-        targets[i] = bootstrap[i].target / normaliser.divisor(bootstrap[i].pixel, std::uint32_t(width));
-        bootstrapSums.add(targets[i]);
-        // With blocks, the samples the divisors were built from are left out of b̂.
-        if (normaliser.block == 0 || i % 2 == 1) fresh.add(targets[i]);
-    }
-    bootstrap = {};
-    stats.mlt.bootstrapEss = bootstrapSums.effectiveSampleSize();
-    // b' of the splat weights (mlt.glsl): the bootstrap's b̂.
-    const auto misNormalisation = static_cast<float>(bootstrapSums.normalisation().b);
-    pass.setMisNormalisation(misNormalisation);
-    stats.mlt.chains = po.chains;
-    stats.mlt.bootstrapSamples = targets.size();
-    const std::vector<std::uint32_t> starts = mltChainStarts(targets, po.chains, options.seed);
-    targets = {};
+    vk::GpuTimer* timer = options.profile ? &gpuTimer : nullptr;
+    run.submit(name_ + " direct light", [&](VkCommandBuffer cmd) {
+        pass.recordDirect(cmd, options_.directSamples, options.seed, timer);
+    });
+    MltRun::Starts starts = run.bootstrap(options_);
 
-    // Stage 2: the chains. Mutation steps in batches; the host splats each batch's records
-    // in record order while nothing else runs (the same order on every run).
-    MltAccumulator acc(width, height, misNormalisation, po.largeStep);
-    const bool timed = options.timeBudget > 0.0;
-    const double budget = options.timeBudget - options.elapsedBefore;
-    const std::uint64_t wantedMutations = std::uint64_t{options.spp} * pixels;
-    const std::uint64_t wantedSteps = (wantedMutations + po.chains - 1) / po.chains;
-    std::uint64_t steps = 0;
-    if (!starts.empty() && !cancelled()) {
-        submit(name_ + " chain start",
-               [&](VkCommandBuffer cmd) { pass.recordStart(cmd, starts, options.seed, timer); });
-        Progress progress("render " + name_, timed ? budget : double(wantedSteps), options.quiet);
-        double secondsPerStep = 0.0;
-        stats.setupSeconds = options.elapsedBefore + total.seconds();  // the bootstrap included
-        while (!cancelled()) {
-            std::uint32_t n = kStepsPerBatch;
-            if (!timed) {
-                if (steps >= wantedSteps) break;
-                n = static_cast<std::uint32_t>(std::min<std::uint64_t>(n, wantedSteps - steps));
-            } else if (steps == 0) {
-                n = 1;  // measures a step; the set-up may have used the budget already
-            } else {
-                const double left = budget - total.seconds();
-                const auto fits =
-                    static_cast<std::uint64_t>(std::max(0.0, left / std::max(secondsPerStep, 1e-9)));
-                if (fits == 0) break;
-                n = static_cast<std::uint32_t>(std::min<std::uint64_t>(n, fits));
-            }
-            if (steps + n > UINT32_MAX) break;  // step indices are 32-bit
-            Timer batch;
-            submit(name_ + " mutation steps " + std::to_string(steps) + ".." + std::to_string(steps + n - 1) +
-                       " (seed " + std::to_string(options.seed) + ")",
-                   [&](VkCommandBuffer cmd) {
-                       pass.recordMutations(cmd, static_cast<std::uint32_t>(steps), n, options.seed, timer);
-                   });
-            Timer splat;
-            acc.add(pass.records(n), std::size_t{2} * po.chains * n);
-            stats.mlt.splatMs += splat.ms();
-            steps += n;
-            ++stats.batches;
-            secondsPerStep = batch.seconds() / n;
-            if (stats.firstBatchSeconds == 0.0) stats.firstBatchSeconds = batch.seconds();
-            char rate[64];
-            std::snprintf(rate, sizeof rate, "%.1f mutations/pixel",
-                          double(steps) * double(po.chains) / double(pixels));
-            progress.update(timed ? total.seconds() : double(steps), rate);
-        }
-        progress.finish();
-        const MltAcceptance a = pass.acceptance();
-        stats.mlt.proposedSmall = a.proposedSmall;
-        stats.mlt.acceptedSmall = a.acceptedSmall;
-        stats.mlt.proposedLarge = a.proposedLarge;
-        stats.mlt.acceptedLarge = a.acceptedLarge;
-    }
+    // Stage 2: the chains.
+    MltAccumulator acc(width, height, starts.misNormalisation, po.largeStep);
+    const std::uint64_t steps = run.chains(starts.chains, acc, total);
     stats.mlt.mutations = steps * po.chains;
     stats.spp = static_cast<std::uint32_t>(stats.mlt.mutations / pixels);
     stats.samplingMs = sampling.ms();
     stats.kernels = gpuTimer.totals();
-    if (cancelled()) {
+    if (run.cancelled()) {
         stats.cancelled = true;
         return out;
     }
@@ -241,19 +312,9 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
         std::fprintf(stderr, "gdpt: warning: %s: %llu samples were NaN/Inf and were counted as zero\n",
                      name_.c_str(), static_cast<unsigned long long>(stats.nanSamples));
 
-    // Stage 3: the estimate, X(p) = W·H/N Σ (b̂·weight + largeWeight)·X (mlt_estimate.h), with
-    // b̂ from every fresh state (Kelemen et al. 2002, §4); gmlt reconstructs.
-    fresh.add(acc.largeSteps());
-    const MltNormalisation norm = fresh.normalisation();
-    stats.mlt.normalisation = norm.b;
-    stats.mlt.normalisationStdErr = norm.standardError;
-    stats.mlt.normalisationSamples = norm.samples;
+    // Stage 3: the estimate; gmlt reconstructs.
+    const MltScale scale = run.scale(std::move(starts.fresh), acc);
     Timer readback;
-    MltScale scale;
-    if (stats.mlt.mutations) {
-        scale.large = double(pixels) / double(stats.mlt.mutations);
-        scale.metropolis = scale.large * norm.b;
-    }
     Image direct = pass.directImage();
     stats.readbackMs = readback.ms();
     const gpu::VisibleCounter visible = pass.emitterSupersampling().report();
