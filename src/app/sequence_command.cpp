@@ -64,6 +64,230 @@ std::string seconds(double s) {
     return text;
 }
 
+// One sequence's frames, rendered in order on one device by one integrator (made once), each
+// written when it is done.
+class SequenceRender {
+public:
+    SequenceRender(const RenderArgs& args, const FrameRange& range, const RenderOptions& options,
+                   const GltfAsset& asset, int animation, const vk::Context& ctx, Integrator& integrator,
+                   const Timer& total, const TextOutput& jsonOutput)
+        : args_(args),
+          range_(range),
+          options_(options),
+          asset_(asset),
+          animation_(animation),
+          ctx_(ctx),
+          integrator_(integrator),
+          total_(total),
+          jsonOutput_(jsonOutput),
+          quiet_(options.quiet),
+          timed_(args.time > 0.0),
+          reserved_(timed_ ? integrator.reserveAfterSampling(ctx, args.width, args.height).seconds : 0.0),
+          frame_(range.first) {}
+
+    // An interrupt ends the sequence with exit 130; the frames before the current one are
+    // written whole, the current one not at all.
+    int interrupted(const std::string& phase) const {
+        const std::string written =
+            frame_ == range_.first ? "no frame written"
+            : frame_ == range_.first + 1
+                ? "frame " + std::to_string(range_.first) + " written"
+                : "frames " + std::to_string(range_.first) + " to " + std::to_string(frame_ - 1) + " written";
+        if (frame_ > range_.last)
+            std::fprintf(stderr, "gdpt: interrupted while %s; all %d frames written\n", phase.c_str(),
+                         range_.count());
+        else
+            std::fprintf(stderr, "gdpt: interrupted while %s frame %d; %s (continue with --frames %d:%d)\n",
+                         phase.c_str(), frame_, written.c_str(), frame_, range_.last);
+        return 130;
+    }
+
+    // Timed: the kernels compile once for the sequence (the context keeps them), before the
+    // frames' shares are set, by a one-sample render of the first frame at 8x8 pixels (the
+    // pipelines do not depend on the image size). Else the first frame compiled them inside its
+    // own share and had a sample or two per pixel where the others have dozens. Returns 130
+    // (interrupted) or 0.
+    int compileKernels() {
+        Timer warmUp;
+        RenderOptions warm = options_;
+        warm.scene.width = warm.scene.height = 8;
+        warm.spp = 1;
+        warm.timeBudget = 0.0;
+        warm.quiet = true;
+        const char* phase = "compiling the kernels for";
+        bool cancelled = false;
+        try {
+            enterPhase(phase);
+            if (integrator_.windowFrames() > 0) {
+                const std::vector<RenderOutput> outs =
+                    integrator_.renderWindow(ctx_, windowOf(frame_, 1), warm);
+                cancelled = outs.empty() || outs.back().stats.cancelled;
+            } else {
+                cancelled = integrator_.render(ctx_, sceneAt(frame_), warm).stats.cancelled;
+            }
+        } catch (const Interrupted&) {
+            cancelled = true;
+        }
+        if (cancelled || interruptRequested()) return interrupted(phase);
+        if (!quiet_)
+            std::fprintf(stderr, "gdpt: kernels ready for the sequence in %s\n",
+                         seconds(warmUp.seconds()).c_str());
+        return 0;
+    }
+
+    // Every frame of the range, each written when done (a temporal method's in windows).
+    // Returns 130 (interrupted) or 0.
+    int renderFrames() {
+        const int window = integrator_.windowFrames();
+        while (frame_ <= range_.last) {
+            try {
+                if (window > 0) {
+                    // A temporal method: a window of frames sampled and reconstructed together.
+                    Timer windowTimer;
+                    const FrameWindow w = windowOf(frame_, std::min(window, range_.last - frame_ + 1));
+                    RenderOptions windowOptions = options_;
+                    if (timed_) windowOptions.timeBudget = budgetFor(w.count);
+                    enterPhase("sampling");
+                    std::vector<RenderOutput> outs = integrator_.renderWindow(ctx_, w, windowOptions);
+                    if (outs.empty() || outs.back().stats.cancelled) return interrupted("sampling");
+                    const double each = windowTimer.seconds() / double(outs.size());
+                    for (RenderOutput& out : outs) {
+                        writeFrame(out, each, each - out.stats.reconstructionMs * 1e-3);
+                        ++frame_;
+                    }
+                    continue;
+                }
+                Timer frameTimer;
+                const Scene scene = sceneAt(frame_);
+                RenderOptions frameOptions = options_;
+                frameOptions.seed = sequenceFrameSeed(args_.seed, frame_);
+                if (timed_) frameOptions.timeBudget = budgetFor(1);
+                frameOptions.elapsedBefore = frameTimer.seconds();
+                enterPhase("sampling");
+                RenderOutput out = integrator_.render(ctx_, scene, frameOptions);
+                if (out.stats.cancelled) return interrupted("sampling");
+                const double sampledAt =
+                    frameTimer.seconds() - (out.stats.readbackMs + out.stats.reconstructionMs) * 1e-3;
+                writeFrame(out, frameTimer.seconds(), sampledAt);
+                ++frame_;
+            } catch (const Interrupted& e) {
+                return interrupted(e.phase());
+            } catch (const std::exception&) {
+                if (interruptRequested()) return interrupted("rendering");  // a layer re-wrapped it
+                throw;
+            }
+        }
+        return 0;
+    }
+
+    // The frames' JSON summaries (--json), in order.
+    nlohmann::json takeFrameSummaries() { return std::move(frames_); }
+
+private:
+    // The scene of a frame (the first one also says what the scene cannot show).
+    Scene sceneAt(int f) {
+        enterPhase("loading");
+        Scene scene = asset_.instance(animation_, double(f) / args_.fps);
+        if (!warned_ && !quiet_) warnAboutScene(args_.scene, scene, options_.scene.envRadiance);
+        warned_ = true;
+        return scene;
+    }
+
+    // Frames first .. first + count - 1 as a temporal method's window.
+    FrameWindow windowOf(int first, int count) {
+        FrameWindow w;
+        w.first = first;
+        w.count = count;
+        w.scene = [this](int f) { return sceneAt(f); };
+        w.seed = [this](int f) { return sequenceFrameSeed(args_.seed, f); };
+        w.startsSequence = first == range_.first;
+        return w;
+    }
+
+    // --time is the whole sequence's: each frame gets an equal share of what is left, less what
+    // the method reserves after sampling and the last frame needed to be written; a window of
+    // `count` frames gets their shares.
+    double budgetFor(int count) const {
+        const int left = range_.last - frame_ + 1;
+        const double share = std::max(0.0, args_.time - total_.seconds()) / double(left);
+        return std::max(0.05 * args_.time / double(range_.count()),
+                        double(count) * (share - afterSamplingSeconds_) - reserved_);
+    }
+
+    // Writes the current frame's EXR and PNG (together, whole or not at all), its summary and
+    // progress. `frameSeconds` is what the frame cost (a window's frames share its time),
+    // `sampledAt` when its sampling ended.
+    void writeFrame(RenderOutput& out, double frameSeconds, double sampledAt) {
+        enterPhase("writing");
+        const RenderStats& s = out.stats;
+        const std::string exrPath = framePath(args_.output, frame_);
+        const double time = double(frame_) / args_.fps;
+        Timer writeTimer;
+        OutputSet outputs({{"scene", args_.scene}});
+        const StagedFile& exrFile = outputs.add(exrPath, "-o (frame " + std::to_string(frame_) + ")");
+        const StagedFile& pngFile = outputs.add(previewPath(exrPath), "PNG preview of -o");
+        checkFinite(out.layers, exrPath);
+        writeExr(exrFile, out.layers);
+        throwIfInterrupted("writing");
+        writePngPreview(pngFile, out.image());
+        throwIfInterrupted("writing");
+        outputs.commit();
+        const double writeMs = writeTimer.ms();
+        frameSeconds += writeMs * 1e-3;
+        afterSamplingSeconds_ = std::max(0.0, frameSeconds - sampledAt - s.reconstructionMs * 1e-3);
+        if (jsonOutput_.wanted()) {
+            RenderArgs frameArgs = args_;
+            frameArgs.output = exrPath;
+            frameArgs.seed = sequenceFrameSeed(args_.seed, frame_);
+            json j = summaryJson(frameArgs, ctx_, integrator_, s, frameSeconds, reserved_,
+                                 afterSamplingSeconds_, writeMs);
+            j["frame"] = frame_;
+            j["time"] = time;
+            frames_.push_back(std::move(j));
+        }
+        if (!quiet_) {
+            const int done = frame_ - range_.first + 1, left = range_.last - frame_;
+            const double elapsed = total_.seconds();
+            const double remaining = elapsed / double(done) * double(left);
+            std::fprintf(
+                stderr, "gdpt: frame %d (%d/%d, t = %.4g s): wrote %s (%u spp%s, %s); sequence %s, %s\n",
+                frame_, done, range_.count(), time, exrPath.c_str(), s.spp, integrator_.summary(s).c_str(),
+                seconds(frameSeconds).c_str(), seconds(elapsed).c_str(),
+                left > 0 ? ("about " + seconds(remaining) + " left").c_str() : "done");
+        }
+        if (args_.profile) printProfile(s.kernels);
+    }
+
+    const RenderArgs& args_;
+    const FrameRange& range_;
+    const RenderOptions& options_;
+    const GltfAsset& asset_;
+    int animation_;
+    const vk::Context& ctx_;
+    Integrator& integrator_;
+    const Timer& total_;
+    const TextOutput& jsonOutput_;
+    bool quiet_, timed_;
+    double reserved_;  // what the method reserves after each frame's sampling (timed)
+    int frame_;        // the frame being rendered
+    json frames_ = json::array();
+    double afterSamplingSeconds_ = 0.0;  // the last frame's time after its sampling (reconstruction aside)
+    bool warned_ = false;
+};
+
+// The animation --animation names, else the file's first; -1 for a file without animations.
+int chosenAnimation(const GltfAsset& asset, const RenderArgs& args, bool quiet) {
+    int animation = -1;
+    if (!args.animation.empty())
+        animation = asset.findAnimation(args.animation);
+    else if (!asset.animations().empty())
+        animation = 0;
+    if (animation < 0 && !quiet)
+        std::fprintf(stderr, "gdpt: note: %s has no animations; every frame is the same still scene\n",
+                     args.scene.c_str());
+    return animation;
+}
+
 }  // namespace
 
 int runSequence(const RenderArgs& args) {
@@ -74,7 +298,6 @@ int runSequence(const RenderArgs& args) {
     Timer total;
     RenderOptions options = renderOptionsFor(args);
     const bool quiet = options.quiet;
-    const bool timed = args.time > 0.0;
     const ReconTimeCache cache(ReconTimeCache::defaultPath());
 
     // The outputs that exist once per sequence, and the first frame's, are checked before
@@ -94,14 +317,7 @@ int runSequence(const RenderArgs& args) {
 
     enterPhase("loading");
     const GltfAsset asset(args.scene, deviceLoadOptions(args.device, quiet));
-    int animation = -1;
-    if (!args.animation.empty())
-        animation = asset.findAnimation(args.animation);
-    else if (!asset.animations().empty())
-        animation = 0;
-    if (animation < 0 && !quiet)
-        std::fprintf(stderr, "gdpt: note: %s has no animations; every frame is the same still scene\n",
-                     args.scene.c_str());
+    const int animation = chosenAnimation(asset, args, quiet);
     const double duration =
         animation >= 0 ? asset.animations()[static_cast<std::size_t>(animation)].duration() : 0.0;
     throwIfInterrupted("loading");
@@ -119,167 +335,10 @@ int runSequence(const RenderArgs& args) {
                 ? (", animation " + std::to_string(animation) + " (" + seconds(duration) + ")").c_str()
                 : "");
     std::unique_ptr<Integrator> integrator = integratorFor(args, &cache);
-    const double reserved =
-        timed ? integrator->reserveAfterSampling(ctx, args.width, args.height).seconds : 0.0;
-
-    json frames = json::array();
-    double afterSamplingSeconds = 0.0;  // the last frame's time after its sampling (reconstruction aside)
-    bool warned = false;
-    int frame = range.first;
-    // An interrupt ends the sequence with exit 130; the frames before the current one are
-    // written whole, the current one not at all.
-    const auto interrupted = [&](const std::string& phase) {
-        const std::string written =
-            frame == range.first ? "no frame written"
-            : frame == range.first + 1
-                ? "frame " + std::to_string(range.first) + " written"
-                : "frames " + std::to_string(range.first) + " to " + std::to_string(frame - 1) + " written";
-        if (frame > range.last)
-            std::fprintf(stderr, "gdpt: interrupted while %s; all %d frames written\n", phase.c_str(),
-                         range.count());
-        else
-            std::fprintf(stderr, "gdpt: interrupted while %s frame %d; %s (continue with --frames %d:%d)\n",
-                         phase.c_str(), frame, written.c_str(), frame, range.last);
-        return 130;
-    };
-    // The scene of a frame (the first one also says what the scene cannot show).
-    const auto sceneAt = [&](int f) {
-        enterPhase("loading");
-        Scene scene = asset.instance(animation, double(f) / args.fps);
-        if (!warned && !quiet) warnAboutScene(args.scene, scene, options.scene.envRadiance);
-        warned = true;
-        return scene;
-    };
-    // Frames first .. first + count - 1 as a temporal method's window.
-    const auto windowOf = [&](int first, int count) {
-        FrameWindow w;
-        w.first = first;
-        w.count = count;
-        w.scene = sceneAt;
-        w.seed = [&](int f) { return sequenceFrameSeed(args.seed, f); };
-        w.startsSequence = first == range.first;
-        return w;
-    };
-    // Writes frame f's EXR and PNG (together, whole or not at all), its summary and progress.
-    // `seconds` is what the frame cost (a window's frames share its time).
-    const auto writeFrame = [&](RenderOutput& out, double frameSeconds, double sampledAt) {
-        enterPhase("writing");
-        const RenderStats& s = out.stats;
-        const std::string exrPath = framePath(args.output, frame);
-        const double time = double(frame) / args.fps;
-        Timer writeTimer;
-        OutputSet outputs({{"scene", args.scene}});
-        const StagedFile& exrFile = outputs.add(exrPath, "-o (frame " + std::to_string(frame) + ")");
-        const StagedFile& pngFile = outputs.add(previewPath(exrPath), "PNG preview of -o");
-        checkFinite(out.layers, exrPath);
-        writeExr(exrFile, out.layers);
-        throwIfInterrupted("writing");
-        writePngPreview(pngFile, out.image());
-        throwIfInterrupted("writing");
-        outputs.commit();
-        const double writeMs = writeTimer.ms();
-        frameSeconds += writeMs * 1e-3;
-        afterSamplingSeconds = std::max(0.0, frameSeconds - sampledAt - s.reconstructionMs * 1e-3);
-        if (jsonOutput.wanted()) {
-            RenderArgs frameArgs = args;
-            frameArgs.output = exrPath;
-            frameArgs.seed = sequenceFrameSeed(args.seed, frame);
-            json j = summaryJson(frameArgs, ctx, *integrator, s, frameSeconds, reserved, afterSamplingSeconds,
-                                 writeMs);
-            j["frame"] = frame;
-            j["time"] = time;
-            frames.push_back(std::move(j));
-        }
-        if (!quiet) {
-            const int done = frame - range.first + 1, left = range.last - frame;
-            const double elapsed = total.seconds();
-            const double remaining = elapsed / double(done) * double(left);
-            std::fprintf(
-                stderr, "gdpt: frame %d (%d/%d, t = %.4g s): wrote %s (%u spp%s, %s); sequence %s, %s\n",
-                frame, done, range.count(), time, exrPath.c_str(), s.spp, integrator->summary(s).c_str(),
-                seconds(frameSeconds).c_str(), seconds(elapsed).c_str(),
-                left > 0 ? ("about " + seconds(remaining) + " left").c_str() : "done");
-        }
-        if (args.profile) printProfile(s.kernels);
-    };
-    // --time is the whole sequence's: each frame gets an equal share of what is left, less what
-    // the method reserves after sampling and the last frame needed to be written; a window of
-    // `count` frames gets their shares.
-    const auto budgetFor = [&](int count) {
-        const int left = range.last - frame + 1;
-        const double share = std::max(0.0, args.time - total.seconds()) / double(left);
-        return std::max(0.05 * args.time / double(range.count()),
-                        double(count) * (share - afterSamplingSeconds) - reserved);
-    };
-    const int window = integrator->windowFrames();
-    // Timed: the kernels compile once for the sequence (the context keeps them), before the
-    // frames' shares are set, by a one-sample render of the first frame at 8x8 pixels (the
-    // pipelines do not depend on the image size). Else the first frame compiled them inside its
-    // own share and had a sample or two per pixel where the others have dozens.
-    if (timed) {
-        Timer warmUp;
-        RenderOptions warm = options;
-        warm.scene.width = warm.scene.height = 8;
-        warm.spp = 1;
-        warm.timeBudget = 0.0;
-        warm.quiet = true;
-        const char* phase = "compiling the kernels for";
-        bool cancelled = false;
-        try {
-            enterPhase(phase);
-            if (window > 0) {
-                const std::vector<RenderOutput> outs =
-                    integrator->renderWindow(ctx, windowOf(frame, 1), warm);
-                cancelled = outs.empty() || outs.back().stats.cancelled;
-            } else {
-                cancelled = integrator->render(ctx, sceneAt(frame), warm).stats.cancelled;
-            }
-        } catch (const Interrupted&) {
-            cancelled = true;
-        }
-        if (cancelled || interruptRequested()) return interrupted(phase);
-        if (!quiet)
-            std::fprintf(stderr, "gdpt: kernels ready for the sequence in %s\n",
-                         seconds(warmUp.seconds()).c_str());
-    }
-    while (frame <= range.last) {
-        try {
-            if (window > 0) {
-                // A temporal method: a window of frames sampled and reconstructed together.
-                Timer windowTimer;
-                const FrameWindow w = windowOf(frame, std::min(window, range.last - frame + 1));
-                RenderOptions windowOptions = options;
-                if (timed) windowOptions.timeBudget = budgetFor(w.count);
-                enterPhase("sampling");
-                std::vector<RenderOutput> outs = integrator->renderWindow(ctx, w, windowOptions);
-                if (outs.empty() || outs.back().stats.cancelled) return interrupted("sampling");
-                const double each = windowTimer.seconds() / double(outs.size());
-                for (RenderOutput& out : outs) {
-                    writeFrame(out, each, each - out.stats.reconstructionMs * 1e-3);
-                    ++frame;
-                }
-                continue;
-            }
-            Timer frameTimer;
-            const Scene scene = sceneAt(frame);
-            RenderOptions frameOptions = options;
-            frameOptions.seed = sequenceFrameSeed(args.seed, frame);
-            if (timed) frameOptions.timeBudget = budgetFor(1);
-            frameOptions.elapsedBefore = frameTimer.seconds();
-            enterPhase("sampling");
-            RenderOutput out = integrator->render(ctx, scene, frameOptions);
-            if (out.stats.cancelled) return interrupted("sampling");
-            const double sampledAt =
-                frameTimer.seconds() - (out.stats.readbackMs + out.stats.reconstructionMs) * 1e-3;
-            writeFrame(out, frameTimer.seconds(), sampledAt);
-            ++frame;
-        } catch (const Interrupted& e) {
-            return interrupted(e.phase());
-        } catch (const std::exception&) {
-            if (interruptRequested()) return interrupted("rendering");  // a layer re-wrapped it
-            throw;
-        }
-    }
+    SequenceRender sequence(args, range, options, asset, animation, ctx, *integrator, total, jsonOutput);
+    if (args.time > 0.0)
+        if (const int status = sequence.compileKernels()) return status;
+    if (const int status = sequence.renderFrames()) return status;
 
     std::string videoNote;
     if (ffmpeg) {
@@ -287,7 +346,7 @@ int runSequence(const RenderArgs& args) {
         const std::string pngPattern = previewPath(args.output);
         const std::string failure =
             encodeVideo(*ffmpeg, pngPattern, range.first, range.count(), args.fps, video);
-        if (interruptRequested()) return interrupted("writing the video");
+        if (interruptRequested()) return sequence.interrupted("writing the video");
         if (!failure.empty()) {
             if (!quiet)
                 std::fprintf(stderr, "gdpt: warning: no video of the sequence: %s\n", failure.c_str());
@@ -312,9 +371,9 @@ int runSequence(const RenderArgs& args) {
             {"time_s", total.seconds()},
             {"video", videoNote.empty() ? json(nullptr) : json(video)},
             {"validation_errors", ctx.validationErrors()},
-            {"frame_summaries", std::move(frames)}};
+            {"frame_summaries", sequence.takeFrameSummaries()}};
         jsonOutput.write(summary.dump(2) + "\n");
-        if (interruptRequested()) return interrupted("writing the summary");
+        if (interruptRequested()) return sequence.interrupted("writing the summary");
     }
     sequenceOutputs.commit();
     if (!quiet)
