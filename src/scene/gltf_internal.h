@@ -1,7 +1,8 @@
 // gltf_internal.h — shared state and helpers of the glTF loader's translation units
-// (gltf_loader.cpp: file, node graph, cameras, lights; gltf_precheck.cpp: checks of the JSON
-// text before tinygltf parses it; gltf_geometry.cpp: accessors and primitives;
-// gltf_materials.cpp: materials and textures; gltf_images.cpp: image decoding).
+// (gltf_loader.cpp: the file and the scene's instances; gltf_nodes.cpp: node graph, cameras,
+// lights; gltf_precheck.cpp: checks of the JSON text before tinygltf parses it;
+// gltf_geometry.cpp: accessors and primitives; gltf_materials.cpp: materials and textures;
+// gltf_images.cpp: image decoding).
 // Not part of the public API.
 #pragma once
 
@@ -80,6 +81,21 @@ struct Context {
 std::string elementName(const char* kind, int index, const std::string& name);
 // A number in messages: "%g" ("-0.5", "1e+38", "nan").
 std::string formatNumber(double v);
+
+// The node graph (gltf_nodes.cpp). Local transform of a node: `matrix` (column-major) or
+// T * R * S (glTF 2.0 §3.5.3), an animation's pose (if any) replacing the node's own
+// translation, rotation or scale.
+glm::dmat4 localMatrix(const tinygltf::Node& node, const NodePose* pose = nullptr);
+// Checks the node graph (children in range, one parent each, no cycles); the parent of each
+// node (-1 for none).
+std::vector<int> checkNodeGraph(const tinygltf::Model& model);
+// The root nodes of the default scene (every root node of a file without scenes).
+std::vector<int> sceneRoots(const tinygltf::Model& model, const std::vector<int>& parent);
+// The camera of `node`, placed by its world matrix, into ctx.scene.cameras.
+void addCamera(Context& ctx, const tinygltf::Node& node, const glm::dmat4& world);
+// A KHR_lights_punctual light of a node (its extension object `ext`) into ctx.scene.punctualLights;
+// unsupported kinds are noted.
+void addLight(Context& ctx, const tinygltf::Value& ext, const glm::dmat4& world);
 
 // Checks of the JSON text (gltf_precheck.cpp), in order: nesting depth (kMaxJsonDepth),
 // required extensions, bufferView strides, every accessor's count and byte range against its
