@@ -254,8 +254,9 @@ double timeToReach(const json& summary, const std::string& method, double target
     return -1.0;
 }
 
-int runConverge(const ConvergeArgs& a) {
-    // The arguments first: a usage error never waits for a scene or a reference.
+// The methods and budgets of the command line, checked before any work (a usage error never
+// waits for a scene or a reference).
+std::pair<std::vector<std::string>, std::vector<double>> methodsAndTimes(const ConvergeArgs& a) {
     const auto methods = splitList(a.methods);
     if (methods.empty()) throw UsageError("--methods: no method given");
     for (const std::string& m : methods)  // unknown names, and methods of sequences, fail before any render
@@ -274,37 +275,22 @@ int runConverge(const ConvergeArgs& a) {
     if (times.empty()) throw UsageError("--times: no time budget given");
     if (a.reference.empty() && a.makeReference == 0)
         throw UsageError("give --reference REF.exr or --make-reference SPP");
+    return {methods, times};
+}
 
-    installInterruptHandlers();
-    const fs::path dir(a.output);
-    std::error_code dirError;
-    fs::create_directories(dir, dirError);
-    if (dirError) throw Error(a.output + ": cannot create the output directory: " + dirError.message());
-    ConvergeOutputs out{OutputSet({{"scene", a.scene}, {"--reference", a.reference}})};
-    out.json = &out.set.add((dir / "results.json").string(), "results");
-    out.csv = &out.set.add((dir / "results.csv").string(), "results table");
-    out.dat = &out.set.add((dir / "error_vs_time.dat").string(), "plot data");
-    out.gp = &out.set.add((dir / "error_vs_time.gp").string(), "plot script");
-    out.png = std::make_unique<StagedFile>((dir / "error_vs_time.png").string());
-
-    const Scene scene = loadGltf(a.scene);
-    throwIfInterrupted("loading");
-    if (const auto black = blackImageWarning(scene, a.envRadiance))
-        std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
-    vk::ContextOptions co;
-    co.device = a.device;
-    co.validation = a.validate;
-    vk::Context ctx(co);
-
+// The reference image: --reference's, or a PT render of --make-reference spp, cached in the
+// output directory `dir` by scene, size, spp and sky. `name` gets its file's name.
+Image convergeReference(const ConvergeArgs& a, const fs::path& dir, const vk::Context& ctx,
+                        const Scene& scene, std::string& name) {
     Image reference;
-    std::string referenceName = a.reference;
+    name = a.reference;
     if (!a.reference.empty()) {
         reference = readExrLayer(a.reference);
     } else {
         const fs::path cached =
             dir / ("reference_" + referenceKey(a.scene, a.width, a.height, a.makeReference, a.envRadiance) +
                    ".exr");
-        referenceName = cached.string();
+        name = cached.string();
         if (fs::exists(cached)) {
             reference = readExrLayer(cached.string());
         } else {
@@ -324,13 +310,17 @@ int runConverge(const ConvergeArgs& a) {
         }
     }
     if (reference.width() != a.width || reference.height() != a.height)
-        throw Error(referenceName + ": reference is " + std::to_string(reference.width()) + "x" +
+        throw Error(name + ": reference is " + std::to_string(reference.width()) + "x" +
                     std::to_string(reference.height()) + ", the render is " + std::to_string(a.width) + "x" +
                     std::to_string(a.height) + " (use --width/--height)");
-    checkReference(reference, referenceName);
+    checkReference(reference, name);
+    return reference;
+}
 
-    Converger conv(ctx, scene, a);
-    std::vector<Run> runs;
+// Every method at every budget, --repeats times each (seeds 1, 2, ... in that order): the runs
+// into `runs`, and per method and budget the medians (the summary's rows).
+json runAll(Converger& conv, const ConvergeArgs& a, const std::vector<std::string>& methods,
+            const std::vector<double>& times, const Image& reference, std::vector<Run>& runs) {
     json summary = json::array();
     std::uint32_t seed = 1;
     for (const auto& m : methods) conv.warmUp(m);
@@ -359,14 +349,12 @@ int runConverge(const ConvergeArgs& a) {
                                {"mse_median", median(mse)},
                                {"bias_median", median(bias)}});
         }
+    return summary;
+}
 
-    // Equal-time table (ratio to PT where PT was run) and time to reach the target.
-    double target = a.target;
-    if (!(target > 0.0)) {
-        // Default target: PT's median error at its largest budget (or the first method's).
-        for (const auto& s : summary)
-            if (s["method"] == methods.front() && s["budget_s"] == times.back()) target = s["relmse_median"];
-    }
+// The equal-time table: per budget each method's median relMSE and, where PT ran, its gain
+// over PT.
+json equalTimeTable(const json& summary, const std::vector<double>& times) {
     json equalTime = json::array();
     for (double t : times) {
         json row = {{"budget_s", t}};
@@ -382,30 +370,93 @@ int runConverge(const ConvergeArgs& a) {
             }
         equalTime.push_back(row);
     }
-    json reach = json::object();
-    for (const auto& m : methods) reach[m] = timeToReach(summary, m, target);
+    return equalTime;
+}
 
-    json runsJson = json::array();
-    std::ostringstream csv;
+// Every run as JSON rows, and the same as CSV into `csv`.
+json runRows(const std::vector<Run>& runs, int repeats, std::ostringstream& csv) {
+    json rows = json::array();
     csv << "method,budget_s,repeat,seconds,recon_seconds,spp,partial_pass_rows,relmse,mse,mae,mean_bias\n";
     for (std::size_t i = 0; i < runs.size(); ++i) {
         const Run& r = runs[i];
-        const int repeat = static_cast<int>(i % static_cast<std::size_t>(a.repeats));
-        runsJson.push_back({{"method", r.method},
-                            {"budget_s", r.budget},
-                            {"repeat", repeat},
-                            {"seconds", r.seconds},
-                            {"recon_seconds", r.reconSeconds},
-                            {"spp", r.spp},
-                            {"partial_pass_rows", r.partialPassRows},
-                            {"relmse", r.error.relMse},
-                            {"mse", r.error.mse},
-                            {"mae", r.error.mae},
-                            {"mean_bias", r.error.meanBias}});
+        const int repeat = static_cast<int>(i % static_cast<std::size_t>(repeats));
+        rows.push_back({{"method", r.method},
+                        {"budget_s", r.budget},
+                        {"repeat", repeat},
+                        {"seconds", r.seconds},
+                        {"recon_seconds", r.reconSeconds},
+                        {"spp", r.spp},
+                        {"partial_pass_rows", r.partialPassRows},
+                        {"relmse", r.error.relMse},
+                        {"mse", r.error.mse},
+                        {"mae", r.error.mae},
+                        {"mean_bias", r.error.meanBias}});
         csv << r.method << "," << r.budget << "," << repeat << "," << r.seconds << "," << r.reconSeconds
             << "," << r.spp << "," << r.partialPassRows << "," << r.error.relMse << "," << r.error.mse << ","
             << r.error.mae << "," << r.error.meanBias << "\n";
     }
+    return rows;
+}
+
+// The equal-time table and the times to the target on stdout.
+void printTables(const std::vector<std::string>& methods, const json& equalTime, const json& reach,
+                 double target, const fs::path& dir, bool plotted) {
+    std::printf("%-10s", "budget(s)");
+    for (const auto& m : methods) std::printf(" %12s", m.c_str());
+    std::printf("\n");
+    for (const auto& row : equalTime) {
+        std::printf("%-10g", row["budget_s"].get<double>());
+        for (const auto& m : methods) std::printf(" %12.5g", row.value(m, 0.0));
+        std::printf("\n");
+    }
+    std::printf("time to relMSE %.4g:", target);
+    for (const auto& m : methods) std::printf("  %s %.3gs", m.c_str(), reach[m].get<double>());
+    std::printf("\nwrote %s/results.json, results.csv, error_vs_time.dat, error_vs_time.gp%s\n", dir.c_str(),
+                plotted ? ", error_vs_time.png" : "");
+}
+
+int runConverge(const ConvergeArgs& a) {
+    const auto [methods, times] = methodsAndTimes(a);
+
+    installInterruptHandlers();
+    const fs::path dir(a.output);
+    std::error_code dirError;
+    fs::create_directories(dir, dirError);
+    if (dirError) throw Error(a.output + ": cannot create the output directory: " + dirError.message());
+    ConvergeOutputs out{OutputSet({{"scene", a.scene}, {"--reference", a.reference}})};
+    out.json = &out.set.add((dir / "results.json").string(), "results");
+    out.csv = &out.set.add((dir / "results.csv").string(), "results table");
+    out.dat = &out.set.add((dir / "error_vs_time.dat").string(), "plot data");
+    out.gp = &out.set.add((dir / "error_vs_time.gp").string(), "plot script");
+    out.png = std::make_unique<StagedFile>((dir / "error_vs_time.png").string());
+
+    const Scene scene = loadGltf(a.scene);
+    throwIfInterrupted("loading");
+    if (const auto black = blackImageWarning(scene, a.envRadiance))
+        std::fprintf(stderr, "gdpt: warning: %s\n", black->c_str());
+    vk::ContextOptions co;
+    co.device = a.device;
+    co.validation = a.validate;
+    vk::Context ctx(co);
+
+    std::string referenceName;
+    const Image reference = convergeReference(a, dir, ctx, scene, referenceName);
+    Converger conv(ctx, scene, a);
+    std::vector<Run> runs;
+    const json summary = runAll(conv, a, methods, times, reference, runs);
+
+    // Equal-time table (ratio to PT where PT was run) and time to reach the target.
+    double target = a.target;
+    if (!(target > 0.0)) {
+        // Default target: PT's median error at its largest budget (or the first method's).
+        for (const auto& s : summary)
+            if (s["method"] == methods.front() && s["budget_s"] == times.back()) target = s["relmse_median"];
+    }
+    const json equalTime = equalTimeTable(summary, times);
+    json reach = json::object();
+    for (const auto& m : methods) reach[m] = timeToReach(summary, m, target);
+    std::ostringstream csv;
+    const json runsJson = runRows(runs, a.repeats, csv);
     const json results = {{"schema", "gdpt-converge-1"},
                           {"scene", a.scene},
                           {"reference", a.reference.empty() ? "(made)" : a.reference},
@@ -430,19 +481,7 @@ int runConverge(const ConvergeArgs& a) {
     throwIfInterrupted("writing");
     out.set.commit();
     if (plotted) out.png->commit();
-
-    std::printf("%-10s", "budget(s)");
-    for (const auto& m : methods) std::printf(" %12s", m.c_str());
-    std::printf("\n");
-    for (const auto& row : equalTime) {
-        std::printf("%-10g", row["budget_s"].get<double>());
-        for (const auto& m : methods) std::printf(" %12.5g", row.value(m, 0.0));
-        std::printf("\n");
-    }
-    std::printf("time to relMSE %.4g:", target);
-    for (const auto& m : methods) std::printf("  %s %.3gs", m.c_str(), reach[m].get<double>());
-    std::printf("\nwrote %s/results.json, results.csv, error_vs_time.dat, error_vs_time.gp%s\n", dir.c_str(),
-                plotted ? ", error_vs_time.png" : "");
+    printTables(methods, equalTime, reach, target, dir, plotted);
     if (ctx.validationErrors() > 0) {
         std::fprintf(stderr, "gdpt converge: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
         return 1;
