@@ -1,5 +1,5 @@
-// render_command.cpp — `gdpt render SCENE`: parses the options, makes the integrator of
-// --method, renders, and writes the EXR (every layer), the PNG preview and the JSON summary.
+// render_command.cpp — `gdpt render SCENE` (its options: render_cli.cpp): makes the integrator
+// of --method, renders, and writes the EXR (every layer), the PNG preview and the JSON summary.
 // Time budgets, checkpoints and interrupts are handled here; the method is the integrator's.
 #include <sys/resource.h>
 

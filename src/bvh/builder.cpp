@@ -1,7 +1,9 @@
 // builder.cpp — top-down binned SAH construction (Wald 2007, "On fast Construction of
 // SAH-based Bounding Volume Hierarchies", IEEE RT'07), written straight into the two-wide
 // gpu::BvhNode layout: a node stores the boxes of both children, and a child is either an
-// inner node (count 0) or a leaf range of TriangleGeom (count > 0).
+// inner node (count 0) or a leaf range of TriangleGeom (count > 0). One range's step (leaf or
+// split: the bins, the SAH sweep, the partition) is sah_split.h's; this file builds the tree
+// around it.
 //
 // Data layout (as Embree's builders keep their PrimRefs): every triangle becomes a 32-byte
 // reference holding its padded box and its index; splits partition these references in place,

@@ -50,6 +50,7 @@ void append(std::array<Field, 3>& to, const Image& image) {
     for (int c = 0; c < 3; ++c) to[c].insert(to[c].end(), image.plane(c).begin(), image.plane(c).end());
 }
 
+// Frame `frame` of a frame-major field of W·H pixels per frame.
 Image frameOf(const std::array<Field, 3>& x, std::size_t frame, int width, int height) {
     Image out(width, height);
     const std::size_t np = out.pixelCount();
