@@ -282,7 +282,8 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     stats.uploadMs = total.ms() - stats.bvhBuildMs;
 
     vk::GpuTimer gpuTimer(ctx);
-    MltRun run(ctx, name_, pass, po, options, stats, options.profile ? &gpuTimer : nullptr);
+    vk::GpuTimer* timer = options.profile ? &gpuTimer : nullptr;
+    MltRun run(ctx, name_, pass, po, options, stats, timer);
     // The kernel's compile at its first dispatch: a fixed cost (time_s.kernel_compile), not
     // the very-direct light's (PixelSampling::run does the same for PT and G-PT).
     Timer compile;
@@ -291,7 +292,6 @@ RenderOutput MltIntegrator::render(const vk::Context& ctx, const Scene& scene, c
     Timer sampling;
 
     // Stage 1: the very-direct light, and the bootstrap: b and the chains' starts.
-    vk::GpuTimer* timer = options.profile ? &gpuTimer : nullptr;
     run.submit(name_ + " direct light", [&](VkCommandBuffer cmd) {
         pass.recordDirect(cmd, options_.directSamples, options.seed, timer);
     });
